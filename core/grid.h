@@ -1,0 +1,90 @@
+// Grid<T, D>: a flat, size-checked, structure-of-arrays field on a regular
+// D-dimensional lattice (D = 2, 3). x varies fastest, so one buffer uploads
+// unchanged to a GL image or SSBO.
+#pragma once
+
+#include <cassert>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "core/vec.h"
+
+namespace morphoflow {
+
+template <typename T, int D>
+class Grid {
+  static_assert(D == 2 || D == 3, "morphoflow grids are 2D or 3D");
+
+ public:
+  using value_type = T;
+  static constexpr int kDim = D;
+
+  Grid() = default;
+  explicit Grid(IVec<D> dims, T value = T{}) : dims_(dims) {
+    size_t n = 1;
+    for (int a = 0; a < D; ++a) {
+      assert(dims[a] > 0);
+      n *= size_t(dims[a]);
+    }
+    data_.assign(n, value);
+  }
+
+  const IVec<D>& dims() const { return dims_; }
+  int dim(int axis) const { return dims_[axis]; }
+  size_t size() const { return data_.size(); }
+  bool empty() const { return data_.empty(); }
+
+  // Linear index of a cell; x fastest.
+  size_t index(const IVec<D>& c) const {
+    assert(contains(c));
+    size_t i = size_t(c[D - 1]);
+    for (int a = D - 2; a >= 0; --a) i = i * size_t(dims_[a]) + size_t(c[a]);
+    return i;
+  }
+  IVec<D> coord(size_t i) const {
+    IVec<D> c;
+    for (int a = 0; a < D; ++a) {
+      c[a] = int(i % size_t(dims_[a]));
+      i /= size_t(dims_[a]);
+    }
+    return c;
+  }
+  // Distance in the flat array between neighbours along `axis`.
+  size_t stride(int axis) const {
+    size_t s = 1;
+    for (int a = 0; a < axis; ++a) s *= size_t(dims_[a]);
+    return s;
+  }
+  bool contains(const IVec<D>& c) const {
+    for (int a = 0; a < D; ++a)
+      if (c[a] < 0 || c[a] >= dims_[a]) return false;
+    return true;
+  }
+
+  T& operator[](size_t i) { return data_[i]; }
+  const T& operator[](size_t i) const { return data_[i]; }
+  T& operator()(const IVec<D>& c) { return data_[index(c)]; }
+  const T& operator()(const IVec<D>& c) const { return data_[index(c)]; }
+
+  T* data() { return data_.data(); }
+  const T* data() const { return data_.data(); }
+  std::vector<T>& values() { return data_; }
+  const std::vector<T>& values() const { return data_; }
+
+  void fill(T v) { std::fill(data_.begin(), data_.end(), v); }
+  bool sameShape(const Grid& o) const { return dims_ == o.dims_; }
+
+ private:
+  IVec<D> dims_{};
+  std::vector<T> data_;
+};
+
+template <int D>
+size_t cellCount(const IVec<D>& dims) {
+  size_t n = 1;
+  for (int a = 0; a < D; ++a) n *= size_t(dims[a]);
+  return n;
+}
+
+}  // namespace morphoflow

@@ -1,0 +1,71 @@
+// LaplaceSystem<D>: the symmetric positive (semi-)definite 5-/7-point systems
+// that the pressure projection, implicit viscosity and implicit diffusion all
+// solve, written once for 2D and 3D:
+//
+//   (A x)_i = scale * ( c_i x_i + sum_{faces f of i} w_f (x_i - x_j(f)) )
+//
+// w_f in [0, 1] is the open fraction of the face between two cells (0 for a
+// solid face or a Neumann wall), c_i collects identity terms (implicit
+// diffusion: h^2 / (nu dt)) and Dirichlet couplings. A cell whose diagonal is
+// zero is inactive: its unknown is pinned at 0 and it couples to nothing.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "core/grid.h"
+
+namespace morphoflow {
+
+using Vector = std::vector<double>;
+
+template <int D>
+struct LaplaceSystem {
+  IVec<D> dims{0};
+  std::array<bool, D> periodic{};
+  double scale = 1.0;               // 1 / h^2 for a Laplacian
+  Grid<float, D> c;                 // diagonal-only term
+  std::array<Grid<float, D>, D> w;  // w[a](i): coupling of i and i + e_a (wrapped if periodic)
+  Grid<float, D> diag;              // c + sum of the 2D face weights; 0 = inactive
+
+  LaplaceSystem() = default;
+  LaplaceSystem(const IVec<D>& dims, const std::array<bool, D>& periodic, double scale);
+
+  size_t size() const { return c.size(); }
+  // Zeroes couplings across non-periodic domain edges and computes diag. Call
+  // after filling c and w.
+  void finalize();
+  // True when no c_i > 0: constants are then in the null space, and solvers
+  // work on mean-free vectors.
+  bool singular() const { return singular_; }
+  size_t activeCount() const { return active_; }
+
+  void apply(const Vector& x, Vector* y) const;
+  // r = b - A x; returns ||r||_2.
+  double residual(const Vector& b, const Vector& x, Vector* r) const;
+  // One red-black Gauss-Seidel sweep; `reverse` runs black first (so a
+  // reversed post-smoother makes a symmetric V-cycle).
+  void gaussSeidel(const Vector& b, Vector* x, bool reverse) const;
+  // Removes the mean over active cells (for singular systems).
+  void removeNullSpace(Vector* x) const;
+
+ private:
+  bool singular_ = false;
+  size_t active_ = 0;
+  Vector zerosX_;               // a row of zeros: the neighbour beyond a wall
+  std::vector<float> zerosW_;
+};
+
+// Builds the plain Laplacian with Neumann walls (periodic where asked) on a
+// full box: w = 1 everywhere inside, c = 0. Convenience for tests and the
+// multigrid's coarse levels.
+template <int D>
+LaplaceSystem<D> makeNeumannLaplacian(const IVec<D>& dims, const std::array<bool, D>& periodic,
+                                      double h);
+
+// Vector helpers (deterministic reductions).
+double dot(const Vector& a, const Vector& b);
+double norm2(const Vector& a);
+void axpy(double alpha, const Vector& x, Vector* y);  // y += alpha x
+
+}  // namespace morphoflow

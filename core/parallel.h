@@ -1,0 +1,114 @@
+// Parallel loops (TBB). Work is cut into chunks that do not depend on the
+// thread count, and reductions sum per-chunk partials in a fixed order, so
+// results are bitwise identical for any number of threads.
+#pragma once
+
+#include <algorithm>
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/partitioner.h>
+
+#include "core/vec.h"
+
+namespace morphoflow {
+
+// Calls fn(i) for i in [0, n), in parallel, `grain` items per task.
+template <typename Fn>
+void parallelFor(size_t n, Fn&& fn, size_t grain = 1) {
+  if (n == 0) return;
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, n, grain),
+      [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) fn(i);
+      },
+      tbb::simple_partitioner());
+}
+
+// Calls fn(row) for each row of a D-dim lattice (a row = all x for fixed y[, z]);
+// row r covers cells [r * nx, (r + 1) * nx).
+template <int D, typename Fn>
+void parallelForRows(const IVec<D>& dims, Fn&& fn) {
+  size_t rows = 1;
+  for (int a = 1; a < D; ++a) rows *= size_t(dims[a]);
+  // Aim for tasks of ~16k cells; fixed, independent of the thread count.
+  size_t grain = std::max<size_t>(1, 16384 / size_t(dims[0]));
+  parallelFor(rows, fn, grain);
+}
+
+// Calls fn(cell, index) for every cell, in parallel over rows.
+template <int D, typename Fn>
+void forEachCell(const IVec<D>& dims, Fn&& fn) {
+  parallelForRows<D>(dims, [&](size_t row) {
+    IVec<D> c(0);
+    size_t rest = row;
+    for (int a = 1; a < D; ++a) {
+      c[a] = int(rest % size_t(dims[a]));
+      rest /= size_t(dims[a]);
+    }
+    size_t base = row * size_t(dims[0]);
+    for (int x = 0; x < dims[0]; ++x) {
+      c[0] = x;
+      fn(c, base + size_t(x));
+    }
+  });
+}
+
+// Deterministic sum of f(i), i in [0, n): fixed chunks, partials summed in order.
+template <typename Fn>
+double deterministicSum(size_t n, Fn&& f) {
+  constexpr size_t kChunk = 8192;
+  size_t chunks = (n + kChunk - 1) / kChunk;
+  if (chunks <= 1) {
+    double s = 0;
+    for (size_t i = 0; i < n; ++i) s += f(i);
+    return s;
+  }
+  std::vector<double> partial(chunks, 0.0);
+  parallelFor(chunks, [&](size_t k) {
+    double s = 0;
+    size_t end = std::min(n, (k + 1) * kChunk);
+    for (size_t i = k * kChunk; i < end; ++i) s += f(i);
+    partial[k] = s;
+  });
+  double s = 0;
+  for (double p : partial) s += p;
+  return s;
+}
+
+// Deterministic maximum of f(i).
+template <typename Fn>
+double deterministicMax(size_t n, Fn&& f, double init = 0.0) {
+  constexpr size_t kChunk = 8192;
+  size_t chunks = (n + kChunk - 1) / kChunk;
+  std::vector<double> partial(std::max<size_t>(chunks, 1), init);
+  parallelFor(chunks, [&](size_t k) {
+    double m = init;
+    size_t end = std::min(n, (k + 1) * kChunk);
+    for (size_t i = k * kChunk; i < end; ++i) m = std::max(m, double(f(i)));
+    partial[k] = m;
+  });
+  double m = init;
+  for (double p : partial) m = std::max(m, p);
+  return m;
+}
+
+// Limits TBB to `threads` worker threads while alive (0 = all cores).
+class ThreadLimit {
+ public:
+  explicit ThreadLimit(int threads);
+  ~ThreadLimit();
+  ThreadLimit(const ThreadLimit&) = delete;
+  ThreadLimit& operator=(const ThreadLimit&) = delete;
+
+ private:
+  std::unique_ptr<tbb::global_control> control_;
+};
+
+int hardwareThreads();
+
+}  // namespace morphoflow

@@ -1,0 +1,73 @@
+#include "core/pcg.h"
+
+#include <cmath>
+
+#include "core/parallel.h"
+
+namespace morphoflow {
+
+template <int D>
+SolverResult solvePCG(const LaplaceSystem<D>& A, const Vector& bIn, Vector* xp, Preconditioner* M,
+                      const SolverOptions& opt, Interrupter* interrupter) {
+  Vector& x = *xp;
+  const size_t n = A.size();
+  x.resize(n, 0.0);
+  SolverResult result;
+  Vector b = bIn;
+  if (A.singular()) A.removeNullSpace(&b);  // keep the system consistent
+  const double bnorm = norm2(b);
+  if (bnorm == 0.0) {
+    std::fill(x.begin(), x.end(), 0.0);
+    result.converged = true;
+    return result;
+  }
+  Vector r(n), z(n), p(n), q(n);
+  double rnorm = A.residual(b, x, &r);
+  result.residual = rnorm / bnorm;
+  if (result.residual <= opt.tolerance) {
+    result.converged = true;
+    return result;
+  }
+  auto precondition = [&] {
+    if (M)
+      M->apply(r, &z);
+    else
+      z = r;
+    if (A.singular()) A.removeNullSpace(&z);
+  };
+  precondition();
+  p = z;
+  double rz = dot(r, z);
+  for (int it = 1; it <= opt.maxIterations; ++it) {
+    A.apply(p, &q);
+    double pq = dot(p, q);
+    if (!(pq > 0.0)) break;  // breakdown: A not SPD on this subspace
+    double alpha = rz / pq;
+    parallelFor(n, [&](size_t i) {
+      x[i] += alpha * p[i];
+      r[i] -= alpha * q[i];
+    }, 4096);
+    rnorm = norm2(r);
+    result.iterations = it;
+    result.residual = rnorm / bnorm;
+    if (result.residual <= opt.tolerance) break;
+    if (interrupter && interrupter->progress(-1.0)) break;
+    precondition();
+    double rzNew = dot(r, z);
+    double beta = rzNew / rz;
+    rz = rzNew;
+    parallelFor(n, [&](size_t i) { p[i] = z[i] + beta * p[i]; }, 4096);
+  }
+  // Report the true residual, not the recursively updated one.
+  result.residual = A.residual(b, x, &r) / bnorm;
+  if (A.singular()) A.removeNullSpace(&x);
+  result.converged = result.residual <= opt.tolerance * 1.0001;
+  return result;
+}
+
+template SolverResult solvePCG<2>(const LaplaceSystem<2>&, const Vector&, Vector*, Preconditioner*,
+                                  const SolverOptions&, Interrupter*);
+template SolverResult solvePCG<3>(const LaplaceSystem<3>&, const Vector&, Vector*, Preconditioner*,
+                                  const SolverOptions&, Interrupter*);
+
+}  // namespace morphoflow

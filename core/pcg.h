@@ -1,0 +1,23 @@
+// Preconditioned conjugate gradients on a LaplaceSystem (Bridson, "Fluid
+// Simulation for Computer Graphics", ch. 5; the seeds' ICCG with M = MIC(0)).
+// Singular (pure-Neumann) systems are solved in the mean-free subspace.
+#pragma once
+
+#include "core/interrupter.h"
+#include "core/laplace_system.h"
+#include "core/preconditioner.h"
+#include "core/solver_result.h"
+
+namespace morphoflow {
+
+struct SolverOptions {
+  double tolerance = 1e-6;  // relative residual ||b - Ax||_2 / ||b||_2
+  int maxIterations = 1000;
+};
+
+// Solves A x = b starting from *x. M may be null (plain CG).
+template <int D>
+SolverResult solvePCG(const LaplaceSystem<D>& A, const Vector& b, Vector* x, Preconditioner* M,
+                      const SolverOptions& options, Interrupter* interrupter = nullptr);
+
+}  // namespace morphoflow

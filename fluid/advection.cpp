@@ -1,0 +1,74 @@
+#include "fluid/advection.h"
+
+#include <algorithm>
+
+#include "core/parallel.h"
+
+namespace morphoflow {
+
+namespace {
+
+// One semi-Lagrangian pass; optionally records the min/max of each stencil.
+template <int D>
+void semiLagrangian(const Grid<float, D>& src, const Layout<D>& layout, const MacVelocity<D>& u,
+                    double dt, Grid<float, D>* dst, Grid<float, D>* lo, Grid<float, D>* hi) {
+  forEachCell<D>(src.dims(), [&](const IVec<D>& k, size_t i) {
+    Vec<D> x = traceBack(u, layout.toWorld(k), dt);
+    if (lo) {
+      float mn, mx;
+      (*dst)[i] = sampleLinear(src, layout, x, &mn, &mx);
+      (*lo)[i] = mn;
+      (*hi)[i] = mx;
+    } else {
+      (*dst)[i] = sampleLinear(src, layout, x);
+    }
+  });
+}
+
+}  // namespace
+
+template <int D>
+void advectField(const Grid<float, D>& src, const Layout<D>& layout, const MacVelocity<D>& u,
+                 double dt, AdvectionScheme scheme, Grid<float, D>* dst) {
+  if (scheme == AdvectionScheme::SemiLagrangian) {
+    semiLagrangian<D>(src, layout, u, dt, dst, nullptr, nullptr);
+    return;
+  }
+  Grid<float, D> lo(src.dims()), hi(src.dims()), back(src.dims());
+  if (scheme == AdvectionScheme::MacCormack) {
+    // phi^ = A(phi); phi~ = A^-1(phi^); phi = phi^ + (phi - phi~) / 2, limited.
+    Grid<float, D>& fwd = *dst;
+    semiLagrangian<D>(src, layout, u, dt, &fwd, &lo, &hi);
+    semiLagrangian<D>(fwd, layout, u, -dt, &back, nullptr, nullptr);
+    parallelFor(src.size(), [&](size_t i) {
+      float v = fwd[i] + 0.5f * (src[i] - back[i]);
+      // Revert to first order where the correction leaves the stencil's range.
+      if (v >= lo[i] && v <= hi[i]) fwd[i] = v;
+    }, 4096);
+    return;
+  }
+  // BFECC: phi_bar = phi + (phi - A^-1 A phi) / 2, then A(phi_bar), limited.
+  Grid<float, D> fwd(src.dims()), corrected(src.dims());
+  semiLagrangian<D>(src, layout, u, dt, &fwd, nullptr, nullptr);
+  semiLagrangian<D>(fwd, layout, u, -dt, &back, nullptr, nullptr);
+  parallelFor(src.size(), [&](size_t i) { corrected[i] = src[i] + 0.5f * (src[i] - back[i]); }, 4096);
+  semiLagrangian<D>(corrected, layout, u, dt, dst, nullptr, nullptr);
+  semiLagrangian<D>(src, layout, u, dt, &back, &lo, &hi);  // first-order fallback
+  parallelFor(src.size(), [&](size_t i) {
+    if ((*dst)[i] < lo[i] || (*dst)[i] > hi[i]) (*dst)[i] = back[i];
+  }, 4096);
+}
+
+template <int D>
+void advectVelocity(const MacVelocity<D>& u, double dt, AdvectionScheme scheme, MacVelocity<D>* dst) {
+  for (int a = 0; a < D; ++a) advectField<D>(u[a], u.layout(a), u, dt, scheme, &(*dst)[a]);
+}
+
+template void advectField<2>(const Grid<float, 2>&, const Layout<2>&, const MacVelocity<2>&, double,
+                             AdvectionScheme, Grid<float, 2>*);
+template void advectField<3>(const Grid<float, 3>&, const Layout<3>&, const MacVelocity<3>&, double,
+                             AdvectionScheme, Grid<float, 3>*);
+template void advectVelocity<2>(const MacVelocity<2>&, double, AdvectionScheme, MacVelocity<2>*);
+template void advectVelocity<3>(const MacVelocity<3>&, double, AdvectionScheme, MacVelocity<3>*);
+
+}  // namespace morphoflow

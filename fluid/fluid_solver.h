@@ -1,0 +1,67 @@
+// FluidSolver<D>: Stam's stable fluids as a fixed sequence of named, timed
+// stages (forces, advect, diffuse, project), written once for 2D and 3D.
+// A passive dye rides along for rendering and buoyancy.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <string>
+
+#include "core/mac_velocity.h"
+#include "fluid/fluid_settings.h"
+#include "fluid/pressure_projection.h"
+#include "fluid/velocity_constraints.h"
+#include "fluid/viscosity.h"
+
+namespace morphoflow {
+
+struct FluidStepStats {
+  static constexpr int kStages = 4;
+  static constexpr const char* kStageNames[kStages] = {"forces", "advect", "diffuse", "project"};
+  std::array<double, kStages> seconds{};  // wall time of each stage in this step
+  SolverResult pressure;
+  SolverResult viscosity;
+};
+
+template <int D>
+class FluidSolver {
+ public:
+  // Throws std::invalid_argument when the settings are inconsistent.
+  explicit FluidSolver(const FluidSettings& settings);
+
+  void step(double dt);
+  // Largest dt with |u|max dt <= cfl h (dtMax when the fluid is at rest).
+  double cflTimeStep(double cfl, double dtMax) const;
+  double maxSpeed() const;
+
+  const FluidSettings& settings() const { return settings_; }
+  const IVec<D>& cells() const { return cells_; }
+  double h() const { return h_; }
+  double time() const { return time_; }
+  long steps() const { return steps_; }
+  const MacVelocity<D>& velocity() const { return u_; }
+  MacVelocity<D>& velocity() { return u_; }
+  Grid<float, D>& dye() { return dye_; }
+  const Grid<float, D>& dye() const { return dye_; }
+  const Grid<uint8_t, D>& solid() const { return constraints_.solid; }
+  const VelocityConstraints<D>& constraints() const { return constraints_; }
+  Grid<float, D> pressure() const { return projection_->pressure(); }
+  const FluidStepStats& lastStats() const { return stats_; }
+  PressureProjection<D>& projection() { return *projection_; }
+  Layout<D> cellLayout() const { return Layout<D>::cellCentred(h_, cells_, constraints_.periodic()); }
+
+ private:
+  FluidSettings settings_;
+  IVec<D> cells_;
+  double h_;
+  VelocityConstraints<D> constraints_;
+  std::unique_ptr<PressureProjection<D>> projection_;
+  std::unique_ptr<ViscositySolver<D>> viscosity_;
+  MacVelocity<D> u_, scratch_;
+  Grid<float, D> dye_, dyeScratch_;
+  double time_ = 0.0;
+  long steps_ = 0;
+  FluidStepStats stats_;
+};
+
+}  // namespace morphoflow

@@ -1,0 +1,77 @@
+#include "fluid/obstacle.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "core/parallel.h"
+
+namespace morphoflow {
+
+namespace {
+// Bilinear sample of the spec's 2D field at normalised (s, t) in [0, 1]^2.
+double sampleField(const ObstacleSpec& o, double s, double t) {
+  double gx = std::clamp(s * o.fieldWidth - 0.5, 0.0, double(o.fieldWidth - 1));
+  double gy = std::clamp(t * o.fieldHeight - 0.5, 0.0, double(o.fieldHeight - 1));
+  int x0 = std::min(int(gx), std::max(o.fieldWidth - 2, 0));
+  int y0 = std::min(int(gy), std::max(o.fieldHeight - 2, 0));
+  int x1 = std::min(x0 + 1, o.fieldWidth - 1), y1 = std::min(y0 + 1, o.fieldHeight - 1);
+  double fx = gx - x0, fy = gy - y0;
+  auto at = [&](int x, int y) { return double(o.field[size_t(y) * size_t(o.fieldWidth) + size_t(x)]); };
+  double a = at(x0, y0) + fx * (at(x1, y0) - at(x0, y0));
+  double b = at(x0, y1) + fx * (at(x1, y1) - at(x0, y1));
+  return a + fy * (b - a);
+}
+}  // namespace
+
+double obstacleDistance(const ObstacleSpec& o, const double* x, int dims, const double* size) {
+  switch (o.shape) {
+    case ObstacleShape::Circle:
+    case ObstacleShape::Sphere: {
+      // A circle in 3D is a cylinder along z; a sphere in 2D is a circle.
+      int n = (o.shape == ObstacleShape::Circle) ? 2 : dims;
+      double r2 = 0;
+      for (int a = 0; a < n; ++a) r2 += (x[a] - o.center[size_t(a)]) * (x[a] - o.center[size_t(a)]);
+      return std::sqrt(r2) - o.radius;
+    }
+    case ObstacleShape::Box: {
+      double outside = 0, inside = -1e300;
+      for (int a = 0; a < dims; ++a) {
+        double q = std::abs(x[a] - o.center[size_t(a)]) - o.halfSize[size_t(a)];
+        outside += std::max(q, 0.0) * std::max(q, 0.0);
+        inside = std::max(inside, q);
+      }
+      return std::sqrt(outside) + std::min(inside, 0.0);
+    }
+    case ObstacleShape::Image: {
+      // Image rows run top to bottom; world y runs bottom to top.
+      double v = sampleField(o, x[0] / size[0], 1.0 - x[1] / size[1]);
+      bool solid = o.invert ? v <= o.threshold : v > o.threshold;
+      return solid ? -1.0 : 1.0;
+    }
+    case ObstacleShape::Sdf:
+      return sampleField(o, x[0] / size[0], 1.0 - x[1] / size[1]);
+  }
+  return 1.0;
+}
+
+template <int D>
+Grid<uint8_t, D> solidMask(const std::vector<ObstacleSpec>& obstacles, const IVec<D>& cells, double h) {
+  Grid<uint8_t, D> mask(cells, 0);
+  double size[3] = {0, 0, 0};
+  for (int a = 0; a < D; ++a) size[a] = cells[a] * h;
+  forEachCell<D>(cells, [&](const IVec<D>& c, size_t i) {
+    double x[3] = {0, 0, 0};
+    for (int a = 0; a < D; ++a) x[a] = (c[a] + 0.5) * h;
+    for (const ObstacleSpec& o : obstacles)
+      if (obstacleDistance(o, x, D, size) < 0) {
+        mask[i] = 1;
+        break;
+      }
+  });
+  return mask;
+}
+
+template Grid<uint8_t, 2> solidMask<2>(const std::vector<ObstacleSpec>&, const IVec<2>&, double);
+template Grid<uint8_t, 3> solidMask<3>(const std::vector<ObstacleSpec>&, const IVec<3>&, double);
+
+}  // namespace morphoflow

@@ -1,0 +1,36 @@
+// Solid obstacles: analytic shapes, or masks from an image or a signed
+// distance field. Cells whose centre lies inside are solid (no-slip).
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "core/grid.h"
+
+namespace morphoflow {
+
+enum class ObstacleShape { Circle, Sphere, Box, Image, Sdf };
+
+struct ObstacleSpec {
+  ObstacleShape shape = ObstacleShape::Circle;
+  std::array<double, 3> center{0.5, 0.5, 0.5};
+  double radius = 0.1;                          // circle, sphere
+  std::array<double, 3> halfSize{0.1, 0.1, 0.1};  // box
+  // Image and Sdf: a 2D field (x fastest) stretched over the domain's x-y
+  // extent (extruded along z in 3D). Image: solid where value > threshold;
+  // Sdf: signed distance in world units, negative inside.
+  int fieldWidth = 0, fieldHeight = 0;
+  std::vector<float> field;
+  double threshold = 0.5;
+  bool invert = false;  // image: solid where value <= threshold
+};
+
+// Signed distance (negative inside) of the obstacle at a world position.
+double obstacleDistance(const ObstacleSpec& spec, const double* x, int dims, const double* domainSize);
+
+// Solid flags (1 = solid) of the cells of a D-dim grid of cell size h.
+template <int D>
+Grid<uint8_t, D> solidMask(const std::vector<ObstacleSpec>& obstacles, const IVec<D>& cells, double h);
+
+}  // namespace morphoflow

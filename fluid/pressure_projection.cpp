@@ -1,0 +1,119 @@
+#include "fluid/pressure_projection.h"
+
+#include "core/parallel.h"
+#include "core/pcg.h"
+
+namespace morphoflow {
+
+namespace {
+template <int D>
+LaplaceSystem<D> buildPressureSystem(const VelocityConstraints<D>& vc) {
+  const IVec<D>& n = vc.cells;
+  LaplaceSystem<D> A(n, vc.periodic(), 1.0 / (vc.h * vc.h));
+  forEachCell<D>(n, [&](const IVec<D>& k, size_t i) {
+    if (vc.solid[i]) return;
+    for (int a = 0; a < D; ++a) {
+      IVec<D> up = k + unitVector<D>(a);
+      if (up[a] == n[a]) up[a] = 0;  // wraps on periodic axes; zeroed by finalize otherwise
+      if (!vc.solid(up)) A.w[a][i] = 1.0f;
+      // p = 0 on an outflow side, through a ghost cell mirrored about the face.
+      if (k[a] == 0 && vc.boundaries.side(a, false).kind == BoundaryKind::Outflow) A.c[i] += 2.0f;
+      if (k[a] == n[a] - 1 && vc.boundaries.side(a, true).kind == BoundaryKind::Outflow) A.c[i] += 2.0f;
+    }
+  });
+  A.finalize();
+  return A;
+}
+}  // namespace
+
+template <int D>
+PressureProjection<D>::PressureProjection(const VelocityConstraints<D>& vc, PressureSolver solver,
+                                          const SolverOptions& options)
+    : vc_(vc), solver_(solver), options_(options), A_(buildPressureSystem(vc)) {
+  if (solver_ == PressureSolver::ICPCG)
+    mic_ = std::make_unique<MIC0Preconditioner<D>>(A_);
+  else
+    multigrid_ = std::make_unique<Multigrid<D>>(A_);
+  phi_.assign(A_.size(), 0.0);
+  rhs_.assign(A_.size(), 0.0);
+}
+
+template <int D>
+void PressureProjection<D>::divergence(const MacVelocity<D>& u, Vector* div) const {
+  div->resize(A_.size());
+  const double invH = 1.0 / vc_.h;
+  forEachCell<D>(vc_.cells, [&](const IVec<D>& k, size_t i) {
+    if (vc_.solid[i]) {
+      (*div)[i] = 0.0;
+      return;
+    }
+    double d = 0.0;
+    for (int a = 0; a < D; ++a) d += double(u[a](k + unitVector<D>(a))) - double(u[a](k));
+    (*div)[i] = d * invH;
+  });
+}
+
+template <int D>
+SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double density) {
+  divergence(*u, &rhs_);
+  parallelFor(rhs_.size(), [&](size_t i) { rhs_[i] = -rhs_[i]; }, 4096);
+  // Warm start: phi scales with dt for the same pressure.
+  if (lastDt_ > 0 && dt != lastDt_) {
+    double s = dt / lastDt_;
+    parallelFor(phi_.size(), [&](size_t i) { phi_[i] *= s; }, 4096);
+  }
+  SolverResult r;
+  if (solver_ == PressureSolver::Multigrid)
+    r = multigrid_->solve(rhs_, &phi_, options_);
+  else
+    r = solvePCG<D>(A_, rhs_, &phi_, solver_ == PressureSolver::ICPCG
+                                          ? static_cast<Preconditioner*>(mic_.get())
+                                          : static_cast<Preconditioner*>(multigrid_.get()),
+                    options_);
+  lastDt_ = dt;
+  lastDensity_ = density;
+  // u -= grad(phi) on every face that is not prescribed.
+  const double invH = 1.0 / vc_.h;
+  const IVec<D>& n = vc_.cells;
+  for (int a = 0; a < D; ++a) {
+    Grid<float, D>& g = (*u)[a];
+    const Grid<uint8_t, D>& fixed = vc_.fixed[a];
+    const bool periodic = vc_.boundaries.periodic(a);
+    forEachCell<D>(g.dims(), [&](const IVec<D>& k, size_t i) {
+      if (fixed[i]) return;
+      IVec<D> lo = k - unitVector<D>(a), hi = k;
+      if (periodic) {
+        if (lo[a] < 0) lo[a] += n[a];
+        if (hi[a] >= n[a]) hi[a] -= n[a];
+      }
+      double pl, ph;
+      if (lo[a] < 0) {  // outflow on the low side: ghost phi = -phi
+        ph = phi_[A_.diag.index(hi)];
+        pl = -ph;
+      } else if (hi[a] >= n[a]) {
+        pl = phi_[A_.diag.index(lo)];
+        ph = -pl;
+      } else {
+        pl = phi_[A_.diag.index(lo)];
+        ph = phi_[A_.diag.index(hi)];
+      }
+      g[i] = float(double(g[i]) - (ph - pl) * invH);
+    });
+  }
+  vc_.apply(u);
+  return r;
+}
+
+template <int D>
+Grid<float, D> PressureProjection<D>::pressure() const {
+  Grid<float, D> p(vc_.cells, 0.0f);
+  if (lastDt_ <= 0) return p;
+  const double s = lastDensity_ / lastDt_;
+  parallelFor(p.size(), [&](size_t i) { p[i] = float(phi_[i] * s); }, 4096);
+  return p;
+}
+
+template class PressureProjection<2>;
+template class PressureProjection<3>;
+
+}  // namespace morphoflow

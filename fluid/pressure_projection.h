@@ -1,0 +1,43 @@
+// Pressure projection (Stam 1999; Kim & Lin eq. 18): solve
+//   -lap(phi) = -div(u*),  u = u* - grad(phi),  p = rho phi / dt
+// on the fluid cells, Neumann at walls, inflow and solids, p = 0 at outflow,
+// to a relative residual tolerance, by MGPCG (default), MIC(0)-PCG or
+// multigrid V-cycles. The previous phi warm-starts the next solve.
+#pragma once
+
+#include <memory>
+
+#include "core/laplace_system.h"
+#include "core/multigrid.h"
+#include "core/mic0.h"
+#include "core/solver_result.h"
+#include "fluid/fluid_settings.h"
+#include "fluid/velocity_constraints.h"
+
+namespace morphoflow {
+
+template <int D>
+class PressureProjection {
+ public:
+  PressureProjection(const VelocityConstraints<D>& constraints, PressureSolver solver,
+                     const SolverOptions& options);
+
+  SolverResult project(MacVelocity<D>* u, double dt, double density);
+  // Cell divergence of u (0 on solid cells).
+  void divergence(const MacVelocity<D>& u, Vector* div) const;
+  // Pressure of the last projection, p = rho phi / dt.
+  Grid<float, D> pressure() const;
+  const LaplaceSystem<D>& system() const { return A_; }
+
+ private:
+  const VelocityConstraints<D>& vc_;
+  PressureSolver solver_;
+  SolverOptions options_;
+  LaplaceSystem<D> A_;
+  std::unique_ptr<Multigrid<D>> multigrid_;
+  std::unique_ptr<MIC0Preconditioner<D>> mic_;
+  Vector phi_, rhs_;
+  double lastDt_ = 0.0, lastDensity_ = 1.0;
+};
+
+}  // namespace morphoflow

@@ -1,0 +1,85 @@
+#include "fluid/velocity_constraints.h"
+
+#include "core/parallel.h"
+
+namespace morphoflow {
+
+template <int D>
+VelocityConstraints<D>::VelocityConstraints(const IVec<D>& c, double hh, const DomainBoundaries& b,
+                                            const Grid<uint8_t, D>& s)
+    : cells(c), h(hh), boundaries(b), solid(s) {
+  for (int a = 0; a < D; ++a) {
+    IVec<D> fd = cells + unitVector<D>(a);
+    fixed[a] = Grid<uint8_t, D>(fd, 0);
+    value[a] = Grid<float, D>(fd, 0.0f);
+    Layout<D> layout = Layout<D>::face(a, h, cells, periodic());
+    forEachCell<D>(fd, [&](const IVec<D>& k, size_t i) {
+      bool boundary = !boundaries.periodic(a) && (k[a] == 0 || k[a] == cells[a]);
+      if (boundary) {
+        bool high = k[a] == cells[a];
+        const DomainSide& side = boundaries.side(a, high);
+        if (side.kind == BoundaryKind::Wall) {
+          fixed[a][i] = 1;
+        } else if (side.kind == BoundaryKind::Inflow) {
+          fixed[a][i] = 1;
+          double speed = inflowSpeed(a, layout.toWorld(k));
+          value[a][i] = float(high ? -speed : speed);
+        }
+      }
+      // A face touching a solid cell is held at the obstacle's (zero) velocity.
+      IVec<D> lo = k - unitVector<D>(a);
+      if (boundaries.periodic(a) && lo[a] < 0) lo[a] += cells[a];
+      IVec<D> hi = k;
+      if (boundaries.periodic(a) && hi[a] >= cells[a]) hi[a] -= cells[a];
+      bool solidLo = lo[a] >= 0 && solid(lo), solidHi = hi[a] < cells[a] && solid(hi);
+      if (solidLo || solidHi) {
+        fixed[a][i] = 1;
+        value[a][i] = 0.0f;
+      }
+    });
+  }
+}
+
+template <int D>
+std::array<bool, D> VelocityConstraints<D>::periodic() const {
+  std::array<bool, D> p{};
+  for (int a = 0; a < D; ++a) p[size_t(a)] = boundaries.periodic(a);
+  return p;
+}
+
+template <int D>
+double VelocityConstraints<D>::inflowSpeed(int axis, const Vec<D>& x) const {
+  double u = boundaries.inflowMeanVelocity;
+  if (boundaries.profile == InflowProfile::Uniform) return u;
+  // Plane Poiseuille across each transverse axis bounded by walls: the
+  // profile 4 s (1 - s) has mean 2/3, so the peak is 1.5 times the mean.
+  for (int b = 0; b < D; ++b) {
+    if (b == axis || boundaries.periodic(b)) continue;
+    double s = x[b] / (cells[b] * h);
+    u *= 1.5 * 4.0 * s * (1.0 - s);
+  }
+  return u;
+}
+
+template <int D>
+void VelocityConstraints<D>::apply(MacVelocity<D>* u) const {
+  for (int a = 0; a < D; ++a) {
+    Grid<float, D>& g = (*u)[a];
+    const Grid<uint8_t, D>& f = fixed[a];
+    const Grid<float, D>& v = value[a];
+    parallelFor(g.size(), [&](size_t i) {
+      if (f[i]) g[i] = v[i];
+    }, 8192);
+    if (boundaries.periodic(a)) {
+      size_t stride = g.stride(a);
+      forEachCell<D>(g.dims(), [&](const IVec<D>& k, size_t i) {
+        if (k[a] == cells[a]) g[i] = g[i - stride * size_t(cells[a])];
+      });
+    }
+  }
+}
+
+template struct VelocityConstraints<2>;
+template struct VelocityConstraints<3>;
+
+}  // namespace morphoflow

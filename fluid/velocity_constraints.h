@@ -1,0 +1,33 @@
+// Which velocity faces are prescribed (walls, inflow, solid obstacles) and to
+// what value; the tangential wall velocities that no-slip ghosts reflect.
+// Built once per scene from the domain sides and the solid mask.
+#pragma once
+
+#include <array>
+
+#include "core/mac_velocity.h"
+#include "fluid/domain_boundary.h"
+
+namespace morphoflow {
+
+template <int D>
+struct VelocityConstraints {
+  IVec<D> cells{0};
+  double h = 1.0;
+  DomainBoundaries boundaries;
+  Grid<uint8_t, D> solid;                   // cell flags
+  std::array<Grid<uint8_t, D>, D> fixed;    // per face grid: 1 = prescribed
+  std::array<Grid<float, D>, D> value;      // the prescribed value
+
+  VelocityConstraints() = default;
+  VelocityConstraints(const IVec<D>& cells, double h, const DomainBoundaries& b,
+                      const Grid<uint8_t, D>& solid);
+
+  std::array<bool, D> periodic() const;
+  // Sets every prescribed face and copies face 0 onto face n on periodic axes.
+  void apply(MacVelocity<D>* u) const;
+  // Inflow normal speed (into the domain) at a position on the inflow side.
+  double inflowSpeed(int axis, const Vec<D>& x) const;
+};
+
+}  // namespace morphoflow
