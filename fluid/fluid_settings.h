@@ -27,6 +27,7 @@ struct FluidSettings {
   std::array<double, 3> buoyancyDirection{0.0, 1.0, 0.0};
   double buoyancy = 0.0;                   // acceleration per unit dye along buoyancyDirection
   DomainBoundaries boundaries;
+  int inflowDyeStripes = 0;                // > 0: dye enters through the inflow in this many stripes
   std::vector<ObstacleSpec> obstacles;
 };
 

@@ -73,6 +73,7 @@ void FluidSolver<D>::step(double dt) {
   std::swap(u_, scratch_);
   std::swap(dye_, dyeScratch_);
   constraints_.apply(&u_);
+  injectInflowDye();
   lap(1);
   // 3. diffuse (implicit viscosity)
   stats_.viscosity = viscosity_->diffuse(&u_, settings_.viscosity, dt);
@@ -82,6 +83,23 @@ void FluidSolver<D>::step(double dt) {
   lap(3);
   time_ += dt;
   ++steps_;
+}
+
+template <int D>
+void FluidSolver<D>::injectInflowDye() {
+  const int stripes = settings_.inflowDyeStripes;
+  if (stripes <= 0) return;
+  for (int a = 0; a < D; ++a)
+    for (bool high : {false, true}) {
+      if (settings_.boundaries.side(a, high).kind != BoundaryKind::Inflow) continue;
+      // Stripes alternate along the first transverse axis of the inflow side.
+      int across = a == 0 ? 1 : 0;
+      forEachCell<D>(cells_, [&](const IVec<D>& k, size_t i) {
+        if (k[a] != (high ? cells_[a] - 1 : 0) || constraints_.solid[i]) return;
+        int band = int(std::floor(double(k[across]) / cells_[across] * 2 * stripes));
+        dye_[i] = band % 2 == 0 ? 1.0f : 0.0f;
+      });
+    }
 }
 
 template <int D>

@@ -51,6 +51,8 @@ class FluidSolver {
   Layout<D> cellLayout() const { return Layout<D>::cellCentred(h_, cells_, constraints_.periodic()); }
 
  private:
+  void injectInflowDye();
+
   FluidSettings settings_;
   IVec<D> cells_;
   double h_;

@@ -1,0 +1,188 @@
+// The morphoflow command line (DESIGN.md: "The command-line contract").
+// Exit status: 0 success, 2 user error (file:line:col on stderr), 1 internal error.
+#include <filesystem>
+#include <iostream>
+#include <thread>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "app/run_options.h"
+#include "app/version.h"
+#include "bench/bench_suites.h"
+#include "core/error.h"
+#include "render/colormap.h"
+#include "scenes/scene_loader.h"
+
+using namespace morphoflow;
+namespace fs = std::filesystem;
+
+namespace {
+
+// Parses "A:B" (either side may be empty).
+void parseFrames(const std::string& s, RunOptions* o) {
+  size_t colon = s.find(':');
+  if (colon == std::string::npos)
+    throw UserError({"--frames", 0, 0}, "", "expected A:B (first and last frame, inclusive), got '" + s + "'");
+  try {
+    std::string a = s.substr(0, colon), b = s.substr(colon + 1);
+    o->firstFrame = a.empty() ? 0 : std::stoi(a);
+    o->lastFrame = b.empty() ? -1 : std::stoi(b);
+  } catch (...) {
+    throw UserError({"--frames", 0, 0}, "", "expected whole numbers in A:B, got '" + s + "'");
+  }
+  if (o->firstFrame < 0 || (o->lastFrame >= 0 && o->lastFrame < o->firstFrame))
+    throw UserError({"--frames", 0, 0}, "", "expected 0 <= A <= B in A:B, got '" + s + "'");
+}
+
+std::vector<fs::path> shippedScenes() {
+  std::vector<fs::path> found;
+  for (fs::path dir : {fs::path("scenes"), fs::path(MORPHOFLOW_SCENE_DIR)}) {
+    std::error_code ec;
+    if (!fs::is_directory(dir, ec)) continue;
+    for (auto& e : fs::recursive_directory_iterator(dir, ec))
+      if (e.path().extension() == ".toml") found.push_back(e.path());
+    if (!found.empty()) break;
+  }
+  std::sort(found.begin(), found.end());
+  return found;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"morphoflow: stable fluids carrying reaction-diffusion patterns"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", kVersion);
+
+  RunOptions run;
+  std::string frames;
+  bool resume = false;
+  CLI::App* runCmd = app.add_subcommand("run", "run a scene");
+  runCmd->add_option("scene", run.scene, "scene file (.toml)")->required();
+  runCmd->add_option("--set", run.overrides, "override a scene key: key.path=value (TOML value)");
+  runCmd->add_option("--out", run.out, "output directory")->capture_default_str();
+  runCmd->add_option("--backend", run.backend, "serial | tbb | gpu")
+      ->check(CLI::IsMember({"serial", "tbb", "gpu"}))
+      ->capture_default_str();
+  runCmd->add_option("--threads", run.threads, "worker threads (0 = all cores)")->check(CLI::Range(0, 1024));
+  runCmd->add_option("--frames", frames, "A:B: write frames A to B (inclusive), stop after B");
+  runCmd->add_flag("--resume", resume, "continue an interrupted run");
+  runCmd->add_flag("--quiet", run.quiet, "no progress output");
+
+  std::vector<std::string> batchScenes;
+  std::string shard;
+  int jobs = 1;
+  std::string batchOut = "out";
+  CLI::App* batchCmd = app.add_subcommand("batch", "run several scenes, each into OUT/<scene name>");
+  batchCmd->add_option("scenes", batchScenes, "scene files")->required();
+  batchCmd->add_option("--jobs", jobs, "scenes run at once")->check(CLI::Range(1, 256));
+  batchCmd->add_option("--shard", shard, "I/N: run only every N-th scene starting at I (0-based)");
+  batchCmd->add_option("--out", batchOut, "output root")->capture_default_str();
+
+  std::vector<std::string> validateScenes;
+  CLI::App* validateCmd = app.add_subcommand("validate", "parse and check scenes; no simulation");
+  validateCmd->add_option("scenes", validateScenes, "scene files")->required();
+
+  std::string what;
+  CLI::App* listCmd = app.add_subcommand("list", "list models, scenes or palettes");
+  listCmd->add_option("what", what, "models | scenes | palettes")
+      ->required()
+      ->check(CLI::IsMember({"models", "scenes", "palettes"}));
+
+  std::string suite;
+  BenchOptions bench;
+  CLI::App* benchCmd = app.add_subcommand("bench", "run a benchmark suite");
+  benchCmd->add_option("suite", suite, std::string("suite: ") + benchSuiteNames())->required();
+  benchCmd->add_option("--size", bench.size, "only grids of this many cells per axis");
+  benchCmd->add_option("--json", bench.json, "also write results as JSON");
+  benchCmd->add_option("--seconds", bench.minSeconds, "minimum timed seconds per case");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
+
+  try {
+    if (*runCmd) {
+      if (resume)
+        throw UserError({"--resume", 0, 0}, "", "this build writes no checkpoints, so there is nothing to resume",
+                        "run the scene again without --resume");
+      if (!frames.empty()) parseFrames(frames, &run);
+      return runScene(run);
+    }
+    if (*batchCmd) {
+      int shardI = 0, shardN = 1;
+      if (!shard.empty() && (std::sscanf(shard.c_str(), "%d/%d", &shardI, &shardN) != 2 || shardN < 1 ||
+                             shardI < 0 || shardI >= shardN))
+        throw UserError({"--shard", 0, 0}, "", "expected I/N with 0 <= I < N, got '" + shard + "'");
+      // Check every scene first: a batch fails fast, before any simulation.
+      std::vector<std::string> mine;
+      for (size_t i = 0; i < batchScenes.size(); ++i)
+        if (int(i % size_t(shardN)) == shardI) {
+          loadScene(batchScenes[i]);
+          mine.push_back(batchScenes[i]);
+        }
+      std::vector<int> status(mine.size(), 0);
+      std::vector<std::string> errors(mine.size());
+      auto work = [&](size_t i) {
+        RunOptions o;
+        o.scene = mine[i];
+        o.out = (fs::path(batchOut) / fs::path(mine[i]).stem()).string();
+        o.quiet = true;
+        try {
+          status[i] = runScene(o);
+        } catch (const std::exception& e) {
+          errors[i] = e.what();
+          status[i] = dynamic_cast<const UserError*>(&e) ? 2 : 1;
+        }
+      };
+      for (size_t start = 0; start < mine.size(); start += size_t(jobs)) {
+        std::vector<std::thread> pool;
+        for (size_t i = start; i < std::min(mine.size(), start + size_t(jobs)); ++i) pool.emplace_back(work, i);
+        for (auto& t : pool) t.join();
+      }
+      int worst = 0;
+      for (size_t i = 0; i < mine.size(); ++i) {
+        std::cerr << fmt::format("{}: {}\n", mine[i], status[i] == 0 ? "ok" : errors[i]);
+        worst = std::max(worst, status[i]);
+      }
+      return worst;
+    }
+    if (*validateCmd) {
+      for (const std::string& s : validateScenes) {
+        Scene sc = loadScene(s);
+        std::cout << fmt::format("{}: ok ({}D, {} steps, Re = {:.4g})\n", s, sc.dimension, sc.totalSteps(), sc.reynolds);
+      }
+      return 0;
+    }
+    if (*listCmd) {
+      if (what == "palettes") {
+        for (const auto& n : colormapNames()) std::cout << n << "\n";
+      } else if (what == "scenes") {
+        for (const auto& p : shippedScenes()) {
+          Scene sc = loadScene(p.string());
+          std::cout << fmt::format("{:<48} {}D  Re = {:<8.4g} grid {}\n", p.string(), sc.dimension, sc.reynolds,
+                                   fmt::join(sc.fluid.resolution, "x"));
+        }
+      } else {
+        std::cout << "no reaction models in this build yet (the reaction-diffusion engine is issue 3)\n";
+      }
+      return 0;
+    }
+    if (*benchCmd) {
+      if (!runBenchSuite(suite, bench))
+        throw UserError({"bench", 0, 0}, "", "unknown suite '" + suite + "'", std::string("suites: ") + benchSuiteNames());
+      return 0;
+    }
+  } catch (const UserError& e) {
+    std::cerr << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "internal error: " << e.what() << "\n";
+    return 1;
+  }
+  return 1;
+}

@@ -1,0 +1,18 @@
+// `morphoflow bench SUITE`: benchmark suites that print a table (and JSON).
+#pragma once
+
+#include <string>
+
+namespace morphoflow {
+
+struct BenchOptions {
+  int size = 0;            // 0 = the suite's full list of sizes
+  std::string json;        // write results here when not empty
+  double minSeconds = 1.0; // time each case for at least this long (after warm-up)
+};
+
+// Runs the named suite; returns false when the suite does not exist.
+bool runBenchSuite(const std::string& suite, const BenchOptions& options);
+const char* benchSuiteNames();
+
+}  // namespace morphoflow

@@ -1,0 +1,104 @@
+// Suite `fluid`: ms per stable-fluids step (lid-driven cavity, Re = 100,
+// MacCormack advection, MGPCG pressure to 1e-6) in 2D and 3D, 1 and 2 threads.
+#include <algorithm>
+#include <chrono>
+#include <fstream>
+#include <iostream>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "bench/bench_suites.h"
+#include "core/parallel.h"
+#include "fluid/fluid_solver.h"
+
+namespace morphoflow {
+
+namespace {
+
+struct Case {
+  int dim, n;
+};
+
+template <int D>
+nlohmann::json benchFluid(int n, int threads, double minSeconds) {
+  ThreadLimit limit(threads);
+  FluidSettings s;
+  s.resolution.assign(D, n);
+  s.size.assign(D, 1.0);
+  s.viscosity = 1.0 / 100.0;  // Re = 100 with a unit lid
+  s.boundaries.sides[3].wallVelocity = {1.0, 0.0, 0.0};
+  s.pressureTolerance = 1e-6;
+  FluidSolver<D> f(s);
+  const double dt = f.h();  // CFL 1 at the lid speed
+  for (int i = 0; i < 3; ++i) f.step(dt);  // warm-up: the flow starts to develop
+  std::vector<double> times, pit;
+  std::array<double, FluidStepStats::kStages> stage{};
+  double total = 0;
+  bool converged = true;
+  while (total < minSeconds || times.size() < 5) {
+    auto t0 = std::chrono::steady_clock::now();
+    f.step(dt);
+    double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    times.push_back(t);
+    total += t;
+    pit.push_back(f.lastStats().pressure.iterations);
+    converged &= f.lastStats().pressure.converged;
+    for (int k = 0; k < FluidStepStats::kStages; ++k) stage[size_t(k)] += f.lastStats().seconds[size_t(k)];
+    if (times.size() >= 200) break;
+  }
+  std::vector<double> sorted = times;
+  std::sort(sorted.begin(), sorted.end());
+  double median = sorted[sorted.size() / 2];
+  double meanIt = 0;
+  for (double p : pit) meanIt += p;
+  meanIt /= double(pit.size());
+  nlohmann::json j = {{"dim", D},       {"n", n},
+                      {"threads", threads}, {"steps", times.size()},
+                      {"ms_per_step_median", 1e3 * median},
+                      {"pressure_iterations_mean", meanIt},
+                      {"pressure_converged", converged}};
+  for (int k = 0; k < FluidStepStats::kStages; ++k)
+    j["ms_" + std::string(FluidStepStats::kStageNames[k])] = 1e3 * stage[size_t(k)] / double(times.size());
+  return j;
+}
+
+}  // namespace
+
+bool runFluidBench(const BenchOptions& o) {
+  std::vector<Case> cases = {{2, 128}, {2, 256}, {2, 512}, {2, 1024}, {3, 64}, {3, 128}};
+  if (o.size > 0) {
+    std::vector<Case> pick;
+    for (Case c : cases)
+      if (c.n == o.size) pick.push_back(c);
+    if (pick.empty()) pick = {{2, o.size}};
+    cases = pick;
+  }
+  nlohmann::json all = nlohmann::json::array();
+  std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12} {:>10} {:>9} {:>9} {:>9} {:>9}\n", "dim", "n", "threads",
+                           "ms/step(med)", "p-iters", "forces", "advect", "diffuse", "project");
+  for (Case c : cases) {
+    for (int threads : {1, 2}) {
+      nlohmann::json j = c.dim == 2 ? benchFluid<2>(c.n, threads, o.minSeconds) : benchFluid<3>(c.n, threads, o.minSeconds);
+      std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12.2f} {:>10.1f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f}{}\n", c.dim,
+                               c.n, threads, j["ms_per_step_median"].get<double>(),
+                               j["pressure_iterations_mean"].get<double>(), j["ms_forces"].get<double>(),
+                               j["ms_advect"].get<double>(), j["ms_diffuse"].get<double>(),
+                               j["ms_project"].get<double>(), j["pressure_converged"].get<bool>() ? "" : "  (unconverged)")
+                << std::flush;
+      all.push_back(j);
+    }
+  }
+  if (!o.json.empty()) std::ofstream(o.json) << all.dump(2) << "\n";
+  return true;
+}
+
+bool runBenchSuite(const std::string& suite, const BenchOptions& o) {
+  if (suite == "fluid") return runFluidBench(o);
+  return false;
+}
+
+const char* benchSuiteNames() { return "fluid"; }
+
+}  // namespace morphoflow

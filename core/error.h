@@ -1,0 +1,42 @@
+// User errors carry the place in the input that caused them (file, line,
+// column), the key, and a suggestion; the command line maps them to exit 2.
+#pragma once
+
+#include <sstream>
+#include <stdexcept>
+#include <string>
+
+namespace morphoflow {
+
+struct SourceLocation {
+  std::string file;
+  int line = 0;    // 1-based; 0 when unknown
+  int column = 0;  // 1-based; 0 when unknown
+};
+
+class UserError : public std::runtime_error {
+ public:
+  UserError(SourceLocation where, std::string key, std::string message, std::string hint = {})
+      : std::runtime_error(format(where, key, message, hint)),
+        where_(std::move(where)),
+        key_(std::move(key)) {}
+  const SourceLocation& where() const { return where_; }
+  const std::string& key() const { return key_; }
+
+ private:
+  static std::string format(const SourceLocation& w, const std::string& key, const std::string& msg,
+                            const std::string& hint) {
+    std::ostringstream s;
+    s << w.file;
+    if (w.line > 0) s << ':' << w.line << ':' << w.column;
+    s << ": error: ";
+    if (!key.empty()) s << '\'' << key << "': ";
+    s << msg;
+    if (!hint.empty()) s << " (" << hint << ')';
+    return s.str();
+  }
+  SourceLocation where_;
+  std::string key_;
+};
+
+}  // namespace morphoflow

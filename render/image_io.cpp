@@ -1,0 +1,67 @@
+#include "render/image_io.h"
+
+#include <filesystem>
+
+#include <OpenImageIO/imageio.h>
+
+namespace morphoflow {
+
+bool readGrayImage(const std::string& path, GrayImage* image, std::string* error) {
+  if (!std::filesystem::exists(path)) {
+    *error = "no such file: " + path;
+    return false;
+  }
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) {
+    *error = OIIO::geterror();
+    return false;
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0) {
+    *error = "empty image";
+    return false;
+  }
+  std::vector<float> all(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data())) {
+    *error = in->geterror();
+    return false;
+  }
+  image->width = spec.width;
+  image->height = spec.height;
+  image->pixels.resize(size_t(spec.width) * size_t(spec.height));
+  const int nc = spec.nchannels;
+  for (size_t i = 0; i < image->pixels.size(); ++i) {
+    const float* p = &all[i * size_t(nc)];
+    // Luminance for colour images, the channel itself otherwise.
+    image->pixels[i] = nc >= 3 ? 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2] : p[0];
+  }
+  return true;
+}
+
+bool writeRgb8(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb,
+               std::string* error) {
+  std::filesystem::path final(path);
+  std::filesystem::path tmp = final;
+  tmp += ".tmp" + final.extension().string();
+  auto out = OIIO::ImageOutput::create(final.string());
+  if (!out) {
+    *error = "no image writer for " + path + ": " + OIIO::geterror();
+    return false;
+  }
+  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
+  if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) || !out->close()) {
+    *error = out->geterror();
+    std::error_code ec;
+    std::filesystem::remove(tmp, ec);
+    return false;
+  }
+  std::error_code ec;
+  std::filesystem::rename(tmp, final, ec);
+  if (ec) {
+    *error = ec.message();
+    return false;
+  }
+  return true;
+}
+
+}  // namespace morphoflow

@@ -1,0 +1,23 @@
+// Image files through OpenImageIO. Only render/ includes OpenImageIO.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace morphoflow {
+
+struct GrayImage {
+  int width = 0, height = 0;
+  std::vector<float> pixels;  // row-major, top row first; first channel (or luminance)
+};
+
+// Reads any image OpenImageIO knows (PNG, EXR, TIFF, ...). False + message on failure.
+bool readGrayImage(const std::string& path, GrayImage* image, std::string* error);
+
+// Writes 8-bit RGB (row-major, top row first). The file is written to a
+// temporary name and renamed, so a crash never leaves a half-written frame.
+bool writeRgb8(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb,
+               std::string* error);
+
+}  // namespace morphoflow

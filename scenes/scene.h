@@ -1,0 +1,63 @@
+// A scene as plain settings: everything a run needs, resolved from a TOML
+// file plus --set overrides. Owned by the layers below (fluid, render).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fluid/fluid_settings.h"
+
+namespace morphoflow {
+
+struct TimeSettings {
+  double dt = 0.01;        // fixed step, or the largest step when cfl > 0
+  long steps = 0;          // exactly one of steps / duration is used
+  double duration = 0.0;
+  double cfl = 0.0;        // > 0: adaptive dt = min(dt, cfl h / |u|max)
+};
+
+struct OutputSettings {
+  int every = 10;                  // steps between frames
+  bool images = true;
+  bool fields = false;
+  bool vdb = false;
+  bool video = false;
+  std::string field = "vorticity"; // speed | vorticity | dye | pressure
+  std::string colormap = "coolwarm";
+  bool autoRange = true;
+  double range[2] = {0.0, 1.0};
+  int slice = -1;                  // 3D: z slice for images (-1 = middle)
+};
+
+struct ProbeSettings {
+  bool centerlines = false;        // cavity velocity profiles
+  bool forces = false;             // drag and lift on the obstacles
+  double strouhalStart = -1.0;     // time from which the lift period is measured (-1 = half the run)
+  double referenceLength = 1.0;    // for Reynolds number, coefficients, Strouhal number
+  double referenceSpeed = 1.0;
+  double referenceArea = 1.0;      // frontal area of the obstacle (length in 2D)
+};
+
+struct DyeSettings {
+  std::string initial = "none";    // none | stripes | checker
+  int stripes = 8;                 // stripes across the inflow / the domain
+};
+
+struct Scene {
+  std::string path;                // the file it came from
+  std::string name;
+  int dimension = 2;
+  uint64_t seed = 1;
+  FluidSettings fluid;
+  TimeSettings time;
+  OutputSettings output;
+  ProbeSettings probes;
+  DyeSettings dye;
+  double reynolds = 0.0;           // resolved Re = U L / nu
+  std::string resolvedJson;        // the scene as resolved (JSON text), for run.json
+  long totalSteps() const;         // resolved from steps or duration/dt
+};
+
+}  // namespace morphoflow

@@ -1,0 +1,506 @@
+#include "scenes/scene_loader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <sstream>
+
+#include <toml++/toml.h>
+
+#include "render/image_io.h"
+#include "render/colormap.h"
+
+namespace morphoflow {
+
+int editDistance(const std::string& a, const std::string& b) {
+  std::vector<int> prev(b.size() + 1), cur(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) prev[j] = int(j);
+  for (size_t i = 1; i <= a.size(); ++i) {
+    cur[0] = int(i);
+    for (size_t j = 1; j <= b.size(); ++j)
+      cur[j] = std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (a[i - 1] == b[j - 1] ? 0 : 1)});
+    std::swap(prev, cur);
+  }
+  return prev[b.size()];
+}
+
+namespace {
+
+std::string join(const std::vector<std::string>& v, const std::string& sep = ", ") {
+  std::string s;
+  for (size_t i = 0; i < v.size(); ++i) s += (i ? sep : "") + v[i];
+  return s;
+}
+
+std::string nearest(const std::string& word, const std::vector<std::string>& choices) {
+  std::string best;
+  int bestD = 1 << 30;
+  for (const auto& c : choices) {
+    int d = editDistance(word, c);
+    if (d < bestD) {
+      bestD = d;
+      best = c;
+    }
+  }
+  return best;
+}
+
+std::string describe(const toml::node& n) {
+  switch (n.type()) {
+    case toml::node_type::string: return "a string";
+    case toml::node_type::integer: return "an integer";
+    case toml::node_type::floating_point: return "a number";
+    case toml::node_type::boolean: return "a boolean";
+    case toml::node_type::array: return "an array";
+    case toml::node_type::table: return "a table";
+    default: return "a date/time";
+  }
+}
+
+// Reads typed values out of the TOML tree, remembering which keys each table
+// was asked for, so that whatever is left over is an unknown key.
+class Reader {
+ public:
+  Reader(std::string file, toml::table& root, std::map<std::string, SourceLocation> overrideLocs)
+      : file_(std::move(file)), root_(root), overrideLocs_(std::move(overrideLocs)) {}
+
+  SourceLocation where(const toml::node* n, const std::string& key) const {
+    auto it = overrideLocs_.find(key);
+    if (it != overrideLocs_.end()) return it->second;
+    if (!n) return {file_, 0, 0};
+    return {file_, int(n->source().begin.line), int(n->source().begin.column)};
+  }
+  [[noreturn]] void fail(const toml::node* n, const std::string& key, const std::string& msg,
+                         const std::string& hint = {}) const {
+    throw UserError(where(n, key), key, msg, hint);
+  }
+
+  // The sub-table `name` of `parent` (null when absent).
+  const toml::table* table(const toml::table& parent, const std::string& prefix, const std::string& name) {
+    known_[&parent].insert(name);
+    const toml::node* n = parent.get(name);
+    if (!n) return nullptr;
+    if (!n->is_table()) fail(n, prefix + name, "expected a table ([" + prefix + name + "]), found " + describe(*n));
+    return n->as_table();
+  }
+  const toml::node* node(const toml::table* t, const std::string& prefix, const std::string& key) {
+    if (!t) return nullptr;
+    known_[t].insert(key);
+    return t->get(key);
+  }
+
+  double number(const toml::table* t, const std::string& prefix, const std::string& key, double def,
+                double lo, double hi, bool loOpen = false) {
+    const toml::node* n = node(t, prefix, key);
+    if (!n) return def;
+    return checkNumber(n, prefix + key, lo, hi, loOpen);
+  }
+  double checkNumber(const toml::node* n, const std::string& full, double lo, double hi, bool loOpen) {
+    if (!n->is_number()) fail(n, full, "expected a number, found " + describe(*n));
+    double v = n->value<double>().value();
+    if (!std::isfinite(v)) fail(n, full, "expected a finite number");
+    if (v < lo || (loOpen && v == lo) || v > hi) {
+      std::ostringstream r;
+      r << "expected a number in " << (loOpen ? "(" : "[") << lo << ", " << hi << "], found " << v;
+      fail(n, full, r.str());
+    }
+    return v;
+  }
+  long integer(const toml::table* t, const std::string& prefix, const std::string& key, long def, long lo,
+               long hi) {
+    const toml::node* n = node(t, prefix, key);
+    if (!n) return def;
+    if (!n->is_integer()) fail(n, prefix + key, "expected an integer, found " + describe(*n));
+    long v = long(n->value<int64_t>().value());
+    if (v < lo || v > hi)
+      fail(n, prefix + key,
+           "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "], found " +
+               std::to_string(v));
+    return v;
+  }
+  bool boolean(const toml::table* t, const std::string& prefix, const std::string& key, bool def) {
+    const toml::node* n = node(t, prefix, key);
+    if (!n) return def;
+    if (!n->is_boolean()) fail(n, prefix + key, "expected true or false, found " + describe(*n));
+    return n->value<bool>().value();
+  }
+  std::string string(const toml::table* t, const std::string& prefix, const std::string& key,
+                     const std::string& def, const std::vector<std::string>& choices = {}) {
+    const toml::node* n = node(t, prefix, key);
+    if (!n) return def;
+    if (!n->is_string()) fail(n, prefix + key, "expected a string, found " + describe(*n));
+    std::string v = n->value<std::string>().value();
+    if (!choices.empty() && std::find(choices.begin(), choices.end(), v) == choices.end())
+      fail(n, prefix + key, "'" + v + "' is not one of: " + join(choices),
+           "did you mean '" + nearest(v, choices) + "'?");
+    return v;
+  }
+  // An array of numbers of length in [minLen, maxLen].
+  std::vector<double> numbers(const toml::table* t, const std::string& prefix, const std::string& key,
+                              std::vector<double> def, size_t minLen, size_t maxLen, double lo, double hi,
+                              bool loOpen = false, const toml::node** out = nullptr) {
+    const toml::node* n = node(t, prefix, key);
+    if (out) *out = n;
+    if (!n) return def;
+    const std::string full = prefix + key;
+    const toml::array* arr = n->as_array();
+    if (!arr) fail(n, full, "expected an array of numbers, found " + describe(*n));
+    if (arr->size() < minLen || arr->size() > maxLen)
+      fail(n, full,
+           "expected " + (minLen == maxLen ? std::to_string(minLen) : std::to_string(minLen) + " or " + std::to_string(maxLen)) +
+               " numbers, found " + std::to_string(arr->size()));
+    std::vector<double> v;
+    for (const toml::node& e : *arr) v.push_back(checkNumber(&e, full, lo, hi, loOpen));
+    return v;
+  }
+
+  // Every key nobody asked for is an error; the nearest asked-for key is suggested.
+  void checkUnknown(const toml::table& t, const std::string& prefix) {
+    std::vector<std::string> valid(known_[&t].begin(), known_[&t].end());
+    for (auto&& [k, v] : t) {
+      std::string key(k.str());
+      if (!known_[&t].count(key)) {
+        std::string hint = valid.empty() ? "" : "did you mean '" + prefix + nearest(key, valid) + "'?";
+        fail(&v, prefix + key, "unknown key", hint + (valid.empty() ? "" : " valid keys here: " + join(valid)));
+      }
+      if (v.is_table()) checkUnknown(*v.as_table(), prefix + key + ".");
+      if (v.is_array_of_tables()) {
+        const toml::array& a = *v.as_array();
+        for (size_t i = 0; i < a.size(); ++i)
+          if (known_.count(a.get(i)->as_table()))
+            checkUnknown(*a.get(i)->as_table(), prefix + key + "." + std::to_string(i) + ".");
+      }
+    }
+  }
+
+  const std::string& file() const { return file_; }
+  toml::table& root() { return root_; }
+
+ private:
+  std::string file_;
+  toml::table& root_;
+  std::map<std::string, SourceLocation> overrideLocs_;
+  std::map<const toml::table*, std::set<std::string>> known_;
+};
+
+// Applies one --set key.path=value override; value is TOML.
+void applyOverride(toml::table& root, const std::string& kv, std::map<std::string, SourceLocation>* locs) {
+  const std::string origin = "--set " + kv;
+  size_t eq = kv.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw UserError({origin, 1, 1}, "", "expected key.path=value", "e.g. --set fluid.reynolds=400");
+  std::string key = kv.substr(0, eq), value = kv.substr(eq + 1);
+  toml::table parsed;
+  try {
+    parsed = toml::parse("v = " + value, origin);
+  } catch (const toml::parse_error& e) {
+    throw UserError({origin, 1, int(eq) + 2}, key, "the value is not valid TOML: " + std::string(e.description()),
+                    "strings need quotes: --set 'rd.model=\"gray-scott\"'");
+  }
+  std::vector<std::string> parts;
+  std::stringstream ss(key);
+  for (std::string p; std::getline(ss, p, '.');) parts.push_back(p);
+  toml::node* cur = &root;
+  for (size_t i = 0; i + 1 < parts.size(); ++i) {
+    if (toml::array* a = cur->as_array()) {
+      size_t idx = 0;
+      try {
+        idx = std::stoul(parts[i]);
+      } catch (...) {
+        throw UserError({origin, 1, 1}, key, "'" + parts[i] + "' should be an index into an array");
+      }
+      if (idx >= a->size())
+        throw UserError({origin, 1, 1}, key, "index " + parts[i] + " is past the end of the array");
+      cur = a->get(idx);
+      continue;
+    }
+    toml::table* t = cur->as_table();
+    if (!t) throw UserError({origin, 1, 1}, key, "'" + parts[i] + "' is not a table");
+    if (!t->contains(parts[i])) t->insert(parts[i], toml::table{});
+    cur = t->get(parts[i]);
+  }
+  toml::table* t = cur->as_table();
+  if (!t) throw UserError({origin, 1, 1}, key, "the parent of '" + parts.back() + "' is not a table");
+  parsed.get("v")->visit([&](auto&& n) { t->insert_or_assign(parts.back(), n); });
+  (*locs)[key] = {origin, 1, int(eq) + 2};
+}
+
+ObstacleShape parseShape(const std::string& s) {
+  if (s == "circle") return ObstacleShape::Circle;
+  if (s == "sphere") return ObstacleShape::Sphere;
+  if (s == "box") return ObstacleShape::Box;
+  if (s == "image") return ObstacleShape::Image;
+  return ObstacleShape::Sdf;
+}
+
+BoundaryKind parseBoundary(const std::string& s) {
+  if (s == "inflow") return BoundaryKind::Inflow;
+  if (s == "outflow") return BoundaryKind::Outflow;
+  if (s == "periodic") return BoundaryKind::Periodic;
+  return BoundaryKind::Wall;
+}
+
+}  // namespace
+
+long Scene::totalSteps() const {
+  if (time.steps > 0) return time.steps;
+  return long(std::ceil(time.duration / time.dt - 1e-9));
+}
+
+Scene loadScene(const std::string& path, const std::vector<std::string>& overrides) {
+  toml::table root;
+  {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw UserError({path, 0, 0}, "", "cannot open the scene file", "check the path");
+    std::stringstream buf;
+    buf << in.rdbuf();
+    try {
+      root = toml::parse(buf.str(), path);
+    } catch (const toml::parse_error& e) {
+      throw UserError({path, int(e.source().begin.line), int(e.source().begin.column)}, "",
+                      "not valid TOML: " + std::string(e.description()));
+    }
+  }
+  std::map<std::string, SourceLocation> overrideLocs;
+  for (const std::string& kv : overrides) applyOverride(root, kv, &overrideLocs);
+
+  Reader r(path, root, overrideLocs);
+  Scene s;
+  s.path = path;
+  s.name = std::filesystem::path(path).stem().string();
+  const std::filesystem::path sceneDir = std::filesystem::path(path).parent_path();
+  const toml::table* top = &root;
+  s.name = r.string(top, "", "name", s.name);
+  s.seed = uint64_t(r.integer(top, "", "seed", 1, 0, (1L << 62)));
+
+  // [grid] and [domain]
+  const toml::table* grid = r.table(root, "", "grid");
+  const toml::node* resNode = nullptr;
+  std::vector<double> res = r.numbers(grid, "grid.", "resolution", {128, 128}, 2, 3, 4, 8192, false, &resNode);
+  for (double v : res)
+    if (v != std::floor(v)) r.fail(resNode, "grid.resolution", "cell counts must be whole numbers");
+  s.dimension = int(res.size());
+  const int D = s.dimension;
+  double cells = 1;
+  for (double v : res) cells *= v;
+  if (cells > double(1 << 28))
+    r.fail(resNode, "grid.resolution", "the grid has too many cells for this machine's memory",
+           "at most 268435456 cells");
+  std::vector<double> defSize;
+  for (double v : res) defSize.push_back(v / res[0]);
+  const toml::table* domain = r.table(root, "", "domain");
+  const toml::node* sizeNode = nullptr;
+  std::vector<double> size = r.numbers(domain, "domain.", "size", defSize, size_t(D), size_t(D), 0, 1e9, true, &sizeNode);
+  const double h = size[0] / res[0];
+  for (int a = 1; a < D; ++a)
+    if (std::abs(size[size_t(a)] / res[size_t(a)] - h) > 1e-6 * h) {
+      std::ostringstream hint;
+      hint << "cells must be square: use domain.size = [";
+      for (int b = 0; b < D; ++b) hint << (b ? ", " : "") << h * res[size_t(b)];
+      hint << "] or change grid.resolution";
+      r.fail(sizeNode ? sizeNode : resNode, "domain.size", "size / resolution differs between axes", hint.str());
+    }
+  s.fluid.resolution.clear();
+  for (double v : res) s.fluid.resolution.push_back(int(v));
+  s.fluid.size = size;
+
+  // [time]
+  const toml::table* time = r.table(root, "", "time");
+  s.time.dt = r.number(time, "time.", "dt", 0.01, 0, 1e6, true);
+  const toml::node* stepsNode = r.node(time, "time.", "steps");
+  const toml::node* durNode = r.node(time, "time.", "duration");
+  if (stepsNode && durNode) r.fail(durNode, "time.duration", "give either time.steps or time.duration, not both");
+  s.time.steps = r.integer(time, "time.", "steps", 0, 1, 100'000'000);
+  s.time.duration = r.number(time, "time.", "duration", 0.0, 0, 1e9, true);
+  if (!stepsNode && !durNode) s.time.steps = 100;
+  s.time.cfl = r.number(time, "time.", "cfl", 0.0, 0, 1000);
+
+  // [boundary]
+  const toml::table* bnd = r.table(root, "", "boundary");
+  const char* sideNames[6] = {"x_min", "x_max", "y_min", "y_max", "z_min", "z_max"};
+  const std::vector<std::string> kinds = {"wall", "inflow", "outflow", "periodic"};
+  int inflowSide = -1, outflows = 0;
+  for (int k = 0; k < 2 * D; ++k) {
+    std::string v = r.string(bnd, "boundary.", sideNames[k], "wall", kinds);
+    s.fluid.boundaries.sides[size_t(k)].kind = parseBoundary(v);
+    if (v == "inflow") {
+      if (inflowSide >= 0)
+        r.fail(r.node(bnd, "boundary.", sideNames[k]), std::string("boundary.") + sideNames[k],
+               "only one side may be an inflow");
+      inflowSide = k;
+    }
+    outflows += v == "outflow";
+  }
+  for (int a = 0; a < D; ++a) {
+    bool lo = s.fluid.boundaries.sides[size_t(2 * a)].kind == BoundaryKind::Periodic;
+    bool hi = s.fluid.boundaries.sides[size_t(2 * a + 1)].kind == BoundaryKind::Periodic;
+    if (lo != hi)
+      r.fail(r.node(bnd, "boundary.", sideNames[2 * a + (lo ? 1 : 0)]),
+             std::string("boundary.") + sideNames[2 * a + (lo ? 1 : 0)],
+             "a periodic side needs a periodic opposite side");
+  }
+  if (inflowSide >= 0 && outflows == 0)
+    r.fail(r.node(bnd, "boundary.", sideNames[inflowSide]), std::string("boundary.") + sideNames[inflowSide],
+           "an inflow needs an outflow side, or the fluid has nowhere to go");
+
+  // [inflow]
+  const toml::table* inflow = r.table(root, "", "inflow");
+  std::string profile = r.string(inflow, "inflow.", "profile", "parabolic", {"parabolic", "uniform"});
+  s.fluid.boundaries.profile = profile == "uniform" ? InflowProfile::Uniform : InflowProfile::Parabolic;
+  s.fluid.boundaries.inflowMeanVelocity = r.number(inflow, "inflow.", "mean_velocity", 1.0, -1e6, 1e6);
+  s.fluid.inflowDyeStripes = int(r.integer(inflow, "inflow.", "dye_stripes", 0, 0, 4096));
+
+  // [[obstacles]]
+  r.node(top, "", "obstacles");
+  if (const toml::node* obs = root.get("obstacles")) {
+    const toml::array* arr = obs->as_array();
+    if (!arr || !arr->is_array_of_tables())
+      r.fail(obs, "obstacles", "expected an array of tables ([[obstacles]])");
+    for (size_t i = 0; i < arr->size(); ++i) {
+      const toml::table* o = arr->get(i)->as_table();
+      const std::string p = "obstacles." + std::to_string(i) + ".";
+      ObstacleSpec spec;
+      std::string shape = r.string(o, p, "shape", "circle", {"circle", "sphere", "box", "image", "sdf"});
+      spec.shape = parseShape(shape);
+      std::vector<double> centre(static_cast<size_t>(D), 0.0);
+      for (int a = 0; a < D; ++a) centre[size_t(a)] = 0.5 * size[size_t(a)];
+      const toml::node* cn = nullptr;
+      centre = r.numbers(o, p, "center", centre, size_t(D), size_t(D), -1e9, 1e9, false, &cn);
+      for (int a = 0; a < D; ++a) {
+        if (centre[size_t(a)] < 0 || centre[size_t(a)] > size[size_t(a)])
+          r.fail(cn, p + "center", "the centre lies outside the domain", "domain.size is " + std::to_string(size[size_t(a)]) + " along axis " + std::to_string(a));
+        spec.center[size_t(a)] = centre[size_t(a)];
+      }
+      if (spec.shape == ObstacleShape::Circle || spec.shape == ObstacleShape::Sphere) {
+        if (!r.node(o, p, "radius")) r.fail(o, p + "radius", "a " + shape + " needs a radius");
+        spec.radius = r.number(o, p, "radius", 0.1, 0, 1e9, true);
+      } else if (spec.shape == ObstacleShape::Box) {
+        if (!r.node(o, p, "size")) r.fail(o, p + "size", "a box needs a size = [..] (its full extent)");
+        std::vector<double> sz = r.numbers(o, p, "size", {}, size_t(D), size_t(D), 0, 1e9, true);
+        for (int a = 0; a < D; ++a) spec.halfSize[size_t(a)] = 0.5 * sz[size_t(a)];
+      } else {
+        const std::string key = "file";
+        const toml::node* fn = r.node(o, p, key);
+        if (!fn) r.fail(o, p + key, "an " + shape + " obstacle needs file = \"path\"");
+        std::string file = r.string(o, p, key, "");
+        std::filesystem::path fp = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : sceneDir / file;
+        GrayImage img;
+        std::string err;
+        if (!readGrayImage(fp.string(), &img, &err)) r.fail(fn, p + key, "cannot read the image: " + err);
+        spec.fieldWidth = img.width;
+        spec.fieldHeight = img.height;
+        spec.field = std::move(img.pixels);
+        spec.threshold = r.number(o, p, "threshold", 0.5, -1e9, 1e9);
+        spec.invert = r.boolean(o, p, "invert", false);
+      }
+      s.fluid.obstacles.push_back(spec);
+    }
+  }
+
+  // [fluid]
+  const toml::table* fluid = r.table(root, "", "fluid");
+  s.fluid.density = r.number(fluid, "fluid.", "density", 1.0, 0, 1e9, true);
+  double lid = r.number(fluid, "fluid.", "lid_velocity", 0.0, -1e6, 1e6);
+  if (lid != 0.0) {
+    if (s.fluid.boundaries.sides[3].kind != BoundaryKind::Wall)
+      r.fail(r.node(fluid, "fluid.", "lid_velocity"), "fluid.lid_velocity", "the lid is the y_max side, which must be a wall");
+    s.fluid.boundaries.sides[3].wallVelocity = {lid, 0.0, 0.0};
+  }
+  // Reference scales: obstacle diameter and mean inflow, else the lid.
+  ProbeSettings& pr = s.probes;
+  pr.referenceLength = size[0];
+  pr.referenceSpeed = lid != 0.0 ? std::abs(lid) : 1.0;
+  pr.referenceArea = D == 2 ? size[0] : size[0] * size[2];
+  if (inflowSide >= 0) pr.referenceSpeed = std::abs(s.fluid.boundaries.inflowMeanVelocity);
+  if (inflowSide >= 0 && !s.fluid.obstacles.empty()) {
+    const ObstacleSpec& o = s.fluid.obstacles.front();
+    int flow = inflowSide / 2, across = flow == 1 ? 0 : 1;
+    if (o.shape == ObstacleShape::Box) {
+      pr.referenceLength = 2 * o.halfSize[size_t(across)];
+      pr.referenceArea = 1.0;
+      for (int b = 0; b < D; ++b)
+        if (b != flow) pr.referenceArea *= 2 * o.halfSize[size_t(b)];
+    } else if (o.shape == ObstacleShape::Circle || o.shape == ObstacleShape::Sphere) {
+      pr.referenceLength = 2 * o.radius;
+      if (D == 2)
+        pr.referenceArea = 2 * o.radius;
+      else
+        pr.referenceArea = o.shape == ObstacleShape::Sphere ? M_PI * o.radius * o.radius : 2 * o.radius * size[2];
+    }
+  }
+  const toml::node* reNode = r.node(fluid, "fluid.", "reynolds");
+  const toml::node* nuNode = r.node(fluid, "fluid.", "viscosity");
+  if (reNode && nuNode && overrideLocs.count("fluid.reynolds") == overrideLocs.count("fluid.viscosity"))
+    r.fail(reNode, "fluid.reynolds", "give either fluid.reynolds or fluid.viscosity, not both");
+  bool useRe = reNode && !(nuNode && overrideLocs.count("fluid.viscosity"));
+  if (useRe) {
+    s.reynolds = r.number(fluid, "fluid.", "reynolds", 100.0, 0, 1e12, true);
+    s.fluid.viscosity = pr.referenceSpeed * pr.referenceLength / s.reynolds;
+  } else {
+    s.fluid.viscosity = r.number(fluid, "fluid.", "viscosity", 1e-3, 0, 1e9);
+    s.reynolds = s.fluid.viscosity > 0 ? pr.referenceSpeed * pr.referenceLength / s.fluid.viscosity : 0.0;
+  }
+  std::string adv = r.string(fluid, "fluid.", "advection", "maccormack", {"semi-lagrangian", "maccormack", "bfecc"});
+  s.fluid.advection = adv == "semi-lagrangian" ? AdvectionScheme::SemiLagrangian
+                      : adv == "bfecc"         ? AdvectionScheme::Bfecc
+                                               : AdvectionScheme::MacCormack;
+  std::string ps = r.string(fluid, "fluid.", "pressure_solver", "mgpcg", {"mgpcg", "icpcg", "multigrid"});
+  s.fluid.pressureSolver = ps == "icpcg" ? PressureSolver::ICPCG : ps == "multigrid" ? PressureSolver::Multigrid : PressureSolver::MGPCG;
+  s.fluid.pressureTolerance = r.number(fluid, "fluid.", "pressure_tolerance", 1e-6, 0, 1, true);
+  s.fluid.pressureMaxIterations = int(r.integer(fluid, "fluid.", "pressure_max_iterations", 500, 1, 100000));
+  std::vector<double> force = r.numbers(fluid, "fluid.", "force", std::vector<double>(size_t(D), 0.0), size_t(D), size_t(D), -1e9, 1e9);
+  for (int a = 0; a < D; ++a) s.fluid.force[size_t(a)] = force[size_t(a)];
+  s.fluid.buoyancy = r.number(fluid, "fluid.", "buoyancy", 0.0, -1e9, 1e9);
+  std::vector<double> up(size_t(D), 0.0);
+  up[1] = 1.0;
+  up = r.numbers(fluid, "fluid.", "buoyancy_direction", up, size_t(D), size_t(D), -1e9, 1e9);
+  for (int a = 0; a < D; ++a) s.fluid.buoyancyDirection[size_t(a)] = up[size_t(a)];
+
+  // [dye]
+  const toml::table* dye = r.table(root, "", "dye");
+  s.dye.initial = r.string(dye, "dye.", "initial", "none", {"none", "stripes", "checker"});
+  s.dye.stripes = int(r.integer(dye, "dye.", "stripes", 8, 1, 4096));
+
+  // [probes]
+  const toml::table* probes = r.table(root, "", "probes");
+  pr.centerlines = r.boolean(probes, "probes.", "centerlines", false);
+  pr.forces = r.boolean(probes, "probes.", "forces", false);
+  if (pr.forces && s.fluid.obstacles.empty())
+    r.fail(r.node(probes, "probes.", "forces"), "probes.forces", "there is no obstacle to measure forces on");
+  pr.strouhalStart = r.number(probes, "probes.", "strouhal_start", -1.0, -1.0, 1e12);
+
+  // [output]
+  const toml::table* out = r.table(root, "", "output");
+  s.output.every = int(r.integer(out, "output.", "every", 10, 1, 1'000'000'000));
+  s.output.images = r.boolean(out, "output.", "images", true);
+  for (const char* k : {"fields", "vdb", "video"}) {
+    if (r.boolean(out, "output.", k, false))
+      r.fail(r.node(out, "output.", k), std::string("output.") + k,
+             "this build of morphoflow does not write " + std::string(k) + " yet", "set it to false");
+  }
+  s.output.field = r.string(out, "output.", "field", "vorticity", {"speed", "vorticity", "dye", "pressure"});
+  s.output.colormap = r.string(out, "output.", "colormap", s.output.field == "vorticity" ? "coolwarm" : "viridis",
+                               colormapNames());
+  const toml::node* rangeNode = nullptr;
+  std::vector<double> range = r.numbers(out, "output.", "range", {}, 2, 2, -1e30, 1e30, false, &rangeNode);
+  if (!range.empty()) {
+    if (!(range[0] < range[1])) r.fail(rangeNode, "output.range", "expected [low, high] with low < high");
+    s.output.autoRange = false;
+    s.output.range[0] = range[0];
+    s.output.range[1] = range[1];
+  }
+  s.output.slice = int(r.integer(out, "output.", "slice", -1, -1, D == 3 ? long(res[2]) - 1 : -1));
+
+  r.checkUnknown(root, "");
+
+  // The scene as resolved, for run.json.
+  std::ostringstream json;
+  json << toml::json_formatter{root};
+  s.resolvedJson = json.str();
+  return s;
+}
+
+}  // namespace morphoflow

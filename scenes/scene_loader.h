@@ -1,0 +1,22 @@
+// Reads a scene file (TOML, toml++), applies --set overrides, and checks
+// every key: unknown keys, wrong types and out-of-range values raise a
+// UserError naming file:line:column, the key, what was expected and the
+// nearest valid key.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "core/error.h"
+#include "scenes/scene.h"
+
+namespace morphoflow {
+
+// `overrides` are "key.path=value" strings, value in TOML syntax
+// (e.g. "fluid.reynolds=400", "grid.resolution=[256,256]").
+Scene loadScene(const std::string& path, const std::vector<std::string>& overrides = {});
+
+// Levenshtein distance, for "did you mean" suggestions.
+int editDistance(const std::string& a, const std::string& b);
+
+}  // namespace morphoflow
