@@ -1,0 +1,180 @@
+// The command line: bad scene files exit 2 with file:line:column, the key
+// and a suggestion; overrides work; outputs are complete; no input crashes.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <random>
+#include <regex>
+
+#include <nlohmann/json.hpp>
+
+#include "test_support.h"
+
+using namespace morphoflow::testing;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path writeScene(const fs::path& dir, const std::string& name, const std::string& text) {
+  fs::path p = dir / name;
+  std::ofstream(p) << text;
+  return p;
+}
+
+const char* kSmall = R"(
+[grid]
+resolution = [16, 16]
+[time]
+dt = 0.01
+steps = 4
+[fluid]
+viscosity = 0.01
+lid_velocity = 1.0
+[output]
+images = false
+)";
+
+}  // namespace
+
+struct BadScene {
+  std::string name, text, expectLocation, expectWords;
+};
+void PrintTo(const BadScene& b, std::ostream* os) { *os << b.name; }
+
+class BadScenes : public ::testing::TestWithParam<BadScene> {};
+
+TEST_P(BadScenes, ExitTwoWithLocationAndHint) {
+  auto dir = tempDir("bad");
+  const BadScene& b = GetParam();
+  fs::path p = writeScene(dir, b.name + ".toml", b.text);
+  CommandResult r = runMorphoflow("validate " + p.string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find(p.string() + ":" + b.expectLocation), std::string::npos)
+      << "expected location " << b.expectLocation << " in: " << r.output;
+  EXPECT_NE(r.output.find(b.expectWords), std::string::npos) << r.output;
+  // `run` reports the same error and writes nothing.
+  CommandResult run = runMorphoflow("run " + p.string() + " --out " + (dir / "out").string());
+  EXPECT_EQ(run.status, 2);
+  EXPECT_FALSE(fs::exists(dir / "out" / "run.json"));
+  fs::remove_all(dir);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, BadScenes,
+    ::testing::Values(
+        BadScene{"unknown_key", "[fluid]\nviscosty = 0.1\n", "2:1", "did you mean 'fluid.viscosity'"},
+        BadScene{"unknown_table", "[fluids]\nviscosity = 0.1\n", "1:1", "did you mean 'fluid'"},
+        BadScene{"wrong_type", "[grid]\nresolution = \"big\"\n", "2:14", "expected an array of numbers"},
+        BadScene{"out_of_range", "[fluid]\npressure_tolerance = -1\n", "2:22", "expected a number in"},
+        BadScene{"bad_choice", "[fluid]\nadvection = \"maccormak\"\n", "2:13", "did you mean 'maccormack'"},
+        BadScene{"syntax", "[grid\nresolution = [1]\n", "1:", "not valid TOML"},
+        BadScene{"wrong_length", "[grid]\nresolution = [8, 8, 8, 8]\n", "2:14", "2 or 3 numbers"},
+        BadScene{"non_square", "[grid]\nresolution = [64, 32]\n[domain]\nsize = [1.0, 1.0]\n", "4:8",
+                 "domain.size = [1, 0.5]"},
+        BadScene{"both_re_and_nu", "[fluid]\nreynolds = 100\nviscosity = 0.01\n", "2:12", "not both"},
+        BadScene{"inflow_no_outflow", "[boundary]\nx_min = \"inflow\"\n", "2:9", "needs an outflow"},
+        BadScene{"obstacle_outside", "[[obstacles]]\nshape = \"circle\"\ncenter = [2.0, 0.5]\nradius = 0.1\n", "3:10",
+                 "outside the domain"},
+        BadScene{"missing_radius", "[[obstacles]]\nshape = \"circle\"\n", "1:1", "needs a radius"},
+        BadScene{"bad_palette", "[output]\ncolormap = \"virdis\"\n", "2:12", "did you mean 'viridis'"},
+        BadScene{"missing_image", "[[obstacles]]\nshape = \"image\"\nfile = \"nope.png\"\n", "3:8", "cannot read"}),
+    [](const ::testing::TestParamInfo<BadScene>& i) { return i.param.name; });
+
+TEST(Cli, MissingFileAndBadOverrideExitTwo) {
+  CommandResult r = runMorphoflow("validate /nonexistent/scene.toml");
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("cannot open"), std::string::npos);
+  auto dir = tempDir("override");
+  fs::path p = writeScene(dir, "s.toml", kSmall);
+  r = runMorphoflow("run " + p.string() + " --set fluid.viscosity=abc --out " + dir.string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("--set fluid.viscosity=abc"), std::string::npos) << r.output;
+  r = runMorphoflow("run " + p.string() + " --set fluid.viscosityy=1 --out " + dir.string());
+  EXPECT_EQ(r.status, 2);
+  EXPECT_NE(r.output.find("did you mean 'fluid.viscosity'"), std::string::npos) << r.output;
+  r = runMorphoflow("run " + p.string() + " --frames 5:2 --out " + dir.string());
+  EXPECT_EQ(r.status, 2);
+  fs::remove_all(dir);
+}
+
+TEST(Cli, OverridesReachTheSimulationAndRunJsonIsComplete) {
+  auto dir = tempDir("run");
+  fs::path p = writeScene(dir, "s.toml", kSmall);
+  CommandResult r = runMorphoflow("run " + p.string() +
+                                  " --set grid.resolution=[24,24] --set fluid.reynolds=50 --set output.images=true"
+                                  " --set output.every=2 --quiet --out " + (dir / "out").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(dir / "out" / "run.json"));
+  EXPECT_EQ(j["resolved"]["resolution"], nlohmann::json({24, 24}));
+  EXPECT_NEAR(j["resolved"]["viscosity"].get<double>(), 1.0 / 50.0, 1e-12);  // U L / Re
+  EXPECT_EQ(j["steps"].get<int>(), 4);
+  EXPECT_TRUE(j.contains("version"));
+  for (const char* stage : {"forces", "advect", "diffuse", "project"}) EXPECT_TRUE(j["stages"].contains(stage));
+  EXPECT_GT(j["solvers"]["pressure_iterations_mean"].get<double>(), 0.0);
+  // Frames 0, 2 and 4 (every 2 steps, the initial state included).
+  for (const char* f : {"000000.png", "000001.png", "000002.png"}) EXPECT_TRUE(fs::exists(dir / "out" / "frames" / f)) << f;
+  EXPECT_FALSE(fs::exists(dir / "out" / "frames" / "000003.png"));
+  fs::remove_all(dir);
+}
+
+TEST(Cli, SerialAndTbbBackendsGiveIdenticalResults) {
+  auto dir = tempDir("backends");
+  fs::path p = writeScene(dir, "s.toml", kSmall);
+  for (std::string b : {"serial", "tbb"}) {
+    CommandResult r = runMorphoflow("run " + p.string() + " --set probes.centerlines=true --set time.steps=30 --backend " +
+                                    b + " --quiet --out " + (dir / b).string());
+    ASSERT_EQ(r.status, 0) << r.output;
+  }
+  auto read = [](const fs::path& f) {
+    std::ifstream in(f);
+    return std::string(std::istreambuf_iterator<char>(in), {});
+  };
+  for (const char* f : {"u_vertical_centerline.csv", "v_horizontal_centerline.csv"})
+    EXPECT_EQ(read(dir / "serial" / "profiles" / f), read(dir / "tbb" / "profiles" / f)) << f;
+  fs::remove_all(dir);
+}
+
+TEST(Cli, ShippedScenesValidate) {
+  for (const char* s : {"lid_driven_cavity.toml", "lid_driven_cavity_3d.toml", "flow_past_obstacle.toml",
+                        "flow_past_obstacle_3d.toml"}) {
+    CommandResult r = runMorphoflow("validate " + sceneFile(s));
+    EXPECT_EQ(r.status, 0) << s << ": " << r.output;
+  }
+}
+
+TEST(Cli, ThreeDScenesRunAtLowResolution) {
+  auto dir = tempDir("threed");
+  for (const char* s : {"lid_driven_cavity_3d.toml", "flow_past_obstacle_3d.toml"}) {
+    std::string res = std::string(s).find("obstacle") != std::string::npos ? "[24,8,8]" : "[12,12,12]";
+    CommandResult r = runMorphoflow("run " + sceneFile(s) + " --set grid.resolution=" + res +
+                                    " --set time.duration=0.5 --set output.every=5 --quiet --out " + (dir / s).string());
+    ASSERT_EQ(r.status, 0) << s << ": " << r.output;
+    EXPECT_TRUE(fs::exists(dir / s / "run.json"));
+    EXPECT_TRUE(fs::exists(dir / s / "frames" / "000000.png"));
+  }
+  fs::remove_all(dir);
+}
+
+// Random mutations of a valid scene never crash or hang: exit 0 or 2 only.
+TEST(Cli, MutatedScenesNeverCrash) {
+  auto dir = tempDir("fuzz");
+  std::mt19937 rng(12345);
+  const std::string base = kSmall;
+  const std::string alphabet = "[]=\"., 0123456789-eE+abcxyz#\n{}";
+  for (int i = 0; i < 60; ++i) {
+    std::string s = base;
+    int edits = 1 + int(rng() % 4);
+    for (int e = 0; e < edits; ++e) {
+      size_t pos = rng() % s.size();
+      switch (rng() % 3) {
+        case 0: s[pos] = alphabet[rng() % alphabet.size()]; break;
+        case 1: s.erase(pos, 1 + rng() % 6); break;
+        default: s.insert(pos, 1, alphabet[rng() % alphabet.size()]);
+      }
+    }
+    fs::path p = writeScene(dir, "m" + std::to_string(i) + ".toml", s);
+    CommandResult r = runMorphoflow("run " + p.string() + " --quiet --out " + (dir / "o").string());
+    EXPECT_TRUE(r.status == 0 || r.status == 2) << "exit " << r.status << " for:\n" << s << "\n" << r.output;
+  }
+  fs::remove_all(dir);
+}

@@ -1,0 +1,55 @@
+// Flow past a cylinder at Re = 100 (Schaefer & Turek 2D-2 geometry) sheds
+// vortices: the lift oscillates periodically about zero, the Strouhal number
+// of successive periods is stable, and it lies near the benchmark's 0.30.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "test_support.h"
+
+using namespace morphoflow::testing;
+
+TEST(ObstacleShedding, Re100LiftIsPeriodicWithStableStrouhal) {
+  auto out = tempDir("shedding");
+  // Default: half the scene's resolution (D = 5 cells) for CI;
+  // MORPHOFLOW_FULL_VALIDATION=1 runs the shipped 440 x 82 grid.
+  std::string grid = fullValidation() ? "" : " --set grid.resolution=[220,41] --set time.dt=0.008";
+  CommandResult r = runMorphoflow("run " + sceneFile("flow_past_obstacle.toml") + grid +
+                                  " --set output.images=false --quiet --out " + out.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  std::ifstream in(out / "run.json");
+  nlohmann::json j = nlohmann::json::parse(in);
+  ASSERT_FALSE(j["strouhal"].is_null()) << "no lift oscillation detected";
+  const double st = j["strouhal"].get<double>();
+  const int periods = j["lift"]["periods"].get<int>();
+  EXPECT_GE(periods, 5) << "too few shedding periods";
+  // Stable: every measured period gives the same St within 3%.
+  for (double s : j["lift"]["period_strouhal"]) EXPECT_NEAR(s, st, 0.03 * st);
+  EXPECT_LT(j["lift"]["period_spread"].get<double>(), 0.06);
+  // Schaefer & Turek (1996) report St = 0.295-0.305 for this geometry.
+  EXPECT_GT(st, 0.25);
+  EXPECT_LT(st, 0.36);
+
+  // The lift swings both ways with a real amplitude.
+  auto rows = std::vector<double>{};
+  std::ifstream csv(out / "forces.csv");
+  std::string line;
+  std::getline(csv, line);
+  ASSERT_EQ(line, "step,time,drag_coefficient,lift_coefficient");
+  double lo = 1e9, hi = -1e9, t = 0;
+  while (std::getline(csv, line)) {
+    double step, time, cd, cl;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf", &step, &time, &cd, &cl), 4);
+    t = time;
+    if (time > 4.0) {
+      lo = std::min(lo, cl);
+      hi = std::max(hi, cl);
+      EXPECT_GT(cd, 1.0);  // the drag stays positive and sizeable
+    }
+  }
+  EXPECT_GT(t, 7.9);
+  EXPECT_LT(lo, -0.2);
+  EXPECT_GT(hi, 0.2);
+  std::filesystem::remove_all(out);
+}
