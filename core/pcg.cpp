@@ -8,20 +8,28 @@ namespace morphoflow {
 
 template <int D>
 SolverResult solvePCG(const LaplaceSystem<D>& A, const Vector& bIn, Vector* xp, Preconditioner* M,
-                      const SolverOptions& opt, Interrupter* interrupter) {
+                      const SolverOptions& opt, Interrupter* interrupter, PcgWorkspace* workspace) {
   Vector& x = *xp;
   const size_t n = A.size();
   x.resize(n, 0.0);
   SolverResult result;
-  Vector b = bIn;
-  if (A.singular()) A.removeNullSpace(&b);  // keep the system consistent
+  PcgWorkspace local;
+  PcgWorkspace& ws = workspace ? *workspace : local;
+  for (Vector* v : {&ws.r, &ws.z, &ws.p, &ws.q}) v->resize(n);
+  const Vector* bp = &bIn;
+  if (A.singular()) {  // keep the system consistent
+    ws.b = bIn;
+    A.removeNullSpace(&ws.b);
+    bp = &ws.b;
+  }
+  const Vector& b = *bp;
   const double bnorm = norm2(b);
   if (bnorm == 0.0) {
     std::fill(x.begin(), x.end(), 0.0);
     result.converged = true;
     return result;
   }
-  Vector r(n), z(n), p(n), q(n);
+  Vector &r = ws.r, &z = ws.z, &p = ws.p, &q = ws.q;
   double rnorm = A.residual(b, x, &r);
   result.residual = rnorm / bnorm;
   if (result.residual <= opt.tolerance) {
@@ -66,8 +74,8 @@ SolverResult solvePCG(const LaplaceSystem<D>& A, const Vector& bIn, Vector* xp, 
 }
 
 template SolverResult solvePCG<2>(const LaplaceSystem<2>&, const Vector&, Vector*, Preconditioner*,
-                                  const SolverOptions&, Interrupter*);
+                                  const SolverOptions&, Interrupter*, PcgWorkspace*);
 template SolverResult solvePCG<3>(const LaplaceSystem<3>&, const Vector&, Vector*, Preconditioner*,
-                                  const SolverOptions&, Interrupter*);
+                                  const SolverOptions&, Interrupter*, PcgWorkspace*);
 
 }  // namespace morphoflow

@@ -15,9 +15,15 @@ struct SolverOptions {
   int maxIterations = 1000;
 };
 
+// Work vectors of PCG, kept between solves to avoid reallocating them.
+struct PcgWorkspace {
+  Vector b, r, z, p, q;
+};
+
 // Solves A x = b starting from *x. M may be null (plain CG).
 template <int D>
 SolverResult solvePCG(const LaplaceSystem<D>& A, const Vector& b, Vector* x, Preconditioner* M,
-                      const SolverOptions& options, Interrupter* interrupter = nullptr);
+                      const SolverOptions& options, Interrupter* interrupter = nullptr,
+                      PcgWorkspace* workspace = nullptr);
 
 }  // namespace morphoflow

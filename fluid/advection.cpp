@@ -29,12 +29,16 @@ void semiLagrangian(const Grid<float, D>& src, const Layout<D>& layout, const Ma
 
 template <int D>
 void advectField(const Grid<float, D>& src, const Layout<D>& layout, const MacVelocity<D>& u,
-                 double dt, AdvectionScheme scheme, Grid<float, D>* dst) {
+                 double dt, AdvectionScheme scheme, Grid<float, D>* dst, AdvectionScratch<D>* scratch) {
   if (scheme == AdvectionScheme::SemiLagrangian) {
     semiLagrangian<D>(src, layout, u, dt, dst, nullptr, nullptr);
     return;
   }
-  Grid<float, D> lo(src.dims()), hi(src.dims()), back(src.dims());
+  AdvectionScratch<D> local;
+  AdvectionScratch<D>& s = scratch ? *scratch : local;
+  for (Grid<float, D>* g : {&s.lo, &s.hi, &s.back, &s.fwd})
+    if (g->dims() != src.dims()) *g = Grid<float, D>(src.dims());
+  Grid<float, D>&lo = s.lo, &hi = s.hi, &back = s.back;
   if (scheme == AdvectionScheme::MacCormack) {
     // phi^ = A(phi); phi~ = A^-1(phi^); phi = phi^ + (phi - phi~) / 2, limited.
     Grid<float, D>& fwd = *dst;
@@ -48,9 +52,10 @@ void advectField(const Grid<float, D>& src, const Layout<D>& layout, const MacVe
     return;
   }
   // BFECC: phi_bar = phi + (phi - A^-1 A phi) / 2, then A(phi_bar), limited.
-  Grid<float, D> fwd(src.dims()), corrected(src.dims());
+  Grid<float, D>& fwd = s.fwd;
   semiLagrangian<D>(src, layout, u, dt, &fwd, nullptr, nullptr);
   semiLagrangian<D>(fwd, layout, u, -dt, &back, nullptr, nullptr);
+  Grid<float, D>& corrected = fwd;  // fwd is no longer needed
   parallelFor(src.size(), [&](size_t i) { corrected[i] = src[i] + 0.5f * (src[i] - back[i]); }, 4096);
   semiLagrangian<D>(corrected, layout, u, dt, dst, nullptr, nullptr);
   semiLagrangian<D>(src, layout, u, dt, &back, &lo, &hi);  // first-order fallback
@@ -60,15 +65,16 @@ void advectField(const Grid<float, D>& src, const Layout<D>& layout, const MacVe
 }
 
 template <int D>
-void advectVelocity(const MacVelocity<D>& u, double dt, AdvectionScheme scheme, MacVelocity<D>* dst) {
-  for (int a = 0; a < D; ++a) advectField<D>(u[a], u.layout(a), u, dt, scheme, &(*dst)[a]);
+void advectVelocity(const MacVelocity<D>& u, double dt, AdvectionScheme scheme, MacVelocity<D>* dst,
+                    AdvectionScratch<D>* scratch) {
+  for (int a = 0; a < D; ++a) advectField<D>(u[a], u.layout(a), u, dt, scheme, &(*dst)[a], scratch);
 }
 
 template void advectField<2>(const Grid<float, 2>&, const Layout<2>&, const MacVelocity<2>&, double,
-                             AdvectionScheme, Grid<float, 2>*);
+                             AdvectionScheme, Grid<float, 2>*, AdvectionScratch<2>*);
 template void advectField<3>(const Grid<float, 3>&, const Layout<3>&, const MacVelocity<3>&, double,
-                             AdvectionScheme, Grid<float, 3>*);
-template void advectVelocity<2>(const MacVelocity<2>&, double, AdvectionScheme, MacVelocity<2>*);
-template void advectVelocity<3>(const MacVelocity<3>&, double, AdvectionScheme, MacVelocity<3>*);
+                             AdvectionScheme, Grid<float, 3>*, AdvectionScratch<3>*);
+template void advectVelocity<2>(const MacVelocity<2>&, double, AdvectionScheme, MacVelocity<2>*, AdvectionScratch<2>*);
+template void advectVelocity<3>(const MacVelocity<3>&, double, AdvectionScheme, MacVelocity<3>*, AdvectionScratch<3>*);
 
 }  // namespace morphoflow

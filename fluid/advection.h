@@ -9,15 +9,23 @@
 
 namespace morphoflow {
 
+// Scratch grids of the second-order schemes, kept between steps.
+template <int D>
+struct AdvectionScratch {
+  Grid<float, D> lo, hi, back, fwd;
+};
+
 // dst(x) = src(x - dt u(x)): every sample of `src` (laid out by `layout`) is
 // traced back through `u`. src and dst must not alias.
 template <int D>
 void advectField(const Grid<float, D>& src, const Layout<D>& layout, const MacVelocity<D>& u,
-                 double dt, AdvectionScheme scheme, Grid<float, D>* dst);
+                 double dt, AdvectionScheme scheme, Grid<float, D>* dst,
+                 AdvectionScratch<D>* scratch = nullptr);
 
 // Advects every component of a MAC velocity through itself.
 template <int D>
-void advectVelocity(const MacVelocity<D>& u, double dt, AdvectionScheme scheme, MacVelocity<D>* dst);
+void advectVelocity(const MacVelocity<D>& u, double dt, AdvectionScheme scheme, MacVelocity<D>* dst,
+                    AdvectionScratch<D>* scratch = nullptr);
 
 // Foot of the characteristic through x over a step dt (midpoint rule).
 template <int D>

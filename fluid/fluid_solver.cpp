@@ -68,8 +68,8 @@ void FluidSolver<D>::step(double dt) {
   constraints_.apply(&u_);
   lap(0);
   // 2. advect (velocity through itself, dye through the same field)
-  advectVelocity<D>(u_, dt, settings_.advection, &scratch_);
-  advectField<D>(dye_, cellLayout(), u_, dt, settings_.advection, &dyeScratch_);
+  advectVelocity<D>(u_, dt, settings_.advection, &scratch_, &advectionScratch_);
+  advectField<D>(dye_, cellLayout(), u_, dt, settings_.advection, &dyeScratch_, &advectionScratch_);
   std::swap(u_, scratch_);
   std::swap(dye_, dyeScratch_);
   constraints_.apply(&u_);

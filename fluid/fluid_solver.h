@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/mac_velocity.h"
+#include "fluid/advection.h"
 #include "fluid/fluid_settings.h"
 #include "fluid/pressure_projection.h"
 #include "fluid/velocity_constraints.h"
@@ -61,6 +62,7 @@ class FluidSolver {
   std::unique_ptr<ViscositySolver<D>> viscosity_;
   MacVelocity<D> u_, scratch_;
   Grid<float, D> dye_, dyeScratch_;
+  AdvectionScratch<D> advectionScratch_;
   double time_ = 0.0;
   long steps_ = 0;
   FluidStepStats stats_;

@@ -69,7 +69,7 @@ SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double
     r = solvePCG<D>(A_, rhs_, &phi_, solver_ == PressureSolver::ICPCG
                                           ? static_cast<Preconditioner*>(mic_.get())
                                           : static_cast<Preconditioner*>(multigrid_.get()),
-                    options_);
+                    options_, nullptr, &workspace_);
   lastDt_ = dt;
   lastDensity_ = density;
   // u -= grad(phi) on every face that is not prescribed.

@@ -37,6 +37,7 @@ class PressureProjection {
   std::unique_ptr<Multigrid<D>> multigrid_;
   std::unique_ptr<MIC0Preconditioner<D>> mic_;
   Vector phi_, rhs_;
+  PcgWorkspace workspace_;
   double lastDt_ = 0.0, lastDensity_ = 1.0;
 };
 

@@ -8,32 +8,33 @@
 namespace morphoflow {
 
 template <int D>
-SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt) const {
-  SolverResult worst;
-  worst.converged = true;
-  if (nu <= 0 || dt <= 0) return worst;
-  const double s = nu * dt / (vc_.h * vc_.h);
+ViscositySolver<D>::ViscositySolver(const VelocityConstraints<D>& vc, const SolverOptions& options)
+    : vc_(vc), options_(options) {
   const IVec<D>& n = vc_.cells;
   const std::array<bool, D> periodic = vc_.periodic();
   for (int a = 0; a < D; ++a) {
-    Grid<float, D>& g = (*u)[a];
+    Component& C = comp_[size_t(a)];
     const Grid<uint8_t, D>& fixed = vc_.fixed[a];
+    const Grid<float, D>& value = vc_.value[a];
     // Unknowns: the face grid, less the duplicate face n_a on a periodic axis.
-    IVec<D> sd = g.dims();
-    if (periodic[size_t(a)]) sd[a] = n[a];
-    LaplaceSystem<D> A(sd, periodic, s);
-    Vector b(A.size(), 0.0), x(A.size(), 0.0);
-    forEachCell<D>(sd, [&](const IVec<D>& k, size_t i) {
-      size_t gi = g.index(k);
+    C.dims = n + unitVector<D>(a);
+    if (periodic[size_t(a)]) C.dims[a] = n[a];
+    C.A = LaplaceSystem<D>(C.dims, periodic, 1.0);
+    C.cBoundary = Grid<float, D>(C.dims, 0.0f);
+    C.boundaryRhs.assign(C.A.size(), 0.0);
+    C.b.assign(C.A.size(), 0.0);
+    C.x.assign(C.A.size(), 0.0);
+    forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) {
+      size_t gi = fixed.index(k);
       if (fixed[gi]) return;
-      double c = 1.0 / s, extra = 0.0;
+      double c = 0.0, extra = 0.0;
       for (int bx = 0; bx < D; ++bx) {
         for (int dir = -1; dir <= 1; dir += 2) {
           IVec<D> nb = k;
           nb[bx] += dir;
-          if (nb[bx] < 0 || nb[bx] >= sd[bx]) {
+          if (nb[bx] < 0 || nb[bx] >= C.dims[bx]) {
             if (periodic[size_t(bx)]) {
-              nb[bx] = (nb[bx] + sd[bx]) % sd[bx];
+              nb[bx] = (nb[bx] + C.dims[bx]) % C.dims[bx];
             } else {
               if (bx == a) continue;  // an outflow face: zero gradient
               const DomainSide& side = vc_.boundaries.side(bx, dir > 0);
@@ -45,30 +46,54 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
               continue;
             }
           }
-          size_t ni = g.index(nb);
+          size_t ni = fixed.index(nb);
           if (fixed[ni]) {
             c += 1.0;
-            extra += double(g[ni]);
+            extra += double(value[ni]);
           } else if (dir > 0) {
-            A.w[bx][i] = 1.0f;
+            C.A.w[bx][i] = 1.0f;
           }
         }
       }
-      A.c[i] = float(c);
-      b[i] = double(g[gi]) + s * extra;
-      x[i] = double(g[gi]);
+      C.cBoundary[i] = float(c);
+      C.boundaryRhs[i] = extra;
     });
-    A.finalize();
-    JacobiPreconditioner<D> M(A);
-    SolverResult r = solvePCG<D>(A, b, &x, &M, options_);
-    forEachCell<D>(sd, [&](const IVec<D>& k, size_t i) {
+  }
+}
+
+template <int D>
+SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt) {
+  SolverResult worst;
+  worst.converged = true;
+  if (nu <= 0 || dt <= 0) return worst;
+  const double s = nu * dt / (vc_.h * vc_.h);
+  for (int a = 0; a < D; ++a) {
+    Component& C = comp_[size_t(a)];
+    Grid<float, D>& g = (*u)[a];
+    const Grid<uint8_t, D>& fixed = vc_.fixed[a];
+    if (s != s_) {  // A = s (c + sum w (x_i - x_j)), c = 1/s + boundary terms
+      C.A.scale = s;
+      forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) {
+        C.A.c[i] = fixed[fixed.index(k)] ? 0.0f : float(1.0 / s + C.cBoundary[i]);
+      });
+      C.A.finalize();
+    }
+    forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) {
       size_t gi = g.index(k);
-      if (!fixed[gi]) g[gi] = float(x[i]);
+      C.x[i] = double(g[gi]);
+      C.b[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * C.boundaryRhs[i];
+    });
+    JacobiPreconditioner<D> M(C.A);
+    SolverResult r = solvePCG<D>(C.A, C.b, &C.x, &M, options_, nullptr, &workspace_);
+    forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) {
+      size_t gi = g.index(k);
+      if (!fixed[gi]) g[gi] = float(C.x[i]);
     });
     worst.converged = worst.converged && r.converged;
     worst.iterations = std::max(worst.iterations, r.iterations);
     worst.residual = std::max(worst.residual, r.residual);
   }
+  s_ = s;
   vc_.apply(u);
   return worst;
 }

@@ -2,10 +2,13 @@
 // component on its face grid, no-slip at walls through mirrored ghost values
 // (moving walls reflect their velocity), zero gradient at outflow. Solved by
 // Jacobi-preconditioned CG: the system is diagonally dominant for any dt.
+// The systems are built once; a new nu dt only rescales their diagonal.
 #pragma once
 
-#include "core/solver_result.h"
+#include <array>
+
 #include "core/pcg.h"
+#include "core/solver_result.h"
 #include "fluid/velocity_constraints.h"
 
 namespace morphoflow {
@@ -13,14 +16,23 @@ namespace morphoflow {
 template <int D>
 class ViscositySolver {
  public:
-  ViscositySolver(const VelocityConstraints<D>& constraints, const SolverOptions& options)
-      : vc_(constraints), options_(options) {}
+  ViscositySolver(const VelocityConstraints<D>& constraints, const SolverOptions& options);
   // Diffuses u in place; returns the worst of the component solves.
-  SolverResult diffuse(MacVelocity<D>* u, double viscosity, double dt) const;
+  SolverResult diffuse(MacVelocity<D>* u, double viscosity, double dt);
 
  private:
+  struct Component {
+    IVec<D> dims;               // the face grid less a periodic duplicate layer
+    LaplaceSystem<D> A;
+    Grid<float, D> cBoundary;   // diagonal terms from walls and prescribed neighbours
+    Vector boundaryRhs;         // their prescribed values, times the coupling
+    Vector b, x;
+  };
   const VelocityConstraints<D>& vc_;
   SolverOptions options_;
+  std::array<Component, D> comp_;
+  double s_ = -1.0;  // nu dt / h^2 the diagonals were built for
+  PcgWorkspace workspace_;
 };
 
 }  // namespace morphoflow
