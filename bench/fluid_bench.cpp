@@ -33,7 +33,7 @@ nlohmann::json benchFluid(int n, int threads, double minSeconds) {
   FluidSolver<D> f(s);
   const double dt = f.h();  // CFL 1 at the lid speed
   for (int i = 0; i < 3; ++i) f.step(dt);  // warm-up: the flow starts to develop
-  std::vector<double> times, pit;
+  std::vector<double> times, pit, vit;
   std::array<double, FluidStepStats::kStages> stage{};
   double total = 0;
   bool converged = true;
@@ -44,6 +44,7 @@ nlohmann::json benchFluid(int n, int threads, double minSeconds) {
     times.push_back(t);
     total += t;
     pit.push_back(f.lastStats().pressure.iterations);
+    vit.push_back(f.lastStats().viscosity.iterations);
     converged &= f.lastStats().pressure.converged;
     for (int k = 0; k < FluidStepStats::kStages; ++k) stage[size_t(k)] += f.lastStats().seconds[size_t(k)];
     if (times.size() >= 200) break;
@@ -51,13 +52,16 @@ nlohmann::json benchFluid(int n, int threads, double minSeconds) {
   std::vector<double> sorted = times;
   std::sort(sorted.begin(), sorted.end());
   double median = sorted[sorted.size() / 2];
-  double meanIt = 0;
+  double meanIt = 0, meanVit = 0;
   for (double p : pit) meanIt += p;
+  for (double v : vit) meanVit += v;
   meanIt /= double(pit.size());
+  meanVit /= double(vit.size());
   nlohmann::json j = {{"dim", D},       {"n", n},
                       {"threads", threads}, {"steps", times.size()},
                       {"ms_per_step_median", 1e3 * median},
                       {"pressure_iterations_mean", meanIt},
+                      {"viscosity_iterations_mean", meanVit},
                       {"pressure_converged", converged}};
   for (int k = 0; k < FluidStepStats::kStages; ++k)
     j["ms_" + std::string(FluidStepStats::kStageNames[k])] = 1e3 * stage[size_t(k)] / double(times.size());
@@ -76,14 +80,15 @@ bool runFluidBench(const BenchOptions& o) {
     cases = pick;
   }
   nlohmann::json all = nlohmann::json::array();
-  std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12} {:>10} {:>9} {:>9} {:>9} {:>9}\n", "dim", "n", "threads",
-                           "ms/step(med)", "p-iters", "forces", "advect", "diffuse", "project");
+  std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9}\n", "dim", "n", "threads",
+                           "ms/step(med)", "p-iters", "v-iters", "forces", "advect", "diffuse", "project");
   for (Case c : cases) {
     for (int threads : {1, 2}) {
       nlohmann::json j = c.dim == 2 ? benchFluid<2>(c.n, threads, o.minSeconds) : benchFluid<3>(c.n, threads, o.minSeconds);
-      std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12.2f} {:>10.1f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f}{}\n", c.dim,
-                               c.n, threads, j["ms_per_step_median"].get<double>(),
-                               j["pressure_iterations_mean"].get<double>(), j["ms_forces"].get<double>(),
+      std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12.2f} {:>8.1f} {:>8.1f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f}{}\n",
+                               c.dim, c.n, threads, j["ms_per_step_median"].get<double>(),
+                               j["pressure_iterations_mean"].get<double>(),
+                               j["viscosity_iterations_mean"].get<double>(), j["ms_forces"].get<double>(),
                                j["ms_advect"].get<double>(), j["ms_diffuse"].get<double>(),
                                j["ms_project"].get<double>(), j["pressure_converged"].get<bool>() ? "" : "  (unconverged)")
                 << std::flush;

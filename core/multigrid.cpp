@@ -109,30 +109,42 @@ void Multigrid<D>::restrict(int l) {
       b[ci] = 0.0;
       return;
     }
-    // Fine cells whose prolongation stencil can touch cc: 2cc-1 .. 2cc+2 (wrapped).
-    double sum = 0.0;
-    int range = 1;
-    for (int a = 0; a < D; ++a) range *= 4;
-    for (int k = 0; k < range; ++k) {
-      IVec<D> f;
-      double wgt = 1.0;
-      bool inside = true;
-      int kk = k;
-      for (int a = 0; a < D && inside; ++a) {
-        int fi = 2 * cc[a] - 1 + (kk & 3);
-        kk >>= 2;
-        if (fi < 0 || fi >= F.dims[a]) {
-          if (!F.periodic[a]) {
-            inside = false;
-            break;
-          }
-          fi = (fi + F.dims[a]) % F.dims[a];
+    // Fine cells whose prolongation stencil can touch cc: 2cc-1 .. 2cc+2
+    // (wrapped); the weight is a product of per-axis weights.
+    int fi[D][4];
+    double wt[D][4];
+    for (int a = 0; a < D; ++a)
+      for (int m = 0; m < 4; ++m) {
+        int f = 2 * cc[a] - 1 + m;
+        wt[a][m] = 0.0;
+        fi[a][m] = 0;
+        if (f < 0 || f >= F.dims[a]) {
+          if (!F.periodic[a]) continue;
+          f = (f + F.dims[a]) % F.dims[a];
         }
-        f[a] = fi;
-        wgt *= prolongWeight1(fi, cc[a], C.dims[a], C.periodic[a]);
+        fi[a][m] = f;
+        wt[a][m] = prolongWeight1(f, cc[a], C.dims[a], C.periodic[a]);
       }
-      if (!inside || wgt == 0.0) continue;
-      sum += wgt * r[F.diag.index(f)];
+    double sum = 0.0;
+    const size_t sx = 1, sy = size_t(F.dims[0]);
+    const size_t sz = D == 3 ? sy * size_t(F.dims[1]) : 0;
+    for (int mz = 0; mz < (D == 3 ? 4 : 1); ++mz) {
+      double wz = 1.0;
+      size_t oz = 0;
+      if constexpr (D == 3) {
+        wz = wt[2][mz];
+        if (wz == 0.0) continue;
+        oz = size_t(fi[2][mz]) * sz;
+      }
+      for (int my = 0; my < 4; ++my) {
+        double wy = wz * wt[1][my];
+        if (wy == 0.0) continue;
+        size_t oy = oz + size_t(fi[1][my]) * sy;
+        for (int mx = 0; mx < 4; ++mx) {
+          double wx = wy * wt[0][mx];
+          if (wx != 0.0) sum += wx * r[oy + size_t(fi[0][mx]) * sx];
+        }
+      }
     }
     b[ci] = sum * inv2D;
   });

@@ -77,14 +77,18 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
         C.A.c[i] = fixed[fixed.index(k)] ? 0.0f : float(1.0 / s + C.cBoundary[i]);
       });
       C.A.finalize();
+      // Below s ~ 1 the diagonal dominates and Jacobi needs a handful of
+      // iterations; above, multigrid keeps the count independent of s.
+      C.multigrid = s > 1.0 ? std::make_unique<Multigrid<D>>(C.A) : nullptr;
     }
     forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) {
       size_t gi = g.index(k);
       C.x[i] = double(g[gi]);
       C.b[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * C.boundaryRhs[i];
     });
-    JacobiPreconditioner<D> M(C.A);
-    SolverResult r = solvePCG<D>(C.A, C.b, &C.x, &M, options_, nullptr, &workspace_);
+    JacobiPreconditioner<D> jacobi(C.A);
+    Preconditioner* M = C.multigrid ? static_cast<Preconditioner*>(C.multigrid.get()) : &jacobi;
+    SolverResult r = solvePCG<D>(C.A, C.b, &C.x, M, options_, nullptr, &workspace_);
     forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) {
       size_t gi = g.index(k);
       if (!fixed[gi]) g[gi] = float(C.x[i]);

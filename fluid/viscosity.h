@@ -1,12 +1,16 @@
 // Implicit viscosity (Stam 1999): (I - nu dt lap) u = u*, per velocity
 // component on its face grid, no-slip at walls through mirrored ghost values
 // (moving walls reflect their velocity), zero gradient at outflow. Solved by
-// Jacobi-preconditioned CG: the system is diagonally dominant for any dt.
-// The systems are built once; a new nu dt only rescales their diagonal.
+// CG, preconditioned with multigrid when nu dt / h^2 is large (the system is
+// then Poisson-like) and with its diagonal otherwise. The systems are built
+// once; a new nu dt only rescales their diagonal.
 #pragma once
 
 #include <array>
 
+#include <memory>
+
+#include "core/multigrid.h"
 #include "core/pcg.h"
 #include "core/solver_result.h"
 #include "fluid/velocity_constraints.h"
@@ -27,6 +31,7 @@ class ViscositySolver {
     Grid<float, D> cBoundary;   // diagonal terms from walls and prescribed neighbours
     Vector boundaryRhs;         // their prescribed values, times the coupling
     Vector b, x;
+    std::unique_ptr<Multigrid<D>> multigrid;  // rebuilt when nu dt changes
   };
   const VelocityConstraints<D>& vc_;
   SolverOptions options_;

@@ -68,6 +68,11 @@ void checkProjection(const FluidSettings& s) {
 
 }  // namespace
 
+std::string solverName(const ::testing::TestParamInfo<PressureSolver>& info) {
+  static const char* names[] = {"MGPCG", "ICPCG", "Multigrid"};
+  return names[int(info.param)];
+}
+
 class Projection : public ::testing::TestWithParam<PressureSolver> {};
 
 TEST_P(Projection, RandomField2DClosedBox) { checkProjection<2>(box({64, 64}, false, false, GetParam())); }
@@ -78,7 +83,8 @@ TEST_P(Projection, RandomField3DChannelPeriodicSpan) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Solvers, Projection,
-                         ::testing::Values(PressureSolver::MGPCG, PressureSolver::ICPCG, PressureSolver::Multigrid));
+                         ::testing::Values(PressureSolver::MGPCG, PressureSolver::ICPCG, PressureSolver::Multigrid),
+                         solverName);
 
 TEST(Projection, ProjectingTwiceChangesNothing) {
   // A divergence-free field is a fixed point of the projection.
