@@ -73,18 +73,10 @@ class Grid {
   const std::vector<T>& values() const { return data_; }
 
   void fill(T v) { std::fill(data_.begin(), data_.end(), v); }
-  bool sameShape(const Grid& o) const { return dims_ == o.dims_; }
 
  private:
   IVec<D> dims_{};
   std::vector<T> data_;
 };
-
-template <int D>
-size_t cellCount(const IVec<D>& dims) {
-  size_t n = 1;
-  for (int a = 0; a < D; ++a) n *= size_t(dims[a]);
-  return n;
-}
 
 }  // namespace morphoflow

@@ -38,7 +38,6 @@ struct LaplaceSystem {
   // True when no c_i > 0: constants are then in the null space, and solvers
   // work on mean-free vectors.
   bool singular() const { return singular_; }
-  size_t activeCount() const { return active_; }
 
   void apply(const Vector& x, Vector* y) const;
   // r = b - A x; returns ||r||_2.
