@@ -65,6 +65,7 @@ void LaplaceSystem<D>::finalize() {
       if (cell[a] == dims[a] - 1) w[a][i] = 0.0f;
     });
   }
+  invDiag_.assign(size(), 0.0);
   forEachCell<D>(dims, [&](const IVec<D>& cell, size_t i) {
     float d = c[i];
     for (int a = 0; a < D; ++a) {
@@ -73,9 +74,20 @@ void LaplaceSystem<D>::finalize() {
       d += w[a][i] + w[a][w[a].index(lo)];
     }
     diag[i] = d;
+    invDiag_[i] = d > 0 ? 1.0 / double(d) : 0.0;
   });
   active_ = size_t(deterministicSum(diag.size(), [&](size_t i) { return diag[i] > 0 ? 1.0 : 0.0; }));
   singular_ = deterministicMax(c.size(), [&](size_t i) { return c[i]; }) <= 0.0;
+}
+
+// Neighbour sum sum_f w_f x_j(f) of cell i of a row; il/ih are the x
+// neighbours (wrapped) and wl the weight of the low x face.
+template <int D>
+inline double neighbourSum(const RowStencil<D>& s, const float* const* wa, const double* xr, size_t i,
+                           size_t il, size_t ih, float wl) {
+  double sum = double(wa[0][i]) * xr[ih] + double(wl) * xr[il];
+  for (int a = 1; a < D; ++a) sum += double(wa[a][i]) * s.xhi[a][i] + double(s.wlo[a][i]) * s.xlo[a][i];
+  return sum;
 }
 
 template <int D>
@@ -85,20 +97,20 @@ void LaplaceSystem<D>::apply(const Vector& x, Vector* yp) const {
   const bool px = periodic[0];
   parallelForRows<D>(dims, [&](size_t row) {
     RowStencil<D> s = rowStencil<D>(*this, x.data(), zerosX_.data(), zerosW_.data(), row);
-    const float* w0 = w[0].data() + s.base;
+    const float* wa[D];
+    for (int a = 0; a < D; ++a) wa[a] = w[a].data() + s.base;
     const float* dg = diag.data() + s.base;
     const double* xr = x.data() + s.base;
     double* yr = y.data() + s.base;
-    for (size_t i = 0; i < nx; ++i) {
+    auto edge = [&](size_t i) {
       size_t il = i == 0 ? nx - 1 : i - 1, ih = i + 1 == nx ? 0 : i + 1;
-      float wl = (i == 0 && !px) ? 0.0f : w0[il];
-      double sum = double(w0[i]) * xr[ih] + double(wl) * xr[il];
-      for (int a = 1; a < D; ++a) {
-        const float* wa = w[a].data() + s.base;
-        sum += double(wa[i]) * s.xhi[a][i] + double(s.wlo[a][i]) * s.xlo[a][i];
-      }
-      yr[i] = scale * (double(dg[i]) * xr[i] - sum);
-    }
+      float wl = (i == 0 && !px) ? 0.0f : wa[0][il];
+      yr[i] = scale * (double(dg[i]) * xr[i] - neighbourSum<D>(s, wa, xr, i, il, ih, wl));
+    };
+    edge(0);
+    for (size_t i = 1; i + 1 < nx; ++i)  // interior: no wrap, no branch
+      yr[i] = scale * (double(dg[i]) * xr[i] - neighbourSum<D>(s, wa, xr, i, i - 1, i + 1, wa[0][i - 1]));
+    if (nx > 1) edge(nx - 1);
   });
 }
 
@@ -128,19 +140,25 @@ void LaplaceSystem<D>::gaussSeidel(const Vector& b, Vector* xp, bool reverse) co
       RowStencil<D> s = rowStencil<D>(*this, x.data(), zerosX_.data(), zerosW_.data(), row);
       size_t parity = row % size_t(dims[1]);
       if constexpr (D == 3) parity += row / size_t(dims[1]);
-      const float* w0 = w[0].data() + s.base;
+      const float* wa[D];
+      for (int a = 0; a < D; ++a) wa[a] = w[a].data() + s.base;
+      const double* rd = invDiag_.data() + s.base;
+      const double* br = b.data() + s.base;
       double* xr = x.data() + s.base;
-      for (size_t i = (size_t(colour) + parity) & 1; i < nx; i += 2) {
-        size_t k = s.base + i;
-        double dg = diag[k];
-        if (dg <= 0) continue;
+      // x_i = (b_i / scale + sum_f w_f x_j) / diag_i; invDiag is 0 on inactive cells.
+      auto edge = [&](size_t i) {
         size_t il = i == 0 ? nx - 1 : i - 1, ih = i + 1 == nx ? 0 : i + 1;
-        float wl = (i == 0 && !px) ? 0.0f : w0[il];
-        double sum = double(w0[i]) * xr[ih] + double(wl) * xr[il];
-        for (int a = 1; a < D; ++a)
-          sum += double(w[a][k]) * s.xhi[a][i] + double(s.wlo[a][i]) * s.xlo[a][i];
-        xr[i] = (b[k] * inv + sum) / dg;
+        float wl = (i == 0 && !px) ? 0.0f : wa[0][il];
+        xr[i] = (br[i] * inv + neighbourSum<D>(s, wa, xr, i, il, ih, wl)) * rd[i];
+      };
+      size_t i = (size_t(colour) + parity) & 1;
+      if (i == 0) {
+        edge(0);
+        i = 2;
       }
+      for (; i + 1 < nx; i += 2)
+        xr[i] = (br[i] * inv + neighbourSum<D>(s, wa, xr, i, i - 1, i + 1, wa[0][i - 1])) * rd[i];
+      if (i + 1 == nx && nx > 1) edge(i);
     };
     if (serial)
       for (size_t r = 0; r < rows; ++r) sweepRow(r);

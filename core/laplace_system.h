@@ -51,6 +51,7 @@ struct LaplaceSystem {
  private:
   bool singular_ = false;
   size_t active_ = 0;
+  Vector invDiag_;              // 1 / diag, 0 on inactive cells
   Vector zerosX_;               // a row of zeros: the neighbour beyond a wall
   std::vector<float> zerosW_;
 };

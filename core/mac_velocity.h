@@ -6,6 +6,7 @@
 #include <array>
 
 #include "core/grid.h"
+#include "core/linear_sampler.h"
 #include "core/sampling.h"
 
 namespace morphoflow {
@@ -49,5 +50,15 @@ class MacVelocity {
   std::array<Grid<float, D>, D> u_;
   std::array<Layout<D>, D> layout_;
 };
+
+// One LinearSampler per component (for hot loops in cell units).
+template <int D>
+std::array<LinearSampler<D>, D> makeVelocitySamplers(const MacVelocity<D>& u) {
+  if constexpr (D == 2)
+    return {LinearSampler<2>(u[0], u.layout(0)), LinearSampler<2>(u[1], u.layout(1))};
+  else
+    return {LinearSampler<3>(u[0], u.layout(0)), LinearSampler<3>(u[1], u.layout(1)),
+            LinearSampler<3>(u[2], u.layout(2))};
+}
 
 }  // namespace morphoflow

@@ -89,6 +89,7 @@ Multigrid<D>::Multigrid(const LaplaceSystem<D>& fine, const MultigridOptions& op
     levels_.push_back(std::move(next));
     cur = &levels_.back().A;
   }
+  for (size_t l = 0; l + 1 < levels_.size(); ++l) buildTransfer(int(l));
   for (size_t l = 0; l < levels_.size(); ++l) {
     size_t n = level(int(l)).size();
     levels_[l].x.assign(n, 0.0);
@@ -98,55 +99,85 @@ Multigrid<D>::Multigrid(const LaplaceSystem<D>& fine, const MultigridOptions& op
 }
 
 template <int D>
+void Multigrid<D>::buildTransfer(int l) {
+  const LaplaceSystem<D>& F = level(l);
+  const LaplaceSystem<D>& C = level(l + 1);
+  for (int a = 0; a < D; ++a) {
+    AxisTransfer& t = levels_[size_t(l)].transfer[size_t(a)];
+    int nf = F.dims[a], nc = C.dims[a];
+    t.lo.assign(size_t(nf), 0);
+    t.hi.assign(size_t(nf), 0);
+    t.w.assign(size_t(nf), 1.0);
+    for (int f = 0; f < nf; ++f) {
+      int parent = f >> 1;
+      int nb = (f & 1) ? parent + 1 : parent - 1;
+      if (nb < 0 || nb >= nc) nb = C.periodic[a] ? (nb + nc) % nc : parent;
+      t.lo[size_t(f)] = parent;
+      t.hi[size_t(f)] = nb;
+      t.w[size_t(f)] = nb == parent ? 1.0 : 0.75;
+    }
+    t.fine.assign(size_t(nc), {0, 0, 0, 0});
+    t.fineWeight.assign(size_t(nc), {0.0, 0.0, 0.0, 0.0});
+    for (int I = 0; I < nc; ++I)
+      for (int m = 0; m < 4; ++m) {
+        int f = 2 * I - 1 + m;
+        if (f < 0 || f >= nf) {
+          if (!F.periodic[a]) continue;
+          f = (f + nf) % nf;
+        }
+        t.fine[size_t(I)][size_t(m)] = f;
+        t.fineWeight[size_t(I)][size_t(m)] = prolongWeight1(f, I, nc, C.periodic[a]);
+      }
+  }
+}
+
+// Row r of a lattice -> its coordinates along axes 1.. (index 0 unused).
+template <int D>
+inline void rowCoords(const IVec<D>& dims, size_t row, int* c) {
+  c[0] = 0;
+  for (int a = 1; a < D; ++a) {
+    c[a] = int(row % size_t(dims[a]));
+    row /= size_t(dims[a]);
+  }
+}
+
+template <int D>
 void Multigrid<D>::restrict(int l) {
   const LaplaceSystem<D>& F = level(l);
   const LaplaceSystem<D>& C = level(l + 1);
+  const std::array<AxisTransfer, D>& T = levels_[size_t(l)].transfer;
   const Vector& r = levels_[size_t(l)].r;
   Vector& b = levels_[size_t(l) + 1].b;
   const double inv2D = 1.0 / double(1 << D);
-  forEachCell<D>(C.dims, [&](const IVec<D>& cc, size_t ci) {
-    if (C.diag[ci] <= 0) {
-      b[ci] = 0.0;
-      return;
-    }
-    // Fine cells whose prolongation stencil can touch cc: 2cc-1 .. 2cc+2
-    // (wrapped); the weight is a product of per-axis weights.
-    int fi[D][4];
-    double wt[D][4];
-    for (int a = 0; a < D; ++a)
-      for (int m = 0; m < 4; ++m) {
-        int f = 2 * cc[a] - 1 + m;
-        wt[a][m] = 0.0;
-        fi[a][m] = 0;
-        if (f < 0 || f >= F.dims[a]) {
-          if (!F.periodic[a]) continue;
-          f = (f + F.dims[a]) % F.dims[a];
-        }
-        fi[a][m] = f;
-        wt[a][m] = prolongWeight1(f, cc[a], C.dims[a], C.periodic[a]);
-      }
-    double sum = 0.0;
-    const size_t sx = 1, sy = size_t(F.dims[0]);
-    const size_t sz = D == 3 ? sy * size_t(F.dims[1]) : 0;
+  const size_t ncx = size_t(C.dims[0]), nfx = size_t(F.dims[0]);
+  const size_t nfy = size_t(F.dims[1]);
+  parallelForRows<D>(C.dims, [&](size_t row) {
+    int cc[3];
+    rowCoords<D>(C.dims, row, cc);
+    double* br = b.data() + row * ncx;
+    for (size_t X = 0; X < ncx; ++X) br[X] = 0.0;
+    // Sum the fine rows that touch this coarse row, each with its weight.
     for (int mz = 0; mz < (D == 3 ? 4 : 1); ++mz) {
       double wz = 1.0;
-      size_t oz = 0;
+      size_t fz = 0;
       if constexpr (D == 3) {
-        wz = wt[2][mz];
+        wz = T[2].fineWeight[size_t(cc[2])][size_t(mz)];
+        fz = size_t(T[2].fine[size_t(cc[2])][size_t(mz)]);
         if (wz == 0.0) continue;
-        oz = size_t(fi[2][mz]) * sz;
       }
       for (int my = 0; my < 4; ++my) {
-        double wy = wz * wt[1][my];
+        double wy = wz * T[1].fineWeight[size_t(cc[1])][size_t(my)];
         if (wy == 0.0) continue;
-        size_t oy = oz + size_t(fi[1][my]) * sy;
-        for (int mx = 0; mx < 4; ++mx) {
-          double wx = wy * wt[0][mx];
-          if (wx != 0.0) sum += wx * r[oy + size_t(fi[0][mx]) * sx];
+        const double* fr = r.data() + (fz * nfy + size_t(T[1].fine[size_t(cc[1])][size_t(my)])) * nfx;
+        for (size_t X = 0; X < ncx; ++X) {
+          const std::array<int, 4>& fx = T[0].fine[X];
+          const std::array<double, 4>& wx = T[0].fineWeight[X];
+          br[X] += wy * (wx[0] * fr[fx[0]] + wx[1] * fr[fx[1]] + wx[2] * fr[fx[2]] + wx[3] * fr[fx[3]]);
         }
       }
     }
-    b[ci] = sum * inv2D;
+    const float* cd = C.diag.data() + row * ncx;
+    for (size_t X = 0; X < ncx; ++X) br[X] = cd[X] > 0 ? br[X] * inv2D : 0.0;
   });
 }
 
@@ -154,41 +185,47 @@ template <int D>
 void Multigrid<D>::prolongAdd(int l) {
   const LaplaceSystem<D>& F = level(l);
   const LaplaceSystem<D>& C = level(l + 1);
+  const std::array<AxisTransfer, D>& T = levels_[size_t(l)].transfer;
   const Vector& xc = levels_[size_t(l) + 1].x;
   Vector& x = levels_[size_t(l)].x;
-  forEachCell<D>(F.dims, [&](const IVec<D>& f, size_t fi) {
-    if (F.diag[fi] <= 0) return;
-    int lo[D], hi[D];
-    double wlo[D];
-    for (int a = 0; a < D; ++a) {
-      int parent = f[a] >> 1;
-      int nb = (f[a] & 1) ? parent + 1 : parent - 1;
-      if (nb < 0 || nb >= C.dims[a]) {
-        if (C.periodic[a])
-          nb = (nb + C.dims[a]) % C.dims[a];
-        else
-          nb = parent;
+  const size_t ncx = size_t(C.dims[0]), nfx = size_t(F.dims[0]);
+  const size_t ncy = size_t(C.dims[1]);
+  parallelForRows<D>(F.dims, [&](size_t row) {
+    int f[3];
+    rowCoords<D>(F.dims, row, f);
+    // The (up to) 2^(D-1) coarse rows and weights of this fine row.
+    const double* crow[4];
+    double cw[4];
+    int nrows = 0;
+    for (int kz = 0; kz < (D == 3 ? 2 : 1); ++kz) {
+      double wz = 1.0;
+      size_t z = 0;
+      if constexpr (D == 3) {
+        size_t fz = size_t(f[2]);
+        wz = kz ? 1.0 - T[2].w[fz] : T[2].w[fz];
+        z = size_t(kz ? T[2].hi[fz] : T[2].lo[fz]);
+        if (wz == 0.0) continue;
       }
-      lo[a] = parent;
-      hi[a] = nb;
-      wlo[a] = nb == parent ? 1.0 : 0.75;
-    }
-    double v = 0.0;
-    for (int k = 0; k < (1 << D); ++k) {
-      IVec<D> cc;
-      double wgt = 1.0;
-      for (int a = 0; a < D; ++a) {
-        bool up = (k >> a) & 1;
-        if (up && hi[a] == lo[a]) {
-          wgt = 0.0;
-          break;
-        }
-        cc[a] = up ? hi[a] : lo[a];
-        wgt *= up ? 1.0 - wlo[a] : wlo[a];
+      for (int ky = 0; ky < 2; ++ky) {
+        size_t fy = size_t(f[1]);
+        double wy = wz * (ky ? 1.0 - T[1].w[fy] : T[1].w[fy]);
+        if (wy == 0.0) continue;
+        size_t y = size_t(ky ? T[1].hi[fy] : T[1].lo[fy]);
+        crow[nrows] = xc.data() + (z * ncy + y) * ncx;
+        cw[nrows++] = wy;
       }
-      if (wgt != 0.0) v += wgt * xc[C.diag.index(cc)];
     }
-    x[fi] += v;
+    const float* fd = F.diag.data() + row * nfx;
+    double* xr = x.data() + row * nfx;
+    const int* lo = T[0].lo.data();
+    const int* hi = T[0].hi.data();
+    const double* wx = T[0].w.data();
+    for (size_t i = 0; i < nfx; ++i) {
+      if (fd[i] <= 0) continue;
+      double v = 0.0;
+      for (int k = 0; k < nrows; ++k) v += cw[k] * (wx[i] * crow[k][lo[i]] + (1.0 - wx[i]) * crow[k][hi[i]]);
+      xr[i] += v;
+    }
   });
 }
 

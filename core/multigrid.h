@@ -9,6 +9,7 @@
 // black-first after the coarse correction, so the cycle is symmetric.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -42,10 +43,22 @@ class Multigrid final : public Preconditioner {
   const LaplaceSystem<D>& level(int l) const { return l == 0 ? fine_ : levels_[size_t(l)].A; }
 
  private:
+  // Per-axis transfer tables between this level (fine) and the next (coarse).
+  struct AxisTransfer {
+    // Prolongation: fine index f takes w * x_c[lo] + (1 - w) * x_c[hi].
+    std::vector<int> lo, hi;
+    std::vector<double> w;
+    // Restriction (the transpose): coarse index C gathers up to 4 fine
+    // indices with these weights (unused entries weigh 0).
+    std::vector<std::array<int, 4>> fine;
+    std::vector<std::array<double, 4>> fineWeight;
+  };
   struct Level {
     LaplaceSystem<D> A;  // unused on level 0 (fine_ is used)
     Vector x, b, r;
+    std::array<AxisTransfer, D> transfer;  // to level + 1 (absent on the coarsest)
   };
+  void buildTransfer(int l);
   void cycle(int l);
   void restrict(int l);   // r of level l -> b of level l + 1
   void prolongAdd(int l); // x of level l + 1 added into x of level l

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "core/linear_sampler.h"
 #include "core/parallel.h"
 
 namespace morphoflow {
@@ -9,18 +10,31 @@ namespace morphoflow {
 namespace {
 
 // One semi-Lagrangian pass; optionally records the min/max of each stencil.
+// Works in cell units: p = k + offset, foot = p - (dt/h) u(p - (dt/2h) u(p)).
 template <int D>
 void semiLagrangian(const Grid<float, D>& src, const Layout<D>& layout, const MacVelocity<D>& u,
                     double dt, Grid<float, D>* dst, Grid<float, D>* lo, Grid<float, D>* hi) {
-  forEachCell<D>(src.dims(), [&](const IVec<D>& k, size_t i) {
-    Vec<D> x = traceBack(u, layout.toWorld(k), dt);
-    if (lo) {
-      float mn, mx;
-      (*dst)[i] = sampleLinear(src, layout, x, &mn, &mx);
-      (*lo)[i] = mn;
-      (*hi)[i] = mx;
-    } else {
-      (*dst)[i] = sampleLinear(src, layout, x);
+  const LinearSampler<D> field(src, layout);
+  std::array<LinearSampler<D>, D> vel = makeVelocitySamplers(u);
+  const float c = float(dt / u.h());
+  const IVec<D> dims = src.dims();
+  parallelForRows<D>(dims, [&](size_t row) {
+    float p[D], m[D], f[D];
+    size_t rest = row;
+    for (int a = 1; a < D; ++a) {
+      p[a] = float(int(rest % size_t(dims[a]))) + field.offset[a];
+      rest /= size_t(dims[a]);
+    }
+    const size_t base = row * size_t(dims[0]);
+    for (int x = 0; x < dims[0]; ++x) {
+      p[0] = float(x) + field.offset[0];
+      for (int a = 0; a < D; ++a) m[a] = p[a] - 0.5f * c * vel[size_t(a)](p);
+      for (int a = 0; a < D; ++a) f[a] = p[a] - c * vel[size_t(a)](m);
+      size_t i = base + size_t(x);
+      if (lo)
+        (*dst)[i] = field(f, &(*lo)[i], &(*hi)[i]);
+      else
+        (*dst)[i] = field(f);
     }
   });
 }
@@ -35,9 +49,7 @@ void advectField(const Grid<float, D>& src, const Layout<D>& layout, const MacVe
     return;
   }
   AdvectionScratch<D> local;
-  AdvectionScratch<D>& s = scratch ? *scratch : local;
-  for (Grid<float, D>* g : {&s.lo, &s.hi, &s.back, &s.fwd})
-    if (g->dims() != src.dims()) *g = Grid<float, D>(src.dims());
+  typename AdvectionScratch<D>::Set& s = (scratch ? *scratch : local).forShape(src.dims());
   Grid<float, D>&lo = s.lo, &hi = s.hi, &back = s.back;
   if (scheme == AdvectionScheme::MacCormack) {
     // phi^ = A(phi); phi~ = A^-1(phi^); phi = phi^ + (phi - phi~) / 2, limited.

@@ -4,6 +4,8 @@
 // stencil so they stay bounded. Unconditionally stable at any CFL number.
 #pragma once
 
+#include <vector>
+
 #include "core/mac_velocity.h"
 #include "fluid/fluid_settings.h"
 
@@ -12,7 +14,17 @@ namespace morphoflow {
 // Scratch grids of the second-order schemes, kept between steps.
 template <int D>
 struct AdvectionScratch {
-  Grid<float, D> lo, hi, back, fwd;
+  struct Set {
+    Grid<float, D> lo, hi, back, fwd;
+  };
+  std::vector<Set> sets;  // one per grid shape (each velocity component, cells)
+  Set& forShape(const IVec<D>& dims) {
+    for (Set& s : sets)
+      if (s.lo.dims() == dims) return s;
+    Set& s = sets.emplace_back();
+    for (Grid<float, D>* g : {&s.lo, &s.hi, &s.back, &s.fwd}) *g = Grid<float, D>(dims);
+    return s;
+  }
 };
 
 // dst(x) = src(x - dt u(x)): every sample of `src` (laid out by `layout`) is
