@@ -1,0 +1,87 @@
+// RDSolver<D>: a reaction-diffusion layer on a cell-centred grid, advanced by
+// one of the integrators of rd_settings.h. Diffusion is the standard 5-/7-point
+// Laplacian (seed 001 eq. 4) with periodic, zero-flux (Neumann) or fixed-value
+// (Dirichlet, through a ghost cell mirrored about the wall) boundaries; its
+// implicit solves use the shared LaplaceSystem / PCG / multigrid of core/.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/grid.h"
+#include "core/laplace_system.h"
+#include "core/pcg.h"
+#include "core/solver_result.h"
+#include "rd/rd_settings.h"
+#include "rd/reaction_lut.h"
+#include "rd/reaction_model.h"
+
+namespace morphoflow {
+
+struct RDStepStats {
+  NewtonStats newton;       // implicit reaction (Kim & Lin)
+  SolverResult diffusion;   // worst species solve
+  int lookups = 0;          // cells served by the lookup table
+};
+
+template <int D>
+class RDSolver {
+ public:
+  RDSolver(const RDSettings& settings, const ReactionModel& model);
+  ~RDSolver();
+
+  const ReactionModel& model() const { return model_; }
+  const RDSettings& settings() const { return settings_; }
+  const IVec<D>& cells() const { return cells_; }
+  double h() const { return h_; }
+  int species() const { return int(x_.size()); }
+  Grid<double, D>& field(int s) { return x_[size_t(s)]; }
+  const Grid<double, D>& field(int s) const { return x_[size_t(s)]; }
+  const std::vector<double>& diffusion() const { return d_; }
+
+  // Parameter k as a per-cell field (replaces its uniform value).
+  void setParameterField(int k, std::vector<double> values);
+  const std::vector<double>& parameterField(int k) const { return fields_[size_t(k)]; }
+  double parameter(int k) const { return params_.constant[size_t(k)]; }
+  // Cells whose species values are held fixed (seed 004 fig. 20's fixed rows):
+  // after every step, cell i of species s is reset to values[s][i] wherever mask[i].
+  void setFixedCells(std::vector<uint8_t> mask, std::vector<std::vector<double>> values);
+
+  void step(double dt);
+  const RDStepStats& lastStats() const { return stats_; }
+  double time() const { return time_; }
+  long steps() const { return steps_; }
+
+  // Largest stable explicit-Euler step for the diffusion alone: h^2 / (2 D d_max).
+  double explicitDiffusionLimit() const;
+
+ private:
+  struct Diffusion;  // per-species implicit system and its solver state
+  void react(double dt, bool implicit);
+  void applyLaplacian(int s, const Vector& x, Vector* out) const;  // out = lap x (with boundary terms)
+  void solveDiffusion(int s, double theta_dt, Vector* rhs_to_x);
+  void holdFixed();
+
+  RDSettings settings_;
+  const ReactionModel& model_;
+  IVec<D> cells_;
+  double h_;
+  std::vector<Grid<double, D>> x_;
+  std::vector<double> d_;
+  ParameterValues params_;
+  std::vector<std::vector<double>> fields_;
+  LaplaceSystem<D> laplacian_;        // -h^2 lap, with c = 2 per Dirichlet face
+  Vector boundaryFaces_;              // Dirichlet faces per cell
+  std::vector<std::unique_ptr<Diffusion>> diffusion_;
+  std::vector<Vector> scratch_, rates_;
+  std::vector<uint8_t> fixedMask_;
+  std::vector<std::vector<double>> fixedValues_;
+  std::vector<std::vector<double>> frozenValues_;
+  ReactionLUT lut_;
+  RDStepStats stats_;
+  double time_ = 0.0;
+  long steps_ = 0;
+};
+
+}  // namespace morphoflow
