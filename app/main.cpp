@@ -12,6 +12,7 @@
 #include "bench/bench_suites.h"
 #include "core/error.h"
 #include "render/colormap.h"
+#include "rd/model_registry.h"
 #include "scenes/scene_loader.h"
 
 using namespace morphoflow;
@@ -168,7 +169,7 @@ int main(int argc, char** argv) {
                                    fmt::join(sc.fluid.resolution, "x"));
         }
       } else {
-        std::cout << "no reaction models in this build yet (the reaction-diffusion engine is issue 3)\n";
+        for (const ReactionModel* m : allModels()) std::cout << describeModel(*m) << "\n";
       }
       return 0;
     }

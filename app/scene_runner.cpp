@@ -11,6 +11,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "app/output_files.h"
+#include "app/rd_runner.h"
 #include "app/run_options.h"
 #include "app/version.h"
 #include "core/error.h"
@@ -26,17 +28,6 @@ namespace fs = std::filesystem;
 namespace morphoflow {
 
 namespace {
-
-void writeTextFile(const fs::path& path, const std::string& text) {
-  fs::path tmp = path;
-  tmp += ".tmp";
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << text;
-    if (!out) throw std::runtime_error("cannot write " + tmp.string());
-  }
-  fs::rename(tmp, path);
-}
 
 std::string profileCsv(const Profile& p) {
   std::string s = "coord,value\n";
@@ -228,6 +219,7 @@ int runScene(const RunOptions& opt) {
     throw UserError({"--backend", 0, 0}, "", "the gpu backend is not part of this build yet", "use --backend tbb or serial");
   int threads = opt.backend == "serial" ? 1 : opt.threads;
   ThreadLimit limit(threads);
+  if (!scene.hasFluid) return runReactionDiffusion(scene, opt);
   return scene.dimension == 2 ? run<2>(scene, opt) : run<3>(scene, opt);
 }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "fluid/fluid_settings.h"
+#include "rd/rd_settings.h"
 
 namespace morphoflow {
 
@@ -45,6 +46,23 @@ struct DyeSettings {
   int stripes = 8;                 // stripes across the inflow / the domain
 };
 
+// Initial state of a reaction-diffusion layer.
+struct RDInitial {
+  std::vector<double> values;        // uniform state per species (empty: the model's)
+  std::vector<double> noise;         // +- uniform noise amplitude per species
+  bool randomRange = false;          // every species uniform in [range0, range1] (seed 002)
+  double range[2] = {0.0, 8.0};
+  double square = 0.0;               // side of a central square, as a fraction of the domain (Pearson)
+  std::vector<double> squareValues;  // species values inside it
+};
+
+struct RDScene {
+  bool enabled = false;
+  RDSettings settings;
+  RDInitial initial;
+  std::vector<std::pair<int, double>> perturb;  // parameter index, Gaussian sigma in percent (seed 004 sec. 3.1)
+};
+
 struct Scene {
   std::string path;                // the file it came from
   std::string name;
@@ -55,6 +73,8 @@ struct Scene {
   OutputSettings output;
   ProbeSettings probes;
   DyeSettings dye;
+  bool hasFluid = true;            // false for reaction-diffusion-only scenes
+  RDScene rd;
   double reynolds = 0.0;           // resolved Re = U L / nu
   std::string resolvedJson;        // the scene as resolved (JSON text), for run.json
   long totalSteps() const;         // resolved from steps or duration/dt

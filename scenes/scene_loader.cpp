@@ -12,6 +12,7 @@
 
 #include "render/image_io.h"
 #include "render/colormap.h"
+#include "rd/model_registry.h"
 
 namespace morphoflow {
 
@@ -289,8 +290,11 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
   if (cells > double(1 << 28))
     r.fail(resNode, "grid.resolution", "the grid has too many cells for this machine's memory",
            "at most 268435456 cells");
+  // Reaction-diffusion-only scenes default to unit cells (the seeds' units);
+  // fluid scenes to a unit-wide box.
+  const bool rdOnly = root.contains("rd") && !root.contains("fluid");
   std::vector<double> defSize;
-  for (double v : res) defSize.push_back(v / res[0]);
+  for (double v : res) defSize.push_back(rdOnly ? v : v / res[0]);
   const toml::table* domain = r.table(root, "", "domain");
   const toml::node* sizeNode = nullptr;
   std::vector<double> size = r.numbers(domain, "domain.", "size", defSize, size_t(D), size_t(D), 0, 1e9, true, &sizeNode);
@@ -472,6 +476,86 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
     r.fail(r.node(probes, "probes.", "forces"), "probes.forces", "there is no obstacle to measure forces on");
   pr.strouhalStart = r.number(probes, "probes.", "strouhal_start", -1.0, -1.0, 1e12);
 
+  // [rd]
+  std::vector<std::string> species;
+  if (const toml::table* rdt = r.table(root, "", "rd")) {
+    if (!rdOnly)
+      r.fail(rdt, "rd", "a scene with both [fluid] and [rd] is the coupled advection-reaction-diffusion layer, which is not in this build yet",
+             "drop [fluid] for a reaction-diffusion-only scene");
+    s.hasFluid = false;
+    RDScene& R = s.rd;
+    R.enabled = true;
+    const std::vector<std::string> names = modelNames();
+    if (!r.node(rdt, "rd.", "model")) r.fail(rdt, "rd.model", "a reaction-diffusion scene needs rd.model", "models: " + join(names));
+    const std::string model = r.string(rdt, "rd.", "model", "", names);
+    const ModelInfo& in = findModel(model)->info();
+    const size_t n = in.species.size();
+    species = in.species;
+    RDSettings& st = R.settings;
+    st.model = model;
+    st.resolution.clear();
+    for (double v : res) st.resolution.push_back(int(v));
+    st.size = size;
+    st.diffusion = r.numbers(rdt, "rd.", "diffusion", in.diffusion, n, n, 0, 1e12);
+    const std::string integ = r.string(rdt, "rd.", "integrator", "kim-lin", {"kim-lin", "explicit", "semi-implicit", "crank-nicolson"});
+    st.integrator = integ == "explicit"        ? RDIntegrator::ExplicitEuler
+                    : integ == "semi-implicit" ? RDIntegrator::SemiImplicit
+                    : integ == "crank-nicolson" ? RDIntegrator::CrankNicolson
+                                               : RDIntegrator::KimLin;
+    const std::string bc = r.string(rdt, "rd.", "boundary", "periodic", {"periodic", "neumann", "dirichlet"});
+    st.boundary = bc == "neumann" ? RDBoundary::Neumann : bc == "dirichlet" ? RDBoundary::Dirichlet : RDBoundary::Periodic;
+    st.dirichletValues = r.numbers(rdt, "rd.", "boundary_values", {}, n, n, -1e12, 1e12);
+    if (st.boundary == RDBoundary::Dirichlet && st.dirichletValues.empty())
+      r.fail(r.node(rdt, "rd.", "boundary"), "rd.boundary_values", "Dirichlet boundaries need boundary_values, one per species",
+             "species: " + join(species));
+    st.lookupTable = r.boolean(rdt, "rd.", "lookup_table", false);
+    st.lookupSize = int(r.integer(rdt, "rd.", "lookup_size", 256, 2, 4096));
+    const std::string ls = r.string(rdt, "rd.", "linear_solver", "mgpcg", {"mgpcg", "icpcg"});
+    st.linearSolver = ls == "icpcg" ? RDLinearSolver::ICPCG : RDLinearSolver::MGPCG;
+    st.tolerance = r.number(rdt, "rd.", "tolerance", 1e-8, 0, 1, true);
+    if (const toml::node* fr = r.node(rdt, "rd.", "frozen")) {
+      const toml::array* arr = fr->as_array();
+      if (!arr) r.fail(fr, "rd.frozen", "expected an array of species names");
+      for (const toml::node& e : *arr) {
+        auto v = e.value<std::string>();
+        auto it = v ? std::find(species.begin(), species.end(), *v) : species.end();
+        if (it == species.end())
+          r.fail(&e, "rd.frozen", "expected species names of " + model + ": " + join(species));
+        st.frozen.push_back(int(it - species.begin()));
+      }
+    }
+    // [rd.parameters]: uniform values by name.
+    const toml::table* pt = r.table(*rdt, "rd.", "parameters");
+    for (const ParameterInfo& p : in.parameters)
+      st.parameters.push_back(r.number(pt, "rd.parameters.", p.name, p.value, -1e12, 1e12));
+    // [rd.initial]
+    const toml::table* it = r.table(*rdt, "rd.", "initial");
+    RDInitial& I = R.initial;
+    I.values = r.numbers(it, "rd.initial.", "values", in.initial, n, n, -1e12, 1e12);
+    if (const toml::node* nz = r.node(it, "rd.initial.", "noise"); nz && nz->is_number())
+      I.noise.assign(n, r.number(it, "rd.initial.", "noise", 0.0, 0, 1e12));
+    else
+      I.noise = r.numbers(it, "rd.initial.", "noise", std::vector<double>(n, 0.0), n, n, 0, 1e12);
+    const toml::node* rn = nullptr;
+    std::vector<double> range = r.numbers(it, "rd.initial.", "random_range", {}, 2, 2, -1e12, 1e12, false, &rn);
+    if (!range.empty()) {
+      if (!(range[0] < range[1])) r.fail(rn, "rd.initial.random_range", "expected [low, high] with low < high");
+      I.randomRange = true;
+      I.range[0] = range[0];
+      I.range[1] = range[1];
+    }
+    I.square = r.number(it, "rd.initial.", "square", 0.0, 0, 1);
+    I.squareValues = r.numbers(it, "rd.initial.", "square_values", {}, n, n, -1e12, 1e12);
+    if (I.square > 0 && I.squareValues.empty())
+      r.fail(r.node(it, "rd.initial.", "square"), "rd.initial.square_values", "a central square needs square_values, one per species",
+             "species: " + join(species));
+    // [rd.perturb]: Gaussian perturbation of parameters, sigma in percent.
+    const toml::table* pp = r.table(*rdt, "rd.", "perturb");
+    for (size_t k = 0; k < in.parameters.size(); ++k)
+      if (r.node(pp, "rd.perturb.", in.parameters[k].name))
+        R.perturb.push_back({int(k), r.number(pp, "rd.perturb.", in.parameters[k].name, 0.0, 0, 100)});
+  }
+
   // [output]
   const toml::table* out = r.table(root, "", "output");
   s.output.every = int(r.integer(out, "output.", "every", 10, 1, 1'000'000'000));
@@ -481,7 +565,10 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
       r.fail(r.node(out, "output.", k), std::string("output.") + k,
              "this build of morphoflow does not write " + std::string(k) + " yet", "set it to false");
   }
-  s.output.field = r.string(out, "output.", "field", "vorticity", {"speed", "vorticity", "dye", "pressure"});
+  if (s.rd.enabled)
+    s.output.field = r.string(out, "output.", "field", species.front(), species);
+  else
+    s.output.field = r.string(out, "output.", "field", "vorticity", {"speed", "vorticity", "dye", "pressure"});
   s.output.colormap = r.string(out, "output.", "colormap", s.output.field == "vorticity" ? "coolwarm" : "viridis",
                                colormapNames());
   const toml::node* rangeNode = nullptr;

@@ -77,7 +77,15 @@ INSTANTIATE_TEST_SUITE_P(
                  "outside the domain"},
         BadScene{"missing_radius", "[[obstacles]]\nshape = \"circle\"\n", "1:1", "needs a radius"},
         BadScene{"bad_palette", "[output]\ncolormap = \"virdis\"\n", "2:12", "did you mean 'viridis'"},
-        BadScene{"missing_image", "[[obstacles]]\nshape = \"image\"\nfile = \"nope.png\"\n", "3:8", "cannot read"}),
+        BadScene{"missing_image", "[[obstacles]]\nshape = \"image\"\nfile = \"nope.png\"\n", "3:8", "cannot read"},
+        BadScene{"rd_unknown_model", "[rd]\nmodel = \"grey-scott\"\n", "2:9", "did you mean 'gray-scott'"},
+        BadScene{"rd_negative_diffusion", "[rd]\nmodel = \"gray-scott\"\ndiffusion = [1.0, -0.5]\n", "3:19",
+                 "expected a number in [0,"},
+        BadScene{"rd_unknown_parameter", "[rd]\nmodel = \"gray-scott\"\n[rd.parameters]\nf = 0.04\n", "4:5",
+                 "did you mean 'rd.parameters.F'"},
+        BadScene{"rd_bad_palette", "[rd]\nmodel = \"barkley\"\n[output]\ncolormap = \"jet\"\n", "4:12", "is not one of"},
+        BadScene{"rd_bad_species", "[rd]\nmodel = \"barkley\"\n[output]\nfield = \"u\"\n", "4:9", "A, B"},
+        BadScene{"rd_missing_model", "[rd]\nintegrator = \"kim-lin\"\n", "1:1", "needs rd.model"}),
     [](const ::testing::TestParamInfo<BadScene>& i) { return i.param.name; });
 
 TEST(Cli, MissingFileAndBadOverrideExitTwo) {
@@ -176,5 +184,41 @@ TEST(Cli, MutatedScenesNeverCrash) {
     CommandResult r = runMorphoflow("run " + p.string() + " --quiet --out " + (dir / "o").string());
     EXPECT_TRUE(r.status == 0 || r.status == 2) << "exit " << r.status << " for:\n" << s << "\n" << r.output;
   }
+  fs::remove_all(dir);
+}
+
+// A reaction-diffusion-only scene runs, writes frames of the chosen species
+// and reports its solvers in run.json.
+TEST(Cli, ReactionDiffusionSceneRuns) {
+  auto dir = tempDir("rd");
+  fs::path p = writeScene(dir, "gs.toml", R"(
+[grid]
+resolution = [32, 32]
+[time]
+dt = 1.0
+steps = 20
+[rd]
+model = "gray-scott"
+diffusion = [0.2, 0.1]
+[rd.initial]
+square = 0.25
+square_values = [0.5, 0.25]
+noise = 0.01
+[output]
+every = 10
+field = "v"
+)");
+  CommandResult r = runMorphoflow("run " + p.string() + " --quiet --out " + (dir / "out").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(fs::exists(dir / "out" / "frames" / "000002.png"));
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(dir / "out" / "run.json"));
+  EXPECT_EQ(j["resolved"]["model"], "gray-scott");
+  EXPECT_EQ(j["solvers"]["newton_failures"].get<int>(), 0);
+  EXPECT_EQ(j["steps"].get<int>(), 20);
+  EXPECT_DOUBLE_EQ(j["resolved"]["cell_size"].get<double>(), 1.0);  // rd scenes default to unit cells
+  CommandResult list = runMorphoflow("list models");
+  EXPECT_EQ(list.status, 0);
+  for (const char* m : {"gray-scott", "brusselator", "oregonator-3layer", "meinhardt-lateral"})
+    EXPECT_NE(list.output.find(m), std::string::npos) << m;
   fs::remove_all(dir);
 }
