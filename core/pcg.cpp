@@ -22,18 +22,30 @@ SolverResult solvePCG(const LaplaceSystem<D>& A, const Vector& bIn, Vector* xp, 
     A.removeNullSpace(&ws.b);
     bp = &ws.b;
   }
-  const Vector& b = *bp;
-  const double bnorm = norm2(b);
-  if (bnorm == 0.0) {
+  const double bnorm0 = norm2(*bp);
+  if (bnorm0 == 0.0) {
     std::fill(x.begin(), x.end(), 0.0);
     result.converged = true;
     return result;
   }
+  // A tiny right-hand side (a decaying species near 1e-150) would underflow
+  // the inner products: solve for x / |b| instead and scale back.
+  const double unit = bnorm0 < 1e-100 || bnorm0 > 1e100 ? 1.0 / bnorm0 : 1.0;
+  if (unit != 1.0) {
+    if (bp != &ws.b) ws.b = *bp;
+    for (double& v : ws.b) v *= unit;
+    for (double& v : x) v *= unit;
+    bp = &ws.b;
+  }
+  const Vector& b = *bp;
+  const double bnorm = norm2(b);
   Vector &r = ws.r, &z = ws.z, &p = ws.p, &q = ws.q;
   double rnorm = A.residual(b, x, &r);
   result.residual = rnorm / bnorm;
   if (result.residual <= opt.tolerance) {
     result.converged = true;
+    if (unit != 1.0)
+      for (double& v : x) v /= unit;
     return result;
   }
   auto precondition = [&] {
@@ -69,6 +81,8 @@ SolverResult solvePCG(const LaplaceSystem<D>& A, const Vector& bIn, Vector* xp, 
   // Report the true residual, not the recursively updated one.
   result.residual = A.residual(b, x, &r) / bnorm;
   if (A.singular()) A.removeNullSpace(&x);
+  if (unit != 1.0)
+    for (double& v : x) v /= unit;
   result.converged = result.residual <= opt.tolerance * 1.0001;
   return result;
 }
