@@ -196,3 +196,22 @@ TEST(LinearSolvers, ResultsIndependentOfThreadCount) {
   }
   EXPECT_EQ(x1, x2);
 }
+
+// A right-hand side near 1e-160 (a decaying species) must not underflow the
+// inner products: the solution scales with b.
+TEST(LinearSolvers, TinyRightHandSideSolvesToScale) {
+  IVec<2> dims(32, 32);
+  LaplaceSystem<2> A = makeNeumannLaplacian<2>(dims, {true, true}, 1.0 / 32);
+  for (size_t i = 0; i < A.size(); ++i) A.c[i] = 1.0f;
+  A.finalize();
+  Vector b(A.size()), big(A.size()), x(A.size(), 0.0), xt(A.size(), 0.0);
+  for (size_t i = 0; i < b.size(); ++i) {
+    big[i] = std::sin(0.3 * double(i));
+    b[i] = 1e-160 * big[i];
+  }
+  SolverOptions o{1e-10, 500};
+  SolverResult r1 = solvePCG<2>(A, big, &x, nullptr, o);
+  SolverResult r2 = solvePCG<2>(A, b, &xt, nullptr, o);
+  ASSERT_TRUE(r1.converged && r2.converged) << r2.residual;
+  for (size_t i = 0; i < x.size(); ++i) EXPECT_NEAR(xt[i] * 1e160, x[i], 1e-8 * std::abs(x[i]) + 1e-12);
+}
