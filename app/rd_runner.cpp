@@ -11,14 +11,13 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "app/frame_writer.h"
 #include "app/output_files.h"
 #include "app/version.h"
 #include "core/parallel.h"
 #include "core/random.h"
 #include "rd/model_registry.h"
 #include "rd/rd_solver.h"
-#include "render/field_image.h"
-#include "render/image_io.h"
 
 namespace fs = std::filesystem;
 
@@ -67,11 +66,10 @@ int run(const Scene& scene, const RunOptions& opt) {
   initialise<D>(scene, &rd);
   const fs::path out(opt.out);
   fs::create_directories(out);
-  if (scene.output.images) fs::create_directories(out / "frames");
+  FrameWriter frames(out, scene.output, opt);
   const std::vector<std::string>& names = model.info().species;
   const int shown = int(std::find(names.begin(), names.end(), scene.output.field) - names.begin());
   const long steps = scene.totalSteps();
-  int framesWritten = 0;
   auto checkFinite = [&](long step) {
     for (int s = 0; s < rd.species(); ++s)
       for (double v : rd.field(s).values())
@@ -81,25 +79,13 @@ int run(const Scene& scene, const RunOptions& opt) {
                                                step, names[size_t(s)]));
   };
   auto writeFrame = [&](long step) {
-    if (!scene.output.images || step % scene.output.every != 0) return;
-    long frame = step / scene.output.every;
-    if (frame < opt.firstFrame || (opt.lastFrame >= 0 && frame > opt.lastFrame)) return;
+    long frame = frames.frameAt(step);
+    if (frame < 0) return;
     checkFinite(step);
     const Grid<double, D>& src = rd.field(shown);
     Grid<float, D> f(src.dims());
     for (size_t i = 0; i < f.size(); ++i) f[i] = float(src[i]);
-    FieldImageOptions io;
-    io.colormap = scene.output.colormap;
-    io.autoRange = scene.output.autoRange;
-    io.range[0] = scene.output.range[0];
-    io.range[1] = scene.output.range[1];
-    io.slice = scene.output.slice;
-    int w, h;
-    std::vector<uint8_t> rgb = fieldToRgb<D>(f, io, &w, &h);
-    std::string err;
-    fs::path file = out / "frames" / fmt::format("{:06d}.png", frame);
-    if (!writeRgb8(file.string(), w, h, rgb, &err)) throw std::runtime_error("writing " + file.string() + ": " + err);
-    ++framesWritten;
+    frames.write<D>(frame, f, false);
   };
   const auto wall0 = std::chrono::steady_clock::now();
   NewtonStats newton;
@@ -140,7 +126,7 @@ int run(const Scene& scene, const RunOptions& opt) {
   j["threads"] = opt.threads > 0 ? opt.threads : hardwareThreads();
   j["steps"] = step;
   j["time"] = rd.time();
-  j["frames_written"] = framesWritten;
+  j["frames_written"] = frames.written();
   j["wall_seconds"] = wall;
   j["solvers"] = {{"newton_cells", newton.cells},
                   {"newton_failures", newton.failures},
@@ -152,7 +138,7 @@ int run(const Scene& scene, const RunOptions& opt) {
   writeTextFile(out / "run.json", j.dump(2) + "\n");
   if (!opt.quiet)
     std::cerr << fmt::format("done: {} steps, t = {:.4g}, {:.2f} s wall, {} frames -> {}\n", step, rd.time(), wall,
-                             framesWritten, out.string());
+                             frames.written(), out.string());
   return 0;
 }
 

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "app/frame_writer.h"
 #include "app/output_files.h"
 #include "app/rd_runner.h"
 #include "app/run_options.h"
@@ -19,8 +20,6 @@
 #include "core/parallel.h"
 #include "fluid/fluid_solver.h"
 #include "fluid/probes.h"
-#include "render/field_image.h"
-#include "render/image_io.h"
 #include "scenes/scene_loader.h"
 
 namespace fs = std::filesystem;
@@ -61,7 +60,6 @@ template <int D>
 int run(const Scene& scene, const RunOptions& opt) {
   const fs::path out(opt.out);
   fs::create_directories(out);
-  if (scene.output.images) fs::create_directories(out / "frames");
 
   FluidSolver<D> fluid(scene.fluid);
   initialiseDye<D>(scene, &fluid);
@@ -85,26 +83,11 @@ int run(const Scene& scene, const RunOptions& opt) {
     for (bool hi : {false, true})
       if (scene.fluid.boundaries.side(a, hi).kind == BoundaryKind::Inflow) flowAxis = a;
   const int liftAxis = flowAxis == 1 ? 0 : 1;
-  int framesWritten = 0;
-
+  FrameWriter frames(out, scene.output, opt);
   auto writeFrame = [&](long step) {
-    if (!scene.output.images || step % scene.output.every != 0) return;
-    long frame = step / scene.output.every;
-    if (frame < opt.firstFrame || (opt.lastFrame >= 0 && frame > opt.lastFrame)) return;
-    Grid<float, D> field = outputField<D>(scene.output.field, fluid);
-    FieldImageOptions io;
-    io.colormap = scene.output.colormap;
-    io.autoRange = scene.output.autoRange;
-    io.symmetric = scene.output.field == "vorticity" && D == 2;
-    io.range[0] = scene.output.range[0];
-    io.range[1] = scene.output.range[1];
-    io.slice = scene.output.slice;
-    int w, h;
-    std::vector<uint8_t> rgb = fieldToRgb<D>(field, io, &w, &h);
-    std::string err;
-    fs::path file = out / "frames" / fmt::format("{:06d}.png", frame);
-    if (!writeRgb8(file.string(), w, h, rgb, &err)) throw std::runtime_error("writing " + file.string() + ": " + err);
-    ++framesWritten;
+    long frame = frames.frameAt(step);
+    if (frame >= 0)
+      frames.write<D>(frame, outputField<D>(scene.output.field, fluid), scene.output.field == "vorticity" && D == 2);
   };
 
   writeFrame(0);
@@ -165,7 +148,7 @@ int run(const Scene& scene, const RunOptions& opt) {
   j["threads"] = opt.threads > 0 ? opt.threads : hardwareThreads();
   j["steps"] = step;
   j["time"] = fluid.time();
-  j["frames_written"] = framesWritten;
+  j["frames_written"] = frames.written();
   j["wall_seconds"] = wall;
   nlohmann::json stages;
   for (int k = 0; k < FluidStepStats::kStages; ++k)
@@ -207,7 +190,7 @@ int run(const Scene& scene, const RunOptions& opt) {
   writeTextFile(out / "run.json", j.dump(2) + "\n");
   if (!opt.quiet)
     std::cerr << fmt::format("done: {} steps, t = {:.4f}, {:.2f} s wall, {} frames -> {}\n", step, fluid.time(), wall,
-                             framesWritten, out.string());
+                             frames.written(), out.string());
   return 0;
 }
 

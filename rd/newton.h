@@ -120,20 +120,15 @@ NewtonResult newtonImplicit(int n, const double* x0, double dt, double* x, Rates
   int total = r.iterations;
   // Continuation: solve for tau dt with tau doubling towards 1.
   for (int s = 0; s < n; ++s) x[s] = start[s];
-  bool ok = true;
   for (double tau : {1.0 / 64, 1.0 / 16, 1.0 / 4, 0.5, 0.75, 1.0}) {
     NewtonResult c = newtonFrom<N>(n, x0, tau * dt, x, rates, jacobian, fixed, maxIterations);
     total += c.iterations;
-    if (!c.converged) {
-      ok = false;
-      break;
-    }
+    if (!c.converged) break;
     if (tau == 1.0) {
       c.iterations = total;
       return c;
     }
   }
-  (void)ok;
   // Deterministic restarts around x0: a Halton set of offsets in
   // (-1, 1) (1 + |x0|) per species.
   static constexpr int kPrimes[8] = {2, 3, 5, 7, 11, 13, 17, 19};
@@ -172,8 +167,6 @@ NewtonResult implicitReactionCell(int n, const double* x0, double dt, double* x,
   for (int s = 0; s < n; ++s)
     if (((clamped >> s) & 1u) && (!r.converged ? true : x[s] < 0.0)) active |= 1u << s;
   if (!active) return r;
-  double keep[N];
-  for (int s = 0; s < n; ++s) keep[s] = x[s];
   for (int s = 0; s < n; ++s)
     if ((active >> s) & 1u) x[s] = 0.0;
   NewtonResult c = newtonImplicit<N>(n, x0, dt, x, rates, jacobian, active);
@@ -203,7 +196,6 @@ NewtonResult implicitReactionCell(int n, const double* x0, double dt, double* x,
       return f;
     }
   }
-  (void)keep;
   c.iterations += r.iterations;
   return c;
 }

@@ -219,54 +219,29 @@ void RDSolver<D>::step(double dt) {
   stats_ = RDStepStats{};
   stats_.diffusion.converged = true;
   const size_t cells = laplacian_.size();
-  auto projectAll = [&] {
-    if (model_.info().clamped.empty()) return;
-    for (int s : model_.info().clamped) {
-      Grid<double, D>& g = x_[size_t(s)];
-      parallelFor(cells, [&](size_t i) { g[i] = std::max(g[i], 0.0); }, kChunk);
-    }
-  };
-  switch (settings_.integrator) {
-    case RDIntegrator::ExplicitEuler:
-      react(dt, false);
-      for (int s = 0; s < n; ++s) {
-        Vector& x = x_[size_t(s)].values();
-        applyLaplacian(s, x, &scratch_[size_t(s)]);
-        const Vector &L = scratch_[size_t(s)], &R = rates_[size_t(s)];
-        const double d = d_[size_t(s)];
-        parallelFor(cells, [&](size_t i) { x[i] += dt * (R[i] + d * L[i]); }, kChunk);
-      }
-      projectAll();
-      break;
-    case RDIntegrator::SemiImplicit:
-      react(dt, false);
-      for (int s = 0; s < n; ++s) {
-        Vector& x = x_[size_t(s)].values();
-        const Vector& R = rates_[size_t(s)];
-        parallelFor(cells, [&](size_t i) { x[i] += dt * R[i]; }, kChunk);
-        solveDiffusion(s, dt, &x);
-      }
-      projectAll();
-      break;
-    case RDIntegrator::KimLin:
-      react(dt, true);  // projects per cell
-      for (int s = 0; s < n; ++s) solveDiffusion(s, dt, &x_[size_t(s)].values());
-      projectAll();
-      break;
-    case RDIntegrator::CrankNicolson:
-      react(dt, false);
-      for (int s = 0; s < n; ++s) {
-        Vector& x = x_[size_t(s)].values();
-        applyLaplacian(s, x, &scratch_[size_t(s)]);
-        const Vector &L = scratch_[size_t(s)], &R = rates_[size_t(s)];
-        const double d = d_[size_t(s)];
-        // The explicit half carries its own boundary term inside L; the
-        // implicit half adds the other through solveDiffusion.
-        parallelFor(cells, [&](size_t i) { x[i] += dt * R[i] + 0.5 * dt * d * L[i]; }, kChunk);
-        solveDiffusion(s, 0.5 * dt, &x);
-      }
-      projectAll();
-      break;
+  // Every integrator is a theta scheme on the diffusion,
+  //   (1 - theta dt d lap) x' = x + dt R + (1 - theta) dt d lap x,
+  // with R = R(x) lagged, or for Kim & Lin the implicit reaction step first.
+  const RDIntegrator integ = settings_.integrator;
+  const bool implicitReaction = integ == RDIntegrator::KimLin;
+  const double theta = integ == RDIntegrator::ExplicitEuler ? 0.0 : integ == RDIntegrator::CrankNicolson ? 0.5 : 1.0;
+  react(dt, implicitReaction);  // Kim & Lin: updates x in place (projected per cell)
+  for (int s = 0; s < n; ++s) {
+    Vector& x = x_[size_t(s)].values();
+    const Vector &L = scratch_[size_t(s)], &R = rates_[size_t(s)];
+    const double explicitD = (1.0 - theta) * dt * d_[size_t(s)];
+    // The explicit part carries its Dirichlet term inside L; the implicit
+    // part adds its own through solveDiffusion.
+    if (explicitD > 0) applyLaplacian(s, x, &scratch_[size_t(s)]);
+    if (!implicitReaction && explicitD > 0)
+      parallelFor(cells, [&](size_t i) { x[i] += dt * R[i] + explicitD * L[i]; }, kChunk);
+    else if (!implicitReaction)
+      parallelFor(cells, [&](size_t i) { x[i] += dt * R[i]; }, kChunk);
+    solveDiffusion(s, theta * dt, &x);
+  }
+  for (int s : model_.info().clamped) {
+    Grid<double, D>& g = x_[size_t(s)];
+    parallelFor(cells, [&](size_t i) { g[i] = std::max(g[i], 0.0); }, kChunk);
   }
   holdFixed();
   time_ += dt;
