@@ -161,12 +161,19 @@ int main(int argc, char** argv) {
     }
     if (*listCmd) {
       if (what == "palettes") {
-        for (const auto& n : colormapNames()) std::cout << n << "\n";
+        for (const auto& n : colormapNames())
+          std::cout << n << (n == kTwoSpeciesPalette ? "  (two species: the first in red, the second in green; seed 002)" : "")
+                    << "\n";
+        std::cout << "custom: output.gradient = [\"#rrggbb\", ...] (two or more stops, evenly spaced)\n";
       } else if (what == "scenes") {
         for (const auto& p : shippedScenes()) {
           Scene sc = loadScene(p.string());
-          std::cout << fmt::format("{:<48} {}D  Re = {:<8.4g} grid {}\n", p.string(), sc.dimension, sc.reynolds,
-                                   fmt::join(sc.fluid.resolution, "x"));
+          if (sc.hasFluid)
+            std::cout << fmt::format("{:<48} {}D  Re = {:<8.4g} grid {}\n", p.string(), sc.dimension, sc.reynolds,
+                                     fmt::join(sc.fluid.resolution, "x"));
+          else
+            std::cout << fmt::format("{:<48} {}D  rd {:<19} grid {}\n", p.string(), sc.dimension, sc.rd.settings.model,
+                                     fmt::join(sc.rd.settings.resolution, "x"));
         }
       } else {
         for (const ReactionModel* m : allModels()) std::cout << describeModel(*m) << "\n";

@@ -15,8 +15,10 @@
 #include "app/output_files.h"
 #include "app/version.h"
 #include "core/parallel.h"
+#include "core/spatial_field.h"
 #include "core/random.h"
 #include "rd/model_registry.h"
+#include "render/colormap.h"
 #include "rd/rd_solver.h"
 
 namespace fs = std::filesystem;
@@ -31,13 +33,22 @@ double gaussian(uint64_t seed, uint64_t stream, uint64_t i) {
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
 }
 
+// A scene field at every cell (the loader has checked it is finite everywhere).
+template <int D>
+std::vector<double> sampleSceneField(const SceneField& f, const IVec<D>& cells) {
+  return sampleSpatialField<D>(f.field, cells);
+}
+
 template <int D>
 void initialise(const Scene& scene, RDSolver<D>* rd) {
   const RDInitial& I = scene.rd.initial;
   const IVec<D> n = rd->cells();
   const uint64_t seed = scene.seed;
+  std::vector<std::vector<double>> maps(size_t(rd->species()));
+  for (const auto& [s, f] : scene.rd.initialMaps) maps[size_t(s)] = sampleSceneField<D>(f, n);
   for (int s = 0; s < rd->species(); ++s) {
     Grid<double, D>& g = rd->field(s);
+    const std::vector<double>& map = maps[size_t(s)];
     forEachCell<D>(n, [&](const IVec<D>& k, size_t i) {
       double v = I.values[size_t(s)];
       if (I.randomRange) v = I.range[0] + (I.range[1] - I.range[0]) * uniform01(seed, 100 + uint64_t(s), i);
@@ -46,16 +57,38 @@ void initialise(const Scene& scene, RDSolver<D>* rd) {
         for (int a = 0; a < D; ++a) inside &= std::abs((k[a] + 0.5) / n[a] - 0.5) < 0.5 * I.square;
         if (inside) v = I.squareValues[size_t(s)];
       }
+      if (!map.empty()) v = map[i];
       v += I.noise[size_t(s)] * (2.0 * uniform01(seed, uint64_t(s), i) - 1.0);
       g[i] = v;
     });
   }
-  // Gaussian perturbation of parameters by a percentage (seed 004 sec. 3.1).
+  // Parameter maps, then a Gaussian perturbation by a percentage on top (seed 004 sec. 3.1).
+  const size_t cells = rd->field(0).size();
+  std::vector<std::vector<double>> params(rd->model().info().parameters.size());
+  for (const auto& [k, f] : scene.rd.parameterMaps) params[size_t(k)] = sampleSceneField<D>(f, n);
   for (auto [k, percent] : scene.rd.perturb) {
-    std::vector<double> f(rd->field(0).size());
-    const double base = rd->parameter(k);
-    for (size_t i = 0; i < f.size(); ++i) f[i] = base * (1.0 + 0.01 * percent * gaussian(seed, 200 + uint64_t(k), i));
-    rd->setParameterField(k, std::move(f));
+    std::vector<double>& f = params[size_t(k)];
+    if (f.empty()) f.assign(cells, rd->parameter(k));
+    for (size_t i = 0; i < cells; ++i) f[i] *= 1.0 + 0.01 * percent * gaussian(seed, 200 + uint64_t(k), i);
+  }
+  for (size_t k = 0; k < params.size(); ++k)
+    if (!params[k].empty()) rd->setParameterField(int(k), std::move(params[k]));
+  // Fixed regions: held at their values from the start (seed 004 fig. 20).
+  if (!scene.rd.fixed.empty()) {
+    std::vector<uint8_t> mask(cells, 0);
+    std::vector<std::vector<double>> values(size_t(rd->species()), std::vector<double>(cells, 0.0));
+    for (const RDFixedRegion& fr : scene.rd.fixed) {
+      const std::vector<double> inside = sampleSceneField<D>(fr.where, n);
+      for (size_t i = 0; i < cells; ++i)
+        if (inside[i] != 0.0) {
+          mask[i] = 1;
+          for (int s = 0; s < rd->species(); ++s) values[size_t(s)][i] = fr.values[size_t(s)];
+        }
+    }
+    for (int s = 0; s < rd->species(); ++s)
+      for (size_t i = 0; i < cells; ++i)
+        if (mask[i]) rd->field(s)[i] = values[size_t(s)][i];
+    rd->setFixedCells(std::move(mask), std::move(values));
   }
 }
 
@@ -78,14 +111,28 @@ int run(const Scene& scene, const RunOptions& opt) {
                                                "use the kim-lin integrator or a smaller time.dt",
                                                step, names[size_t(s)]));
   };
+  const bool twoSpecies = scene.output.colormap == kTwoSpeciesPalette;
+  auto asFloat = [&](int s) {
+    const Grid<double, D>& src = rd.field(s);
+    Grid<float, D> f(src.dims());
+    for (size_t i = 0; i < f.size(); ++i) f[i] = float(src[i]);
+    return f;
+  };
   auto writeFrame = [&](long step) {
     long frame = frames.frameAt(step);
     if (frame < 0) return;
     checkFinite(step);
-    const Grid<double, D>& src = rd.field(shown);
-    Grid<float, D> f(src.dims());
-    for (size_t i = 0; i < f.size(); ++i) f[i] = float(src[i]);
-    frames.write<D>(frame, f, false);
+    if (twoSpecies) {
+      const Grid<float, D> green = asFloat(1);
+      frames.write<D>(frame, asFloat(0), false, &green);
+    } else {
+      frames.write<D>(frame, asFloat(shown), false);
+    }
+    if (scene.output.fields) {
+      std::vector<Grid<float, D>> all;
+      for (int s = 0; s < rd.species(); ++s) all.push_back(asFloat(s));
+      frames.writeFields<D>(frame, names, all, rd.time(), step);
+    }
   };
   const auto wall0 = std::chrono::steady_clock::now();
   NewtonStats newton;
@@ -127,6 +174,7 @@ int run(const Scene& scene, const RunOptions& opt) {
   j["steps"] = step;
   j["time"] = rd.time();
   j["frames_written"] = frames.written();
+  j["fields_written"] = frames.fieldsWritten();
   j["wall_seconds"] = wall;
   j["solvers"] = {{"newton_cells", newton.cells},
                   {"newton_failures", newton.failures},

@@ -86,8 +86,14 @@ int run(const Scene& scene, const RunOptions& opt) {
   FrameWriter frames(out, scene.output, opt);
   auto writeFrame = [&](long step) {
     long frame = frames.frameAt(step);
-    if (frame >= 0)
-      frames.write<D>(frame, outputField<D>(scene.output.field, fluid), scene.output.field == "vorticity" && D == 2);
+    if (frame < 0) return;
+    frames.write<D>(frame, outputField<D>(scene.output.field, fluid), scene.output.field == "vorticity" && D == 2);
+    if (scene.output.fields) {
+      static const std::vector<std::string> names = {"speed", "vorticity", "pressure", "dye"};
+      std::vector<Grid<float, D>> all;
+      for (const std::string& n : names) all.push_back(outputField<D>(n, fluid));
+      frames.writeFields<D>(frame, names, all, fluid.time(), step);
+    }
   };
 
   writeFrame(0);
@@ -149,6 +155,7 @@ int run(const Scene& scene, const RunOptions& opt) {
   j["steps"] = step;
   j["time"] = fluid.time();
   j["frames_written"] = frames.written();
+  j["fields_written"] = frames.fieldsWritten();
   j["wall_seconds"] = wall;
   nlohmann::json stages;
   for (int k = 0; k < FluidStepStats::kStages; ++k)

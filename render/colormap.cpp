@@ -1,16 +1,15 @@
 #include "render/colormap.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <map>
 
 namespace morphoflow {
 
 namespace {
-using Stops = std::vector<std::array<uint8_t, 3>>;
-
-const std::map<std::string, Stops>& maps() {
-  static const std::map<std::string, Stops> m = {
+const std::map<std::string, std::vector<Rgb8>>& maps() {
+  static const std::map<std::string, std::vector<Rgb8>> m = {
       {"viridis", {{68, 1, 84}, {71, 45, 123}, {59, 82, 139}, {44, 114, 142}, {33, 145, 140},
                    {40, 174, 128}, {94, 201, 98}, {173, 220, 48}, {253, 231, 37}}},
       {"magma", {{0, 0, 4}, {28, 16, 68}, {79, 18, 123}, {129, 37, 129}, {181, 54, 122},
@@ -25,25 +24,37 @@ const std::map<std::string, Stops>& maps() {
 }
 }  // namespace
 
-std::vector<std::string> colormapNames() {
-  std::vector<std::string> names;
-  for (const auto& [k, v] : maps()) names.push_back(k);
-  return names;
-}
-
-bool hasColormap(const std::string& name) { return maps().count(name) > 0; }
-
-std::array<uint8_t, 3> colormap(const std::string& name, double t) {
-  auto it = maps().find(name);
-  const Stops& s = it != maps().end() ? it->second : maps().at("grayscale");
+Rgb8 Palette::operator()(double t) const {
+  const std::vector<Rgb8>& s = stops;
   if (!std::isfinite(t)) t = 0.0;
   t = std::clamp(t, 0.0, 1.0) * double(s.size() - 1);
   size_t i = std::min(size_t(t), s.size() - 2);
   double f = t - double(i);
-  std::array<uint8_t, 3> c;
-  for (int k = 0; k < 3; ++k)
-    c[size_t(k)] = uint8_t(std::lround(s[i][size_t(k)] + f * (s[i + 1][size_t(k)] - s[i][size_t(k)])));
+  Rgb8 c;
+  for (size_t k = 0; k < 3; ++k) c[k] = uint8_t(std::lround(s[i][k] + f * (s[i + 1][k] - s[i][k])));
   return c;
+}
+
+std::vector<std::string> colormapNames() {
+  std::vector<std::string> names;
+  for (const auto& [k, v] : maps()) names.push_back(k);
+  names.push_back(kTwoSpeciesPalette);
+  return names;
+}
+
+bool hasColormap(const std::string& name) { return maps().count(name) > 0 || name == kTwoSpeciesPalette; }
+
+Palette namedPalette(const std::string& name) {
+  auto it = maps().find(name);
+  return Palette{it != maps().end() ? it->second : maps().at("grayscale")};
+}
+
+bool parseHexColour(const std::string& text, Rgb8* colour) {
+  std::string h = !text.empty() && text[0] == '#' ? text.substr(1) : text;
+  if (h.size() != 6 || !std::all_of(h.begin(), h.end(), [](unsigned char c) { return std::isxdigit(c); }))
+    return false;
+  for (size_t k = 0; k < 3; ++k) (*colour)[k] = uint8_t(std::stoi(h.substr(2 * k, 2), nullptr, 16));
+  return true;
 }
 
 }  // namespace morphoflow

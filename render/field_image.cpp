@@ -4,53 +4,88 @@
 #include <cmath>
 
 #include "core/parallel.h"
-#include "render/colormap.h"
 
 namespace morphoflow {
+
+namespace {
+
+// First cell of the shown slice (0 in 2D).
+template <int D>
+size_t sliceOffset(const Grid<float, D>& f, int slice) {
+  if constexpr (D == 3) {
+    int z = slice >= 0 ? std::min(slice, f.dim(2) - 1) : f.dim(2) / 2;
+    return size_t(z) * size_t(f.dim(0)) * size_t(f.dim(1));
+  }
+  return 0;
+}
+
+// The value range mapped to [0, 1]: fixed, or the finite min..max of the slice.
+std::array<double, 2> valueRange(const float* v, size_t n, const FieldImageOptions& o) {
+  if (!o.autoRange) return {o.range[0], o.range[1]};
+  double lo = 1e300, hi = -1e300;
+  for (size_t i = 0; i < n; ++i) {
+    if (!std::isfinite(v[i])) continue;
+    lo = std::min(lo, double(v[i]));
+    hi = std::max(hi, double(v[i]));
+  }
+  if (o.symmetric) {
+    double m = std::max(std::abs(lo), std::abs(hi));
+    lo = -m;
+    hi = m;
+  }
+  if (!(hi > lo)) {
+    lo = lo > 1e299 ? 0.0 : lo;
+    hi = lo + 1.0;
+  }
+  return {lo, hi};
+}
+
+// Fills RGB rows top to bottom (y up) with colour(cell index).
+template <typename Colour>
+std::vector<uint8_t> paint(int nx, int ny, size_t offset, Colour colour) {
+  std::vector<uint8_t> rgb(size_t(nx) * size_t(ny) * 3);
+  parallelFor(size_t(ny), [&](size_t row) {
+    size_t y = size_t(ny) - 1 - row;
+    for (size_t x = 0; x < size_t(nx); ++x) {
+      Rgb8 c = colour(offset + y * size_t(nx) + x);
+      std::copy(c.begin(), c.end(), &rgb[(row * size_t(nx) + x) * 3]);
+    }
+  });
+  return rgb;
+}
+
+}  // namespace
 
 template <int D>
 std::vector<uint8_t> fieldToRgb(const Grid<float, D>& f, const FieldImageOptions& o, int* width, int* height) {
   const int nx = f.dim(0), ny = f.dim(1);
-  size_t offset = 0;
-  if constexpr (D == 3) {
-    int z = o.slice >= 0 ? std::min(o.slice, f.dim(2) - 1) : f.dim(2) / 2;
-    offset = size_t(z) * size_t(nx) * size_t(ny);
-  }
-  const size_t n = size_t(nx) * size_t(ny);
-  double lo = o.range[0], hi = o.range[1];
-  if (o.autoRange) {
-    lo = 1e300;
-    hi = -1e300;
-    for (size_t i = 0; i < n; ++i) {
-      double v = f[offset + i];
-      if (!std::isfinite(v)) continue;
-      lo = std::min(lo, v);
-      hi = std::max(hi, v);
-    }
-    if (o.symmetric) {
-      double m = std::max(std::abs(lo), std::abs(hi));
-      lo = -m;
-      hi = m;
-    }
-    if (!(hi > lo)) {
-      lo = lo > 1e299 ? 0.0 : lo;
-      hi = lo + 1.0;
-    }
-  }
-  std::vector<uint8_t> rgb(n * 3);
-  parallelFor(size_t(ny), [&](size_t row) {
-    size_t y = size_t(ny) - 1 - row;  // y up
-    for (size_t x = 0; x < size_t(nx); ++x) {
-      auto c = colormap(o.colormap, (f[offset + y * size_t(nx) + x] - lo) / (hi - lo));
-      std::copy(c.begin(), c.end(), &rgb[(row * size_t(nx) + x) * 3]);
-    }
-  });
+  const size_t offset = sliceOffset(f, o.slice);
+  const auto [lo, hi] = valueRange(&f[offset], size_t(nx) * size_t(ny), o);
   *width = nx;
   *height = ny;
-  return rgb;
+  return paint(nx, ny, offset, [&](size_t i) { return o.palette((f[i] - lo) / (hi - lo)); });
+}
+
+template <int D>
+std::vector<uint8_t> twoFieldsToRgb(const Grid<float, D>& red, const Grid<float, D>& green,
+                                    const FieldImageOptions& o, int* width, int* height) {
+  const int nx = red.dim(0), ny = red.dim(1);
+  const size_t offset = sliceOffset(red, o.slice), n = size_t(nx) * size_t(ny);
+  const auto [rlo, rhi] = valueRange(&red[offset], n, o);
+  const auto [glo, ghi] = valueRange(&green[offset], n, o);
+  auto byte = [](double t) { return uint8_t(std::lround(255.0 * std::clamp(std::isfinite(t) ? t : 0.0, 0.0, 1.0))); };
+  *width = nx;
+  *height = ny;
+  return paint(nx, ny, offset, [&](size_t i) {
+    return Rgb8{byte((red[i] - rlo) / (rhi - rlo)), byte((green[i] - glo) / (ghi - glo)), 0};
+  });
 }
 
 template std::vector<uint8_t> fieldToRgb<2>(const Grid<float, 2>&, const FieldImageOptions&, int*, int*);
 template std::vector<uint8_t> fieldToRgb<3>(const Grid<float, 3>&, const FieldImageOptions&, int*, int*);
+template std::vector<uint8_t> twoFieldsToRgb<2>(const Grid<float, 2>&, const Grid<float, 2>&,
+                                                const FieldImageOptions&, int*, int*);
+template std::vector<uint8_t> twoFieldsToRgb<3>(const Grid<float, 3>&, const Grid<float, 3>&,
+                                                const FieldImageOptions&, int*, int*);
 
 }  // namespace morphoflow

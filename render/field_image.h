@@ -1,5 +1,5 @@
-// Turns a 2D scalar field (or a z slice of a 3D one) into colormapped RGB,
-// y up (the image's top row is the field's last row).
+// Turns a 2D scalar field (or a z slice of a 3D one) into RGB through a
+// palette, y up (the image's top row is the field's last row).
 #pragma once
 
 #include <array>
@@ -7,11 +7,12 @@
 #include <vector>
 
 #include "core/grid.h"
+#include "render/colormap.h"
 
 namespace morphoflow {
 
 struct FieldImageOptions {
-  std::string colormap = "viridis";
+  Palette palette = namedPalette("viridis");
   bool autoRange = true;   // min..max, or symmetric -m..m when `symmetric`
   bool symmetric = false;
   double range[2] = {0.0, 1.0};
@@ -21,5 +22,11 @@ struct FieldImageOptions {
 template <int D>
 std::vector<uint8_t> fieldToRgb(const Grid<float, D>& field, const FieldImageOptions& options, int* width,
                                 int* height);
+
+// Seed 002's view of two species: `red` in the red channel and `green` in the
+// green one, each scaled to its own range (automatic, or options.range for both).
+template <int D>
+std::vector<uint8_t> twoFieldsToRgb(const Grid<float, D>& red, const Grid<float, D>& green,
+                                    const FieldImageOptions& options, int* width, int* height);
 
 }  // namespace morphoflow

@@ -4,6 +4,8 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include "render/atomic_image_write.h"
+
 namespace morphoflow {
 
 bool readGrayImage(const std::string& path, GrayImage* image, std::string* error) {
@@ -38,8 +40,8 @@ bool readGrayImage(const std::string& path, GrayImage* image, std::string* error
   return true;
 }
 
-bool writeRgb8(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb,
-               std::string* error) {
+bool writeImageAtomically(const std::string& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc type,
+                          const void* pixels, std::string* error) {
   std::filesystem::path final(path);
   std::filesystem::path tmp = final;
   tmp += ".tmp" + final.extension().string();
@@ -48,8 +50,7 @@ bool writeRgb8(const std::string& path, int width, int height, const std::vector
     *error = "no image writer for " + path + ": " + OIIO::geterror();
     return false;
   }
-  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
-  if (!out->open(tmp.string(), spec) || !out->write_image(OIIO::TypeDesc::UINT8, rgb.data()) || !out->close()) {
+  if (!out->open(tmp.string(), spec) || !out->write_image(type, pixels) || !out->close()) {
     *error = out->geterror();
     std::error_code ec;
     std::filesystem::remove(tmp, ec);
@@ -62,6 +63,19 @@ bool writeRgb8(const std::string& path, int width, int height, const std::vector
     return false;
   }
   return true;
+}
+
+bool writeRgb8(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb,
+               std::string* error) {
+  // EXR frames store the palette colours as half floats in [0, 1]; other formats as 8 bits.
+  if (std::filesystem::path(path).extension() == ".exr") {
+    std::vector<float> f(rgb.size());
+    for (size_t i = 0; i < rgb.size(); ++i) f[i] = float(rgb[i]) / 255.0f;
+    OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::HALF);
+    return writeImageAtomically(path, spec, OIIO::TypeDesc::FLOAT, f.data(), error);
+  }
+  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
+  return writeImageAtomically(path, spec, OIIO::TypeDesc::UINT8, rgb.data(), error);
 }
 
 }  // namespace morphoflow

@@ -15,7 +15,8 @@ struct GrayImage {
 // Reads any image OpenImageIO knows (PNG, EXR, TIFF, ...). False + message on failure.
 bool readGrayImage(const std::string& path, GrayImage* image, std::string* error);
 
-// Writes 8-bit RGB (row-major, top row first). The file is written to a
+// Writes 8-bit RGB (row-major, top row first): 8-bit files (PNG), or half-float
+// RGB in [0, 1] when the path ends in .exr. The file is written to a
 // temporary name and renamed, so a crash never leaves a half-written frame.
 bool writeRgb8(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb,
                std::string* error);

@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "core/error.h"
+#include "core/spatial_field.h"
 #include "fluid/fluid_settings.h"
 #include "rd/rd_settings.h"
 
@@ -26,7 +28,9 @@ struct OutputSettings {
   bool vdb = false;
   bool video = false;
   std::string field = "vorticity"; // speed | vorticity | dye | pressure
-  std::string colormap = "coolwarm";
+  std::string colormap = "coolwarm"; // a named palette, or "red-green" (two species)
+  std::vector<std::array<uint8_t, 3>> gradient;  // custom palette stops (overrides colormap)
+  std::string format = "png";      // image frames: png | exr
   bool autoRange = true;
   double range[2] = {0.0, 1.0};
   int slice = -1;                  // 3D: z slice for images (-1 = middle)
@@ -56,11 +60,27 @@ struct RDInitial {
   std::vector<double> squareValues;  // species values inside it
 };
 
+// A spatial field from the scene file, with where it was written (for errors at run time).
+struct SceneField {
+  SpatialField field;
+  SourceLocation where;
+  std::string key;
+};
+
+// Cells held at fixed species values for the whole run (seed 004 fig. 20).
+struct RDFixedRegion {
+  SceneField where;                  // nonzero inside the region
+  std::vector<double> values;        // one per species
+};
+
 struct RDScene {
   bool enabled = false;
   RDSettings settings;
   RDInitial initial;
+  std::vector<std::pair<int, SceneField>> initialMaps;  // species index -> its initial field
+  std::vector<std::pair<int, SceneField>> parameterMaps;  // parameter index -> its field ([rd.maps])
   std::vector<std::pair<int, double>> perturb;  // parameter index, Gaussian sigma in percent (seed 004 sec. 3.1)
+  std::vector<RDFixedRegion> fixed;
 };
 
 struct Scene {

@@ -177,6 +177,42 @@ class Reader {
     }
   }
 
+  // A spatial field: an expression string, or { image = "file", range = [lo, hi] }.
+  SceneField field(const toml::node* n, const std::string& full, const std::filesystem::path& sceneDir) {
+    SceneField f;
+    f.where = where(n, full);
+    f.key = full;
+    if (n->is_string() || n->is_number()) {
+      f.field.expression = n->is_string() ? n->value<std::string>().value() : std::to_string(n->value<double>().value());
+      try {
+        compileSpatialField(f.field.expression);
+      } catch (const ExpressionError& e) {
+        SourceLocation at = f.where;
+        if (at.line > 0 && n->is_string()) at.column += 1 + int(e.column());
+        throw UserError(at, full, std::string("in the expression: ") + e.what(),
+                        "see docs/scenes.md, Spatial fields");
+      }
+      return f;
+    }
+    const toml::table* t = n->as_table();
+    if (!t)
+      fail(n, full, "expected an expression string or a table { image = \"file\", range = [low, high] }, found " + describe(*n));
+    const toml::node* img = node(t, full + ".", "image");
+    if (!img) fail(n, full, "an image field needs image = \"path\"");
+    std::string file = string(t, full + ".", "image", "");
+    std::filesystem::path fp = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : sceneDir / file;
+    GrayImage g;
+    std::string err;
+    if (!readGrayImage(fp.string(), &g, &err)) fail(img, full + ".image", "cannot read the image: " + err);
+    f.field.imageWidth = g.width;
+    f.field.imageHeight = g.height;
+    f.field.image = std::move(g.pixels);
+    std::vector<double> range = numbers(t, full + ".", "range", {0.0, 1.0}, 2, 2, -1e12, 1e12);
+    f.field.range[0] = range[0];
+    f.field.range[1] = range[1];
+    return f;
+  }
+
   const std::string& file() const { return file_; }
   toml::table& root() { return root_; }
 
@@ -549,6 +585,49 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
     if (I.square > 0 && I.squareValues.empty())
       r.fail(r.node(it, "rd.initial.", "square"), "rd.initial.square_values", "a central square needs square_values, one per species",
              "species: " + join(species));
+    // [rd.initial.maps]: species -> spatial field, replacing its uniform value.
+    if (const toml::table* im = it ? r.table(*it, "rd.initial.", "maps") : nullptr) {
+      for (auto&& [k, v] : *im) {
+        const std::string name(k.str());
+        auto sp = std::find(species.begin(), species.end(), name);
+        if (sp == species.end())
+          r.fail(&v, "rd.initial.maps." + name, "not a species of " + model, "species: " + join(species));
+        r.node(im, "rd.initial.maps.", name);
+        R.initialMaps.push_back({int(sp - species.begin()), r.field(&v, "rd.initial.maps." + name, sceneDir)});
+      }
+    }
+    // [rd.maps]: parameter -> spatial field (gradients, radial/angular functions, images).
+    std::vector<std::string> pnames;
+    for (const ParameterInfo& p : in.parameters) pnames.push_back(p.name);
+    if (const toml::table* mp = r.table(*rdt, "rd.", "maps")) {
+      for (auto&& [k, v] : *mp) {
+        const std::string name(k.str());
+        auto pi = std::find(pnames.begin(), pnames.end(), name);
+        if (pi == pnames.end())
+          r.fail(&v, "rd.maps." + name, "not a parameter of " + model,
+                 "did you mean '" + nearest(name, pnames) + "'? parameters: " + join(pnames));
+        r.node(mp, "rd.maps.", name);
+        R.parameterMaps.push_back({int(pi - pnames.begin()), r.field(&v, "rd.maps." + name, sceneDir)});
+      }
+    }
+    // [[rd.fixed]]: regions held at fixed values (seed 004 fig. 20).
+    r.node(rdt, "rd.", "fixed");
+    if (const toml::node* fx = rdt->get("fixed")) {
+      const toml::array* arr = fx->as_array();
+      if (!arr || !arr->is_array_of_tables())
+        r.fail(fx, "rd.fixed", "expected [[rd.fixed]] tables with where = \"expression\" and values = [...]");
+      for (size_t q = 0; q < arr->size(); ++q) {
+        const toml::table* t = arr->get(q)->as_table();
+        const std::string p = "rd.fixed." + std::to_string(q) + ".";
+        const toml::node* w = r.node(t, p, "where");
+        if (!w) r.fail(t, p + "where", "a fixed region needs where = \"expression\" (nonzero inside), e.g. \"j == 0\"");
+        RDFixedRegion fr;
+        fr.where = r.field(w, p + "where", sceneDir);
+        if (!r.node(t, p, "values")) r.fail(t, p + "values", "a fixed region needs values, one per species", "species: " + join(species));
+        fr.values = r.numbers(t, p, "values", {}, n, n, -1e12, 1e12);
+        R.fixed.push_back(std::move(fr));
+      }
+    }
     // [rd.perturb]: Gaussian perturbation of parameters, sigma in percent.
     const toml::table* pp = r.table(*rdt, "rd.", "perturb");
     for (size_t k = 0; k < in.parameters.size(); ++k)
@@ -556,11 +635,37 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
         R.perturb.push_back({int(k), r.number(pp, "rd.perturb.", in.parameters[k].name, 0.0, 0, 100)});
   }
 
+  // Every spatial field is finite on the grid, and every fixed region holds a cell.
+  if (s.rd.enabled) {
+    auto check = [&](const SceneField& f, bool region) {
+      const std::vector<double> v = D == 2 ? sampleSpatialField<2>(f.field, IVec<2>(int(res[0]), int(res[1])))
+                                           : sampleSpatialField<3>(f.field, IVec<3>(int(res[0]), int(res[1]), int(res[2])));
+      size_t inside = 0;
+      for (size_t i = 0; i < v.size(); ++i) {
+        if (!std::isfinite(v[i])) {
+          std::ostringstream c;
+          c << "the field is not finite at cell (" << i % size_t(res[0]) << ", " << (i / size_t(res[0])) % size_t(res[1]);
+          if (D == 3) c << ", " << i / size_t(res[0] * res[1]);
+          throw UserError(f.where, f.key, c.str() + ")", "guard divisions and logarithms, e.g. 1 / max(r, 1e-6)");
+        }
+        inside += v[i] != 0.0;
+      }
+      if (region && inside == 0)
+        throw UserError(f.where, f.key, "no cell is inside this region",
+                        "the expression must be nonzero somewhere, e.g. \"j == 0\" for the first row");
+    };
+    for (const auto& [k, f] : s.rd.initialMaps) check(f, false);
+    for (const auto& [k, f] : s.rd.parameterMaps) check(f, false);
+    for (const RDFixedRegion& fr : s.rd.fixed) check(fr.where, true);
+  }
+
   // [output]
   const toml::table* out = r.table(root, "", "output");
   s.output.every = int(r.integer(out, "output.", "every", 10, 1, 1'000'000'000));
   s.output.images = r.boolean(out, "output.", "images", true);
-  for (const char* k : {"fields", "vdb", "video"}) {
+  s.output.fields = r.boolean(out, "output.", "fields", false);
+  s.output.format = r.string(out, "output.", "format", "png", {"png", "exr"});
+  for (const char* k : {"vdb", "video"}) {
     if (r.boolean(out, "output.", k, false))
       r.fail(r.node(out, "output.", k), std::string("output.") + k,
              "this build of morphoflow does not write " + std::string(k) + " yet", "set it to false");
@@ -571,6 +676,22 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
     s.output.field = r.string(out, "output.", "field", "vorticity", {"speed", "vorticity", "dye", "pressure"});
   s.output.colormap = r.string(out, "output.", "colormap", s.output.field == "vorticity" ? "coolwarm" : "viridis",
                                colormapNames());
+  if (s.output.colormap == kTwoSpeciesPalette && species.size() < 2)
+    r.fail(r.node(out, "output.", "colormap"), "output.colormap",
+           std::string(kTwoSpeciesPalette) + " shows two reaction-diffusion species (the first in red, the second in green)",
+           "use it with an [rd] model of two or more species, or pick a scalar palette");
+  if (const toml::node* g = r.node(out, "output.", "gradient")) {
+    const toml::array* arr = g->as_array();
+    if (!arr || arr->size() < 2)
+      r.fail(g, "output.gradient", "expected an array of two or more colours, e.g. [\"#000000\", \"#ff8800\", \"#ffffff\"]");
+    for (const toml::node& e : *arr) {
+      Rgb8 c;
+      auto text = e.value<std::string>();
+      if (!text || !parseHexColour(*text, &c))
+        r.fail(&e, "output.gradient", "expected a colour as \"#rrggbb\"", "e.g. \"#ff8800\" for orange");
+      s.output.gradient.push_back(c);
+    }
+  }
   const toml::node* rangeNode = nullptr;
   std::vector<double> range = r.numbers(out, "output.", "range", {}, 2, 2, -1e30, 1e30, false, &rangeNode);
   if (!range.empty()) {

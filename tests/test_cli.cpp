@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "render/field_dump.h"
 #include "test_support.h"
 
 using namespace morphoflow::testing;
@@ -85,7 +86,23 @@ INSTANTIATE_TEST_SUITE_P(
                  "did you mean 'rd.parameters.F'"},
         BadScene{"rd_bad_palette", "[rd]\nmodel = \"barkley\"\n[output]\ncolormap = \"jet\"\n", "4:12", "is not one of"},
         BadScene{"rd_bad_species", "[rd]\nmodel = \"barkley\"\n[output]\nfield = \"u\"\n", "4:9", "A, B"},
-        BadScene{"rd_missing_model", "[rd]\nintegrator = \"kim-lin\"\n", "1:1", "needs rd.model"}),
+        BadScene{"rd_missing_model", "[rd]\nintegrator = \"kim-lin\"\n", "1:1", "needs rd.model"},
+        BadScene{"rd_map_syntax", "[rd]\nmodel = \"turing-sanderson\"\n[rd.maps]\nbeta = \"16 - 0.5 * r /\"\n", "4:23",
+                 "expected a number, a name or '('"},
+        BadScene{"rd_map_unknown_name", "[rd]\nmodel = \"turing-sanderson\"\n[rd.maps]\nbeta = \"16 + rr\"\n", "4:14",
+                 "unknown name 'rr'"},
+        BadScene{"rd_map_unknown_parameter", "[rd]\nmodel = \"turing-sanderson\"\n[rd.maps]\nbetta = \"16\"\n", "4:9",
+                 "did you mean 'beta'"},
+        BadScene{"rd_map_not_finite", "[grid]\nresolution = [8, 8]\n[rd]\nmodel = \"turing-sanderson\"\n[rd.maps]\nbeta = \"1 / (i - 3)\"\n",
+                 "6:8", "not finite at cell (3, 0)"},
+        BadScene{"rd_map_missing_image", "[rd]\nmodel = \"turing-sanderson\"\n[rd.maps]\nbeta = { image = \"nope.png\" }\n",
+                 "4:18", "cannot read the image"},
+        BadScene{"rd_initial_map_species", "[rd]\nmodel = \"barkley\"\n[rd.initial.maps]\nu = \"x\"\n", "4:5",
+                 "not a species of barkley"},
+        BadScene{"rd_fixed_empty", "[rd]\nmodel = \"brusselator\"\n[[rd.fixed]]\nwhere = \"j < 0\"\nvalues = [0, 5]\n", "4:9",
+                 "no cell is inside"},
+        BadScene{"rd_fixed_values", "[rd]\nmodel = \"brusselator\"\n[[rd.fixed]]\nwhere = \"j == 0\"\nvalues = [0]\n", "5:10",
+                 "expected 2 numbers"}),
     [](const ::testing::TestParamInfo<BadScene>& i) { return i.param.name; });
 
 TEST(Cli, MissingFileAndBadOverrideExitTwo) {
@@ -220,5 +237,69 @@ field = "v"
   EXPECT_EQ(list.status, 0);
   for (const char* m : {"gray-scott", "brusselator", "oregonator-3layer", "meinhardt-lateral"})
     EXPECT_NE(list.output.find(m), std::string::npos) << m;
+  fs::remove_all(dir);
+}
+
+// Parameter maps, initial maps and fixed rows reach the solver; output.fields
+// dumps every species as float EXR channels named after the model's species.
+TEST(Cli, FieldDumpsShowMapsAndFixedRows) {
+  auto dir = tempDir("rdfields");
+  fs::path p = writeScene(dir, "fixed.toml", R"toml(
+[grid]
+resolution = [24, 16]
+[time]
+dt = 0.5
+steps = 6
+[rd]
+model = "brusselator"
+boundary = "neumann"
+[rd.maps]
+beta = "lerp(8, 10, x)"
+[rd.initial]
+values = [3.0, 3.0]
+[rd.initial.maps]
+b = "1 + y"
+[[rd.fixed]]
+where = "j == 0"
+values = [0.0, 5.0]
+[[rd.fixed]]
+where = "j == floor(ny / 2)"
+values = [5.0, 0.0]
+[output]
+every = 3
+fields = true
+colormap = "red-green"
+)toml");
+  CommandResult r = runMorphoflow("run " + p.string() + " --quiet --out " + (dir / "out").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(dir / "out" / "run.json"));
+  EXPECT_EQ(j["fields_written"].get<int>(), 3);
+  EXPECT_TRUE(fs::exists(dir / "out" / "frames" / "000002.png"));
+  morphoflow::FieldDump d0, d2;
+  std::string err;
+  ASSERT_TRUE(morphoflow::readFieldDump((dir / "out" / "fields" / "000000.exr").string(), &d0, &err)) << err;
+  ASSERT_TRUE(morphoflow::readFieldDump((dir / "out" / "fields" / "000002.exr").string(), &d2, &err)) << err;
+  ASSERT_EQ(d2.resolution, (std::vector<int>{24, 16}));
+  EXPECT_EQ(d2.step, 6);
+  EXPECT_FLOAT_EQ(float(d2.time), 3.0f);
+  auto channel = [](const morphoflow::FieldDump& d, const std::string& name) -> const std::vector<float>& {
+    auto it = std::find(d.names.begin(), d.names.end(), name);
+    EXPECT_NE(it, d.names.end()) << name;
+    return d.channels[size_t(it - d.names.begin())];
+  };
+  // The initial map: b = 1 + y at cell centres, outside the fixed rows.
+  for (int jy = 1; jy < 16; ++jy)
+    if (jy != 8) {
+      EXPECT_NEAR(channel(d0, "b")[size_t(jy * 24 + 5)], 1.0 + (jy + 0.5) / 16, 1e-6);
+    }
+  // Fixed rows hold their values after six steps, everywhere along the row.
+  for (int x = 0; x < 24; ++x) {
+    EXPECT_EQ(channel(d2, "a")[size_t(x)], 0.0f);
+    EXPECT_EQ(channel(d2, "b")[size_t(x)], 5.0f);
+    EXPECT_EQ(channel(d2, "a")[size_t(8 * 24 + x)], 5.0f);
+    EXPECT_EQ(channel(d2, "b")[size_t(8 * 24 + x)], 0.0f);
+  }
+  // The free cells evolved, and differ along x because beta varies along x.
+  EXPECT_NE(channel(d2, "a")[size_t(4 * 24 + 2)], channel(d2, "a")[size_t(4 * 24 + 21)]);
   fs::remove_all(dir);
 }

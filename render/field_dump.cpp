@@ -1,0 +1,81 @@
+#include "render/field_dump.h"
+
+#include <filesystem>
+
+#include "render/atomic_image_write.h"
+
+namespace morphoflow {
+
+namespace {
+// Image row (from the top) of grid row y in slice z.
+size_t imageRow(int y, int z, int ny) { return size_t(z) * size_t(ny) + size_t(ny - 1 - y); }
+}  // namespace
+
+bool writeFieldDump(const std::string& path, const FieldDump& d, std::string* error) {
+  const int nx = d.resolution[0], ny = d.resolution[1], nz = d.resolution.size() > 2 ? d.resolution[2] : 1;
+  const int nc = int(d.channels.size());
+  OIIO::ImageSpec spec(nx, ny * nz, nc, OIIO::TypeDesc::FLOAT);
+  spec.channelnames = d.names;
+  spec.alpha_channel = -1;
+  spec.attribute("compression", "zip");
+  spec.attribute("morphoflow:resolution", OIIO::TypeDesc(OIIO::TypeDesc::INT, int(d.resolution.size())),
+                 d.resolution.data());
+  spec.attribute("morphoflow:time", float(d.time));
+  spec.attribute("morphoflow:step", int(d.step));
+  std::vector<float> pixels(size_t(nx) * size_t(ny) * size_t(nz) * size_t(nc));
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y)
+      for (int x = 0; x < nx; ++x) {
+        const size_t cell = (size_t(z) * size_t(ny) + size_t(y)) * size_t(nx) + size_t(x);
+        const size_t px = (imageRow(y, z, ny) * size_t(nx) + size_t(x)) * size_t(nc);
+        for (int c = 0; c < nc; ++c) pixels[px + size_t(c)] = d.channels[size_t(c)][cell];
+      }
+  return writeImageAtomically(path, spec, OIIO::TypeDesc::FLOAT, pixels.data(), error);
+}
+
+bool readFieldDump(const std::string& path, FieldDump* d, std::string* error) {
+  if (!std::filesystem::exists(path)) {
+    *error = "no such file: " + path;
+    return false;
+  }
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) {
+    *error = OIIO::geterror();
+    return false;
+  }
+  const OIIO::ImageSpec& spec = in->spec();
+  const int nc = spec.nchannels;
+  if (spec.width <= 0 || spec.height <= 0 || nc <= 0) {
+    *error = "empty image";
+    return false;
+  }
+  d->resolution = {spec.width, spec.height};
+  if (const OIIO::ParamValue* r = spec.find_attribute("morphoflow:resolution");
+      r && r->type().basetype == OIIO::TypeDesc::INT && (r->type().arraylen == 2 || r->type().arraylen == 3)) {
+    const int* v = static_cast<const int*>(r->data());
+    std::vector<int> res(v, v + r->type().arraylen);
+    const long cells = long(res[0]) * res[1] * (res.size() > 2 ? res[2] : 1);
+    if (res[0] == spec.width && cells == long(spec.width) * spec.height) d->resolution = res;
+  }
+  d->time = spec.get_float_attribute("morphoflow:time", 0.0f);
+  d->step = spec.get_int_attribute("morphoflow:step", 0);
+  std::vector<float> pixels(size_t(spec.width) * size_t(spec.height) * size_t(nc));
+  if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, pixels.data())) {
+    *error = in->geterror();
+    return false;
+  }
+  const int nx = d->resolution[0], ny = d->resolution[1], nz = d->resolution.size() > 2 ? d->resolution[2] : 1;
+  d->names.assign(spec.channelnames.begin(), spec.channelnames.end());
+  d->names.resize(size_t(nc));
+  d->channels.assign(size_t(nc), std::vector<float>(size_t(nx) * size_t(ny) * size_t(nz)));
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y)
+      for (int x = 0; x < nx; ++x) {
+        const size_t cell = (size_t(z) * size_t(ny) + size_t(y)) * size_t(nx) + size_t(x);
+        const size_t px = (imageRow(y, z, ny) * size_t(nx) + size_t(x)) * size_t(nc);
+        for (int c = 0; c < nc; ++c) d->channels[size_t(c)][cell] = pixels[px + size_t(c)];
+      }
+  return true;
+}
+
+}  // namespace morphoflow
