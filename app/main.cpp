@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "app/run_options.h"
+#include "app/texture_commands.h"
 #include "app/version.h"
 #include "bench/bench_suites.h"
 #include "core/error.h"
@@ -99,6 +100,32 @@ int main(int argc, char** argv) {
   benchCmd->add_option("--json", bench.json, "also write results as JSON");
   benchCmd->add_option("--seconds", bench.minSeconds, "minimum timed seconds per case");
 
+  AnalyzeOptions analyze;
+  CLI::App* analyzeCmd = app.add_subcommand("analyze", "variogram and regularity REG of an image or field dump (seed 003)");
+  analyzeCmd->add_option("file", analyze.file, "PNG/EXR image or DIR/fields/NNNNNN.exr")->required();
+  analyzeCmd->add_option("--channel", analyze.channel, "channel (species) to analyse; default the first");
+  analyzeCmd->add_option("--max-lag", analyze.maxLag, "largest spacing in cells (default: a quarter of the smaller side)")
+      ->check(CLI::Range(1, 1 << 20));
+  analyzeCmd->add_flag("--periodic", analyze.periodic, "pairs wrap around (for tiles of periodic runs)");
+  analyzeCmd->add_option("--slice", analyze.slice, "z slice of a 3D dump (default: the middle)")->check(CLI::Range(0, 1 << 20));
+  analyzeCmd->add_option("--csv", analyze.csv, "also write the variogram per lag and direction");
+
+  TextonOptions texton;
+  CLI::App* textonCmd = app.add_subcommand("texton", "random-walk texton texture (seed 003 eq. 6)");
+  textonCmd->add_option("--out", texton.out, "output image (.png or .exr)")->required();
+  textonCmd->add_option("--size", texton.walk.width, "field width and height in cells")->capture_default_str()->check(CLI::Range(1, 16384));
+  textonCmd->add_option("--elements", texton.walk.elements, "number of textons")->capture_default_str()->check(CLI::Range(1, 10000000));
+  textonCmd->add_option("--steps", texton.walk.steps, "random-walk steps")->capture_default_str()->check(CLI::Range(0, 100000000));
+  textonCmd->add_option("--step-size", texton.walk.stepSize, "cells per move")->capture_default_str()->check(CLI::Range(1, 16384));
+  textonCmd->add_option("--lifetime", texton.walk.lifetime, "mean lifetime L in steps (0: never expire)")->capture_default_str();
+  textonCmd->add_option("-p", texton.walk.p, "probability of moving right, given not expired")->capture_default_str();
+  textonCmd->add_option("-q", texton.walk.q, "probability of moving left, given not expired")->capture_default_str();
+  textonCmd->add_option("--start", texton.start, "pulse | regular | uniform")
+      ->check(CLI::IsMember({"pulse", "regular", "uniform"}))->capture_default_str();
+  textonCmd->add_option("--radius", texton.walk.radius, "texton disc radius in cells")->capture_default_str();
+  textonCmd->add_option("--seed", texton.walk.seed, "random seed")->capture_default_str();
+  textonCmd->add_flag("--analyze", texton.analyze, "also print the texture's REG");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -179,6 +206,11 @@ int main(int argc, char** argv) {
         for (const ReactionModel* m : allModels()) std::cout << describeModel(*m) << "\n";
       }
       return 0;
+    }
+    if (*analyzeCmd) return analyzeCommand(analyze);
+    if (*textonCmd) {
+      texton.walk.height = texton.walk.width;
+      return textonCommand(texton);
     }
     if (*benchCmd) {
       if (!runBenchSuite(suite, bench))

@@ -303,3 +303,31 @@ colormap = "red-green"
   EXPECT_NE(channel(d2, "a")[size_t(4 * 24 + 2)], channel(d2, "a")[size_t(4 * 24 + 21)]);
   fs::remove_all(dir);
 }
+
+// `texton` writes a texture; `analyze` reads it back (or a field dump) and
+// reports REG; a regular lattice scores higher than the walked texture.
+TEST(Cli, TextonAndAnalyze) {
+  auto dir = tempDir("texture");
+  auto reg = [](const std::string& out) {
+    std::smatch m;
+    EXPECT_TRUE(std::regex_search(out, m, std::regex("REG ([0-9.]+)"))) << out;
+    return m.empty() ? -1.0 : std::stod(m[1]);
+  };
+  const std::string lattice = (dir / "lattice.exr").string(), walked = (dir / "walked.png").string();
+  CommandResult a = runMorphoflow("texton --size 128 --elements 64 --steps 0 --start regular --out " + lattice);
+  ASSERT_EQ(a.status, 0) << a.output;
+  CommandResult b = runMorphoflow("texton --size 128 --elements 64 --steps 400 --step-size 1 --start regular --out " + walked);
+  ASSERT_EQ(b.status, 0) << b.output;
+  CommandResult ra = runMorphoflow("analyze " + lattice + " --max-lag 32 --csv " + (dir / "v.csv").string());
+  CommandResult rb = runMorphoflow("analyze " + walked + " --max-lag 32");
+  ASSERT_EQ(ra.status, 0) << ra.output;
+  ASSERT_EQ(rb.status, 0) << rb.output;
+  EXPECT_GT(reg(ra.output), reg(rb.output) + 0.2);
+  EXPECT_NE(ra.output.find("channel t"), std::string::npos) << ra.output;
+  EXPECT_TRUE(fs::exists(dir / "v.csv"));
+  EXPECT_EQ(runMorphoflow("analyze " + (dir / "missing.exr").string()).status, 2);
+  EXPECT_EQ(runMorphoflow("analyze " + lattice + " --channel zz").status, 2);
+  EXPECT_EQ(runMorphoflow("texton --out " + (dir / "x.png").string() + " -p 0.8 -q 0.8").status, 2);
+  EXPECT_EQ(runMorphoflow("texton --out " + (dir / "x.txt").string()).status, 2);
+  fs::remove_all(dir);
+}

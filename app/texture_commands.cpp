@@ -1,0 +1,107 @@
+#include "app/texture_commands.h"
+
+#include <algorithm>
+#include <filesystem>
+#include <iostream>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "app/output_files.h"
+#include "core/error.h"
+#include "render/colormap.h"
+#include "render/field_dump.h"
+#include "render/image_io.h"
+#include "rd/variogram.h"
+
+namespace morphoflow {
+
+namespace {
+
+const char* kDirectionNames[Variogram::kDirections] = {"(1,0)", "(0,1)", "(1,1)", "(1,-1)"};
+
+void printReg(const std::string& what, const Variogram& v) {
+  std::cout << fmt::format("{}: variance {:.6g}, REG {:.4f} (at spacing {} x {})\n", what, v.variance, v.reg,
+                           v.regLag, kDirectionNames[v.regDirection]);
+}
+
+}  // namespace
+
+int analyzeCommand(const AnalyzeOptions& o) {
+  FieldDump d;
+  std::string err;
+  if (!readFieldDump(o.file, &d, &err)) throw UserError({o.file, 0, 0}, "", "cannot read: " + err, "give a PNG/EXR image or a fields/NNNNNN.exr dump");
+  size_t c = 0;
+  if (!o.channel.empty()) {
+    auto it = std::find(d.names.begin(), d.names.end(), o.channel);
+    if (it == d.names.end())
+      throw UserError({"--channel", 0, 0}, "", "no channel '" + o.channel + "' in " + o.file,
+                      fmt::format("channels: {}", fmt::join(d.names, ", ")));
+    c = size_t(it - d.names.begin());
+  }
+  const int nx = d.resolution[0], ny = d.resolution[1], nz = d.resolution.size() > 2 ? d.resolution[2] : 1;
+  if (o.slice >= nz) throw UserError({"--slice", 0, 0}, "", fmt::format("the field has {} z slices", nz));
+  const int z = o.slice >= 0 ? o.slice : nz / 2;
+  // A colour image without --channel is analysed by its luminance (Rec. 709).
+  if (o.channel.empty() && d.names.size() >= 3 && d.names[0] == "R" && d.names[1] == "G" && d.names[2] == "B") {
+    for (size_t i = 0; i < d.channels[0].size(); ++i)
+      d.channels[0][i] = 0.2126f * d.channels[0][i] + 0.7152f * d.channels[1][i] + 0.0722f * d.channels[2][i];
+    d.names[0] = "luminance";
+  }
+  const std::vector<float>& ch = d.channels[c];
+  std::vector<double> t(ch.begin() + long(z) * nx * ny, ch.begin() + long(z + 1) * nx * ny);
+  if (o.maxLag >= std::max(nx, ny))
+    throw UserError({"--max-lag", 0, 0}, "", fmt::format("the lag must be below the field's size ({} x {})", nx, ny));
+  Variogram v = variogram(t, nx, ny, {.maxLag = o.maxLag, .periodic = o.periodic});
+  std::cout << fmt::format("{}: {} x {}{}, channel {}\n", o.file, nx, ny, nz > 1 ? fmt::format(" (z slice {} of {})", z, nz) : "",
+                           d.names[c].empty() ? "0" : d.names[c]);
+  printReg("variogram (seed 003 eq. 4-5, normalised by the variance)", v);
+  if (!o.csv.empty()) {
+    std::string s = "lag,v_10,v_01,v_11,v_1m1\n";
+    for (size_t l = 0; l < v.v.size(); ++l)
+      s += fmt::format("{},{:.8g},{:.8g},{:.8g},{:.8g}\n", l + 1, v.v[l][0], v.v[l][1], v.v[l][2], v.v[l][3]);
+    writeTextFile(o.csv, s);
+  }
+  return 0;
+}
+
+int textonCommand(TextonOptions o) {
+  TextonWalkSettings& s = o.walk;
+  s.start = o.start == "regular" ? TextonStart::Regular : o.start == "uniform" ? TextonStart::Uniform : TextonStart::Pulse;
+  try {
+    checkTextonWalk(s);
+  } catch (const std::invalid_argument& e) {
+    throw UserError({"texton", 0, 0}, "", e.what());
+  }
+  const std::string ext = std::filesystem::path(o.out).extension().string();
+  if (ext != ".png" && ext != ".exr")
+    throw UserError({"--out", 0, 0}, "", "the texture is written as .png or .exr, got '" + o.out + "'");
+  const std::vector<std::array<int, 2>> at = textonWalk(s);
+  const std::vector<double> img = renderTextons(at, s);
+  std::string err;
+  bool ok;
+  if (ext == ".exr") {
+    FieldDump d;
+    d.resolution = {s.width, s.height};
+    d.names = {"t"};
+    d.channels = {std::vector<float>(img.begin(), img.end())};
+    d.step = s.steps;
+    ok = writeFieldDump(o.out, d, &err);
+  } else {
+    std::vector<uint8_t> rgb(img.size() * 3);
+    const Palette grey = namedPalette("grayscale");
+    for (int y = 0; y < s.height; ++y)
+      for (int x = 0; x < s.width; ++x) {
+        Rgb8 c = grey(img[size_t(y) * size_t(s.width) + size_t(x)]);
+        std::copy(c.begin(), c.end(), &rgb[(size_t(s.height - 1 - y) * size_t(s.width) + size_t(x)) * 3]);
+      }
+    ok = writeRgb8(o.out, s.width, s.height, rgb, &err);
+  }
+  if (!ok) throw std::runtime_error("writing " + o.out + ": " + err);
+  std::cout << fmt::format("{}: {} of {} textons after {} steps of {} cells\n", o.out, at.size(), s.elements, s.steps,
+                           s.stepSize);
+  if (o.analyze) printReg("variogram", variogram(img, s.width, s.height));
+  return 0;
+}
+
+}  // namespace morphoflow

@@ -1,0 +1,29 @@
+// `morphoflow analyze` (seed 003's variogram and REG of an image or a field
+// dump) and `morphoflow texton` (random-walk texton textures, seed 003 eq. 6).
+#pragma once
+
+#include <string>
+
+#include "rd/texton_walk.h"
+
+namespace morphoflow {
+
+struct AnalyzeOptions {
+  std::string file;
+  std::string channel;   // empty: the first
+  int maxLag = 0;        // 0: a quarter of the smaller side
+  bool periodic = false;
+  int slice = -1;        // 3D dumps: z slice (-1 = middle)
+  std::string csv;       // also write the variogram table here
+};
+int analyzeCommand(const AnalyzeOptions& options);
+
+struct TextonOptions {
+  TextonWalkSettings walk;
+  std::string start = "pulse";  // pulse | regular | uniform
+  std::string out;              // .png (grey) or .exr (float channel "t")
+  bool analyze = false;         // also print REG of the result
+};
+int textonCommand(TextonOptions options);
+
+}  // namespace morphoflow
