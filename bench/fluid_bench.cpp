@@ -99,11 +99,14 @@ bool runFluidBench(const BenchOptions& o) {
   return true;
 }
 
+bool runRDBench(const BenchOptions& o);  // rd_bench.cpp
+
 bool runBenchSuite(const std::string& suite, const BenchOptions& o) {
   if (suite == "fluid") return runFluidBench(o);
+  if (suite == "rd") return runRDBench(o);
   return false;
 }
 
-const char* benchSuiteNames() { return "fluid"; }
+const char* benchSuiteNames() { return "fluid, rd"; }
 
 }  // namespace morphoflow
