@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <iostream>
 #include <limits>
+#include <memory>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -17,6 +18,7 @@
 #include "core/parallel.h"
 #include "core/spatial_field.h"
 #include "core/random.h"
+#include "rd/coarse_to_fine.h"
 #include "rd/model_registry.h"
 #include "render/colormap.h"
 #include "rd/rd_solver.h"
@@ -39,8 +41,9 @@ std::vector<double> sampleSceneField(const SceneField& f, const IVec<D>& cells) 
   return sampleSpatialField<D>(f.field, cells);
 }
 
+// The scene's initial species values.
 template <int D>
-void initialise(const Scene& scene, RDSolver<D>* rd) {
+void initialState(const Scene& scene, RDSolver<D>* rd) {
   const RDInitial& I = scene.rd.initial;
   const IVec<D> n = rd->cells();
   const uint64_t seed = scene.seed;
@@ -62,6 +65,13 @@ void initialise(const Scene& scene, RDSolver<D>* rd) {
       g[i] = v;
     });
   }
+}
+
+// The scene's parameter maps, perturbations and fixed regions, sampled on rd's grid.
+template <int D>
+void applyScene(const Scene& scene, RDSolver<D>* rd) {
+  const IVec<D> n = rd->cells();
+  const uint64_t seed = scene.seed;
   // Parameter maps, then a Gaussian perturbation by a percentage on top (seed 004 sec. 3.1).
   const size_t cells = rd->field(0).size();
   std::vector<std::vector<double>> params(rd->model().info().parameters.size());
@@ -75,42 +85,85 @@ void initialise(const Scene& scene, RDSolver<D>* rd) {
     if (!params[k].empty()) rd->setParameterField(int(k), std::move(params[k]));
   // Fixed regions: held at their values from the start (seed 004 fig. 20).
   if (!scene.rd.fixed.empty()) {
-    std::vector<uint8_t> mask(cells, 0);
-    std::vector<std::vector<double>> values(size_t(rd->species()), std::vector<double>(cells, 0.0));
+    const size_t ns = size_t(rd->species());
+    std::vector<std::vector<uint8_t>> mask(ns);
+    std::vector<std::vector<double>> values(ns);
     for (const RDFixedRegion& fr : scene.rd.fixed) {
       const std::vector<double> inside = sampleSceneField<D>(fr.where, n);
-      for (size_t i = 0; i < cells; ++i)
-        if (inside[i] != 0.0) {
-          mask[i] = 1;
-          for (int s = 0; s < rd->species(); ++s) values[size_t(s)][i] = fr.values[size_t(s)];
-        }
+      for (size_t q = 0; q < fr.species.size(); ++q) {
+        const size_t s = size_t(fr.species[q]);
+        if (mask[s].empty()) mask[s].assign(cells, 0), values[s].assign(cells, 0.0);
+        for (size_t i = 0; i < cells; ++i)
+          if (inside[i] != 0.0) {
+            mask[s][i] = 1;
+            values[s][i] = fr.values[q];
+            rd->field(int(s))[i] = fr.values[q];
+          }
+      }
     }
-    for (int s = 0; s < rd->species(); ++s)
-      for (size_t i = 0; i < cells; ++i)
-        if (mask[i]) rd->field(s)[i] = values[size_t(s)][i];
     rd->setFixedCells(std::move(mask), std::move(values));
   }
 }
 
 template <int D>
+void checkFinite(const RDSolver<D>& rd, const std::string& where) {
+  for (int s = 0; s < rd.species(); ++s)
+    for (double v : rd.field(s).values())
+      if (!std::isfinite(v))
+        throw std::runtime_error(fmt::format("the simulation diverged {} (species {} is not finite); "
+                                             "use the kim-lin integrator or a smaller time.dt",
+                                             where, rd.model().info().species[size_t(s)]));
+}
+
+// Coarse-to-fine acceleration (seed 002, seed 000 sec. 6): grows the pattern on
+// grids 2^L, ..., 2 times coarser over the same domain, each started from the
+// previous one prolongated; returns the last (2 times coarser) grid, or null.
+template <int D>
+std::unique_ptr<RDSolver<D>> growCoarse(const Scene& scene, const ReactionModel& model, bool quiet,
+                                        nlohmann::json* report) {
+  std::unique_ptr<RDSolver<D>> prev;
+  for (int level = scene.rd.coarseLevels; level >= 1; --level) {
+    RDSettings st = scene.rd.settings;
+    for (int& r : st.resolution) r >>= level;
+    auto cur = std::make_unique<RDSolver<D>>(st, model);
+    if (!prev) initialState<D>(scene, cur.get());
+    else
+      for (int s = 0; s < cur->species(); ++s)
+        prolongate<D>(prev->field(s), &cur->field(s), st.boundary == RDBoundary::Periodic);
+    applyScene<D>(scene, cur.get());
+    const auto t0 = std::chrono::steady_clock::now();
+    for (long k = 0; k < scene.rd.coarseSteps; ++k) cur->step(scene.time.dt);
+    checkFinite(*cur, fmt::format("on the coarse grid {}", fmt::join(st.resolution, "x")));
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (!quiet)
+      std::cerr << fmt::format("coarse grid {}: {} steps, {:.2f} s\n", fmt::join(st.resolution, "x"),
+                               scene.rd.coarseSteps, wall);
+    report->push_back({{"resolution", st.resolution}, {"steps", scene.rd.coarseSteps}, {"wall_seconds", wall}});
+    prev = std::move(cur);
+  }
+  return prev;
+}
+
+template <int D>
 int run(const Scene& scene, const RunOptions& opt) {
   const ReactionModel& model = *findModel(scene.rd.settings.model);
+  nlohmann::json coarseReport = nlohmann::json::array();
+  std::unique_ptr<RDSolver<D>> coarse = growCoarse<D>(scene, model, opt.quiet, &coarseReport);
   RDSolver<D> rd(scene.rd.settings, model);
-  initialise<D>(scene, &rd);
+  if (coarse) {
+    for (int s = 0; s < rd.species(); ++s)
+      prolongate<D>(coarse->field(s), &rd.field(s), scene.rd.settings.boundary == RDBoundary::Periodic);
+    coarse.reset();
+  } else {
+    initialState<D>(scene, &rd);
+  }
+  applyScene<D>(scene, &rd);
   const fs::path out(opt.out);
   fs::create_directories(out);
   FrameWriter frames(out, scene.output, opt);
   const std::vector<std::string>& names = model.info().species;
   const int shown = int(std::find(names.begin(), names.end(), scene.output.field) - names.begin());
   const long steps = scene.totalSteps();
-  auto checkFinite = [&](long step) {
-    for (int s = 0; s < rd.species(); ++s)
-      for (double v : rd.field(s).values())
-        if (!std::isfinite(v))
-          throw std::runtime_error(fmt::format("the simulation diverged at step {} (species {} is not finite); "
-                                               "use the kim-lin integrator or a smaller time.dt",
-                                               step, names[size_t(s)]));
-  };
   const bool twoSpecies = scene.output.colormap == kTwoSpeciesPalette;
   auto asFloat = [&](int s) {
     const Grid<double, D>& src = rd.field(s);
@@ -121,7 +174,7 @@ int run(const Scene& scene, const RunOptions& opt) {
   auto writeFrame = [&](long step) {
     long frame = frames.frameAt(step);
     if (frame < 0) return;
-    checkFinite(step);
+    checkFinite(rd, fmt::format("at step {}", step));
     if (twoSpecies) {
       const Grid<float, D> green = asFloat(1);
       frames.write<D>(frame, asFloat(0), false, &green);
@@ -152,7 +205,7 @@ int run(const Scene& scene, const RunOptions& opt) {
     if (!opt.quiet && (step + 1) % std::max<long>(1, steps / 20) == 0)
       std::cerr << fmt::format("\rstep {}/{}  t = {:.4g}", step + 1, steps, rd.time()) << std::flush;
   }
-  checkFinite(step);
+  checkFinite(rd, fmt::format("at step {}", step));
   if (!opt.quiet) std::cerr << "\n";
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   nlohmann::json j;
@@ -169,6 +222,7 @@ int run(const Scene& scene, const RunOptions& opt) {
                    {"diffusion", rd.diffusion()},
                    {"dt", scene.time.dt},
                    {"explicit_diffusion_limit", rd.explicitDiffusionLimit()}};
+  j["coarse_to_fine"] = coarseReport;
   j["backend"] = opt.backend;
   j["threads"] = opt.threads > 0 ? opt.threads : hardwareThreads();
   j["steps"] = step;

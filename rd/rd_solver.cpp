@@ -84,8 +84,8 @@ void RDSolver<D>::setParameterField(int k, std::vector<double> values) {
 }
 
 template <int D>
-void RDSolver<D>::setFixedCells(std::vector<uint8_t> mask, std::vector<std::vector<double>> values) {
-  fixedMask_ = std::move(mask);
+void RDSolver<D>::setFixedCells(std::vector<std::vector<uint8_t>> masks, std::vector<std::vector<double>> values) {
+  fixedMasks_ = std::move(masks);
   fixedValues_ = std::move(values);
 }
 
@@ -200,11 +200,12 @@ void RDSolver<D>::holdFixed() {
     Grid<double, D>& g = x_[size_t(s)];
     std::copy(frozenValues_[size_t(s)].begin(), frozenValues_[size_t(s)].end(), g.values().begin());
   }
-  if (fixedMask_.empty()) return;
-  for (int s = 0; s < species(); ++s) {
-    Grid<double, D>& g = x_[size_t(s)];
-    const std::vector<double>& v = fixedValues_[size_t(s)];
-    parallelFor(g.size(), [&](size_t i) { if (fixedMask_[i]) g[i] = v[i]; }, kChunk);
+  for (size_t s = 0; s < fixedMasks_.size(); ++s) {
+    if (fixedMasks_[s].empty()) continue;
+    Grid<double, D>& g = x_[s];
+    const std::vector<double>& v = fixedValues_[s];
+    const std::vector<uint8_t>& mask = fixedMasks_[s];
+    parallelFor(g.size(), [&](size_t i) { if (mask[i]) g[i] = v[i]; }, kChunk);
   }
 }
 

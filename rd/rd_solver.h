@@ -45,8 +45,9 @@ class RDSolver {
   const std::vector<double>& parameterField(int k) const { return fields_[size_t(k)]; }
   double parameter(int k) const { return params_.constant[size_t(k)]; }
   // Cells whose species values are held fixed (seed 004 fig. 20's fixed rows):
-  // after every step, cell i of species s is reset to values[s][i] wherever mask[i].
-  void setFixedCells(std::vector<uint8_t> mask, std::vector<std::vector<double>> values);
+  // after every step, cell i of species s is reset to values[s][i] wherever
+  // masks[s][i]; an empty masks[s] leaves species s free.
+  void setFixedCells(std::vector<std::vector<uint8_t>> masks, std::vector<std::vector<double>> values);
 
   void step(double dt);
   const RDStepStats& lastStats() const { return stats_; }
@@ -75,7 +76,7 @@ class RDSolver {
   Vector boundaryFaces_;              // Dirichlet faces per cell
   std::vector<std::unique_ptr<Diffusion>> diffusion_;
   std::vector<Vector> scratch_, rates_;
-  std::vector<uint8_t> fixedMask_;
+  std::vector<std::vector<uint8_t>> fixedMasks_;
   std::vector<std::vector<double>> fixedValues_;
   std::vector<std::vector<double>> frozenValues_;
   ReactionLUT lut_;

@@ -70,7 +70,8 @@ struct SceneField {
 // Cells held at fixed species values for the whole run (seed 004 fig. 20).
 struct RDFixedRegion {
   SceneField where;                  // nonzero inside the region
-  std::vector<double> values;        // one per species
+  std::vector<int> species;          // the species it holds (default: all)
+  std::vector<double> values;        // one per held species
 };
 
 struct RDScene {
@@ -81,6 +82,8 @@ struct RDScene {
   std::vector<std::pair<int, SceneField>> parameterMaps;  // parameter index -> its field ([rd.maps])
   std::vector<std::pair<int, double>> perturb;  // parameter index, Gaussian sigma in percent (seed 004 sec. 3.1)
   std::vector<RDFixedRegion> fixed;
+  int coarseLevels = 0;              // coarse-to-fine: grids 2^L, ..., 2 times coarser first (seed 002, 000)
+  long coarseSteps = 0;              // steps on each coarse grid
 };
 
 struct Scene {

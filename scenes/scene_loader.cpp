@@ -623,9 +623,37 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
         if (!w) r.fail(t, p + "where", "a fixed region needs where = \"expression\" (nonzero inside), e.g. \"j == 0\"");
         RDFixedRegion fr;
         fr.where = r.field(w, p + "where", sceneDir);
-        if (!r.node(t, p, "values")) r.fail(t, p + "values", "a fixed region needs values, one per species", "species: " + join(species));
-        fr.values = r.numbers(t, p, "values", {}, n, n, -1e12, 1e12);
+        if (const toml::node* sp = r.node(t, p, "species")) {
+          const toml::array* sa = sp->as_array();
+          if (!sa || sa->empty()) r.fail(sp, p + "species", "expected an array of species names", "species: " + join(species));
+          for (const toml::node& e : *sa) {
+            auto v = e.value<std::string>();
+            auto f = v ? std::find(species.begin(), species.end(), *v) : species.end();
+            if (f == species.end()) r.fail(&e, p + "species", "expected species names of " + model + ": " + join(species));
+            fr.species.push_back(int(f - species.begin()));
+          }
+        } else {
+          for (size_t q = 0; q < n; ++q) fr.species.push_back(int(q));
+        }
+        const size_t held = fr.species.size();
+        if (!r.node(t, p, "values"))
+          r.fail(t, p + "values", "a fixed region needs values, one per held species", "species: " + join(species));
+        fr.values = r.numbers(t, p, "values", {}, held, held, -1e12, 1e12);
         R.fixed.push_back(std::move(fr));
+      }
+    }
+    // [rd.coarse_to_fine]: grow the pattern on coarser grids first.
+    if (const toml::table* cf = r.table(*rdt, "rd.", "coarse_to_fine")) {
+      const toml::node* lv = r.node(cf, "rd.coarse_to_fine.", "levels");
+      R.coarseLevels = int(r.integer(cf, "rd.coarse_to_fine.", "levels", 2, 1, 8));
+      R.coarseSteps = r.integer(cf, "rd.coarse_to_fine.", "steps", 1000, 0, 1'000'000'000);
+      for (double v : res) {
+        const long cells = long(v);
+        if (cells % (1L << R.coarseLevels) != 0 || (cells >> R.coarseLevels) < 4)
+          r.fail(lv ? lv : cf, "rd.coarse_to_fine.levels",
+                 "each coarser grid halves the resolution, so every grid.resolution entry must be divisible by 2^levels "
+                 "and leave at least 4 cells",
+                 "use fewer levels or a resolution such as 256");
       }
     }
     // [rd.perturb]: Gaussian perturbation of parameters, sigma in percent.

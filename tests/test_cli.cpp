@@ -101,6 +101,8 @@ INSTANTIATE_TEST_SUITE_P(
                  "not a species of barkley"},
         BadScene{"rd_fixed_empty", "[rd]\nmodel = \"brusselator\"\n[[rd.fixed]]\nwhere = \"j < 0\"\nvalues = [0, 5]\n", "4:9",
                  "no cell is inside"},
+        BadScene{"rd_fixed_species", "[rd]\nmodel = \"brusselator\"\n[[rd.fixed]]\nwhere = \"j == 0\"\nspecies = [\"c\"]\nvalues = [0]\n",
+                 "5:12", "expected species names of brusselator: a, b"},
         BadScene{"rd_fixed_values", "[rd]\nmodel = \"brusselator\"\n[[rd.fixed]]\nwhere = \"j == 0\"\nvalues = [0]\n", "5:10",
                  "expected 2 numbers"}),
     [](const ::testing::TestParamInfo<BadScene>& i) { return i.param.name; });
@@ -265,6 +267,10 @@ values = [0.0, 5.0]
 [[rd.fixed]]
 where = "j == floor(ny / 2)"
 values = [5.0, 0.0]
+[[rd.fixed]]
+where = "i == 0 && j == 4"
+species = ["a"]
+values = [7.0]
 [output]
 every = 3
 fields = true
@@ -299,6 +305,9 @@ colormap = "red-green"
     EXPECT_EQ(channel(d2, "a")[size_t(8 * 24 + x)], 5.0f);
     EXPECT_EQ(channel(d2, "b")[size_t(8 * 24 + x)], 0.0f);
   }
+  // A region that holds one species leaves the other free.
+  EXPECT_EQ(channel(d2, "a")[size_t(4 * 24)], 7.0f);
+  EXPECT_NE(channel(d2, "b")[size_t(4 * 24)], channel(d0, "b")[size_t(4 * 24)]);
   // The free cells evolved, and differ along x because beta varies along x.
   EXPECT_NE(channel(d2, "a")[size_t(4 * 24 + 2)], channel(d2, "a")[size_t(4 * 24 + 21)]);
   fs::remove_all(dir);
