@@ -182,7 +182,11 @@ int main(int argc, char** argv) {
     if (*validateCmd) {
       for (const std::string& s : validateScenes) {
         Scene sc = loadScene(s);
-        std::cout << fmt::format("{}: ok ({}D, {} steps, Re = {:.4g})\n", s, sc.dimension, sc.totalSteps(), sc.reynolds);
+        if (sc.hasFluid)
+          std::cout << fmt::format("{}: ok ({}D, {} steps, Re = {:.4g})\n", s, sc.dimension, sc.totalSteps(), sc.reynolds);
+        else
+          std::cout << fmt::format("{}: ok ({}D, {} steps, reaction-diffusion {})\n", s, sc.dimension, sc.totalSteps(),
+                                   sc.rd.settings.model);
       }
       return 0;
     }

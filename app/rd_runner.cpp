@@ -132,13 +132,15 @@ std::unique_ptr<RDSolver<D>> growCoarse(const Scene& scene, const ReactionModel&
         prolongate<D>(prev->field(s), &cur->field(s), st.boundary == RDBoundary::Periodic);
     applyScene<D>(scene, cur.get());
     const auto t0 = std::chrono::steady_clock::now();
-    for (long k = 0; k < scene.rd.coarseSteps; ++k) cur->step(scene.time.dt);
+    const double dt = scene.time.dt * (scene.rd.coarseScaleDt ? std::pow(4.0, level) : 1.0);
+    for (long k = 0; k < scene.rd.coarseSteps; ++k) cur->step(dt);
     checkFinite(*cur, fmt::format("on the coarse grid {}", fmt::join(st.resolution, "x")));
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (!quiet)
       std::cerr << fmt::format("coarse grid {}: {} steps, {:.2f} s\n", fmt::join(st.resolution, "x"),
                                scene.rd.coarseSteps, wall);
-    report->push_back({{"resolution", st.resolution}, {"steps", scene.rd.coarseSteps}, {"wall_seconds", wall}});
+    report->push_back({{"resolution", st.resolution}, {"steps", scene.rd.coarseSteps}, {"dt", dt}, {"time", cur->time()},
+                       {"wall_seconds", wall}});
     prev = std::move(cur);
   }
   return prev;

@@ -84,6 +84,7 @@ struct RDScene {
   std::vector<RDFixedRegion> fixed;
   int coarseLevels = 0;              // coarse-to-fine: grids 2^L, ..., 2 times coarser first (seed 002, 000)
   long coarseSteps = 0;              // steps on each coarse grid
+  bool coarseScaleDt = false;        // a grid 2^l times coarser steps 4^l dt (explicit limits scale with h^2)
 };
 
 struct Scene {

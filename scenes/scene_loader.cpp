@@ -647,6 +647,7 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
       const toml::node* lv = r.node(cf, "rd.coarse_to_fine.", "levels");
       R.coarseLevels = int(r.integer(cf, "rd.coarse_to_fine.", "levels", 2, 1, 8));
       R.coarseSteps = r.integer(cf, "rd.coarse_to_fine.", "steps", 1000, 0, 1'000'000'000);
+      R.coarseScaleDt = r.boolean(cf, "rd.coarse_to_fine.", "scale_dt", st.integrator == RDIntegrator::ExplicitEuler);
       for (double v : res) {
         const long cells = long(v);
         if (cells % (1L << R.coarseLevels) != 0 || (cells >> R.coarseLevels) < 4)
