@@ -14,7 +14,7 @@
 
 #include "app/frame_writer.h"
 #include "app/output_files.h"
-#include "app/version.h"
+#include "app/run_report.h"
 #include "core/parallel.h"
 #include "core/spatial_field.h"
 #include "core/random.h"
@@ -35,12 +35,6 @@ double gaussian(uint64_t seed, uint64_t stream, uint64_t i) {
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
 }
 
-// A scene field at every cell (the loader has checked it is finite everywhere).
-template <int D>
-std::vector<double> sampleSceneField(const SceneField& f, const IVec<D>& cells) {
-  return sampleSpatialField<D>(f.field, cells);
-}
-
 // The scene's initial species values.
 template <int D>
 void initialState(const Scene& scene, RDSolver<D>* rd) {
@@ -48,7 +42,7 @@ void initialState(const Scene& scene, RDSolver<D>* rd) {
   const IVec<D> n = rd->cells();
   const uint64_t seed = scene.seed;
   std::vector<std::vector<double>> maps(size_t(rd->species()));
-  for (const auto& [s, f] : scene.rd.initialMaps) maps[size_t(s)] = sampleSceneField<D>(f, n);
+  for (const auto& [s, f] : scene.rd.initialMaps) maps[size_t(s)] = sampleSpatialField<D>(f.field, n);
   for (int s = 0; s < rd->species(); ++s) {
     Grid<double, D>& g = rd->field(s);
     const std::vector<double>& map = maps[size_t(s)];
@@ -75,7 +69,7 @@ void applyScene(const Scene& scene, RDSolver<D>* rd) {
   // Parameter maps, then a Gaussian perturbation by a percentage on top (seed 004 sec. 3.1).
   const size_t cells = rd->field(0).size();
   std::vector<std::vector<double>> params(rd->model().info().parameters.size());
-  for (const auto& [k, f] : scene.rd.parameterMaps) params[size_t(k)] = sampleSceneField<D>(f, n);
+  for (const auto& [k, f] : scene.rd.parameterMaps) params[size_t(k)] = sampleSpatialField<D>(f.field, n);
   for (auto [k, percent] : scene.rd.perturb) {
     std::vector<double>& f = params[size_t(k)];
     if (f.empty()) f.assign(cells, rd->parameter(k));
@@ -89,7 +83,7 @@ void applyScene(const Scene& scene, RDSolver<D>* rd) {
     std::vector<std::vector<uint8_t>> mask(ns);
     std::vector<std::vector<double>> values(ns);
     for (const RDFixedRegion& fr : scene.rd.fixed) {
-      const std::vector<double> inside = sampleSceneField<D>(fr.where, n);
+      const std::vector<double> inside = sampleSpatialField<D>(fr.where.field, n);
       for (size_t q = 0; q < fr.species.size(); ++q) {
         const size_t s = size_t(fr.species[q]);
         if (mask[s].empty()) mask[s].assign(cells, 0), values[s].assign(cells, 0.0);
@@ -115,6 +109,13 @@ void checkFinite(const RDSolver<D>& rd, const std::string& where) {
                                              where, rd.model().info().species[size_t(s)]));
 }
 
+// Every species of `coarse` prolongated onto `fine` (twice the cells per axis).
+template <int D>
+void prolongateState(const RDSolver<D>& coarse, RDSolver<D>* fine) {
+  for (int s = 0; s < fine->species(); ++s)
+    prolongate<D>(coarse.field(s), &fine->field(s), fine->settings().boundary == RDBoundary::Periodic);
+}
+
 // Coarse-to-fine acceleration (seed 002, seed 000 sec. 6): grows the pattern on
 // grids 2^L, ..., 2 times coarser over the same domain, each started from the
 // previous one prolongated; returns the last (2 times coarser) grid, or null.
@@ -126,10 +127,8 @@ std::unique_ptr<RDSolver<D>> growCoarse(const Scene& scene, const ReactionModel&
     RDSettings st = scene.rd.settings;
     for (int& r : st.resolution) r >>= level;
     auto cur = std::make_unique<RDSolver<D>>(st, model);
-    if (!prev) initialState<D>(scene, cur.get());
-    else
-      for (int s = 0; s < cur->species(); ++s)
-        prolongate<D>(prev->field(s), &cur->field(s), st.boundary == RDBoundary::Periodic);
+    if (prev) prolongateState<D>(*prev, cur.get());
+    else initialState<D>(scene, cur.get());
     applyScene<D>(scene, cur.get());
     const auto t0 = std::chrono::steady_clock::now();
     const double dt = scene.time.dt * (scene.rd.coarseScaleDt ? std::pow(4.0, level) : 1.0);
@@ -152,13 +151,9 @@ int run(const Scene& scene, const RunOptions& opt) {
   nlohmann::json coarseReport = nlohmann::json::array();
   std::unique_ptr<RDSolver<D>> coarse = growCoarse<D>(scene, model, opt.quiet, &coarseReport);
   RDSolver<D> rd(scene.rd.settings, model);
-  if (coarse) {
-    for (int s = 0; s < rd.species(); ++s)
-      prolongate<D>(coarse->field(s), &rd.field(s), scene.rd.settings.boundary == RDBoundary::Periodic);
-    coarse.reset();
-  } else {
-    initialState<D>(scene, &rd);
-  }
+  if (coarse) prolongateState<D>(*coarse, &rd);
+  else initialState<D>(scene, &rd);
+  coarse.reset();
   applyScene<D>(scene, &rd);
   const fs::path out(opt.out);
   fs::create_directories(out);
@@ -210,28 +205,18 @@ int run(const Scene& scene, const RunOptions& opt) {
   checkFinite(rd, fmt::format("at step {}", step));
   if (!opt.quiet) std::cerr << "\n";
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  nlohmann::json j;
-  j["version"] = kVersion;
-  j["scene_file"] = scene.path;
-  j["scene"] = nlohmann::json::parse(scene.resolvedJson);
-  j["overrides"] = opt.overrides;
-  j["resolved"] = {{"dimension", D},
-                   {"model", model.info().name},
-                   {"species", names},
-                   {"resolution", scene.rd.settings.resolution},
-                   {"size", scene.rd.settings.size},
-                   {"cell_size", rd.h()},
-                   {"diffusion", rd.diffusion()},
-                   {"dt", scene.time.dt},
-                   {"explicit_diffusion_limit", rd.explicitDiffusionLimit()}};
+  nlohmann::json j = runReport(scene, opt,
+                               {{"dimension", D},
+                                {"model", model.info().name},
+                                {"species", names},
+                                {"resolution", scene.rd.settings.resolution},
+                                {"size", scene.rd.settings.size},
+                                {"cell_size", rd.h()},
+                                {"diffusion", rd.diffusion()},
+                                {"dt", scene.time.dt},
+                                {"explicit_diffusion_limit", rd.explicitDiffusionLimit()}},
+                               step, rd.time(), frames, wall);
   j["coarse_to_fine"] = coarseReport;
-  j["backend"] = opt.backend;
-  j["threads"] = opt.threads > 0 ? opt.threads : hardwareThreads();
-  j["steps"] = step;
-  j["time"] = rd.time();
-  j["frames_written"] = frames.written();
-  j["fields_written"] = frames.fieldsWritten();
-  j["wall_seconds"] = wall;
   j["solvers"] = {{"newton_cells", newton.cells},
                   {"newton_failures", newton.failures},
                   {"newton_iterations_max", newton.maxIterations},

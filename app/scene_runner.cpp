@@ -15,7 +15,7 @@
 #include "app/output_files.h"
 #include "app/rd_runner.h"
 #include "app/run_options.h"
-#include "app/version.h"
+#include "app/run_report.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "fluid/fluid_solver.h"
@@ -135,28 +135,18 @@ int run(const Scene& scene, const RunOptions& opt) {
   if (!opt.quiet) std::cerr << "\n";
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
-  nlohmann::json j;
-  j["version"] = kVersion;
-  j["scene_file"] = scene.path;
-  j["scene"] = nlohmann::json::parse(scene.resolvedJson);
-  j["overrides"] = opt.overrides;
-  j["resolved"] = {{"dimension", D},
-                   {"resolution", scene.fluid.resolution},
-                   {"size", scene.fluid.size},
-                   {"cell_size", fluid.h()},
-                   {"viscosity", scene.fluid.viscosity},
-                   {"reynolds", scene.reynolds},
-                   {"reference_length", pr.referenceLength},
-                   {"reference_speed", pr.referenceSpeed},
-                   {"dt", scene.time.dt},
-                   {"cfl", scene.time.cfl}};
-  j["backend"] = opt.backend;
-  j["threads"] = opt.threads > 0 ? opt.threads : hardwareThreads();
-  j["steps"] = step;
-  j["time"] = fluid.time();
-  j["frames_written"] = frames.written();
-  j["fields_written"] = frames.fieldsWritten();
-  j["wall_seconds"] = wall;
+  nlohmann::json j = runReport(scene, opt,
+                               {{"dimension", D},
+                                {"resolution", scene.fluid.resolution},
+                                {"size", scene.fluid.size},
+                                {"cell_size", fluid.h()},
+                                {"viscosity", scene.fluid.viscosity},
+                                {"reynolds", scene.reynolds},
+                                {"reference_length", pr.referenceLength},
+                                {"reference_speed", pr.referenceSpeed},
+                                {"dt", scene.time.dt},
+                                {"cfl", scene.time.cfl}},
+                               step, fluid.time(), frames, wall);
   nlohmann::json stages;
   for (int k = 0; k < FluidStepStats::kStages; ++k)
     stages[FluidStepStats::kStageNames[k]] = {{"total_seconds", stageTotals[size_t(k)]},

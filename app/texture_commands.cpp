@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "render/colormap.h"
 #include "render/field_dump.h"
+#include "render/field_image.h"
 #include "render/image_io.h"
 #include "rd/variogram.h"
 
@@ -88,13 +89,13 @@ int textonCommand(TextonOptions o) {
     d.step = s.steps;
     ok = writeFieldDump(o.out, d, &err);
   } else {
-    std::vector<uint8_t> rgb(img.size() * 3);
-    const Palette grey = namedPalette("grayscale");
-    for (int y = 0; y < s.height; ++y)
-      for (int x = 0; x < s.width; ++x) {
-        Rgb8 c = grey(img[size_t(y) * size_t(s.width) + size_t(x)]);
-        std::copy(c.begin(), c.end(), &rgb[(size_t(s.height - 1 - y) * size_t(s.width) + size_t(x)) * 3]);
-      }
+    Grid<float, 2> g(IVec<2>(s.width, s.height));
+    std::copy(img.begin(), img.end(), g.values().begin());
+    FieldImageOptions io;
+    io.palette = namedPalette("grayscale");
+    io.autoRange = false;  // coverage is in [0, 1]
+    int w, h;
+    const std::vector<uint8_t> rgb = fieldToRgb<2>(g, io, &w, &h);
     ok = writeRgb8(o.out, s.width, s.height, rgb, &err);
   }
   if (!ok) throw std::runtime_error("writing " + o.out + ": " + err);

@@ -10,16 +10,13 @@
 #include <nlohmann/json.hpp>
 
 #include "bench/bench_suites.h"
+#include "bench/bench_timing.h"
 #include "core/parallel.h"
 #include "fluid/fluid_solver.h"
 
 namespace morphoflow {
 
 namespace {
-
-struct Case {
-  int dim, n;
-};
 
 template <int D>
 nlohmann::json benchFluid(int n, int threads, double minSeconds) {
@@ -33,25 +30,15 @@ nlohmann::json benchFluid(int n, int threads, double minSeconds) {
   FluidSolver<D> f(s);
   const double dt = f.h();  // CFL 1 at the lid speed
   for (int i = 0; i < 3; ++i) f.step(dt);  // warm-up: the flow starts to develop
-  std::vector<double> times, pit, vit;
+  std::vector<double> pit, vit;
   std::array<double, FluidStepStats::kStages> stage{};
-  double total = 0;
   bool converged = true;
-  while (total < minSeconds || times.size() < 5) {
-    auto t0 = std::chrono::steady_clock::now();
-    f.step(dt);
-    double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    times.push_back(t);
-    total += t;
+  const std::vector<double> times = timeSteps(minSeconds, [&] { f.step(dt); }, [&] {
     pit.push_back(f.lastStats().pressure.iterations);
     vit.push_back(f.lastStats().viscosity.iterations);
     converged &= f.lastStats().pressure.converged;
     for (int k = 0; k < FluidStepStats::kStages; ++k) stage[size_t(k)] += f.lastStats().seconds[size_t(k)];
-    if (times.size() >= 200) break;
-  }
-  std::vector<double> sorted = times;
-  std::sort(sorted.begin(), sorted.end());
-  double median = sorted[sorted.size() / 2];
+  });
   double meanIt = 0, meanVit = 0;
   for (double p : pit) meanIt += p;
   for (double v : vit) meanVit += v;
@@ -59,7 +46,7 @@ nlohmann::json benchFluid(int n, int threads, double minSeconds) {
   meanVit /= double(vit.size());
   nlohmann::json j = {{"dim", D},       {"n", n},
                       {"threads", threads}, {"steps", times.size()},
-                      {"ms_per_step_median", 1e3 * median},
+                      {"ms_per_step_median", 1e3 * median(times)},
                       {"pressure_iterations_mean", meanIt},
                       {"viscosity_iterations_mean", meanVit},
                       {"pressure_converged", converged}};
@@ -71,18 +58,11 @@ nlohmann::json benchFluid(int n, int threads, double minSeconds) {
 }  // namespace
 
 bool runFluidBench(const BenchOptions& o) {
-  std::vector<Case> cases = {{2, 128}, {2, 256}, {2, 512}, {2, 1024}, {3, 64}, {3, 128}};
-  if (o.size > 0) {
-    std::vector<Case> pick;
-    for (Case c : cases)
-      if (c.n == o.size) pick.push_back(c);
-    if (pick.empty()) pick = {{2, o.size}};
-    cases = pick;
-  }
+  const std::vector<BenchCase> cases = selectBenchCases({{2, 128}, {2, 256}, {2, 512}, {2, 1024}, {3, 64}, {3, 128}}, o.size);
   nlohmann::json all = nlohmann::json::array();
   std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9}\n", "dim", "n", "threads",
                            "ms/step(med)", "p-iters", "v-iters", "forces", "advect", "diffuse", "project");
-  for (Case c : cases) {
+  for (BenchCase c : cases) {
     for (int threads : {1, 2}) {
       nlohmann::json j = c.dim == 2 ? benchFluid<2>(c.n, threads, o.minSeconds) : benchFluid<3>(c.n, threads, o.minSeconds);
       std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12.2f} {:>8.1f} {:>8.1f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f}{}\n",

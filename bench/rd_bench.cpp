@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "bench/bench_suites.h"
+#include "bench/bench_timing.h"
 #include "core/parallel.h"
 #include "core/random.h"
 #include "rd/model_registry.h"
@@ -41,20 +42,12 @@ nlohmann::json benchRD(int n, bool implicit, int threads, double minSeconds) {
   });
   const double dt = 0.9 * rd.explicitDiffusionLimit() * (implicit ? 10.0 : 1.0);
   rd.step(dt);  // warm-up: allocations, multigrid setup
-  std::vector<double> times;
-  double total = 0, newtonIt = 0, diffIt = 0;
-  while (total < minSeconds || times.size() < 5) {
-    auto t0 = std::chrono::steady_clock::now();
-    rd.step(dt);
-    double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    times.push_back(t);
-    total += t;
+  double newtonIt = 0, diffIt = 0;
+  const std::vector<double> times = timeSteps(minSeconds, [&] { rd.step(dt); }, [&] {
     newtonIt = std::max(newtonIt, double(rd.lastStats().newton.maxIterations));
     diffIt += rd.lastStats().diffusion.iterations;
-    if (times.size() >= 200) break;
-  }
-  std::sort(times.begin(), times.end());
-  const double median = times[times.size() / 2];
+  });
+  const double med = median(times);
   double cells = 1;
   for (int a = 0; a < D; ++a) cells *= n;
   return {{"dim", D},
@@ -63,8 +56,8 @@ nlohmann::json benchRD(int n, bool implicit, int threads, double minSeconds) {
           {"threads", threads},
           {"dt", dt},
           {"steps", times.size()},
-          {"ms_per_step_median", 1e3 * median},
-          {"cell_updates_per_second", cells / median},
+          {"ms_per_step_median", 1e3 * med},
+          {"cell_updates_per_second", cells / med},
           {"newton_iterations_max", newtonIt},
           {"diffusion_iterations_mean", diffIt / double(times.size())}};
 }
@@ -72,21 +65,11 @@ nlohmann::json benchRD(int n, bool implicit, int threads, double minSeconds) {
 }  // namespace
 
 bool runRDBench(const BenchOptions& o) {
-  struct Case {
-    int dim, n;
-  };
-  std::vector<Case> cases = {{2, 256}, {2, 512}, {2, 1024}, {2, 2048}, {3, 128}};
-  if (o.size > 0) {
-    std::vector<Case> pick;
-    for (Case c : cases)
-      if (c.n == o.size) pick.push_back(c);
-    if (pick.empty()) pick = {{2, o.size}};
-    cases = pick;
-  }
+  const std::vector<BenchCase> cases = selectBenchCases({{2, 256}, {2, 512}, {2, 1024}, {2, 2048}, {3, 128}}, o.size);
   nlohmann::json all = nlohmann::json::array();
   std::cout << fmt::format("{:>4} {:>6} {:>10} {:>7} {:>12} {:>14} {:>9} {:>9}\n", "dim", "n", "integrator", "threads",
                            "ms/step(med)", "Mcell-updates/s", "newton", "pcg-its");
-  for (Case c : cases)
+  for (BenchCase c : cases)
     for (bool implicit : {false, true})
       for (int threads : {1, 2}) {
         nlohmann::json j = c.dim == 2 ? benchRD<2>(c.n, implicit, threads, o.minSeconds)

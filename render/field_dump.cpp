@@ -1,14 +1,23 @@
 #include "render/field_dump.h"
 
-#include <filesystem>
-
-#include "render/atomic_image_write.h"
+#include "render/image_file.h"
 
 namespace morphoflow {
 
 namespace {
-// Image row (from the top) of grid row y in slice z.
-size_t imageRow(int y, int z, int ny) { return size_t(z) * size_t(ny) + size_t(ny - 1 - y); }
+// Calls fn(cell, pixel) for every grid cell (x fastest) and the index of its
+// first channel in the interleaved atlas image: slice z occupies image rows
+// z ny .. (z + 1) ny - 1, y up within a slice.
+template <typename Fn>
+void forEachCellPixel(const std::vector<int>& res, int nc, Fn&& fn) {
+  const int nx = res[0], ny = res[1], nz = res.size() > 2 ? res[2] : 1;
+  for (int z = 0; z < nz; ++z)
+    for (int y = 0; y < ny; ++y) {
+      const size_t row = size_t(z) * size_t(ny) + size_t(ny - 1 - y);
+      for (int x = 0; x < nx; ++x)
+        fn((size_t(z) * size_t(ny) + size_t(y)) * size_t(nx) + size_t(x), (row * size_t(nx) + size_t(x)) * size_t(nc));
+    }
+}
 }  // namespace
 
 bool writeFieldDump(const std::string& path, const FieldDump& d, std::string* error) {
@@ -23,32 +32,17 @@ bool writeFieldDump(const std::string& path, const FieldDump& d, std::string* er
   spec.attribute("morphoflow:time", float(d.time));
   spec.attribute("morphoflow:step", int(d.step));
   std::vector<float> pixels(size_t(nx) * size_t(ny) * size_t(nz) * size_t(nc));
-  for (int z = 0; z < nz; ++z)
-    for (int y = 0; y < ny; ++y)
-      for (int x = 0; x < nx; ++x) {
-        const size_t cell = (size_t(z) * size_t(ny) + size_t(y)) * size_t(nx) + size_t(x);
-        const size_t px = (imageRow(y, z, ny) * size_t(nx) + size_t(x)) * size_t(nc);
-        for (int c = 0; c < nc; ++c) pixels[px + size_t(c)] = d.channels[size_t(c)][cell];
-      }
+  forEachCellPixel(d.resolution, nc, [&](size_t cell, size_t px) {
+    for (int c = 0; c < nc; ++c) pixels[px + size_t(c)] = d.channels[size_t(c)][cell];
+  });
   return writeImageAtomically(path, spec, OIIO::TypeDesc::FLOAT, pixels.data(), error);
 }
 
 bool readFieldDump(const std::string& path, FieldDump* d, std::string* error) {
-  if (!std::filesystem::exists(path)) {
-    *error = "no such file: " + path;
-    return false;
-  }
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) {
-    *error = OIIO::geterror();
-    return false;
-  }
-  const OIIO::ImageSpec& spec = in->spec();
+  OIIO::ImageSpec spec;
+  std::vector<float> pixels;
+  if (!readImageFloat(path, &spec, &pixels, error)) return false;
   const int nc = spec.nchannels;
-  if (spec.width <= 0 || spec.height <= 0 || nc <= 0) {
-    *error = "empty image";
-    return false;
-  }
   d->resolution = {spec.width, spec.height};
   if (const OIIO::ParamValue* r = spec.find_attribute("morphoflow:resolution");
       r && r->type().basetype == OIIO::TypeDesc::INT && (r->type().arraylen == 2 || r->type().arraylen == 3)) {
@@ -59,22 +53,13 @@ bool readFieldDump(const std::string& path, FieldDump* d, std::string* error) {
   }
   d->time = spec.get_float_attribute("morphoflow:time", 0.0f);
   d->step = spec.get_int_attribute("morphoflow:step", 0);
-  std::vector<float> pixels(size_t(spec.width) * size_t(spec.height) * size_t(nc));
-  if (!in->read_image(0, 0, 0, nc, OIIO::TypeDesc::FLOAT, pixels.data())) {
-    *error = in->geterror();
-    return false;
-  }
   const int nx = d->resolution[0], ny = d->resolution[1], nz = d->resolution.size() > 2 ? d->resolution[2] : 1;
   d->names.assign(spec.channelnames.begin(), spec.channelnames.end());
   d->names.resize(size_t(nc));
   d->channels.assign(size_t(nc), std::vector<float>(size_t(nx) * size_t(ny) * size_t(nz)));
-  for (int z = 0; z < nz; ++z)
-    for (int y = 0; y < ny; ++y)
-      for (int x = 0; x < nx; ++x) {
-        const size_t cell = (size_t(z) * size_t(ny) + size_t(y)) * size_t(nx) + size_t(x);
-        const size_t px = (imageRow(y, z, ny) * size_t(nx) + size_t(x)) * size_t(nc);
-        for (int c = 0; c < nc; ++c) d->channels[size_t(c)][cell] = pixels[px + size_t(c)];
-      }
+  forEachCellPixel(d->resolution, nc, [&](size_t cell, size_t px) {
+    for (int c = 0; c < nc; ++c) d->channels[size_t(c)][cell] = pixels[px + size_t(c)];
+  });
   return true;
 }
 

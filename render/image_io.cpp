@@ -4,11 +4,11 @@
 
 #include <OpenImageIO/imageio.h>
 
-#include "render/atomic_image_write.h"
+#include "render/image_file.h"
 
 namespace morphoflow {
 
-bool readGrayImage(const std::string& path, GrayImage* image, std::string* error) {
+bool readImageFloat(const std::string& path, OIIO::ImageSpec* spec, std::vector<float>* pixels, std::string* error) {
   if (!std::filesystem::exists(path)) {
     *error = "no such file: " + path;
     return false;
@@ -18,16 +18,23 @@ bool readGrayImage(const std::string& path, GrayImage* image, std::string* error
     *error = OIIO::geterror();
     return false;
   }
-  const OIIO::ImageSpec& spec = in->spec();
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0) {
+  *spec = in->spec();
+  if (spec->width <= 0 || spec->height <= 0 || spec->nchannels <= 0) {
     *error = "empty image";
     return false;
   }
-  std::vector<float> all(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, all.data())) {
+  pixels->resize(size_t(spec->width) * size_t(spec->height) * size_t(spec->nchannels));
+  if (!in->read_image(0, 0, 0, spec->nchannels, OIIO::TypeDesc::FLOAT, pixels->data())) {
     *error = in->geterror();
     return false;
   }
+  return true;
+}
+
+bool readGrayImage(const std::string& path, GrayImage* image, std::string* error) {
+  OIIO::ImageSpec spec;
+  std::vector<float> all;
+  if (!readImageFloat(path, &spec, &all, error)) return false;
   image->width = spec.width;
   image->height = spec.height;
   image->pixels.resize(size_t(spec.width) * size_t(spec.height));

@@ -1,0 +1,26 @@
+#include "app/run_report.h"
+
+#include "app/version.h"
+#include "core/parallel.h"
+
+namespace morphoflow {
+
+nlohmann::json runReport(const Scene& scene, const RunOptions& opt, nlohmann::json resolved, long steps, double time,
+                         const FrameWriter& frames, double wallSeconds) {
+  nlohmann::json j;
+  j["version"] = kVersion;
+  j["scene_file"] = scene.path;
+  j["scene"] = nlohmann::json::parse(scene.resolvedJson);
+  j["overrides"] = opt.overrides;
+  j["resolved"] = std::move(resolved);
+  j["backend"] = opt.backend;
+  j["threads"] = opt.threads > 0 ? opt.threads : hardwareThreads();
+  j["steps"] = steps;
+  j["time"] = time;
+  j["frames_written"] = frames.written();
+  j["fields_written"] = frames.fieldsWritten();
+  j["wall_seconds"] = wallSeconds;
+  return j;
+}
+
+}  // namespace morphoflow

@@ -1,0 +1,17 @@
+// The part of DIR/run.json every run writes: version, the scene as written
+// and resolved, overrides, backend and threads, and what the run did. Each
+// runner adds its own solver statistics.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include "app/frame_writer.h"
+#include "app/run_options.h"
+#include "scenes/scene.h"
+
+namespace morphoflow {
+
+nlohmann::json runReport(const Scene& scene, const RunOptions& options, nlohmann::json resolved, long steps,
+                         double time, const FrameWriter& frames, double wallSeconds);
+
+}  // namespace morphoflow
