@@ -77,6 +77,26 @@ void applyScene(const Scene& scene, RDSolver<D>* rd) {
   }
   for (size_t k = 0; k < params.size(); ++k)
     if (!params[k].empty()) rd->setParameterField(int(k), std::move(params[k]));
+  // Inhomogeneous anisotropic diffusion (seed 004 eq. 11-19).
+  if (const RDAnisotropy& an = scene.rd.anisotropy; an.enabled) {
+    DiffusionTensorSpec<D> spec;
+    spec.lambda1 = sampleSpatialField<D>(an.lambda1.field, n);
+    spec.lambda2 = sampleSpatialField<D>(an.lambda2.field, n);
+    if (an.direction.empty()) {  // a = (cos theta, sin theta, 0)   (eq. 12)
+      const std::vector<double> theta = sampleSpatialField<D>(an.theta.field, n);
+      for (int a = 0; a < D; ++a) spec.direction[size_t(a)].assign(cells, 0.0);
+      for (size_t i = 0; i < cells; ++i) {
+        spec.direction[0][i] = std::cos(theta[i]);
+        spec.direction[1][i] = std::sin(theta[i]);
+      }
+    } else {
+      for (int a = 0; a < D; ++a) spec.direction[size_t(a)] = sampleSpatialField<D>(an.direction[size_t(a)].field, n);
+    }
+    spec.species = an.species;
+    spec.shape = an.shape;
+    spec.shapeSpecies = an.shapeSpecies;
+    rd->setDiffusionTensor(std::move(spec));
+  }
   // Fixed regions: held at their values from the start (seed 004 fig. 20).
   if (!scene.rd.fixed.empty()) {
     const size_t ns = size_t(rd->species());

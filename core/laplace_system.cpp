@@ -90,6 +90,19 @@ inline double neighbourSum(const RowStencil<D>& s, const float* const* wa, const
   return sum;
 }
 
+// Face sum sum_f w_f (x_i - x_j(f)): with the c term this is A x, written so
+// that every face's two contributions cancel to round-off (mass conservation
+// does not rest on a float diagonal matching its weights).
+template <int D>
+inline double faceSum(const RowStencil<D>& s, const float* const* wa, const double* xr, size_t i, size_t il,
+                      size_t ih, float wl) {
+  const double xi = xr[i];
+  double sum = double(wa[0][i]) * (xi - xr[ih]) + double(wl) * (xi - xr[il]);
+  for (int a = 1; a < D; ++a)
+    sum += double(wa[a][i]) * (xi - s.xhi[a][i]) + double(s.wlo[a][i]) * (xi - s.xlo[a][i]);
+  return sum;
+}
+
 template <int D>
 void LaplaceSystem<D>::apply(const Vector& x, Vector* yp) const {
   Vector& y = *yp;
@@ -99,17 +112,17 @@ void LaplaceSystem<D>::apply(const Vector& x, Vector* yp) const {
     RowStencil<D> s = rowStencil<D>(*this, x.data(), zerosX_.data(), zerosW_.data(), row);
     const float* wa[D];
     for (int a = 0; a < D; ++a) wa[a] = w[a].data() + s.base;
-    const float* dg = diag.data() + s.base;
+    const float* cr = c.data() + s.base;
     const double* xr = x.data() + s.base;
     double* yr = y.data() + s.base;
     auto edge = [&](size_t i) {
       size_t il = i == 0 ? nx - 1 : i - 1, ih = i + 1 == nx ? 0 : i + 1;
       float wl = (i == 0 && !px) ? 0.0f : wa[0][il];
-      yr[i] = scale * (double(dg[i]) * xr[i] - neighbourSum<D>(s, wa, xr, i, il, ih, wl));
+      yr[i] = scale * (double(cr[i]) * xr[i] + faceSum<D>(s, wa, xr, i, il, ih, wl));
     };
     edge(0);
     for (size_t i = 1; i + 1 < nx; ++i)  // interior: no wrap, no branch
-      yr[i] = scale * (double(dg[i]) * xr[i] - neighbourSum<D>(s, wa, xr, i, i - 1, i + 1, wa[0][i - 1]));
+      yr[i] = scale * (double(cr[i]) * xr[i] + faceSum<D>(s, wa, xr, i, i - 1, i + 1, wa[0][i - 1]));
     if (nx > 1) edge(nx - 1);
   });
 }

@@ -2,13 +2,17 @@
 
 #include <cmath>
 
+#include "core/anisotropic_system.h"
 #include "core/parallel.h"
 
 namespace morphoflow {
 
-template <int D>
-SolverResult solvePCG(const LaplaceSystem<D>& A, const Vector& bIn, Vector* xp, Preconditioner* M,
-                      const SolverOptions& opt, Interrupter* interrupter, PcgWorkspace* workspace) {
+namespace {
+
+// The algorithm for any symmetric operator with size/apply/residual/singular/removeNullSpace.
+template <class Op>
+SolverResult pcg(const Op& A, const Vector& bIn, Vector* xp, Preconditioner* M, const SolverOptions& opt,
+                 Interrupter* interrupter, PcgWorkspace* workspace) {
   Vector& x = *xp;
   const size_t n = A.size();
   x.resize(n, 0.0);
@@ -87,6 +91,25 @@ SolverResult solvePCG(const LaplaceSystem<D>& A, const Vector& bIn, Vector* xp, 
   return result;
 }
 
+}  // namespace
+
+template <int D>
+SolverResult solvePCG(const LaplaceSystem<D>& A, const Vector& b, Vector* x, Preconditioner* M,
+                      const SolverOptions& options, Interrupter* interrupter, PcgWorkspace* workspace) {
+  return pcg(A, b, x, M, options, interrupter, workspace);
+}
+
+template <int D>
+SolverResult solvePCG(const AnisotropicSystem<D>& A, const Vector& b, Vector* x, Preconditioner* M,
+                      const SolverOptions& options, Interrupter* interrupter, PcgWorkspace* workspace) {
+  if (!A.hasCross) return pcg(A.axis, b, x, M, options, interrupter, workspace);
+  return pcg(A, b, x, M, options, interrupter, workspace);
+}
+
+template SolverResult solvePCG<2>(const AnisotropicSystem<2>&, const Vector&, Vector*, Preconditioner*,
+                                  const SolverOptions&, Interrupter*, PcgWorkspace*);
+template SolverResult solvePCG<3>(const AnisotropicSystem<3>&, const Vector&, Vector*, Preconditioner*,
+                                  const SolverOptions&, Interrupter*, PcgWorkspace*);
 template SolverResult solvePCG<2>(const LaplaceSystem<2>&, const Vector&, Vector*, Preconditioner*,
                                   const SolverOptions&, Interrupter*, PcgWorkspace*);
 template SolverResult solvePCG<3>(const LaplaceSystem<3>&, const Vector&, Vector*, Preconditioner*,

@@ -26,4 +26,12 @@ SolverResult solvePCG(const LaplaceSystem<D>& A, const Vector& b, Vector* x, Pre
                       const SolverOptions& options, Interrupter* interrupter = nullptr,
                       PcgWorkspace* workspace = nullptr);
 
+template <int D>
+struct AnisotropicSystem;
+// The same for a tensor diffusion system (M typically built on A.axis).
+template <int D>
+SolverResult solvePCG(const AnisotropicSystem<D>& A, const Vector& b, Vector* x, Preconditioner* M,
+                      const SolverOptions& options, Interrupter* interrupter = nullptr,
+                      PcgWorkspace* workspace = nullptr);
+
 }  // namespace morphoflow

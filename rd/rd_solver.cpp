@@ -17,11 +17,12 @@ constexpr size_t kChunk = 4096;  // cells per reaction task (fixed: results do n
 
 template <int D>
 struct RDSolver<D>::Diffusion {
-  LaplaceSystem<D> A;  // I - theta dt d lap, as c x + sum w (x_i - x_j)
+  AnisotropicSystem<D> A;  // I - theta dt d lap, as c x + sum w (x_i - x_j) (+ diagonal pairs)
   std::unique_ptr<Preconditioner> M;
   PcgWorkspace ws;
   Vector x;
   double thetaDt = -1.0;
+  long version = -1;  // tensor version it was built from
 };
 
 template <int D>
@@ -51,20 +52,21 @@ RDSolver<D>::RDSolver(const RDSettings& s, const ReactionModel& model) : setting
 
   std::array<bool, D> periodic{};
   for (int a = 0; a < D; ++a) periodic[size_t(a)] = s.boundary == RDBoundary::Periodic;
-  laplacian_ = LaplaceSystem<D>(cells_, periodic, 1.0 / (h_ * h_));
-  boundaryFaces_.assign(laplacian_.size(), 0.0);
+  LaplaceSystem<D> lap(cells_, periodic, 1.0 / (h_ * h_));
+  boundaryFaces_.assign(lap.size(), 0.0);
   forEachCell<D>(cells_, [&](const IVec<D>& k, size_t i) {
     int faces = 0;
     for (int a = 0; a < D; ++a) {
-      laplacian_.w[a][i] = 1.0f;  // finalize() cuts the wrap on non-periodic axes
+      lap.w[a][i] = 1.0f;  // finalize() cuts the wrap on non-periodic axes
       if (!periodic[size_t(a)]) faces += (k[a] == 0) + (k[a] == cells_[a] - 1);
     }
     if (s.boundary == RDBoundary::Dirichlet) {
       boundaryFaces_[i] = faces;
-      laplacian_.c[i] = float(2 * faces);
+      lap.c[i] = float(2 * faces);
     }
   });
-  laplacian_.finalize();
+  lap.finalize();
+  laplacian_ = AnisotropicSystem<D>(std::move(lap));
   if (s.boundary == RDBoundary::Dirichlet && int(s.dirichletValues.size()) != n)
     throw std::invalid_argument("rd: Dirichlet boundaries need one value per species");
   for (int sp = 0; sp < n; ++sp) diffusion_.push_back(std::make_unique<Diffusion>());
@@ -90,18 +92,68 @@ void RDSolver<D>::setFixedCells(std::vector<std::vector<uint8_t>> masks, std::ve
 }
 
 template <int D>
+void RDSolver<D>::setDiffusionTensor(DiffusionTensorSpec<D> spec) {
+  const size_t cells = laplacian_.size();
+  for (int a = 0; a < D; ++a)
+    if (spec.direction[size_t(a)].size() != cells) throw std::invalid_argument("rd: tensor direction has the wrong size");
+  if (spec.lambda1.size() != cells || spec.lambda2.size() != cells)
+    throw std::invalid_argument("rd: principal diffusivities have the wrong size");
+  for (size_t i = 0; i < cells; ++i)
+    if (!(spec.lambda1[i] > 0) || !(spec.lambda2[i] > 0))
+      throw std::invalid_argument("rd: principal diffusivities must be > 0 (sigma positive definite)");
+  if (spec.dynamic() && (spec.shapeSpecies < 0 || spec.shapeSpecies >= species()))
+    throw std::invalid_argument("rd: the shape species is out of range");
+  tensorSpecies_.assign(size_t(species()), spec.species.empty() ? 1 : 0);
+  for (int s : spec.species) {
+    if (s < 0 || s >= species()) throw std::invalid_argument("rd: anisotropic species out of range");
+    tensorSpecies_[size_t(s)] = 1;
+  }
+  tensorSpec_ = std::make_unique<DiffusionTensorSpec<D>>(std::move(spec));
+  buildTensor();
+}
+
+// sigma from the spec (and the shape species' current gradient), assembled into
+// -h^2 div(sigma grad) with the Dirichlet ghosts weighted by sigma_aa.
+template <int D>
+void RDSolver<D>::buildTensor() {
+  const DiffusionTensorSpec<D>& spec = *tensorSpec_;
+  const bool periodic = settings_.boundary == RDBoundary::Periodic;
+  const auto sigma = diffusionTensor<D>(spec, cells_, periodic, spec.dynamic() ? &x_[size_t(spec.shapeSpecies)] : nullptr);
+  std::array<const double*, AnisotropicSystem<D>::kComponents> ptr;
+  for (size_t k = 0; k < sigma.size(); ++k) ptr[k] = sigma[k].data();
+  std::array<bool, D> per{};
+  per.fill(periodic);
+  tensor_ = AnisotropicSystem<D>::fromTensor(cells_, per, 1.0 / (h_ * h_), ptr);
+  tensorBoundary_.assign(tensor_.size(), 0.0);
+  if (settings_.boundary == RDBoundary::Dirichlet) {
+    forEachCell<D>(cells_, [&](const IVec<D>& k, size_t i) {
+      double w = 0.0;
+      for (int a = 0; a < D; ++a) w += sigma[size_t(a)][i] * ((k[a] == 0) + (k[a] == cells_[a] - 1));
+      tensorBoundary_[i] = w;
+      tensor_.axis.c[i] = float(2.0 * w);
+    });
+    tensor_.axis.finalize();
+  }
+  ++tensorVersion_;
+}
+
+template <int D>
 double RDSolver<D>::explicitDiffusionLimit() const {
-  double dmax = *std::max_element(d_.begin(), d_.end());
-  return dmax > 0 ? h_ * h_ / (2.0 * D * dmax) : INFINITY;
+  double worst = 0.0;
+  const double lapBound = laplacian_.maxRowAbsSum();
+  const double tensorBound = tensorSpec_ ? tensor_.maxRowAbsSum() : 0.0;
+  for (int s = 0; s < species(); ++s) worst = std::max(worst, d_[size_t(s)] * (anisotropic(s) ? tensorBound : lapBound));
+  return worst > 0 ? 2.0 * h_ * h_ / worst : INFINITY;
 }
 
 template <int D>
 void RDSolver<D>::applyLaplacian(int s, const Vector& x, Vector* out) const {
-  laplacian_.apply(x, out);
+  diffusionOperator(s).apply(x, out);
   Vector& o = *out;
   const double g = settings_.boundary == RDBoundary::Dirichlet ? settings_.dirichletValues[size_t(s)] : 0.0;
   const double k = 2.0 * g / (h_ * h_);
-  parallelFor(o.size(), [&](size_t i) { o[i] = -o[i] + k * boundaryFaces_[i]; }, kChunk);
+  const Vector& faces = boundaryWeights(s);
+  parallelFor(o.size(), [&](size_t i) { o[i] = -o[i] + k * faces[i]; }, kChunk);
 }
 
 // Solves (I - theta_dt d lap) x = rhs in place; the Dirichlet ghost adds
@@ -112,30 +164,30 @@ void RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
   if (d == 0.0 || thetaDt == 0.0) return;
   Diffusion& df = *diffusion_[size_t(s)];
   const double scale = thetaDt * d / (h_ * h_);
-  if (df.thetaDt != thetaDt) {
+  const long version = anisotropic(s) ? tensorVersion_ : 0;
+  if (df.thetaDt != thetaDt || df.version != version) {
     // x + scale (c_b x + sum (x_i - x_j)): unit scale with w = scale keeps the
     // identity exact (c = 1 away from Dirichlet walls), so a zero-flux run
     // conserves mass to round-off.
-    df.A = laplacian_;
-    df.A.scale = 1.0;
-    for (int a = 0; a < D; ++a)
-      for (size_t i = 0; i < df.A.size(); ++i) df.A.w[a][i] = laplacian_.w[a][i] * float(scale);
-    for (size_t i = 0; i < df.A.size(); ++i) df.A.c[i] = float(1.0 + scale * laplacian_.c[i]);
-    df.A.finalize();
+    df.A = diffusionOperator(s).shifted(thetaDt * d);
     // MIC(0) on request; else multigrid once diffusion dominates the identity
-    // (scale > 1), Jacobi below, where the system is diagonally dominant.
+    // (scale > 1), Jacobi below, where the system is diagonally dominant. With
+    // a tensor they precondition the axis part (the mixed terms are bounded by
+    // it for a positive definite sigma).
     if (settings_.linearSolver == RDLinearSolver::ICPCG)
-      df.M = std::make_unique<MIC0Preconditioner<D>>(df.A);
+      df.M = std::make_unique<MIC0Preconditioner<D>>(df.A.axis);
     else if (scale > 1.0)
-      df.M = std::make_unique<Multigrid<D>>(df.A);
+      df.M = std::make_unique<Multigrid<D>>(df.A.axis);
     else
-      df.M = std::make_unique<JacobiPreconditioner<D>>(df.A);
+      df.M = std::make_unique<JacobiPreconditioner<D>>(df.A.axis);
     df.thetaDt = thetaDt;
+    df.version = version;
   }
   Vector& b = *rhs;
   if (settings_.boundary == RDBoundary::Dirichlet) {
     const double k = scale * 2.0 * settings_.dirichletValues[size_t(s)];
-    parallelFor(b.size(), [&](size_t i) { b[i] += k * boundaryFaces_[i]; }, kChunk);
+    const Vector& faces = boundaryWeights(s);
+    parallelFor(b.size(), [&](size_t i) { b[i] += k * faces[i]; }, kChunk);
   }
   df.x = b;  // warm start: the undiffused state
   SolverOptions o{settings_.tolerance, 2000};
@@ -219,6 +271,7 @@ void RDSolver<D>::step(double dt) {
   }
   stats_ = RDStepStats{};
   stats_.diffusion.converged = true;
+  if (tensorSpec_ && tensorSpec_->dynamic()) buildTensor();  // eq. 18-19 from the state at the step's start
   const size_t cells = laplacian_.size();
   // Every integrator is a theta scheme on the diffusion,
   //   (1 - theta dt d lap) x' = x + dt R + (1 - theta) dt d lap x,

@@ -9,10 +9,11 @@
 #include <string>
 #include <vector>
 
+#include "core/anisotropic_system.h"
 #include "core/grid.h"
-#include "core/laplace_system.h"
 #include "core/pcg.h"
 #include "core/solver_result.h"
+#include "rd/diffusion_tensor.h"
 #include "rd/rd_settings.h"
 #include "rd/reaction_lut.h"
 #include "rd/reaction_model.h"
@@ -48,13 +49,22 @@ class RDSolver {
   // after every step, cell i of species s is reset to values[s][i] wherever
   // masks[s][i]; an empty masks[s] leaves species s free.
   void setFixedCells(std::vector<std::vector<uint8_t>> masks, std::vector<std::vector<double>> values);
+  // Inhomogeneous anisotropic diffusion (seed 004 eq. 11-19): the spec's
+  // species diffuse by div(d sigma grad); a shaped (dynamic) spec rebuilds
+  // sigma from the current state at every step.
+  void setDiffusionTensor(DiffusionTensorSpec<D> spec);
+  bool anisotropic(int s) const { return !tensorSpecies_.empty() && tensorSpecies_[size_t(s)]; }
+  // The operator -h^2 div(sigma grad) (or -h^2 lap) that species s diffuses by.
+  const AnisotropicSystem<D>& diffusionOperator(int s) const { return anisotropic(s) ? tensor_ : laplacian_; }
 
   void step(double dt);
   const RDStepStats& lastStats() const { return stats_; }
   double time() const { return time_; }
   long steps() const { return steps_; }
 
-  // Largest stable explicit-Euler step for the diffusion alone: h^2 / (2 D d_max).
+  // Largest stable explicit-Euler step for the diffusion alone:
+  // 2 h^2 / max_s (d_s * Gershgorin bound of its operator); h^2 / (2 D d_max)
+  // when isotropic.
   double explicitDiffusionLimit() const;
 
  private:
@@ -63,6 +73,8 @@ class RDSolver {
   void applyLaplacian(int s, const Vector& x, Vector* out) const;  // out = lap x (with boundary terms)
   void solveDiffusion(int s, double theta_dt, Vector* rhs_to_x);
   void holdFixed();
+  void buildTensor();
+  const Vector& boundaryWeights(int s) const { return anisotropic(s) ? tensorBoundary_ : boundaryFaces_; }
 
   RDSettings settings_;
   const ReactionModel& model_;
@@ -72,8 +84,13 @@ class RDSolver {
   std::vector<double> d_;
   ParameterValues params_;
   std::vector<std::vector<double>> fields_;
-  LaplaceSystem<D> laplacian_;        // -h^2 lap, with c = 2 per Dirichlet face
+  AnisotropicSystem<D> laplacian_;    // -h^2 lap, with c = 2 per Dirichlet face
   Vector boundaryFaces_;              // Dirichlet faces per cell
+  std::unique_ptr<DiffusionTensorSpec<D>> tensorSpec_;
+  std::vector<uint8_t> tensorSpecies_;
+  AnisotropicSystem<D> tensor_;       // -h^2 div(sigma grad), c = 2 sigma_aa per Dirichlet face
+  Vector tensorBoundary_;             // sum of sigma_aa over the Dirichlet faces per cell
+  long tensorVersion_ = 0;
   std::vector<std::unique_ptr<Diffusion>> diffusion_;
   std::vector<Vector> scratch_, rates_;
   std::vector<std::vector<uint8_t>> fixedMasks_;

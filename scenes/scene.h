@@ -74,6 +74,19 @@ struct RDFixedRegion {
   std::vector<double> values;        // one per held species
 };
 
+// Inhomogeneous anisotropic diffusion, [rd.anisotropy] (seed 004 eq. 11-19):
+// sigma = lambda2 I + (lambda1 - lambda2) a a^T per cell, a from theta (xy
+// plane) or a direction vector field.
+struct RDAnisotropy {
+  bool enabled = false;
+  SceneField lambda1, lambda2;        // principal diffusivities along and across a (> 0)
+  SceneField theta;                   // angle of a in the xy plane, radians (when direction is empty)
+  std::vector<SceneField> direction;  // or a, one field per axis (normalised per cell; zero = isotropic)
+  std::vector<int> species;           // the anisotropic species (empty: all)
+  double shape = 0.0;                 // eq. 18's I (0: off)
+  int shapeSpecies = 0;               // whose gradient shapes the tensor
+};
+
 struct RDScene {
   bool enabled = false;
   RDSettings settings;
@@ -82,6 +95,7 @@ struct RDScene {
   std::vector<std::pair<int, SceneField>> parameterMaps;  // parameter index -> its field ([rd.maps])
   std::vector<std::pair<int, double>> perturb;  // parameter index, Gaussian sigma in percent (seed 004 sec. 3.1)
   std::vector<RDFixedRegion> fixed;
+  RDAnisotropy anisotropy;
   int coarseLevels = 0;              // coarse-to-fine: grids 2^L, ..., 2 times coarser first (seed 002, 000)
   long coarseSteps = 0;              // steps on each coarse grid
   bool coarseScaleDt = false;        // a grid 2^l times coarser steps 4^l dt (explicit limits scale with h^2)

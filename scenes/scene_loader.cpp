@@ -642,6 +642,49 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
         R.fixed.push_back(std::move(fr));
       }
     }
+    // [rd.anisotropy]: inhomogeneous anisotropic tensor diffusion (seed 004 eq. 11-19).
+    if (const toml::table* an = r.table(*rdt, "rd.", "anisotropy")) {
+      RDAnisotropy& A = R.anisotropy;
+      A.enabled = true;
+      const std::string p = "rd.anisotropy.";
+      auto fieldOr = [&](const char* key, const char* def) {
+        if (const toml::node* f = r.node(an, p, key)) return r.field(f, p + key, sceneDir);
+        SceneField d;
+        d.field.expression = def;
+        d.where = r.where(an, p + key);
+        d.key = p + key;
+        return d;
+      };
+      A.lambda1 = fieldOr("lambda1", "1");
+      A.lambda2 = fieldOr("lambda2", "1");
+      const toml::node* th = r.node(an, p, "theta");
+      if (const toml::node* dn = r.node(an, p, "direction")) {
+        if (th)
+          r.fail(th, p + "theta", "give either theta (an angle in the xy plane) or direction (a vector field), not both",
+                 "drop one of them");
+        const toml::array* arr = dn->as_array();
+        if (!arr || arr->size() != size_t(D))
+          r.fail(dn, p + "direction",
+                 "expected an array of " + std::to_string(D) + " fields (one per axis), e.g. [\"y - 0.5\", \"x - 0.5\"]");
+        for (size_t q = 0; q < arr->size(); ++q)
+          A.direction.push_back(r.field(arr->get(q), p + "direction." + std::to_string(q), sceneDir));
+      } else {
+        A.theta = fieldOr("theta", "0");
+      }
+      if (const toml::node* sp = r.node(an, p, "species")) {
+        const toml::array* sa = sp->as_array();
+        if (!sa || sa->empty()) r.fail(sp, p + "species", "expected an array of species names", "species: " + join(species));
+        for (const toml::node& e : *sa) {
+          auto v = e.value<std::string>();
+          auto f = v ? std::find(species.begin(), species.end(), *v) : species.end();
+          if (f == species.end()) r.fail(&e, p + "species", "expected species names of " + model + ": " + join(species));
+          A.species.push_back(int(f - species.begin()));
+        }
+      }
+      A.shape = r.number(an, p, "shape", 0.0, -1e6, 1e6);
+      const std::string ss = r.string(an, p, "shape_species", species.front(), species);
+      A.shapeSpecies = int(std::find(species.begin(), species.end(), ss) - species.begin());
+    }
     // [rd.coarse_to_fine]: grow the pattern on coarser grids first.
     if (const toml::table* cf = r.table(*rdt, "rd.", "coarse_to_fine")) {
       const toml::node* lv = r.node(cf, "rd.coarse_to_fine.", "levels");
@@ -666,7 +709,7 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
 
   // Every spatial field is finite on the grid, and every fixed region holds a cell.
   if (s.rd.enabled) {
-    auto check = [&](const SceneField& f, bool region) {
+    auto check = [&](const SceneField& f, bool region, bool positive = false) {
       const std::vector<double> v = D == 2 ? sampleSpatialField<2>(f.field, IVec<2>(int(res[0]), int(res[1])))
                                            : sampleSpatialField<3>(f.field, IVec<3>(int(res[0]), int(res[1]), int(res[2])));
       size_t inside = 0;
@@ -677,6 +720,13 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
           if (D == 3) c << ", " << i / size_t(res[0] * res[1]);
           throw UserError(f.where, f.key, c.str() + ")", "guard divisions and logarithms, e.g. 1 / max(r, 1e-6)");
         }
+        if (positive && !(v[i] > 0.0)) {
+          std::ostringstream c;
+          c << "a principal diffusivity must be > 0 (the tensor positive definite), but it is " << v[i]
+            << " at cell (" << i % size_t(res[0]) << ", " << (i / size_t(res[0])) % size_t(res[1]);
+          if (D == 3) c << ", " << i / size_t(res[0] * res[1]);
+          throw UserError(f.where, f.key, c.str() + ")", "keep lambda1 and lambda2 positive everywhere, e.g. max(..., 0.1)");
+        }
         inside += v[i] != 0.0;
       }
       if (region && inside == 0)
@@ -686,6 +736,13 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
     for (const auto& [k, f] : s.rd.initialMaps) check(f, false);
     for (const auto& [k, f] : s.rd.parameterMaps) check(f, false);
     for (const RDFixedRegion& fr : s.rd.fixed) check(fr.where, true);
+    if (s.rd.anisotropy.enabled) {
+      const RDAnisotropy& A = s.rd.anisotropy;
+      check(A.lambda1, false, true);
+      check(A.lambda2, false, true);
+      if (A.direction.empty()) check(A.theta, false);
+      for (const SceneField& f : A.direction) check(f, false);
+    }
   }
 
   // [output]

@@ -104,7 +104,15 @@ INSTANTIATE_TEST_SUITE_P(
         BadScene{"rd_fixed_species", "[rd]\nmodel = \"brusselator\"\n[[rd.fixed]]\nwhere = \"j == 0\"\nspecies = [\"c\"]\nvalues = [0]\n",
                  "5:12", "expected species names of brusselator: a, b"},
         BadScene{"rd_fixed_values", "[rd]\nmodel = \"brusselator\"\n[[rd.fixed]]\nwhere = \"j == 0\"\nvalues = [0]\n", "5:10",
-                 "expected 2 numbers"}),
+                 "expected 2 numbers"},
+        BadScene{"rd_anisotropy_negative", "[grid]\nresolution = [8, 8]\n[rd]\nmodel = \"brusselator\"\n[rd.anisotropy]\nlambda2 = \"x - 0.5\"\n",
+                 "6:11", "must be > 0"},
+        BadScene{"rd_anisotropy_both", "[rd]\nmodel = \"brusselator\"\n[rd.anisotropy]\ntheta = 0\ndirection = [\"x\", \"y\"]\n",
+                 "4:9", "not both"},
+        BadScene{"rd_anisotropy_direction", "[rd]\nmodel = \"brusselator\"\n[rd.anisotropy]\ndirection = [\"x\"]\n",
+                 "4:13", "array of 2 fields"},
+        BadScene{"rd_anisotropy_shape_species", "[rd]\nmodel = \"brusselator\"\n[rd.anisotropy]\nshape = 0.2\nshape_species = \"c\"\n",
+                 "5:17", "is not one of"}),
     [](const ::testing::TestParamInfo<BadScene>& i) { return i.param.name; });
 
 TEST(Cli, MissingFileAndBadOverrideExitTwo) {
