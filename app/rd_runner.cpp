@@ -35,6 +35,8 @@ double gaussian(uint64_t seed, uint64_t stream, uint64_t i) {
   return std::sqrt(-2.0 * std::log(u1)) * std::cos(2.0 * M_PI * u2);
 }
 
+}  // namespace
+
 // The scene's initial species values.
 template <int D>
 void initialState(const Scene& scene, RDSolver<D>* rd) {
@@ -128,6 +130,15 @@ void checkFinite(const RDSolver<D>& rd, const std::string& where) {
                                              "use the kim-lin integrator or a smaller time.dt",
                                              where, rd.model().info().species[size_t(s)]));
 }
+
+template void initialState<2>(const Scene&, RDSolver<2>*);
+template void initialState<3>(const Scene&, RDSolver<3>*);
+template void applyScene<2>(const Scene&, RDSolver<2>*);
+template void applyScene<3>(const Scene&, RDSolver<3>*);
+template void checkFinite<2>(const RDSolver<2>&, const std::string&);
+template void checkFinite<3>(const RDSolver<3>&, const std::string&);
+
+namespace {
 
 // Every species of `coarse` prolongated onto `fine` (twice the cells per axis).
 template <int D>

@@ -1,11 +1,23 @@
 // `morphoflow run` for reaction-diffusion-only scenes (no [fluid]).
 #pragma once
 
+#include <string>
+
 #include "app/run_options.h"
+#include "rd/rd_solver.h"
 #include "scenes/scene.h"
 
 namespace morphoflow {
 
 int runReactionDiffusion(const Scene& scene, const RunOptions& options);
+
+// Shared with the coupled runner: the scene's initial state; its parameter
+// maps, perturbations, fixed regions and anisotropy; a divergence check.
+template <int D>
+void initialState(const Scene& scene, RDSolver<D>* rd);
+template <int D>
+void applyScene(const Scene& scene, RDSolver<D>* rd);
+template <int D>
+void checkFinite(const RDSolver<D>& rd, const std::string& where);
 
 }  // namespace morphoflow

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "app/ard_runner.h"
 #include "app/frame_writer.h"
 #include "app/output_files.h"
 #include "app/rd_runner.h"
@@ -200,6 +201,7 @@ int runScene(const RunOptions& opt) {
   int threads = opt.backend == "serial" ? 1 : opt.threads;
   ThreadLimit limit(threads);
   if (!scene.hasFluid) return runReactionDiffusion(scene, opt);
+  if (scene.rd.enabled) return runCoupled(scene, opt);
   return scene.dimension == 2 ? run<2>(scene, opt) : run<3>(scene, opt);
 }
 

@@ -101,6 +101,16 @@ struct RDScene {
   bool coarseScaleDt = false;        // a grid 2^l times coarser steps 4^l dt (explicit limits scale with h^2)
 };
 
+// [coupling]: a fluid carrying a reaction-diffusion layer (seed 001 sec. 5).
+struct CouplingScene {
+  bool enabled = false;
+  std::string mode = "ard";             // ard | passive | rd-only
+  std::string interpolation = "linear"; // linear | cubic
+  double rdTimeScale = 1.0;             // RD time per unit of fluid time
+  std::vector<double> inflowValues;     // per species, chemical entering through inflow sides
+  std::vector<double> solidValues;      // per species, inside obstacles
+};
+
 struct Scene {
   std::string path;                // the file it came from
   std::string name;
@@ -113,6 +123,7 @@ struct Scene {
   DyeSettings dye;
   bool hasFluid = true;            // false for reaction-diffusion-only scenes
   RDScene rd;
+  CouplingScene coupling;          // hasFluid && rd.enabled
   double reynolds = 0.0;           // resolved Re = U L / nu
   std::string resolvedJson;        // the scene as resolved (JSON text), for run.json
   long totalSteps() const;         // resolved from steps or duration/dt

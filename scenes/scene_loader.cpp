@@ -515,10 +515,7 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
   // [rd]
   std::vector<std::string> species;
   if (const toml::table* rdt = r.table(root, "", "rd")) {
-    if (!rdOnly)
-      r.fail(rdt, "rd", "a scene with both [fluid] and [rd] is the coupled advection-reaction-diffusion layer, which is not in this build yet",
-             "drop [fluid] for a reaction-diffusion-only scene");
-    s.hasFluid = false;
+    s.hasFluid = !rdOnly;
     RDScene& R = s.rd;
     R.enabled = true;
     const std::vector<std::string> names = modelNames();
@@ -532,13 +529,37 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
     st.resolution.clear();
     for (double v : res) st.resolution.push_back(int(v));
     st.size = size;
+    if (!rdOnly) {
+      // A coupled layer spans the fluid's domain, on its own grid if asked.
+      const toml::node* rn = nullptr;
+      std::vector<double> rr = r.numbers(rdt, "rd.", "resolution", res, size_t(D), size_t(D), 4, 8192, false, &rn);
+      st.resolution.clear();
+      for (int a = 0; a < D; ++a) {
+        st.resolution.push_back(int(rr[size_t(a)]));
+        if (std::abs(size[size_t(a)] / rr[size_t(a)] - size[0] / rr[0]) > 1e-6 * size[0] / rr[0])
+          r.fail(rn, "rd.resolution", "reaction-diffusion cells must be square over the domain",
+                 "keep rd.resolution proportional to grid.resolution");
+      }
+    }
     st.diffusion = r.numbers(rdt, "rd.", "diffusion", in.diffusion, n, n, 0, 1e12);
     const std::string integ = r.string(rdt, "rd.", "integrator", "kim-lin", {"kim-lin", "explicit", "semi-implicit", "crank-nicolson"});
     st.integrator = integ == "explicit"        ? RDIntegrator::ExplicitEuler
                     : integ == "semi-implicit" ? RDIntegrator::SemiImplicit
                     : integ == "crank-nicolson" ? RDIntegrator::CrankNicolson
                                                : RDIntegrator::KimLin;
-    const std::string bc = r.string(rdt, "rd.", "boundary", "periodic", {"periodic", "neumann", "dirichlet"});
+    // A coupled layer's boundary follows the fluid's: periodic where it wraps, zero flux at walls.
+    int fluidPeriodic = 0;
+    for (int a = 0; a < D; ++a) fluidPeriodic += s.fluid.boundaries.sides[size_t(2 * a)].kind == BoundaryKind::Periodic;
+    if (!rdOnly && fluidPeriodic != 0 && fluidPeriodic != D)
+      r.fail(rdt, "rd", "a reaction-diffusion layer wraps on every axis or none, but the fluid is periodic on only some",
+             "make every boundary periodic, or none");
+    const std::string bcDefault = rdOnly || fluidPeriodic == D ? "periodic" : "neumann";
+    const std::string bc = r.string(rdt, "rd.", "boundary", bcDefault, {"periodic", "neumann", "dirichlet"});
+    if (!rdOnly && (bc == "periodic") != (fluidPeriodic == D))
+      r.fail(r.node(rdt, "rd.", "boundary"), "rd.boundary",
+             "a coupled layer must wrap exactly where the fluid does (the fluid is " +
+                 std::string(fluidPeriodic == D ? "periodic" : "walled") + ")",
+             "use rd.boundary = \"" + bcDefault + "\" or leave it out");
     st.boundary = bc == "neumann" ? RDBoundary::Neumann : bc == "dirichlet" ? RDBoundary::Dirichlet : RDBoundary::Periodic;
     st.dirichletValues = r.numbers(rdt, "rd.", "boundary_values", {}, n, n, -1e12, 1e12);
     if (st.boundary == RDBoundary::Dirichlet && st.dirichletValues.empty())
@@ -687,6 +708,9 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
     }
     // [rd.coarse_to_fine]: grow the pattern on coarser grids first.
     if (const toml::table* cf = r.table(*rdt, "rd.", "coarse_to_fine")) {
+      if (!rdOnly)
+        r.fail(cf, "rd.coarse_to_fine", "coarse-to-fine growth is for reaction-diffusion-only scenes",
+               "drop [rd.coarse_to_fine] from a scene with [fluid]");
       const toml::node* lv = r.node(cf, "rd.coarse_to_fine.", "levels");
       R.coarseLevels = int(r.integer(cf, "rd.coarse_to_fine.", "levels", 2, 1, 8));
       R.coarseSteps = r.integer(cf, "rd.coarse_to_fine.", "steps", 1000, 0, 1'000'000'000);
@@ -707,24 +731,44 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
         R.perturb.push_back({int(k), r.number(pp, "rd.perturb.", in.parameters[k].name, 0.0, 0, 100)});
   }
 
+  // [coupling]: how the fluid carries the layer.
+  if (const toml::table* ct = r.table(root, "", "coupling")) {
+    if (!s.rd.enabled || !s.hasFluid)
+      r.fail(ct, "coupling", "[coupling] joins a [fluid] and an [rd] layer, and this scene lacks one of them",
+             "add the missing table or drop [coupling]");
+  }
+  if (s.rd.enabled && s.hasFluid) {
+    const toml::table* ct = r.table(root, "", "coupling");
+    CouplingScene& C = s.coupling;
+    C.enabled = true;
+    C.mode = r.string(ct, "coupling.", "mode", "ard", {"ard", "passive", "rd-only"});
+    C.interpolation = r.string(ct, "coupling.", "interpolation", "linear", {"linear", "cubic"});
+    C.rdTimeScale = r.number(ct, "coupling.", "rd_time_scale", 1.0, 0, 1e9, true);
+    const size_t n = species.size();
+    C.inflowValues = r.numbers(ct, "coupling.", "inflow_values", s.rd.initial.values, n, n, -1e12, 1e12);
+    C.solidValues = r.numbers(ct, "coupling.", "solid_values", std::vector<double>(n, 0.0), n, n, -1e12, 1e12);
+  }
+
   // Every spatial field is finite on the grid, and every fixed region holds a cell.
   if (s.rd.enabled) {
+    std::vector<double> rres;
+    for (int v : s.rd.settings.resolution) rres.push_back(v);
     auto check = [&](const SceneField& f, bool region, bool positive = false) {
-      const std::vector<double> v = D == 2 ? sampleSpatialField<2>(f.field, IVec<2>(int(res[0]), int(res[1])))
-                                           : sampleSpatialField<3>(f.field, IVec<3>(int(res[0]), int(res[1]), int(res[2])));
+      const std::vector<double> v = D == 2 ? sampleSpatialField<2>(f.field, IVec<2>(int(rres[0]), int(rres[1])))
+                                           : sampleSpatialField<3>(f.field, IVec<3>(int(rres[0]), int(rres[1]), int(rres[2])));
       size_t inside = 0;
       for (size_t i = 0; i < v.size(); ++i) {
         if (!std::isfinite(v[i])) {
           std::ostringstream c;
-          c << "the field is not finite at cell (" << i % size_t(res[0]) << ", " << (i / size_t(res[0])) % size_t(res[1]);
-          if (D == 3) c << ", " << i / size_t(res[0] * res[1]);
+          c << "the field is not finite at cell (" << i % size_t(rres[0]) << ", " << (i / size_t(rres[0])) % size_t(rres[1]);
+          if (D == 3) c << ", " << i / size_t(rres[0] * rres[1]);
           throw UserError(f.where, f.key, c.str() + ")", "guard divisions and logarithms, e.g. 1 / max(r, 1e-6)");
         }
         if (positive && !(v[i] > 0.0)) {
           std::ostringstream c;
           c << "a principal diffusivity must be > 0 (the tensor positive definite), but it is " << v[i]
-            << " at cell (" << i % size_t(res[0]) << ", " << (i / size_t(res[0])) % size_t(res[1]);
-          if (D == 3) c << ", " << i / size_t(res[0] * res[1]);
+            << " at cell (" << i % size_t(rres[0]) << ", " << (i / size_t(rres[0])) % size_t(rres[1]);
+          if (D == 3) c << ", " << i / size_t(rres[0] * rres[1]);
           throw UserError(f.where, f.key, c.str() + ")", "keep lambda1 and lambda2 positive everywhere, e.g. max(..., 0.1)");
         }
         inside += v[i] != 0.0;
@@ -756,7 +800,11 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
       r.fail(r.node(out, "output.", k), std::string("output.") + k,
              "this build of morphoflow does not write " + std::string(k) + " yet", "set it to false");
   }
-  if (s.rd.enabled)
+  if (s.rd.enabled && s.hasFluid) {
+    std::vector<std::string> choices = species;
+    for (const char* f : {"speed", "vorticity", "dye", "pressure"}) choices.push_back(f);
+    s.output.field = r.string(out, "output.", "field", species.front(), choices);
+  } else if (s.rd.enabled)
     s.output.field = r.string(out, "output.", "field", species.front(), species);
   else
     s.output.field = r.string(out, "output.", "field", "vorticity", {"speed", "vorticity", "dye", "pressure"});

@@ -1,0 +1,36 @@
+#include "coupling/ard_solver.h"
+
+#include <stdexcept>
+
+namespace morphoflow {
+
+template <int D>
+ARDSolver<D>::ARDSolver(RDSolver<D>* rd, ChemicalAdvector<D> advector, CouplingMode mode, double rdTimeScale)
+    : rd_(rd), advector_(std::move(advector)), mode_(mode), rdTimeScale_(rdTimeScale) {
+  if (!(rdTimeScale > 0)) throw std::invalid_argument("coupling: the reaction-diffusion time scale must be > 0");
+  if (advector_.domain().cells != rd->cells()) throw std::invalid_argument("coupling: advection and RD grids differ");
+  advector_.emptySolids(species());
+}
+
+template <int D>
+std::vector<Grid<double, D>*> ARDSolver<D>::species() {
+  std::vector<Grid<double, D>*> s;
+  for (int k = 0; k < rd_->species(); ++k) s.push_back(&rd_->field(k));
+  return s;
+}
+
+template <int D>
+void ARDSolver<D>::step(double dt, const MacVelocity<D>& u) {
+  if (mode_ != CouplingMode::Passive) {
+    rd_->step(rdTimeScale_ * dt);       // eq. 6 then eq. 13: implicit reaction, implicit diffusion
+    advector_.emptySolids(species());   // obstacles hold no chemical
+  }
+  if (mode_ != CouplingMode::RDOnly) advector_.advect(u, dt, species());  // eq. 19-20
+  time_ += dt;
+  ++steps_;
+}
+
+template class ARDSolver<2>;
+template class ARDSolver<3>;
+
+}  // namespace morphoflow

@@ -1,0 +1,63 @@
+// Semi-Lagrangian advection of reaction-diffusion species by a fluid velocity
+// (seed 001 sec. 5, eq. 18-20): every RD cell centre x is traced back through
+// the fluid's MAC velocity, x* = x - dt u(x - dt/2 u(x)) (midpoint), and takes
+// the species' value at x*. The RD grid may have another resolution than the
+// fluid grid: the velocity is sampled at RD cell centres in world space.
+//
+// Interpolation is linear (eq. 20) or cubic (Catmull-Rom per axis, clamped to
+// the 2^D linear neighbours so it adds no new extrema). Feet beyond a wall are
+// clamped to it; periodic axes wrap. Past the outermost cell centre of an
+// inflow side the value blends linearly into the inflow concentration, which
+// it takes at the wall and beyond (chemical flowing in, seed 001 fig. 6);
+// solid (obstacle) cells hold the solid values (no chemical).
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "core/grid.h"
+#include "core/mac_velocity.h"
+
+namespace morphoflow {
+
+enum class ChemicalInterpolation { Linear, Cubic };
+
+template <int D>
+struct ChemicalDomain {
+  IVec<D> cells{0};                       // the RD grid
+  double h = 1.0;                         // its cell size (same world units as the fluid)
+  std::array<bool, D> periodic{};         // wrap back-traces along these axes
+  std::array<std::array<bool, 2>, D> inflow{};  // sides (lo, hi) that bring in chemical
+  std::vector<double> inflowValues;       // per species, at inflow sides
+  std::vector<uint8_t> solid;             // per RD cell (empty: none)
+  std::vector<double> solidValues;        // per species, inside solids
+};
+
+template <int D>
+class ChemicalAdvector {
+ public:
+  ChemicalAdvector(ChemicalDomain<D> domain, ChemicalInterpolation interpolation);
+
+  // species[s] <- species[s](x*) for every RD cell; deterministic for any
+  // thread count (every cell is computed independently).
+  void advect(const MacVelocity<D>& u, double dt, const std::vector<Grid<double, D>*>& species);
+  // Sets the solid cells of every species to the solid values.
+  void emptySolids(const std::vector<Grid<double, D>*>& species) const;
+
+  const ChemicalDomain<D>& domain() const { return domain_; }
+
+ private:
+  ChemicalDomain<D> domain_;
+  ChemicalInterpolation interpolation_;
+  std::vector<Vec<D>> feet_;       // foot of every cell (grid coordinates)
+  std::vector<double> fromInflow_;  // weight of the inflow value (1: the foot left through an inflow side)
+  Grid<double, D> scratch_;
+};
+
+// Value of g at continuous grid coordinate c (cell centres at integers),
+// linear or clamped Catmull-Rom, wrapping periodic axes and clamping others.
+template <int D>
+double sampleChemical(const Grid<double, D>& g, const std::array<bool, D>& periodic, const Vec<D>& c,
+                      ChemicalInterpolation interpolation);
+
+}  // namespace morphoflow
