@@ -45,9 +45,10 @@ bool readFieldDump(const std::string& path, FieldDump* d, std::string* error) {
   const int nc = spec.nchannels;
   d->resolution = {spec.width, spec.height};
   if (const OIIO::ParamValue* r = spec.find_attribute("morphoflow:resolution");
-      r && r->type().basetype == OIIO::TypeDesc::INT && (r->type().arraylen == 2 || r->type().arraylen == 3)) {
+      r && r->type().basetype == OIIO::TypeDesc::INT && (r->type().basevalues() == 2 || r->type().basevalues() == 3)) {
+    // OpenEXR keeps int[2] / int[3] as its V2i / V3i vectors: count base values.
     const int* v = static_cast<const int*>(r->data());
-    std::vector<int> res(v, v + r->type().arraylen);
+    std::vector<int> res(v, v + r->type().basevalues());
     const long cells = long(res[0]) * res[1] * (res.size() > 2 ? res[2] : 1);
     if (res[0] == spec.width && cells == long(spec.width) * spec.height) d->resolution = res;
   }

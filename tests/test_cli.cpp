@@ -112,7 +112,12 @@ INSTANTIATE_TEST_SUITE_P(
         BadScene{"rd_anisotropy_direction", "[rd]\nmodel = \"brusselator\"\n[rd.anisotropy]\ndirection = [\"x\"]\n",
                  "4:13", "array of 2 fields"},
         BadScene{"rd_anisotropy_shape_species", "[rd]\nmodel = \"brusselator\"\n[rd.anisotropy]\nshape = 0.2\nshape_species = \"c\"\n",
-                 "5:17", "is not one of"}),
+                 "5:17", "is not one of"},
+        BadScene{"coupling_without_rd", "[fluid]\nreynolds = 100\n[coupling]\nmode = \"ard\"\n", "3:1", "lacks one of them"},
+        BadScene{"coupling_bad_mode", "[fluid]\nreynolds = 100\n[rd]\nmodel = \"gray-scott\"\n[coupling]\nmode = \"pasive\"\n",
+                 "6:8", "did you mean 'passive'"},
+        BadScene{"coupling_boundary_mismatch", "[fluid]\nreynolds = 100\n[rd]\nmodel = \"gray-scott\"\nboundary = \"periodic\"\n",
+                 "5:12", "must wrap exactly where the fluid does"}),
     [](const ::testing::TestParamInfo<BadScene>& i) { return i.param.name; });
 
 TEST(Cli, MissingFileAndBadOverrideExitTwo) {
@@ -175,6 +180,40 @@ TEST(Cli, ShippedScenesValidate) {
     CommandResult r = runMorphoflow("validate " + sceneFile(s));
     EXPECT_EQ(r.status, 0) << s << ": " << r.output;
   }
+}
+
+// Every shipped coupled scene validates, and runs at low resolution with
+// both backends to the same float dumps of its species (the RD grid may differ
+// from the fluid's).
+TEST(Cli, CoupledScenesRunAndBackendsAgree) {
+  auto dir = tempDir("coupled");
+  for (const char* s : {"cavity_gray_scott.toml", "cavity_passive.toml", "cavity_barkley.toml", "obstacle_gray_scott.toml",
+                        "cavity_gray_scott_3d.toml"}) {
+    const std::string file = sceneFile(std::string("coupled/") + s);
+    CommandResult v = runMorphoflow("validate " + file);
+    EXPECT_EQ(v.status, 0) << s << ": " << v.output;
+    const bool obstacle = std::string(s).find("obstacle") != std::string::npos;
+    const bool threeD = std::string(s).find("3d") != std::string::npos;
+    const std::string res = threeD ? "[12,12,12]" : obstacle ? "[220,41]" : "[32,32]";
+    const std::string rdRes = threeD ? "[12,12,12]" : obstacle ? "[220,41]" : "[48,48]";
+    std::vector<morphoflow::FieldDump> dumps;
+    for (std::string b : {"serial", "tbb"}) {
+      const fs::path out = dir / (std::string(s) + b);
+      CommandResult r = runMorphoflow("run " + file + " --set grid.resolution=" + res + " --set rd.resolution=" + rdRes +
+                                      " --set time.steps=12 --set output.every=6 --set output.fields=true --backend " + b +
+                                      " --quiet --out " + out.string());
+      ASSERT_EQ(r.status, 0) << s << ": " << r.output;
+      morphoflow::FieldDump d;
+      std::string err;
+      ASSERT_TRUE(morphoflow::readFieldDump((out / "fields" / "000002.exr").string(), &d, &err)) << err;
+      dumps.push_back(d);
+      nlohmann::json j = nlohmann::json::parse(std::ifstream(out / "run.json"));
+      EXPECT_GT(j["coupling"]["fluid_seconds"].get<double>(), 0.0);
+    }
+    EXPECT_EQ(dumps[0].channels, dumps[1].channels) << s;
+    EXPECT_EQ(dumps[0].resolution.size(), threeD ? 3u : 2u);
+  }
+  fs::remove_all(dir);
 }
 
 TEST(Cli, ThreeDScenesRunAtLowResolution) {
