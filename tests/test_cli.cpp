@@ -187,7 +187,8 @@ TEST(Cli, ShippedScenesValidate) {
 // from the fluid's).
 TEST(Cli, CoupledScenesRunAndBackendsAgree) {
   auto dir = tempDir("coupled");
-  for (const char* s : {"cavity_gray_scott.toml", "cavity_passive.toml", "cavity_barkley.toml", "obstacle_gray_scott.toml",
+  for (const char* s : {"cavity_gray_scott.toml", "cavity_passive.toml", "cavity_barkley.toml", "cavity_fitzhugh_nagumo.toml",
+                        "obstacle_gray_scott.toml",
                         "cavity_gray_scott_3d.toml"}) {
     const std::string file = sceneFile(std::string("coupled/") + s);
     CommandResult v = runMorphoflow("validate " + file);
