@@ -15,6 +15,7 @@
 #include "app/frame_writer.h"
 #include "app/output_files.h"
 #include "app/rd_runner.h"
+#include "app/run_clock.h"
 #include "app/run_report.h"
 #include "core/parallel.h"
 #include "coupling/coupled_stepper.h"
@@ -56,13 +57,6 @@ ChemicalDomain<D> chemicalDomain(const Scene& scene, const FluidSolver<D>& fluid
 }
 
 template <int D>
-Grid<float, D> asFloat(const Grid<double, D>& src) {
-  Grid<float, D> f(src.dims());
-  for (size_t i = 0; i < f.size(); ++i) f[i] = float(src[i]);
-  return f;
-}
-
-template <int D>
 int run(const Scene& scene, const RunOptions& opt) {
   const ReactionModel& model = *findModel(scene.rd.settings.model);
   FluidSolver<D> fluid(scene.fluid);
@@ -91,10 +85,10 @@ int run(const Scene& scene, const RunOptions& opt) {
     if (frame < 0) return;
     checkFinite(rd, fmt::format("at step {}", step));
     if (twoSpecies) {
-      const Grid<float, D> green = asFloat(rd.field(1));
-      frames.write<D>(frame, asFloat(rd.field(0)), false, &green);
+      const Grid<float, D> green = toFloat<D>(rd.field(1));
+      frames.write<D>(frame, toFloat<D>(rd.field(0)), false, &green);
     } else if (showSpecies) {
-      frames.write<D>(frame, asFloat(rd.field(int(shownIt - names.begin()))), false);
+      frames.write<D>(frame, toFloat<D>(rd.field(int(shownIt - names.begin()))), false);
     } else {
       const std::string& f = scene.output.field;
       frames.write<D>(frame, f == "speed" ? speedField(fluid) : f == "dye" ? fluid.dye() : f == "pressure" ? fluid.pressure()
@@ -103,26 +97,24 @@ int run(const Scene& scene, const RunOptions& opt) {
     }
     if (scene.output.fields) {
       std::vector<Grid<float, D>> all;
-      for (int s = 0; s < rd.species(); ++s) all.push_back(asFloat(rd.field(s)));
+      for (int s = 0; s < rd.species(); ++s) all.push_back(toFloat<D>(rd.field(s)));
       frames.writeFields<D>(frame, names, all, fluid.time(), step);
     }
   };
 
-  const long steps = scene.time.steps > 0 ? scene.time.steps : std::numeric_limits<long>::max();
+  // With a duration and adaptive dt the step count is not known up front:
+  // run until the end time (stepsEstimate is then only for progress).
+  const RunClock clock(scene.time);
   const long stepsEstimate = scene.totalSteps();
-  const double endTime = scene.time.steps > 0 ? 1e300 : scene.time.duration;
   const auto wall0 = std::chrono::steady_clock::now();
   double fluidSeconds = 0, ardSeconds = 0, stepSeconds = 0;
   long pressureIterations = 0, diffusionIterations = 0;
   int unconverged = 0;
   writeFrame(0);
   long step = 0;
-  for (; step < steps && fluid.time() < endTime - 1e-12; ++step) {
+  for (; clock.running(step, fluid.time()); ++step) {
     if (opt.lastFrame >= 0 && step >= long(opt.lastFrame + 1) * scene.output.every) break;
-    double dt = scene.time.dt;
-    if (scene.time.cfl > 0) dt = fluid.cflTimeStep(scene.time.cfl, scene.time.dt);
-    if (scene.time.steps == 0) dt = std::min(dt, endTime - fluid.time());
-    stepper.step(dt);
+    stepper.step(clock.dt(fluid));
     fluidSeconds += stepper.fluidSeconds();
     ardSeconds += stepper.ardSeconds();
     stepSeconds += stepper.stepSeconds();

@@ -193,12 +193,7 @@ int run(const Scene& scene, const RunOptions& opt) {
   const int shown = int(std::find(names.begin(), names.end(), scene.output.field) - names.begin());
   const long steps = scene.totalSteps();
   const bool twoSpecies = scene.output.colormap == kTwoSpeciesPalette;
-  auto asFloat = [&](int s) {
-    const Grid<double, D>& src = rd.field(s);
-    Grid<float, D> f(src.dims());
-    for (size_t i = 0; i < f.size(); ++i) f[i] = float(src[i]);
-    return f;
-  };
+  auto asFloat = [&](int s) { return toFloat<D>(rd.field(s)); };
   auto writeFrame = [&](long step) {
     long frame = frames.frameAt(step);
     if (frame < 0) return;

@@ -19,5 +19,12 @@ template <int D>
 void applyScene(const Scene& scene, RDSolver<D>* rd);
 template <int D>
 void checkFinite(const RDSolver<D>& rd, const std::string& where);
+// A species as floats, for frames and dumps.
+template <int D>
+Grid<float, D> toFloat(const Grid<double, D>& src) {
+  Grid<float, D> f(src.dims());
+  for (size_t i = 0; i < f.size(); ++i) f[i] = float(src[i]);
+  return f;
+}
 
 }  // namespace morphoflow

@@ -16,6 +16,7 @@
 #include "app/output_files.h"
 #include "app/rd_runner.h"
 #include "app/run_options.h"
+#include "app/run_clock.h"
 #include "app/run_report.h"
 #include "core/error.h"
 #include "core/parallel.h"
@@ -65,10 +66,9 @@ int run(const Scene& scene, const RunOptions& opt) {
   FluidSolver<D> fluid(scene.fluid);
   initialiseDye<D>(scene, &fluid);
   // With a duration and adaptive dt the step count is not known up front:
-  // run until the end time (steps is then only an estimate for progress).
-  const long steps = scene.time.steps > 0 ? scene.time.steps : std::numeric_limits<long>::max();
+  // run until the end time (stepsEstimate is then only for progress).
+  const RunClock clock(scene.time);
   const long stepsEstimate = scene.totalSteps();
-  const double endTime = scene.time.steps > 0 ? 1e300 : scene.time.duration;
   const auto wall0 = std::chrono::steady_clock::now();
 
   std::array<double, FluidStepStats::kStages> stageTotals{};
@@ -99,12 +99,9 @@ int run(const Scene& scene, const RunOptions& opt) {
 
   writeFrame(0);
   long step = 0;
-  for (; step < steps && fluid.time() < endTime - 1e-12; ++step) {
+  for (; clock.running(step, fluid.time()); ++step) {
     if (opt.lastFrame >= 0 && step >= long(opt.lastFrame + 1) * scene.output.every) break;
-    double dt = scene.time.dt;
-    if (scene.time.cfl > 0) dt = fluid.cflTimeStep(scene.time.cfl, scene.time.dt);
-    if (scene.time.steps == 0) dt = std::min(dt, endTime - fluid.time());
-    fluid.step(dt);
+    fluid.step(clock.dt(fluid));
     const FluidStepStats& st = fluid.lastStats();
     for (int k = 0; k < FluidStepStats::kStages; ++k) stageTotals[size_t(k)] += st.seconds[size_t(k)];
     pressureIterations += st.pressure.iterations;

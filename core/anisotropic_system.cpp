@@ -64,14 +64,12 @@ AnisotropicSystem<D> AnisotropicSystem<D>::fromTensor(const IVec<D>& dims, const
     for (int p = 0; p < kPlanes; ++p) {
       const int a = planeAxis(p, 0), b = planeAxis(p, 1);
       const double* sab = sigma[size_t(D + p)];
-      bool in = true;
-      size_t ia = shiftedIndex<D>(dims, periodic, c, unit<D>(a), &in);
-      size_t ib = shiftedIndex<D>(dims, periodic, c, unit<D>(b), &in);
-      s.up[size_t(p)][i] = in ? float(0.25 * (sab[ia] + sab[ib])) : 0.0f;
-      in = true;
-      ia = shiftedIndex<D>(dims, periodic, c, unit<D>(a), &in);
-      ib = shiftedIndex<D>(dims, periodic, c, unit<D>(b, -1), &in);
-      s.down[size_t(p)][i] = in ? float(-0.25 * (sab[ia] + sab[ib])) : 0.0f;
+      bool inA = true, inUp = true, inDown = true;
+      const size_t ia = shiftedIndex<D>(dims, periodic, c, unit<D>(a), &inA);
+      const size_t ibUp = shiftedIndex<D>(dims, periodic, c, unit<D>(b), &inUp);
+      const size_t ibDown = shiftedIndex<D>(dims, periodic, c, unit<D>(b, -1), &inDown);
+      s.up[size_t(p)][i] = inA && inUp ? float(0.25 * (sab[ia] + sab[ibUp])) : 0.0f;
+      s.down[size_t(p)][i] = inA && inDown ? float(-0.25 * (sab[ia] + sab[ibDown])) : 0.0f;
     }
   });
   s.axis.finalize();

@@ -11,23 +11,12 @@
 // output does not depend on the backend or the thread count.
 #pragma once
 
-#include <string>
-#include <vector>
-
 #include "coupling/ard_solver.h"
 #include "fluid/fluid_solver.h"
 
 namespace morphoflow {
 
 enum class CouplingBackend { Serial, TBB };
-
-// One timed stage on one thread (for Chrome trace-event JSON).
-struct TraceEvent {
-  std::string name;
-  int thread = 0;       // a small stable id per OS thread
-  double begin = 0.0;   // seconds since the stepper was made
-  double end = 0.0;
-};
 
 template <int D>
 class CoupledStepper {
@@ -40,9 +29,6 @@ class CoupledStepper {
   double fluidSeconds() const { return fluidSeconds_; }
   double ardSeconds() const { return ardSeconds_; }
   double stepSeconds() const { return stepSeconds_; }
-  // Collect trace events (stages per thread) from now on.
-  void enableTrace() { tracing_ = true; }
-  const std::vector<TraceEvent>& trace() const { return trace_; }
 
  private:
   FluidSolver<D>* fluid_;
@@ -50,12 +36,6 @@ class CoupledStepper {
   CouplingBackend backend_;
   MacVelocity<D> velocityN_;  // the second velocity buffer: what the ARD step reads
   double fluidSeconds_ = 0, ardSeconds_ = 0, stepSeconds_ = 0;
-  bool tracing_ = false;
-  std::vector<TraceEvent> trace_;
-  double origin_;
 };
-
-// Writes trace events as Chrome trace-event JSON (chrome://tracing, Perfetto).
-std::string traceJson(const std::vector<TraceEvent>& events);
 
 }  // namespace morphoflow

@@ -570,17 +570,21 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
     const std::string ls = r.string(rdt, "rd.", "linear_solver", "mgpcg", {"mgpcg", "icpcg"});
     st.linearSolver = ls == "icpcg" ? RDLinearSolver::ICPCG : RDLinearSolver::MGPCG;
     st.tolerance = r.number(rdt, "rd.", "tolerance", 1e-8, 0, 1, true);
-    if (const toml::node* fr = r.node(rdt, "rd.", "frozen")) {
-      const toml::array* arr = fr->as_array();
-      if (!arr) r.fail(fr, "rd.frozen", "expected an array of species names");
-      for (const toml::node& e : *arr) {
+    // An array of species names, as indices (rd.frozen, fixed regions, anisotropy).
+    auto speciesList = [&](const toml::node* sp, const std::string& key, bool allowEmpty) {
+      std::vector<int> out;
+      const toml::array* sa = sp->as_array();
+      if (!sa || (sa->empty() && !allowEmpty))
+        r.fail(sp, key, "expected an array of species names", "species: " + join(species));
+      for (const toml::node& e : *sa) {
         auto v = e.value<std::string>();
-        auto it = v ? std::find(species.begin(), species.end(), *v) : species.end();
-        if (it == species.end())
-          r.fail(&e, "rd.frozen", "expected species names of " + model + ": " + join(species));
-        st.frozen.push_back(int(it - species.begin()));
+        auto f = v ? std::find(species.begin(), species.end(), *v) : species.end();
+        if (f == species.end()) r.fail(&e, key, "expected species names of " + model + ": " + join(species));
+        out.push_back(int(f - species.begin()));
       }
-    }
+      return out;
+    };
+    if (const toml::node* fr = r.node(rdt, "rd.", "frozen")) st.frozen = speciesList(fr, "rd.frozen", true);
     // [rd.parameters]: uniform values by name.
     const toml::table* pt = r.table(*rdt, "rd.", "parameters");
     for (const ParameterInfo& p : in.parameters)
@@ -645,14 +649,7 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
         RDFixedRegion fr;
         fr.where = r.field(w, p + "where", sceneDir);
         if (const toml::node* sp = r.node(t, p, "species")) {
-          const toml::array* sa = sp->as_array();
-          if (!sa || sa->empty()) r.fail(sp, p + "species", "expected an array of species names", "species: " + join(species));
-          for (const toml::node& e : *sa) {
-            auto v = e.value<std::string>();
-            auto f = v ? std::find(species.begin(), species.end(), *v) : species.end();
-            if (f == species.end()) r.fail(&e, p + "species", "expected species names of " + model + ": " + join(species));
-            fr.species.push_back(int(f - species.begin()));
-          }
+          fr.species = speciesList(sp, p + "species", false);
         } else {
           for (size_t q = 0; q < n; ++q) fr.species.push_back(int(q));
         }
@@ -692,16 +689,7 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
       } else {
         A.theta = fieldOr("theta", "0");
       }
-      if (const toml::node* sp = r.node(an, p, "species")) {
-        const toml::array* sa = sp->as_array();
-        if (!sa || sa->empty()) r.fail(sp, p + "species", "expected an array of species names", "species: " + join(species));
-        for (const toml::node& e : *sa) {
-          auto v = e.value<std::string>();
-          auto f = v ? std::find(species.begin(), species.end(), *v) : species.end();
-          if (f == species.end()) r.fail(&e, p + "species", "expected species names of " + model + ": " + join(species));
-          A.species.push_back(int(f - species.begin()));
-        }
-      }
+      if (const toml::node* sp = r.node(an, p, "species")) A.species = speciesList(sp, p + "species", false);
       A.shape = r.number(an, p, "shape", 0.0, -1e6, 1e6);
       const std::string ss = r.string(an, p, "shape_species", species.front(), species);
       A.shapeSpecies = int(std::find(species.begin(), species.end(), ss) - species.begin());
@@ -757,20 +745,21 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
       const std::vector<double> v = D == 2 ? sampleSpatialField<2>(f.field, IVec<2>(int(rres[0]), int(rres[1])))
                                            : sampleSpatialField<3>(f.field, IVec<3>(int(rres[0]), int(rres[1]), int(rres[2])));
       size_t inside = 0;
+      auto cell = [&](size_t i) {
+        std::ostringstream c;
+        c << "cell (" << i % size_t(rres[0]) << ", " << (i / size_t(rres[0])) % size_t(rres[1]);
+        if (D == 3) c << ", " << i / size_t(rres[0] * rres[1]);
+        return c.str() + ")";
+      };
       for (size_t i = 0; i < v.size(); ++i) {
-        if (!std::isfinite(v[i])) {
-          std::ostringstream c;
-          c << "the field is not finite at cell (" << i % size_t(rres[0]) << ", " << (i / size_t(rres[0])) % size_t(rres[1]);
-          if (D == 3) c << ", " << i / size_t(rres[0] * rres[1]);
-          throw UserError(f.where, f.key, c.str() + ")", "guard divisions and logarithms, e.g. 1 / max(r, 1e-6)");
-        }
-        if (positive && !(v[i] > 0.0)) {
-          std::ostringstream c;
-          c << "a principal diffusivity must be > 0 (the tensor positive definite), but it is " << v[i]
-            << " at cell (" << i % size_t(rres[0]) << ", " << (i / size_t(rres[0])) % size_t(rres[1]);
-          if (D == 3) c << ", " << i / size_t(rres[0] * rres[1]);
-          throw UserError(f.where, f.key, c.str() + ")", "keep lambda1 and lambda2 positive everywhere, e.g. max(..., 0.1)");
-        }
+        if (!std::isfinite(v[i]))
+          throw UserError(f.where, f.key, "the field is not finite at " + cell(i),
+                          "guard divisions and logarithms, e.g. 1 / max(r, 1e-6)");
+        if (positive && !(v[i] > 0.0))
+          throw UserError(f.where, f.key,
+                          "a principal diffusivity must be > 0 (the tensor positive definite), but it is " +
+                              (std::ostringstream() << v[i]).str() + " at " + cell(i),
+                          "keep lambda1 and lambda2 positive everywhere, e.g. max(..., 0.1)");
         inside += v[i] != 0.0;
       }
       if (region && inside == 0)
