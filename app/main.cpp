@@ -99,6 +99,7 @@ int main(int argc, char** argv) {
   benchCmd->add_option("--size", bench.size, "only grids of this many cells per axis");
   benchCmd->add_option("--json", bench.json, "also write results as JSON");
   benchCmd->add_option("--seconds", bench.minSeconds, "minimum timed seconds per case");
+  benchCmd->add_option("--trace", bench.trace, "coupling: write a Chrome trace-event JSON of the stages per thread");
 
   AnalyzeOptions analyze;
   CLI::App* analyzeCmd = app.add_subcommand("analyze", "variogram and regularity REG of an image or field dump (seed 003)");
@@ -217,6 +218,8 @@ int main(int argc, char** argv) {
       return textonCommand(texton);
     }
     if (*benchCmd) {
+      if (!bench.trace.empty() && suite != "coupling")
+        throw UserError({"--trace", 0, 0}, "", "only the coupling suite writes a trace", "drop --trace or run `bench coupling`");
       if (!runBenchSuite(suite, bench))
         throw UserError({"bench", 0, 0}, "", "unknown suite '" + suite + "'", std::string("suites: ") + benchSuiteNames());
       return 0;

@@ -9,6 +9,7 @@ struct BenchOptions {
   int size = 0;            // 0 = the suite's full list of sizes
   std::string json;        // write results here when not empty
   double minSeconds = 1.0; // time each case for at least this long (after warm-up)
+  std::string trace;       // coupling: write a Chrome trace of the stages here
 };
 
 // Runs the named suite; returns false when the suite does not exist.

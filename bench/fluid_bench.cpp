@@ -79,14 +79,16 @@ bool runFluidBench(const BenchOptions& o) {
   return true;
 }
 
-bool runRDBench(const BenchOptions& o);  // rd_bench.cpp
+bool runRDBench(const BenchOptions& o);        // rd_bench.cpp
+bool runCouplingBench(const BenchOptions& o);  // coupling_bench.cpp
 
 bool runBenchSuite(const std::string& suite, const BenchOptions& o) {
   if (suite == "fluid") return runFluidBench(o);
   if (suite == "rd") return runRDBench(o);
+  if (suite == "coupling") return runCouplingBench(o);
   return false;
 }
 
-const char* benchSuiteNames() { return "fluid, rd"; }
+const char* benchSuiteNames() { return "fluid, rd, coupling"; }
 
 }  // namespace morphoflow

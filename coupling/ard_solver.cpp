@@ -2,6 +2,8 @@
 
 #include <stdexcept>
 
+#include "core/stage_trace.h"
+
 namespace morphoflow {
 
 template <int D>
@@ -21,11 +23,14 @@ std::vector<Grid<double, D>*> ARDSolver<D>::species() {
 
 template <int D>
 void ARDSolver<D>::step(double dt, const MacVelocity<D>& u) {
+  const double t0 = traceClock();
   if (mode_ != CouplingMode::Passive) {
     rd_->step(rdTimeScale_ * dt);       // eq. 6 then eq. 13: implicit reaction, implicit diffusion
     advector_.emptySolids(species());   // obstacles hold no chemical
   }
+  const double t1 = traceClock();
   if (mode_ != CouplingMode::RDOnly) advector_.advect(u, dt, species());  // eq. 19-20
+  stageSeconds_ = {t1 - t0, traceClock() - t1};
   time_ += dt;
   ++steps_;
 }

@@ -5,6 +5,8 @@
 // advection only, or reaction-diffusion only.
 #pragma once
 
+#include <array>
+
 #include "coupling/chemical_advection.h"
 #include "rd/rd_solver.h"
 
@@ -28,6 +30,10 @@ class ARDSolver {
   CouplingMode mode() const { return mode_; }
   double time() const { return time_; }
   long steps() const { return steps_; }
+  // Wall seconds of the last step's two stages, run one after the other.
+  static constexpr int kStages = 2;
+  static constexpr const char* kStageNames[kStages] = {"reaction-diffusion", "advect chemicals"};
+  const std::array<double, kStages>& stageSeconds() const { return stageSeconds_; }
 
  private:
   std::vector<Grid<double, D>*> species();
@@ -38,6 +44,7 @@ class ARDSolver {
   double rdTimeScale_;
   double time_ = 0.0;
   long steps_ = 0;
+  std::array<double, kStages> stageSeconds_{};
 };
 
 }  // namespace morphoflow

@@ -1,15 +1,20 @@
 #include "coupling/coupled_stepper.h"
 
-#include <chrono>
-
 #include <tbb/task_group.h>
 
 namespace morphoflow {
 
 namespace {
 
-double now() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+// Records stages that ran back to back from `begin` on the calling thread.
+template <size_t N>
+void recordStages(StageTrace* trace, const char* category, const char* const (&names)[N],
+                  const std::array<double, N>& seconds, double begin) {
+  if (!trace) return;
+  for (size_t k = 0; k < N; ++k) {
+    trace->record(names[k], category, begin, begin + seconds[k]);
+    begin += seconds[k];
+  }
 }
 
 }  // namespace
@@ -20,16 +25,22 @@ CoupledStepper<D>::CoupledStepper(FluidSolver<D>* fluid, ARDSolver<D>* ard, Coup
 
 template <int D>
 void CoupledStepper<D>::step(double dt) {
-  const double t0 = now();
+  const double t0 = traceClock();
   // Velocity n for the ARD step, copied before the fluid writes velocity n + 1.
   for (int a = 0; a < D; ++a) velocityN_[a].values() = fluid_->velocity()[a].values();
-  auto timed = [&](double* seconds, auto&& fn) {
-    const double b = now();
-    fn();
-    *seconds = now() - b;
+  if (trace_) trace_->record("copy velocity", "coupling", t0, traceClock());
+  auto fluidStep = [&] {
+    const double b = traceClock();
+    fluid_->step(dt);
+    fluidSeconds_ = traceClock() - b;
+    recordStages(trace_, "fluid", FluidStepStats::kStageNames, fluid_->lastStats().seconds, b);
   };
-  auto fluidStep = [&] { timed(&fluidSeconds_, [&] { fluid_->step(dt); }); };
-  auto ardStep = [&] { timed(&ardSeconds_, [&] { ard_->step(dt, velocityN_); }); };
+  auto ardStep = [&] {
+    const double b = traceClock();
+    ard_->step(dt, velocityN_);
+    ardSeconds_ = traceClock() - b;
+    recordStages(trace_, "ard", ARDSolver<D>::kStageNames, ard_->stageSeconds(), b);
+  };
   if (backend_ == CouplingBackend::Serial) {
     fluidStep();
     ardStep();
@@ -39,7 +50,7 @@ void CoupledStepper<D>::step(double dt) {
     ardStep();
     group.wait();
   }
-  stepSeconds_ = now() - t0;
+  stepSeconds_ = traceClock() - t0;
 }
 
 template class CoupledStepper<2>;

@@ -11,6 +11,7 @@
 // output does not depend on the backend or the thread count.
 #pragma once
 
+#include "core/stage_trace.h"
 #include "coupling/ard_solver.h"
 #include "fluid/fluid_solver.h"
 
@@ -30,12 +31,17 @@ class CoupledStepper {
   double ardSeconds() const { return ardSeconds_; }
   double stepSeconds() const { return stepSeconds_; }
 
+  // Records every later step's stages (the velocity copy, the fluid's four,
+  // the ARD's two) on the thread that ran each, into `trace` (null: stop).
+  void setTrace(StageTrace* trace) { trace_ = trace; }
+
  private:
   FluidSolver<D>* fluid_;
   ARDSolver<D>* ard_;
   CouplingBackend backend_;
   MacVelocity<D> velocityN_;  // the second velocity buffer: what the ARD step reads
   double fluidSeconds_ = 0, ardSeconds_ = 0, stepSeconds_ = 0;
+  StageTrace* trace_ = nullptr;
 };
 
 }  // namespace morphoflow

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <random>
 #include <regex>
+#include <set>
 
 #include <nlohmann/json.hpp>
 
@@ -386,5 +387,37 @@ TEST(Cli, TextonAndAnalyze) {
   EXPECT_EQ(runMorphoflow("analyze " + lattice + " --channel zz").status, 2);
   EXPECT_EQ(runMorphoflow("texton --out " + (dir / "x.png").string() + " -p 0.8 -q 0.8").status, 2);
   EXPECT_EQ(runMorphoflow("texton --out " + (dir / "x.txt").string()).status, 2);
+  fs::remove_all(dir);
+}
+
+// `bench coupling` prints seed 001's Table 1 and writes a Chrome trace whose
+// stages name the fluid's and the ARD's parts; bad trace requests exit 2.
+TEST(Cli, CouplingBenchWritesAChromeTrace) {
+  auto dir = tempDir("bench");
+  const fs::path trace = dir / "trace.json", table = dir / "table.json";
+  CommandResult r = runMorphoflow("bench coupling --size 32 --seconds 0 --trace " + trace.string() + " --json " +
+                                  table.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  nlohmann::json t = nlohmann::json::parse(std::ifstream(trace));
+  std::set<std::string> stages, groups;
+  for (const auto& e : t["traceEvents"]) {
+    if (e["ph"] == "X") {
+      stages.insert(e["name"].get<std::string>());
+      EXPECT_GE(e["dur"].get<double>(), 0.0);
+    }
+    if (e["name"] == "process_name") groups.insert(e["args"]["name"].get<std::string>());
+  }
+  for (const char* s : {"copy velocity", "forces", "advect", "diffuse", "project", "reaction-diffusion", "advect chemicals"})
+    EXPECT_TRUE(stages.count(s)) << s;
+  EXPECT_EQ(groups, (std::set<std::string>{"serial 32^2", "tbb 32^2"}));
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(table));
+  ASSERT_EQ(j.size(), 1u);
+  for (const char* b : {"serial", "tbb"}) {
+    const double overhead = j[0][b]["overhead"].get<double>();
+    EXPECT_NEAR(overhead, j[0][b]["ms"].get<double>() / j[0]["fluid_only_ms"].get<double>(), 1e-9);
+    EXPECT_GT(overhead, 0.0);
+  }
+  EXPECT_EQ(runMorphoflow("bench fluid --size 32 --seconds 0 --trace " + trace.string()).status, 2);
+  EXPECT_EQ(runMorphoflow("bench coupling --size 32 --seconds 0 --trace " + (dir / "no" / "t.json").string()).status, 2);
   fs::remove_all(dir);
 }

@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <set>
+#include <thread>
 
 #include "core/parallel.h"
 #include "core/random.h"
@@ -122,7 +124,8 @@ struct CoupledRun {
 };
 
 // A Gray-Scott layer in a lid-driven cavity, run with one backend.
-CoupledRun runCavity(CouplingBackend backend, int threads, int steps, double dt, int rdCells) {
+CoupledRun runCavity(CouplingBackend backend, int threads, int steps, double dt, int rdCells,
+                      StageTrace* trace = nullptr) {
   ThreadLimit limit(threads);
   FluidSolver<2> fluid(cavity(24, 400));
   RDSettings s;
@@ -143,6 +146,7 @@ CoupledRun runCavity(CouplingBackend backend, int threads, int steps, double dt,
   d.h = rd.h();
   ARDSolver<2> ard(&rd, ChemicalAdvector<2>(d, ChemicalInterpolation::Cubic), CouplingMode::ARD, 50.0);
   CoupledStepper<2> stepper(&fluid, &ard, backend);
+  stepper.setTrace(trace);
   for (int i = 0; i < steps; ++i) stepper.step(dt);
   CoupledRun r;
   for (int sp = 0; sp < 2; ++sp) r.species.push_back(rd.field(sp).values());
@@ -179,5 +183,37 @@ TEST(CoupledStepper, LargeTimeStepStaysBounded) {
   for (float v : r.velocity) {
     ASSERT_TRUE(std::isfinite(v));
     EXPECT_LT(std::abs(v), 3.0f);
+  }
+}
+
+// The trace shows the schedule: with tbb the ARD step of step n runs on
+// another thread while the fluid computes step n + 1; serial never overlaps.
+TEST(CoupledStepper, TraceShowsTheOverlap) {
+  auto overlaps = [](CouplingBackend backend, int* threads) {
+    StageTrace trace;
+    runCavity(backend, 2, 12, 0.02, 96, &trace);
+    const std::vector<StageTrace::Event> events = trace.events();
+    std::set<int> used;
+    for (const auto& e : events) used.insert(e.thread);
+    *threads = int(used.size());
+    EXPECT_EQ(events.size(), 12u * 7u);  // copy, 4 fluid stages, 2 ARD stages per step
+    int steps = 0;
+    for (size_t i = 0; i < events.size(); i += 7) {  // one step's events: copy first
+      double fluid[2] = {1e300, -1e300}, ard[2] = {1e300, -1e300};
+      for (size_t k = i + 1; k < i + 7; ++k) {
+        double* span = events[k].category == "fluid" ? fluid : ard;
+        span[0] = std::min(span[0], events[k].begin);
+        span[1] = std::max(span[1], events[k].end);
+      }
+      steps += std::max(fluid[0], ard[0]) < std::min(fluid[1], ard[1]) ? 1 : 0;
+    }
+    return steps;
+  };
+  int serialThreads = 0, tbbThreads = 0;
+  EXPECT_EQ(overlaps(CouplingBackend::Serial, &serialThreads), 0);
+  EXPECT_EQ(serialThreads, 1);
+  if (std::thread::hardware_concurrency() >= 2) {
+    EXPECT_GT(overlaps(CouplingBackend::TBB, &tbbThreads), 6);
+    EXPECT_EQ(tbbThreads, 2);
   }
 }

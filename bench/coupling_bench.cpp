@@ -1,0 +1,163 @@
+// Suite `coupling`: seed 001's Table 1 on this machine. Steps per second of
+// the fluid alone (the `fluid` suite's cavity: Re = 100, MacCormack, MGPCG
+// to 1e-6, CFL 1) and of the fluid carrying a Gray-Scott ARD layer on the
+// same grid (Kim & Lin's implicit reaction and MGPCG diffusion at ten times
+// the explicit diffusion limit, then linear semi-Lagrangian advection), with
+// the serial and tbb schedulers, all on 2 threads; the overhead ratio is
+// (fluid + ARD time) / (fluid-only time) per step, from medians.
+#include <fstream>
+#include <iostream>
+#include <optional>
+#include <vector>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "bench/bench_suites.h"
+#include "bench/bench_timing.h"
+#include "core/error.h"
+#include "core/parallel.h"
+#include "core/random.h"
+#include "core/stage_trace.h"
+#include "coupling/coupled_stepper.h"
+#include "rd/model_registry.h"
+
+namespace morphoflow {
+
+namespace {
+
+constexpr int kThreads = 2;
+
+template <int D>
+FluidSettings cavity(int n) {
+  FluidSettings s;
+  s.resolution.assign(D, n);
+  s.size.assign(D, 1.0);
+  s.viscosity = 1.0 / 100.0;
+  s.boundaries.sides[3].wallVelocity = {1.0, 0.0, 0.0};
+  s.pressureTolerance = 1e-6;
+  return s;
+}
+
+// Gray-Scott (Pearson's F = 0.04, k = 0.06) on the fluid's grid, diffusion
+// rates 0.2 h^2 and 0.1 h^2 (the `rd` suite's, per cell), Pearson's start.
+template <int D>
+RDSettings grayScott(int n) {
+  RDSettings s;
+  s.model = "gray-scott";
+  s.resolution.assign(D, n);
+  s.size.assign(D, 1.0);
+  const double h2 = 1.0 / (double(n) * n);
+  s.diffusion = {0.2 * h2, 0.1 * h2};
+  s.integrator = RDIntegrator::KimLin;
+  return s;
+}
+
+template <int D>
+void pearsonStart(RDSolver<D>* rd) {
+  const int n = rd->cells()[0];
+  forEachCell<D>(rd->cells(), [&](const IVec<D>& k, size_t i) {
+    bool inside = true;
+    for (int a = 0; a < D; ++a) inside &= std::abs((k[a] + 0.5) / n - 0.5) < 0.1;
+    rd->field(0)[i] = (inside ? 0.5 : 1.0) + 0.01 * (uniform01(1, 0, i) - 0.5);
+    rd->field(1)[i] = (inside ? 0.25 : 0.0) + 0.01 * (uniform01(1, 1, i) - 0.5);
+  });
+}
+
+constexpr int kWarmup = 3;
+
+template <int D>
+double fluidOnly(int n, double minSeconds) {
+  FluidSolver<D> f(cavity<D>(n));
+  const double dt = f.h();
+  for (int i = 0; i < kWarmup; ++i) f.step(dt);
+  return median(timeSteps(minSeconds, [&] { f.step(dt); }, [] {}));
+}
+
+struct CoupledTiming {
+  double step, fluid, ard;
+};
+
+template <int D>
+CoupledTiming fluidWithARD(int n, CouplingBackend backend, double minSeconds, StageTrace* trace) {
+  FluidSolver<D> f(cavity<D>(n));
+  RDSolver<D> rd(grayScott<D>(n), *findModel("gray-scott"));
+  pearsonStart(&rd);
+  const double dt = f.h();
+  const double rdScale = 10.0 * 0.9 * rd.explicitDiffusionLimit() / dt;
+  ChemicalDomain<D> domain;
+  domain.cells = rd.cells();
+  domain.h = rd.h();
+  ARDSolver<D> ard(&rd, ChemicalAdvector<D>(domain, ChemicalInterpolation::Linear), CouplingMode::ARD, rdScale);
+  CoupledStepper<D> stepper(&f, &ard, backend);
+  for (int i = 0; i < kWarmup; ++i) stepper.step(dt);
+  if (trace)
+    trace->beginGroup(fmt::format("{} {}^{}", backend == CouplingBackend::TBB ? "tbb" : "serial", n, D));
+  stepper.setTrace(trace);
+  std::vector<double> fluid, ardT;
+  const std::vector<double> times = timeSteps(minSeconds, [&] { stepper.step(dt); }, [&] {
+    fluid.push_back(stepper.fluidSeconds());
+    ardT.push_back(stepper.ardSeconds());
+  });
+  return {median(times), median(fluid), median(ardT)};
+}
+
+template <int D>
+nlohmann::json benchCase(int n, double minSeconds, StageTrace* trace) {
+  ThreadLimit limit(kThreads);
+  const double alone = fluidOnly<D>(n, minSeconds);
+  nlohmann::json j = {{"dim", D}, {"n", n}, {"threads", kThreads}, {"fluid_only_ms", 1e3 * alone},
+                      {"fluid_only_steps_per_second", 1.0 / alone}};
+  for (CouplingBackend b : {CouplingBackend::Serial, CouplingBackend::TBB}) {
+    const CoupledTiming t = fluidWithARD<D>(n, b, minSeconds, trace);
+    const std::string k = b == CouplingBackend::TBB ? "tbb" : "serial";
+    j[k] = {{"ms", 1e3 * t.step},
+            {"steps_per_second", 1.0 / t.step},
+            {"fluid_part_ms", 1e3 * t.fluid},
+            {"ard_part_ms", 1e3 * t.ard},
+            {"overhead", t.step / alone}};
+  }
+  return j;
+}
+
+}  // namespace
+
+bool runCouplingBench(const BenchOptions& o) {
+  const std::vector<BenchCase> cases = selectBenchCases({{2, 128}, {2, 256}, {2, 512}, {2, 1024}, {3, 64}, {3, 128}}, o.size);
+  std::optional<StageTrace> trace;
+  std::ofstream traceFile;
+  if (!o.trace.empty()) {
+    trace.emplace();
+    traceFile.open(o.trace);  // before the long run: a bad path fails at once
+    if (!traceFile)
+      throw UserError({"--trace", 0, 0}, "", "cannot write the trace to '" + o.trace + "'",
+                      "give a path in an existing, writable directory");
+  }
+  nlohmann::json all = nlohmann::json::array();
+  std::cout << fmt::format("{} threads; overhead = (fluid + ARD) / fluid only, target <= 1.10 at 512^2 and above\n",
+                           kThreads);
+  std::cout << fmt::format("{:>4} {:>6} {:>10} {:>10} {:>10} {:>10} {:>9} {:>9}\n", "dim", "n", "fluid/s", "serial/s",
+                           "tbb/s", "ms tbb", "ovh ser", "ovh tbb");
+  for (BenchCase c : cases) {
+    nlohmann::json j = c.dim == 2 ? benchCase<2>(c.n, o.minSeconds, trace ? &*trace : nullptr)
+                                  : benchCase<3>(c.n, o.minSeconds, trace ? &*trace : nullptr);
+    std::cout << fmt::format("{:>4} {:>6} {:>10.2f} {:>10.2f} {:>10.2f} {:>10.2f} {:>9.2f} {:>9.2f}\n", c.dim, c.n,
+                             j["fluid_only_steps_per_second"].get<double>(),
+                             j["serial"]["steps_per_second"].get<double>(), j["tbb"]["steps_per_second"].get<double>(),
+                             j["tbb"]["ms"].get<double>(), j["serial"]["overhead"].get<double>(),
+                             j["tbb"]["overhead"].get<double>())
+              << std::flush;
+    all.push_back(j);
+  }
+  if (!o.json.empty()) std::ofstream(o.json) << all.dump(2) << "\n";
+  if (trace) {
+    traceFile << trace->chromeJson();
+    traceFile.close();
+    if (!traceFile) throw std::runtime_error("writing the trace to " + o.trace + " failed");
+    std::cout << fmt::format("trace: {} stages -> {} (open in ui.perfetto.dev or chrome://tracing)\n", trace->events().size(),
+                             o.trace);
+  }
+  return true;
+}
+
+}  // namespace morphoflow
