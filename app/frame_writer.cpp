@@ -1,5 +1,7 @@
 #include "app/frame_writer.h"
 
+#include <algorithm>
+#include <iostream>
 #include <stdexcept>
 
 #include <fmt/format.h>
@@ -38,7 +40,22 @@ void FrameWriter::write(long frame, const Grid<float, D>& field, bool symmetric,
   std::string err;
   std::filesystem::path file = dir_ / fmt::format("{:06d}.{}", frame, output_.format);
   if (!writeRgb8(file.string(), w, h, rgb, &err)) throw std::runtime_error("writing " + file.string() + ": " + err);
+  if (firstWritten_ < 0) firstWritten_ = frame;
   ++written_;
+}
+
+void FrameWriter::finishVideo(const std::string& name) {
+  if (!output_.video) return;
+  VideoRequest r;
+  r.frames = dir_;
+  r.firstFrame = int(std::max<long>(0, firstWritten_));
+  r.frameCount = written_;
+  r.fps = output_.fps;
+  r.file = dir_.parent_path() / ((name.empty() ? std::string("animation") : name) + ".mp4");
+  video_ = encodeVideo(r);
+  videoDone_ = true;
+  videoFile_ = r.file;
+  if (!video_.written) std::cerr << "warning: " << video_.warning << "\n";
 }
 
 template <int D>

@@ -1,7 +1,8 @@
 // Frames of a run: which steps write one (output.every, --frames A:B);
 // writing a scalar field through the scene's palette (or two species in red
 // and green) to DIR/frames/NNNNNN.png|exr, and float dumps of named fields to
-// DIR/fields/NNNNNN.exr when output.fields is set.
+// DIR/fields/NNNNNN.exr when output.fields is set; and the frames as an mp4
+// when output.video is set.
 #pragma once
 
 #include <filesystem>
@@ -10,6 +11,7 @@
 
 #include "app/run_options.h"
 #include "core/grid.h"
+#include "render/video.h"
 #include "scenes/scene.h"
 
 namespace morphoflow {
@@ -28,6 +30,13 @@ class FrameWriter {
   template <int D>
   void writeFields(long frame, const std::vector<std::string>& names, const std::vector<Grid<float, D>>& fields,
                    double time, long step);
+  // After the last frame: encodes the image frames into OUT/<name>.mp4 when
+  // output.video is set (render/video.h); a failure is a warning on stderr
+  // and in run.json, never an error: the frames stay.
+  void finishVideo(const std::string& name);
+  // run.json's "video" entry (null when output.video is off).
+  const VideoResult* video() const { return videoDone_ ? &video_ : nullptr; }
+  const std::filesystem::path& videoFile() const { return videoFile_; }
   int written() const { return written_; }
   int fieldsWritten() const { return fieldsWritten_; }
 
@@ -36,6 +45,10 @@ class FrameWriter {
   const OutputSettings& output_;
   const RunOptions& options_;
   int written_ = 0, fieldsWritten_ = 0;
+  long firstWritten_ = -1;
+  bool videoDone_ = false;
+  VideoResult video_;
+  std::filesystem::path videoFile_;
 };
 
 }  // namespace morphoflow

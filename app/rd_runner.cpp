@@ -231,6 +231,7 @@ int run(const Scene& scene, const RunOptions& opt) {
   checkFinite(rd, fmt::format("at step {}", step));
   if (!opt.quiet) std::cerr << "\n";
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  frames.finishVideo(scene.name);
   nlohmann::json j = runReport(scene, opt,
                                {{"dimension", D},
                                 {"model", model.info().name},

@@ -20,6 +20,11 @@ nlohmann::json runReport(const Scene& scene, const RunOptions& opt, nlohmann::js
   j["frames_written"] = frames.written();
   j["fields_written"] = frames.fieldsWritten();
   j["wall_seconds"] = wallSeconds;
+  if (const VideoResult* v = frames.video())
+    j["video"] = {{"file", frames.videoFile().string()},
+                  {"written", v->written},
+                  {"warning", v->warning},
+                  {"ffmpeg_log", v->log.string()}};
   return j;
 }
 

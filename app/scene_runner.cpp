@@ -133,6 +133,8 @@ int run(const Scene& scene, const RunOptions& opt) {
   if (!opt.quiet) std::cerr << "\n";
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
+  frames.finishVideo(scene.name);
+
   nlohmann::json j = runReport(scene, opt,
                                {{"dimension", D},
                                 {"resolution", scene.fluid.resolution},

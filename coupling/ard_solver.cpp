@@ -11,7 +11,7 @@ ARDSolver<D>::ARDSolver(RDSolver<D>* rd, ChemicalAdvector<D> advector, CouplingM
     : rd_(rd), advector_(std::move(advector)), mode_(mode), rdTimeScale_(rdTimeScale) {
   if (!(rdTimeScale > 0)) throw std::invalid_argument("coupling: the reaction-diffusion time scale must be > 0");
   if (advector_.domain().cells != rd->cells()) throw std::invalid_argument("coupling: advection and RD grids differ");
-  advector_.emptySolids(species());
+  if (mode_ != CouplingMode::RDOnly) advector_.emptySolids(species());
 }
 
 template <int D>
@@ -24,10 +24,8 @@ std::vector<Grid<double, D>*> ARDSolver<D>::species() {
 template <int D>
 void ARDSolver<D>::step(double dt, const MacVelocity<D>& u) {
   const double t0 = traceClock();
-  if (mode_ != CouplingMode::Passive) {
-    rd_->step(rdTimeScale_ * dt);       // eq. 6 then eq. 13: implicit reaction, implicit diffusion
-    advector_.emptySolids(species());   // obstacles hold no chemical
-  }
+  if (mode_ != CouplingMode::Passive) rd_->step(rdTimeScale_ * dt);  // eq. 6 then eq. 13
+  if (mode_ == CouplingMode::ARD) advector_.emptySolids(species());  // obstacles hold no chemical
   const double t1 = traceClock();
   if (mode_ != CouplingMode::RDOnly) advector_.advect(u, dt, species());  // eq. 19-20
   stageSeconds_ = {t1 - t0, traceClock() - t1};

@@ -2,7 +2,8 @@
 // reaction-diffusion layer (RDSolver: implicit reaction, then implicit
 // diffusion, eq. 6 and 13) whose species are then carried by the fluid's
 // velocity (semi-Lagrangian, eq. 19-20). Modes for comparison: passive
-// advection only, or reaction-diffusion only.
+// advection only, or reaction-diffusion only, which ignores the flow and its
+// obstacles (seed 001 fig. 6: "the ball is not included in the RD simulation").
 #pragma once
 
 #include <array>

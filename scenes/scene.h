@@ -26,7 +26,8 @@ struct OutputSettings {
   bool images = true;
   bool fields = false;
   bool vdb = false;
-  bool video = false;
+  bool video = false;               // encode the PNG frames into OUT/<name>.mp4 (ffmpeg)
+  int fps = 30;                     // video frames per second
   std::string field = "vorticity"; // speed | vorticity | dye | pressure
   std::string colormap = "coolwarm"; // a named palette, or "red-green" (two species)
   std::vector<std::array<uint8_t, 3>> gradient;  // custom palette stops (overrides colormap)

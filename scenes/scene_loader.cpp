@@ -784,11 +784,15 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
   s.output.images = r.boolean(out, "output.", "images", true);
   s.output.fields = r.boolean(out, "output.", "fields", false);
   s.output.format = r.string(out, "output.", "format", "png", {"png", "exr"});
-  for (const char* k : {"vdb", "video"}) {
-    if (r.boolean(out, "output.", k, false))
-      r.fail(r.node(out, "output.", k), std::string("output.") + k,
-             "this build of morphoflow does not write " + std::string(k) + " yet", "set it to false");
-  }
+  if (r.boolean(out, "output.", "vdb", false))
+    r.fail(r.node(out, "output.", "vdb"), "output.vdb", "this build of morphoflow does not write vdb yet",
+           "set it to false");
+  s.output.video = r.boolean(out, "output.", "video", false);
+  s.output.fps = int(r.integer(out, "output.", "fps", 30, 1, 240));
+  if (s.output.video && (!s.output.images || s.output.format != "png"))
+    r.fail(r.node(out, "output.", "video"), "output.video",
+           "the video is made from PNG frames, so it needs output.images = true and output.format = \"png\"",
+           "turn the PNG frames on, or set output.video = false");
   if (s.rd.enabled && s.hasFluid) {
     std::vector<std::string> choices = species;
     for (const char* f : {"speed", "vorticity", "dye", "pressure"}) choices.push_back(f);

@@ -65,6 +65,8 @@ INSTANTIATE_TEST_SUITE_P(
     Cases, BadScenes,
     ::testing::Values(
         BadScene{"unknown_key", "[fluid]\nviscosty = 0.1\n", "2:1", "did you mean 'fluid.viscosity'"},
+        BadScene{"video_without_png", "[output]\nformat = \"exr\"\nvideo = true\n", "3:9", "needs output.images = true"},
+        BadScene{"video_fps", "[output]\nvideo = true\nfps = 0\n", "3:7", "output.fps"},
         BadScene{"unknown_table", "[fluids]\nviscosity = 0.1\n", "1:1", "did you mean 'fluid'"},
         BadScene{"wrong_type", "[grid]\nresolution = \"big\"\n", "2:14", "expected an array of numbers"},
         BadScene{"out_of_range", "[fluid]\npressure_tolerance = -1\n", "2:22", "expected a number in"},
@@ -189,15 +191,15 @@ TEST(Cli, ShippedScenesValidate) {
 TEST(Cli, CoupledScenesRunAndBackendsAgree) {
   auto dir = tempDir("coupled");
   for (const char* s : {"cavity_gray_scott.toml", "cavity_passive.toml", "cavity_barkley.toml", "cavity_fitzhugh_nagumo.toml",
-                        "obstacle_gray_scott.toml",
-                        "cavity_gray_scott_3d.toml"}) {
+                        "obstacle_passive.toml", "obstacle_gray_scott_ard.toml", "obstacle_gray_scott_rd_only.toml",
+                        "cavity_gray_scott_3d.toml", "obstacle_gray_scott_3d.toml"}) {
     const std::string file = sceneFile(std::string("coupled/") + s);
     CommandResult v = runMorphoflow("validate " + file);
     EXPECT_EQ(v.status, 0) << s << ": " << v.output;
     const bool obstacle = std::string(s).find("obstacle") != std::string::npos;
     const bool threeD = std::string(s).find("3d") != std::string::npos;
-    const std::string res = threeD ? "[12,12,12]" : obstacle ? "[220,41]" : "[32,32]";
-    const std::string rdRes = threeD ? "[12,12,12]" : obstacle ? "[220,41]" : "[48,48]";
+    const std::string res = threeD ? (obstacle ? "[12,24,12]" : "[12,12,12]") : obstacle ? "[32,64]" : "[32,32]";
+    const std::string rdRes = threeD ? (obstacle ? "[12,24,12]" : "[12,12,12]") : obstacle ? "[48,96]" : "[48,48]";
     std::vector<morphoflow::FieldDump> dumps;
     for (std::string b : {"serial", "tbb"}) {
       const fs::path out = dir / (std::string(s) + b);
@@ -419,5 +421,70 @@ TEST(Cli, CouplingBenchWritesAChromeTrace) {
   }
   EXPECT_EQ(runMorphoflow("bench fluid --size 32 --seconds 0 --trace " + trace.string()).status, 2);
   EXPECT_EQ(runMorphoflow("bench coupling --size 32 --seconds 0 --trace " + (dir / "no" / "t.json").string()).status, 2);
+  fs::remove_all(dir);
+}
+
+// output.video: with ffmpeg an mp4 holding every frame; without it (or when
+// it fails) a warning, exit 0, every frame kept and no half-written video.
+TEST(Cli, VideoWithAndWithoutFfmpeg) {
+  auto dir = tempDir("video");
+  const std::string scene = sceneFile("coupled/cavity_gray_scott.toml");
+  const std::string args = " --set grid.resolution=[24,24] --set rd.resolution=[31,31] --set time.steps=30"
+                           " --set output.every=3 --set output.video=true --quiet --frames 2:8 --out ";
+  auto frames = [](const fs::path& out) {
+    int n = 0;
+    for (auto& e : fs::directory_iterator(out / "frames")) n += e.path().extension() == ".png";
+    return n;
+  };
+  const char* path = std::getenv("PATH");
+  const bool haveFfmpeg = std::system("command -v ffmpeg >/dev/null 2>&1") == 0;
+  if (haveFfmpeg) {
+    CommandResult r = runMorphoflow("run " + scene + args + (dir / "with").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    EXPECT_EQ(r.output.find("warning"), std::string::npos) << r.output;
+    const fs::path mp4 = dir / "with" / "cavity_gray_scott.mp4";
+    ASSERT_TRUE(fs::exists(mp4));
+    EXPECT_EQ(frames(dir / "with"), 7);
+    nlohmann::json j = nlohmann::json::parse(std::ifstream(dir / "with" / "run.json"));
+    EXPECT_TRUE(j["video"]["written"].get<bool>());
+    if (std::system("command -v ffprobe >/dev/null 2>&1") == 0) {
+      const std::string probe = "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+                                "stream=nb_read_frames,width,height -of csv=p=0 " + mp4.string() + " > " +
+                                (dir / "probe.txt").string();
+      ASSERT_EQ(std::system(probe.c_str()), 0);
+      std::string line;
+      std::getline(std::ifstream(dir / "probe.txt"), line);
+      EXPECT_EQ(line, "32,32,7");  // frames 2..8; 31 x 31 padded to even sides
+    }
+  }
+  // No ffmpeg on the PATH.
+  const fs::path empty = dir / "emptybin";
+  fs::create_directories(empty);
+  ASSERT_EQ(setenv("PATH", empty.c_str(), 1), 0);
+  CommandResult none = runMorphoflow("run " + scene + args + (dir / "without").string());
+  // An ffmpeg that fails.
+  const fs::path broken = dir / "brokenbin";
+  fs::create_directories(broken);
+  std::ofstream(broken / "ffmpeg") << "#!/bin/sh\necho 'no encoder here' >&2\nexit 3\n";
+  fs::permissions(broken / "ffmpeg", fs::perms::owner_all);
+  ASSERT_EQ(setenv("PATH", (broken.string() + ":" + (path ? path : "")).c_str(), 1), 0);
+  CommandResult failed = runMorphoflow("run " + scene + args + (dir / "failed").string());
+  if (path) setenv("PATH", path, 1);
+
+  ASSERT_EQ(none.status, 0) << none.output;
+  EXPECT_NE(none.output.find("warning: ffmpeg is not on the PATH"), std::string::npos) << none.output;
+  EXPECT_EQ(frames(dir / "without"), 7);
+  EXPECT_FALSE(fs::exists(dir / "without" / "cavity_gray_scott.mp4"));
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(dir / "without" / "run.json"));
+  EXPECT_FALSE(j["video"]["written"].get<bool>());
+
+  ASSERT_EQ(failed.status, 0) << failed.output;
+  EXPECT_NE(failed.output.find("warning: ffmpeg failed (exit status 3)"), std::string::npos) << failed.output;
+  EXPECT_EQ(frames(dir / "failed"), 7);
+  EXPECT_FALSE(fs::exists(dir / "failed" / "cavity_gray_scott.mp4"));
+  EXPECT_FALSE(fs::exists(dir / "failed" / "cavity_gray_scott.mp4.part"));
+  std::string log;
+  std::getline(std::ifstream(dir / "failed" / "cavity_gray_scott.ffmpeg.log"), log);
+  EXPECT_EQ(log, "no encoder here");
   fs::remove_all(dir);
 }
