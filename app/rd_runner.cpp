@@ -229,9 +229,7 @@ int run(const Scene& scene, const RunOptions& opt) {
       std::cerr << fmt::format("\rstep {}/{}  t = {:.4g}", step + 1, steps, rd.time()) << std::flush;
   }
   checkFinite(rd, fmt::format("at step {}", step));
-  if (!opt.quiet) std::cerr << "\n";
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-  frames.finishVideo(scene.name);
+  const double wall = finishRun(scene, opt, &frames, wall0);
   nlohmann::json j = runReport(scene, opt,
                                {{"dimension", D},
                                 {"model", model.info().name},

@@ -1,9 +1,19 @@
 #include "app/run_report.h"
 
+#include <iostream>
+
 #include "app/version.h"
 #include "core/parallel.h"
 
 namespace morphoflow {
+
+double finishRun(const Scene& scene, const RunOptions& opt, FrameWriter* frames,
+                 std::chrono::steady_clock::time_point wall0) {
+  if (!opt.quiet) std::cerr << "\n";
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  frames->finishVideo(scene.name);
+  return wall;
+}
 
 nlohmann::json runReport(const Scene& scene, const RunOptions& opt, nlohmann::json resolved, long steps, double time,
                          const FrameWriter& frames, double wallSeconds) {

@@ -130,11 +130,7 @@ int run(const Scene& scene, const RunOptions& opt) {
                                fluid.time(), speed, st.pressure.iterations)
                 << std::flush;
   }
-  if (!opt.quiet) std::cerr << "\n";
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-
-  frames.finishVideo(scene.name);
-
+  const double wall = finishRun(scene, opt, &frames, wall0);
   nlohmann::json j = runReport(scene, opt,
                                {{"dimension", D},
                                 {"resolution", scene.fluid.resolution},

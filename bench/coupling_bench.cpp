@@ -13,11 +13,11 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "bench/bench_setups.h"
 #include "bench/bench_suites.h"
 #include "bench/bench_timing.h"
 #include "core/error.h"
 #include "core/parallel.h"
-#include "core/random.h"
 #include "core/stage_trace.h"
 #include "coupling/coupled_stepper.h"
 #include "rd/model_registry.h"
@@ -27,17 +27,6 @@ namespace morphoflow {
 namespace {
 
 constexpr int kThreads = 2;
-
-template <int D>
-FluidSettings cavity(int n) {
-  FluidSettings s;
-  s.resolution.assign(D, n);
-  s.size.assign(D, 1.0);
-  s.viscosity = 1.0 / 100.0;
-  s.boundaries.sides[3].wallVelocity = {1.0, 0.0, 0.0};
-  s.pressureTolerance = 1e-6;
-  return s;
-}
 
 // Gray-Scott (Pearson's F = 0.04, k = 0.06) on the fluid's grid, diffusion
 // rates 0.2 h^2 and 0.1 h^2 (the `rd` suite's, per cell), Pearson's start.
@@ -53,22 +42,11 @@ RDSettings grayScott(int n) {
   return s;
 }
 
-template <int D>
-void pearsonStart(RDSolver<D>* rd) {
-  const int n = rd->cells()[0];
-  forEachCell<D>(rd->cells(), [&](const IVec<D>& k, size_t i) {
-    bool inside = true;
-    for (int a = 0; a < D; ++a) inside &= std::abs((k[a] + 0.5) / n - 0.5) < 0.1;
-    rd->field(0)[i] = (inside ? 0.5 : 1.0) + 0.01 * (uniform01(1, 0, i) - 0.5);
-    rd->field(1)[i] = (inside ? 0.25 : 0.0) + 0.01 * (uniform01(1, 1, i) - 0.5);
-  });
-}
-
 constexpr int kWarmup = 3;
 
 template <int D>
 double fluidOnly(int n, double minSeconds) {
-  FluidSolver<D> f(cavity<D>(n));
+  FluidSolver<D> f(benchCavity<D>(n));
   const double dt = f.h();
   for (int i = 0; i < kWarmup; ++i) f.step(dt);
   return median(timeSteps(minSeconds, [&] { f.step(dt); }, [] {}));
@@ -80,7 +58,7 @@ struct CoupledTiming {
 
 template <int D>
 CoupledTiming fluidWithARD(int n, CouplingBackend backend, double minSeconds, StageTrace* trace) {
-  FluidSolver<D> f(cavity<D>(n));
+  FluidSolver<D> f(benchCavity<D>(n));
   RDSolver<D> rd(grayScott<D>(n), *findModel("gray-scott"));
   pearsonStart(&rd);
   const double dt = f.h();

@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "bench/bench_setups.h"
 #include "bench/bench_suites.h"
 #include "bench/bench_timing.h"
 #include "core/parallel.h"
@@ -21,13 +22,7 @@ namespace {
 template <int D>
 nlohmann::json benchFluid(int n, int threads, double minSeconds) {
   ThreadLimit limit(threads);
-  FluidSettings s;
-  s.resolution.assign(D, n);
-  s.size.assign(D, 1.0);
-  s.viscosity = 1.0 / 100.0;  // Re = 100 with a unit lid
-  s.boundaries.sides[3].wallVelocity = {1.0, 0.0, 0.0};
-  s.pressureTolerance = 1e-6;
-  FluidSolver<D> f(s);
+  FluidSolver<D> f(benchCavity<D>(n));
   const double dt = f.h();  // CFL 1 at the lid speed
   for (int i = 0; i < 3; ++i) f.step(dt);  // warm-up: the flow starts to develop
   std::vector<double> pit, vit;

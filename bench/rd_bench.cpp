@@ -12,10 +12,10 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "bench/bench_setups.h"
 #include "bench/bench_suites.h"
 #include "bench/bench_timing.h"
 #include "core/parallel.h"
-#include "core/random.h"
 #include "rd/model_registry.h"
 #include "rd/rd_solver.h"
 
@@ -33,13 +33,7 @@ nlohmann::json benchRD(int n, bool implicit, int threads, double minSeconds) {
   s.diffusion = {0.2, 0.1};
   s.integrator = implicit ? RDIntegrator::KimLin : RDIntegrator::ExplicitEuler;
   RDSolver<D> rd(s, *findModel(s.model));
-  // Pearson's start: u = 1, v = 0, a perturbed central square (u, v) = (1/2, 1/4).
-  forEachCell<D>(rd.cells(), [&](const IVec<D>& k, size_t i) {
-    bool inside = true;
-    for (int a = 0; a < D; ++a) inside &= std::abs((k[a] + 0.5) / n - 0.5) < 0.1;
-    rd.field(0)[i] = (inside ? 0.5 : 1.0) + 0.01 * (uniform01(1, 0, i) - 0.5);
-    rd.field(1)[i] = (inside ? 0.25 : 0.0) + 0.01 * (uniform01(1, 1, i) - 0.5);
-  });
+  pearsonStart(&rd);
   const double dt = 0.9 * rd.explicitDiffusionLimit() * (implicit ? 10.0 : 1.0);
   rd.step(dt);  // warm-up: allocations, multigrid setup
   double newtonIt = 0, diffIt = 0;

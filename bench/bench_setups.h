@@ -1,0 +1,38 @@
+// The benchmark suites' shared cases: the lid-driven cavity and Pearson's
+// Gray-Scott start, so `fluid`, `rd` and `coupling` time the same problems.
+#pragma once
+
+#include <cmath>
+
+#include "core/parallel.h"
+#include "core/random.h"
+#include "fluid/fluid_settings.h"
+#include "rd/rd_solver.h"
+
+namespace morphoflow {
+
+// Unit cavity at Re = 100 (unit lid speed), pressure to 1e-6.
+template <int D>
+FluidSettings benchCavity(int n) {
+  FluidSettings s;
+  s.resolution.assign(D, n);
+  s.size.assign(D, 1.0);
+  s.viscosity = 1.0 / 100.0;  // Re = 100 with a unit lid
+  s.boundaries.sides[3].wallVelocity = {1.0, 0.0, 0.0};
+  s.pressureTolerance = 1e-6;
+  return s;
+}
+
+// Pearson's start: u = 1, v = 0, a perturbed central square (u, v) = (1/2, 1/4).
+template <int D>
+void pearsonStart(RDSolver<D>* rd) {
+  const int n = rd->cells()[0];
+  forEachCell<D>(rd->cells(), [&](const IVec<D>& k, size_t i) {
+    bool inside = true;
+    for (int a = 0; a < D; ++a) inside &= std::abs((k[a] + 0.5) / n - 0.5) < 0.1;
+    rd->field(0)[i] = (inside ? 0.5 : 1.0) + 0.01 * (uniform01(1, 0, i) - 0.5);
+    rd->field(1)[i] = (inside ? 0.25 : 0.0) + 0.01 * (uniform01(1, 1, i) - 0.5);
+  });
+}
+
+}  // namespace morphoflow
