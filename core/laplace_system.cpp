@@ -1,6 +1,7 @@
 #include "core/laplace_system.h"
 
 #include <cmath>
+#include <type_traits>
 
 #include "core/parallel.h"
 
@@ -10,18 +11,17 @@ namespace {
 
 // Neighbour rows along axes >= 1 of one row. Periodic axes wrap; across a
 // non-periodic edge the neighbour row is a row of zeros (no race, no branch).
-template <int D>
+template <int D, class T>
 struct RowStencil {
   size_t base;
-  const double* xlo[D];
-  const double* xhi[D];
+  const T* xlo[D];
+  const T* xhi[D];
   const float* wlo[D];  // w[a] of the row below (coupling to this row)
 };
 
-template <int D>
-RowStencil<D> rowStencil(const LaplaceSystem<D>& A, const double* x, const double* zx,
-                         const float* zw, size_t row) {
-  RowStencil<D> s{};
+template <int D, class T>
+RowStencil<D, T> rowStencil(const LaplaceSystem<D>& A, const T* x, const T* zx, const float* zw, size_t row) {
+  RowStencil<D, T> s{};
   const IVec<D>& dims = A.dims;
   size_t nx = size_t(dims[0]), ny = size_t(dims[1]);
   s.base = row * nx;
@@ -46,6 +46,42 @@ RowStencil<D> rowStencil(const LaplaceSystem<D>& A, const double* x, const doubl
   return s;
 }
 
+// Neighbour sum sum_f w_f x_j(f) of cell i of a row; il/ih are the x
+// neighbours (wrapped) and wl the weight of the low x face.
+template <int D, class T>
+inline T neighbourSum(const RowStencil<D, T>& s, const float* const* wa, const T* xr, size_t i, size_t il,
+                      size_t ih, float wl) {
+  T sum = T(wa[0][i]) * xr[ih] + T(wl) * xr[il];
+  for (int a = 1; a < D; ++a) sum += T(wa[a][i]) * s.xhi[a][i] + T(s.wlo[a][i]) * s.xlo[a][i];
+  return sum;
+}
+// The same on a uniform row's interior (every w = 1: the same sums).
+template <int D, class T>
+inline T neighbourSumUniform(const RowStencil<D, T>& s, const T* xr, size_t i) {
+  T sum = xr[i + 1] + xr[i - 1];
+  for (int a = 1; a < D; ++a) sum += s.xhi[a][i] + s.xlo[a][i];
+  return sum;
+}
+
+// Face sum sum_f w_f (x_i - x_j(f)): with the c term this is A x, written so
+// that every face's two contributions cancel to round-off (mass conservation
+// does not rest on a float diagonal matching its weights).
+template <int D, class T>
+inline T faceSum(const RowStencil<D, T>& s, const float* const* wa, const T* xr, size_t i, size_t il, size_t ih,
+                 float wl) {
+  const T xi = xr[i];
+  T sum = T(wa[0][i]) * (xi - xr[ih]) + T(wl) * (xi - xr[il]);
+  for (int a = 1; a < D; ++a) sum += T(wa[a][i]) * (xi - s.xhi[a][i]) + T(s.wlo[a][i]) * (xi - s.xlo[a][i]);
+  return sum;
+}
+template <int D, class T>
+inline T faceSumUniform(const RowStencil<D, T>& s, const T* xr, size_t i) {
+  const T xi = xr[i];
+  T sum = (xi - xr[i + 1]) + (xi - xr[i - 1]);
+  for (int a = 1; a < D; ++a) sum += (xi - s.xhi[a][i]) + (xi - s.xlo[a][i]);
+  return sum;
+}
+
 }  // namespace
 
 template <int D>
@@ -54,6 +90,24 @@ LaplaceSystem<D>::LaplaceSystem(const IVec<D>& d, const std::array<bool, D>& p, 
   for (int a = 0; a < D; ++a) w[a] = Grid<float, D>(d, 0.0f);
   zerosX_.assign(size_t(d[0]), 0.0);
   zerosW_.assign(size_t(d[0]), 0.0f);
+}
+
+template <int D>
+template <class T>
+const T* LaplaceSystem<D>::invDiag() const {
+  if constexpr (std::is_same_v<T, double>)
+    return invDiag_.data();
+  else
+    return invDiagF_.data();
+}
+
+template <int D>
+template <class T>
+const T* LaplaceSystem<D>::zeros() const {
+  if constexpr (std::is_same_v<T, double>)
+    return zerosX_.data();
+  else
+    return zerosW_.data();
 }
 
 template <int D>
@@ -66,6 +120,7 @@ void LaplaceSystem<D>::finalize() {
     });
   }
   invDiag_.assign(size(), 0.0);
+  invDiagF_.assign(size(), 0.0f);
   forEachCell<D>(dims, [&](const IVec<D>& cell, size_t i) {
     float d = c[i];
     for (int a = 0; a < D; ++a) {
@@ -75,72 +130,108 @@ void LaplaceSystem<D>::finalize() {
     }
     diag[i] = d;
     invDiag_[i] = d > 0 ? 1.0 / double(d) : 0.0;
+    invDiagF_[i] = float(invDiag_[i]);
+  });
+  // Uniform rows: every interior cell has unit weights on all its faces and
+  // the row's c, hence also the same diagonal.
+  const size_t nx = size_t(dims[0]);
+  size_t rows = size() / nx;
+  rowUniform_.assign(rows, 0);
+  parallelForRows<D>(dims, [&](size_t row) {
+    if (nx < 3) return;
+    RowStencil<D, double> s = rowStencil<D>(*this, zerosX_.data(), zerosX_.data(), zerosW_.data(), row);
+    const float* cr = c.data() + s.base;
+    const float* w0 = w[0].data() + s.base;
+    for (size_t i = 1; i + 1 < nx; ++i) {
+      if (cr[i] != cr[1] || w0[i] != 1.0f || w0[i - 1] != 1.0f) return;
+      for (int a = 1; a < D; ++a)
+        if (w[a][s.base + i] != 1.0f || s.wlo[a][i] != 1.0f) return;
+    }
+    rowUniform_[row] = 1;
   });
   active_ = size_t(deterministicSum(diag.size(), [&](size_t i) { return diag[i] > 0 ? 1.0 : 0.0; }));
   singular_ = deterministicMax(c.size(), [&](size_t i) { return c[i]; }) <= 0.0;
 }
 
-// Neighbour sum sum_f w_f x_j(f) of cell i of a row; il/ih are the x
-// neighbours (wrapped) and wl the weight of the low x face.
 template <int D>
-inline double neighbourSum(const RowStencil<D>& s, const float* const* wa, const double* xr, size_t i,
-                           size_t il, size_t ih, float wl) {
-  double sum = double(wa[0][i]) * xr[ih] + double(wl) * xr[il];
-  for (int a = 1; a < D; ++a) sum += double(wa[a][i]) * s.xhi[a][i] + double(s.wlo[a][i]) * s.xlo[a][i];
-  return sum;
-}
-
-// Face sum sum_f w_f (x_i - x_j(f)): with the c term this is A x, written so
-// that every face's two contributions cancel to round-off (mass conservation
-// does not rest on a float diagonal matching its weights).
-template <int D>
-inline double faceSum(const RowStencil<D>& s, const float* const* wa, const double* xr, size_t i, size_t il,
-                      size_t ih, float wl) {
-  const double xi = xr[i];
-  double sum = double(wa[0][i]) * (xi - xr[ih]) + double(wl) * (xi - xr[il]);
-  for (int a = 1; a < D; ++a)
-    sum += double(wa[a][i]) * (xi - s.xhi[a][i]) + double(s.wlo[a][i]) * (xi - s.xlo[a][i]);
-  return sum;
-}
-
-template <int D>
-void LaplaceSystem<D>::apply(const Vector& x, Vector* yp) const {
-  Vector& y = *yp;
+template <class T>
+void LaplaceSystem<D>::apply(const std::vector<T>& x, std::vector<T>* yp) const {
+  std::vector<T>& y = *yp;
   const size_t nx = size_t(dims[0]);
   const bool px = periodic[0];
+  const T sc = T(scale);
   parallelForRows<D>(dims, [&](size_t row) {
-    RowStencil<D> s = rowStencil<D>(*this, x.data(), zerosX_.data(), zerosW_.data(), row);
+    RowStencil<D, T> s = rowStencil<D>(*this, x.data(), zeros<T>(), zerosW_.data(), row);
     const float* wa[D];
     for (int a = 0; a < D; ++a) wa[a] = w[a].data() + s.base;
     const float* cr = c.data() + s.base;
-    const double* xr = x.data() + s.base;
-    double* yr = y.data() + s.base;
+    const T* xr = x.data() + s.base;
+    T* yr = y.data() + s.base;
     auto edge = [&](size_t i) {
       size_t il = i == 0 ? nx - 1 : i - 1, ih = i + 1 == nx ? 0 : i + 1;
       float wl = (i == 0 && !px) ? 0.0f : wa[0][il];
-      yr[i] = scale * (double(cr[i]) * xr[i] + faceSum<D>(s, wa, xr, i, il, ih, wl));
+      yr[i] = sc * (T(cr[i]) * xr[i] + faceSum<D, T>(s, wa, xr, i, il, ih, wl));
     };
     edge(0);
-    for (size_t i = 1; i + 1 < nx; ++i)  // interior: no wrap, no branch
-      yr[i] = scale * (double(cr[i]) * xr[i] + faceSum<D>(s, wa, xr, i, i - 1, i + 1, wa[0][i - 1]));
+    if (rowUniform_[row]) {
+      const T c0 = T(cr[1]);
+      for (size_t i = 1; i + 1 < nx; ++i) yr[i] = sc * (c0 * xr[i] + faceSumUniform<D, T>(s, xr, i));
+    } else {
+      for (size_t i = 1; i + 1 < nx; ++i)  // interior: no wrap, no branch
+        yr[i] = sc * (T(cr[i]) * xr[i] + faceSum<D, T>(s, wa, xr, i, i - 1, i + 1, wa[0][i - 1]));
+    }
+    if (nx > 1) edge(nx - 1);
+  });
+}
+
+template <int D>
+template <class T>
+void LaplaceSystem<D>::defect(const std::vector<T>& b, const std::vector<T>& x, std::vector<T>* rp) const {
+  std::vector<T>& r = *rp;
+  const size_t nx = size_t(dims[0]);
+  const bool px = periodic[0];
+  const T sc = T(scale);
+  parallelForRows<D>(dims, [&](size_t row) {
+    RowStencil<D, T> s = rowStencil<D>(*this, x.data(), zeros<T>(), zerosW_.data(), row);
+    const float* wa[D];
+    for (int a = 0; a < D; ++a) wa[a] = w[a].data() + s.base;
+    const float* cr = c.data() + s.base;
+    const float* dr = diag.data() + s.base;
+    const T* xr = x.data() + s.base;
+    const T* br = b.data() + s.base;
+    T* rr = r.data() + s.base;
+    auto general = [&](size_t i, size_t il, size_t ih, float wl) {
+      T ax = sc * (T(cr[i]) * xr[i] + faceSum<D, T>(s, wa, xr, i, il, ih, wl));
+      rr[i] = dr[i] > 0 ? br[i] - ax : T(0);
+    };
+    auto edge = [&](size_t i) {
+      size_t il = i == 0 ? nx - 1 : i - 1, ih = i + 1 == nx ? 0 : i + 1;
+      general(i, il, ih, (i == 0 && !px) ? 0.0f : wa[0][il]);
+    };
+    edge(0);
+    if (rowUniform_[row]) {  // every interior diagonal is c + 2D > 0
+      const T c0 = T(cr[1]);
+      for (size_t i = 1; i + 1 < nx; ++i) rr[i] = br[i] - sc * (c0 * xr[i] + faceSumUniform<D, T>(s, xr, i));
+    } else {
+      for (size_t i = 1; i + 1 < nx; ++i) general(i, i - 1, i + 1, wa[0][i - 1]);
+    }
     if (nx > 1) edge(nx - 1);
   });
 }
 
 template <int D>
 double LaplaceSystem<D>::residual(const Vector& b, const Vector& x, Vector* r) const {
-  apply(x, r);
-  Vector& rr = *r;
-  parallelFor(rr.size(), [&](size_t i) { rr[i] = diag[i] > 0 ? b[i] - rr[i] : 0.0; }, 4096);
-  return norm2(rr);
+  defect(b, x, r);
+  return norm2(*r);
 }
 
 template <int D>
-void LaplaceSystem<D>::gaussSeidel(const Vector& b, Vector* xp, bool reverse) const {
-  Vector& x = *xp;
+template <class T>
+void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, bool reverse) const {
+  std::vector<T>& x = *xp;
   const size_t nx = size_t(dims[0]);
   const bool px = periodic[0];
-  const double inv = 1.0 / scale;
+  const T inv = T(1.0 / scale);
   // An odd periodic axis couples cells of one colour across the wrap: run
   // such systems row by row so the sweep stays deterministic and race-free.
   bool serial = false;
@@ -150,27 +241,32 @@ void LaplaceSystem<D>::gaussSeidel(const Vector& b, Vector* xp, bool reverse) co
   for (int pass = 0; pass < 2; ++pass) {
     int colour = reverse ? 1 - pass : pass;
     auto sweepRow = [&](size_t row) {
-      RowStencil<D> s = rowStencil<D>(*this, x.data(), zerosX_.data(), zerosW_.data(), row);
+      RowStencil<D, T> s = rowStencil<D>(*this, x.data(), zeros<T>(), zerosW_.data(), row);
       size_t parity = row % size_t(dims[1]);
       if constexpr (D == 3) parity += row / size_t(dims[1]);
       const float* wa[D];
       for (int a = 0; a < D; ++a) wa[a] = w[a].data() + s.base;
-      const double* rd = invDiag_.data() + s.base;
-      const double* br = b.data() + s.base;
-      double* xr = x.data() + s.base;
+      const T* rd = invDiag<T>() + s.base;
+      const T* br = b.data() + s.base;
+      T* xr = x.data() + s.base;
       // x_i = (b_i / scale + sum_f w_f x_j) / diag_i; invDiag is 0 on inactive cells.
       auto edge = [&](size_t i) {
         size_t il = i == 0 ? nx - 1 : i - 1, ih = i + 1 == nx ? 0 : i + 1;
         float wl = (i == 0 && !px) ? 0.0f : wa[0][il];
-        xr[i] = (br[i] * inv + neighbourSum<D>(s, wa, xr, i, il, ih, wl)) * rd[i];
+        xr[i] = (br[i] * inv + neighbourSum<D, T>(s, wa, xr, i, il, ih, wl)) * rd[i];
       };
       size_t i = (size_t(colour) + parity) & 1;
       if (i == 0) {
         edge(0);
         i = 2;
       }
-      for (; i + 1 < nx; i += 2)
-        xr[i] = (br[i] * inv + neighbourSum<D>(s, wa, xr, i, i - 1, i + 1, wa[0][i - 1])) * rd[i];
+      if (rowUniform_[row]) {
+        const T r0 = rd[1];
+        for (; i + 1 < nx; i += 2) xr[i] = (br[i] * inv + neighbourSumUniform<D, T>(s, xr, i)) * r0;
+      } else {
+        for (; i + 1 < nx; i += 2)
+          xr[i] = (br[i] * inv + neighbourSum<D, T>(s, wa, xr, i, i - 1, i + 1, wa[0][i - 1])) * rd[i];
+      }
       if (i + 1 == nx && nx > 1) edge(i);
     };
     if (serial)
@@ -209,6 +305,16 @@ void axpy(double alpha, const Vector& x, Vector* y) {
 
 template struct LaplaceSystem<2>;
 template struct LaplaceSystem<3>;
+#define MORPHOFLOW_LAPLACE_KERNELS(D, T)                                                        \
+  template void LaplaceSystem<D>::apply<T>(const std::vector<T>&, std::vector<T>*) const;       \
+  template void LaplaceSystem<D>::defect<T>(const std::vector<T>&, const std::vector<T>&,        \
+                                            std::vector<T>*) const;                             \
+  template void LaplaceSystem<D>::gaussSeidel<T>(const std::vector<T>&, std::vector<T>*, bool) const;
+MORPHOFLOW_LAPLACE_KERNELS(2, double)
+MORPHOFLOW_LAPLACE_KERNELS(3, double)
+MORPHOFLOW_LAPLACE_KERNELS(2, float)
+MORPHOFLOW_LAPLACE_KERNELS(3, float)
+#undef MORPHOFLOW_LAPLACE_KERNELS
 template LaplaceSystem<2> makeNeumannLaplacian<2>(const IVec<2>&, const std::array<bool, 2>&, double);
 template LaplaceSystem<3> makeNeumannLaplacian<3>(const IVec<3>&, const std::array<bool, 3>&, double);
 

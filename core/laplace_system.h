@@ -39,21 +39,40 @@ struct LaplaceSystem {
   // work on mean-free vectors.
   bool singular() const { return singular_; }
 
-  void apply(const Vector& x, Vector* y) const;
+  // The kernels run in double (the solvers' outer loops) or float (the
+  // multigrid preconditioner's levels, half the memory traffic).
+  template <class T>
+  void apply(const std::vector<T>& x, std::vector<T>* y) const;
+  // r = b - A x (0 on inactive cells).
+  template <class T>
+  void defect(const std::vector<T>& b, const std::vector<T>& x, std::vector<T>* r) const;
   // r = b - A x; returns ||r||_2.
   double residual(const Vector& b, const Vector& x, Vector* r) const;
   // One red-black Gauss-Seidel sweep; `reverse` runs black first (so a
   // reversed post-smoother makes a symmetric V-cycle).
-  void gaussSeidel(const Vector& b, Vector* x, bool reverse) const;
+  template <class T>
+  void gaussSeidel(const std::vector<T>& b, std::vector<T>* x, bool reverse) const;
   // Removes the mean over active cells (for singular systems).
   void removeNullSpace(Vector* x) const;
 
+  // Rows whose interior cells (all but the two x ends) have unit face
+  // weights and one c: the kernels skip the weight loads there (the memory
+  // traffic, not the arithmetic, bounds them), with the same arithmetic.
+  bool uniformRow(size_t row) const { return rowUniform_[row] != 0; }
+
  private:
+  template <class T>
+  const T* invDiag() const;
+  template <class T>
+  const T* zeros() const;
+
   bool singular_ = false;
   size_t active_ = 0;
   Vector invDiag_;              // 1 / diag, 0 on inactive cells
+  std::vector<float> invDiagF_; // the same in float
   Vector zerosX_;               // a row of zeros: the neighbour beyond a wall
-  std::vector<float> zerosW_;
+  std::vector<float> zerosW_;   // (also the float row of zeros)
+  std::vector<uint8_t> rowUniform_;
 };
 
 // Builds the plain Laplacian with Neumann walls (periodic where asked) on a

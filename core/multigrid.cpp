@@ -1,6 +1,7 @@
 #include "core/multigrid.h"
 
 #include <cmath>
+#include <limits>
 
 #include "core/parallel.h"
 
@@ -92,9 +93,9 @@ Multigrid<D>::Multigrid(const LaplaceSystem<D>& fine, const MultigridOptions& op
   for (size_t l = 0; l + 1 < levels_.size(); ++l) buildTransfer(int(l));
   for (size_t l = 0; l < levels_.size(); ++l) {
     size_t n = level(int(l)).size();
-    levels_[l].x.assign(n, 0.0);
-    levels_[l].b.assign(n, 0.0);
-    levels_[l].r.assign(n, 0.0);
+    levels_[l].x.assign(n, 0.0f);
+    levels_[l].b.assign(n, 0.0f);
+    levels_[l].r.assign(n, 0.0f);
   }
 }
 
@@ -107,17 +108,17 @@ void Multigrid<D>::buildTransfer(int l) {
     int nf = F.dims[a], nc = C.dims[a];
     t.lo.assign(size_t(nf), 0);
     t.hi.assign(size_t(nf), 0);
-    t.w.assign(size_t(nf), 1.0);
+    t.w.assign(size_t(nf), 1.0f);
     for (int f = 0; f < nf; ++f) {
       int parent = f >> 1;
       int nb = (f & 1) ? parent + 1 : parent - 1;
       if (nb < 0 || nb >= nc) nb = C.periodic[a] ? (nb + nc) % nc : parent;
       t.lo[size_t(f)] = parent;
       t.hi[size_t(f)] = nb;
-      t.w[size_t(f)] = nb == parent ? 1.0 : 0.75;
+      t.w[size_t(f)] = nb == parent ? 1.0f : 0.75f;
     }
     t.fine.assign(size_t(nc), {0, 0, 0, 0});
-    t.fineWeight.assign(size_t(nc), {0.0, 0.0, 0.0, 0.0});
+    t.fineWeight.assign(size_t(nc), {0.0f, 0.0f, 0.0f, 0.0f});
     for (int I = 0; I < nc; ++I)
       for (int m = 0; m < 4; ++m) {
         int f = 2 * I - 1 + m;
@@ -126,7 +127,7 @@ void Multigrid<D>::buildTransfer(int l) {
           f = (f + nf) % nf;
         }
         t.fine[size_t(I)][size_t(m)] = f;
-        t.fineWeight[size_t(I)][size_t(m)] = prolongWeight1(f, I, nc, C.periodic[a]);
+        t.fineWeight[size_t(I)][size_t(m)] = float(prolongWeight1(f, I, nc, C.periodic[a]));
       }
   }
 }
@@ -146,38 +147,38 @@ void Multigrid<D>::restrict(int l) {
   const LaplaceSystem<D>& F = level(l);
   const LaplaceSystem<D>& C = level(l + 1);
   const std::array<AxisTransfer, D>& T = levels_[size_t(l)].transfer;
-  const Vector& r = levels_[size_t(l)].r;
-  Vector& b = levels_[size_t(l) + 1].b;
-  const double inv2D = 1.0 / double(1 << D);
+  const FVector& r = levels_[size_t(l)].r;
+  FVector& b = levels_[size_t(l) + 1].b;
+  const float inv2D = 1.0f / float(1 << D);
   const size_t ncx = size_t(C.dims[0]), nfx = size_t(F.dims[0]);
   const size_t nfy = size_t(F.dims[1]);
   parallelForRows<D>(C.dims, [&](size_t row) {
     int cc[3];
     rowCoords<D>(C.dims, row, cc);
-    double* br = b.data() + row * ncx;
-    for (size_t X = 0; X < ncx; ++X) br[X] = 0.0;
+    float* br = b.data() + row * ncx;
+    for (size_t X = 0; X < ncx; ++X) br[X] = 0.0f;
     // Sum the fine rows that touch this coarse row, each with its weight.
     for (int mz = 0; mz < (D == 3 ? 4 : 1); ++mz) {
-      double wz = 1.0;
+      float wz = 1.0f;
       size_t fz = 0;
       if constexpr (D == 3) {
         wz = T[2].fineWeight[size_t(cc[2])][size_t(mz)];
         fz = size_t(T[2].fine[size_t(cc[2])][size_t(mz)]);
-        if (wz == 0.0) continue;
+        if (wz == 0.0f) continue;
       }
       for (int my = 0; my < 4; ++my) {
-        double wy = wz * T[1].fineWeight[size_t(cc[1])][size_t(my)];
-        if (wy == 0.0) continue;
-        const double* fr = r.data() + (fz * nfy + size_t(T[1].fine[size_t(cc[1])][size_t(my)])) * nfx;
+        float wy = wz * T[1].fineWeight[size_t(cc[1])][size_t(my)];
+        if (wy == 0.0f) continue;
+        const float* fr = r.data() + (fz * nfy + size_t(T[1].fine[size_t(cc[1])][size_t(my)])) * nfx;
         for (size_t X = 0; X < ncx; ++X) {
           const std::array<int, 4>& fx = T[0].fine[X];
-          const std::array<double, 4>& wx = T[0].fineWeight[X];
+          const std::array<float, 4>& wx = T[0].fineWeight[X];
           br[X] += wy * (wx[0] * fr[fx[0]] + wx[1] * fr[fx[1]] + wx[2] * fr[fx[2]] + wx[3] * fr[fx[3]]);
         }
       }
     }
     const float* cd = C.diag.data() + row * ncx;
-    for (size_t X = 0; X < ncx; ++X) br[X] = cd[X] > 0 ? br[X] * inv2D : 0.0;
+    for (size_t X = 0; X < ncx; ++X) br[X] = cd[X] > 0 ? br[X] * inv2D : 0.0f;
   });
 }
 
@@ -186,44 +187,44 @@ void Multigrid<D>::prolongAdd(int l) {
   const LaplaceSystem<D>& F = level(l);
   const LaplaceSystem<D>& C = level(l + 1);
   const std::array<AxisTransfer, D>& T = levels_[size_t(l)].transfer;
-  const Vector& xc = levels_[size_t(l) + 1].x;
-  Vector& x = levels_[size_t(l)].x;
+  const FVector& xc = levels_[size_t(l) + 1].x;
+  FVector& x = levels_[size_t(l)].x;
   const size_t ncx = size_t(C.dims[0]), nfx = size_t(F.dims[0]);
   const size_t ncy = size_t(C.dims[1]);
   parallelForRows<D>(F.dims, [&](size_t row) {
     int f[3];
     rowCoords<D>(F.dims, row, f);
     // The (up to) 2^(D-1) coarse rows and weights of this fine row.
-    const double* crow[4];
-    double cw[4];
+    const float* crow[4];
+    float cw[4];
     int nrows = 0;
     for (int kz = 0; kz < (D == 3 ? 2 : 1); ++kz) {
-      double wz = 1.0;
+      float wz = 1.0f;
       size_t z = 0;
       if constexpr (D == 3) {
         size_t fz = size_t(f[2]);
-        wz = kz ? 1.0 - T[2].w[fz] : T[2].w[fz];
+        wz = kz ? 1.0f - T[2].w[fz] : T[2].w[fz];
         z = size_t(kz ? T[2].hi[fz] : T[2].lo[fz]);
-        if (wz == 0.0) continue;
+        if (wz == 0.0f) continue;
       }
       for (int ky = 0; ky < 2; ++ky) {
         size_t fy = size_t(f[1]);
-        double wy = wz * (ky ? 1.0 - T[1].w[fy] : T[1].w[fy]);
-        if (wy == 0.0) continue;
+        float wy = wz * (ky ? 1.0f - T[1].w[fy] : T[1].w[fy]);
+        if (wy == 0.0f) continue;
         size_t y = size_t(ky ? T[1].hi[fy] : T[1].lo[fy]);
         crow[nrows] = xc.data() + (z * ncy + y) * ncx;
         cw[nrows++] = wy;
       }
     }
     const float* fd = F.diag.data() + row * nfx;
-    double* xr = x.data() + row * nfx;
+    float* xr = x.data() + row * nfx;
     const int* lo = T[0].lo.data();
     const int* hi = T[0].hi.data();
-    const double* wx = T[0].w.data();
+    const float* wx = T[0].w.data();
     for (size_t i = 0; i < nfx; ++i) {
       if (fd[i] <= 0) continue;
-      double v = 0.0;
-      for (int k = 0; k < nrows; ++k) v += cw[k] * (wx[i] * crow[k][lo[i]] + (1.0 - wx[i]) * crow[k][hi[i]]);
+      float v = 0.0f;
+      for (int k = 0; k < nrows; ++k) v += cw[k] * (wx[i] * crow[k][lo[i]] + (1.0f - wx[i]) * crow[k][hi[i]]);
       xr[i] += v;
     }
   });
@@ -234,39 +235,45 @@ void Multigrid<D>::cycle(int l) {
   Level& L = levels_[size_t(l)];
   const LaplaceSystem<D>& A = level(l);
   if (l + 1 == levels()) {
-    // Coarsest level: solve accurately with CG so the cycle stays linear.
-    std::fill(L.x.begin(), L.x.end(), 0.0);
+    // Coarsest level: solve accurately with CG (in double) so the cycle stays linear.
+    coarseB_.assign(L.b.begin(), L.b.end());
+    coarseX_.assign(A.size(), 0.0);
     SolverOptions o;
     o.tolerance = 1e-10;
     o.maxIterations = 20 * int(A.size()) + 50;
-    solvePCG<D>(A, L.b, &L.x, nullptr, o);
+    solvePCG<D>(A, coarseB_, &coarseX_, nullptr, o, nullptr, &coarseWork_);
+    for (size_t i = 0; i < L.x.size(); ++i) L.x[i] = float(coarseX_[i]);
     return;
   }
   for (int s = 0; s < options_.preSmooth; ++s) A.gaussSeidel(L.b, &L.x, false);
-  A.residual(L.b, L.x, &L.r);
+  A.defect(L.b, L.x, &L.r);
   restrict(l);
-  std::fill(levels_[size_t(l) + 1].x.begin(), levels_[size_t(l) + 1].x.end(), 0.0);
+  FVector& xc = levels_[size_t(l) + 1].x;
+  std::fill(xc.begin(), xc.end(), 0.0f);
   cycle(l + 1);
   prolongAdd(l);
   for (int s = 0; s < options_.postSmooth; ++s) A.gaussSeidel(L.b, &L.x, true);
 }
 
 template <int D>
-void Multigrid<D>::vcycle(const Vector& b, Vector* x) {
-  Level& L0 = levels_[0];
-  L0.b = b;
-  L0.x = *x;
-  cycle(0);
-  *x = L0.x;
-}
-
-template <int D>
 void Multigrid<D>::apply(const Vector& r, Vector* z) {
   Level& L0 = levels_[0];
-  L0.b = r;
-  std::fill(L0.x.begin(), L0.x.end(), 0.0);
+  z->resize(r.size());
+  Vector& zz = *z;
+  // The cycle is linear: run it on r / max|r| so that single precision
+  // neither underflows nor overflows whatever the scale of r.
+  const double rmax = deterministicMax(r.size(), [&](size_t i) { return std::abs(r[i]); });
+  if (rmax == 0.0 || !std::isfinite(rmax)) {  // zero in, zero out; an overflow stays visible
+    std::fill(zz.begin(), zz.end(), rmax == 0.0 ? 0.0 : std::numeric_limits<double>::quiet_NaN());
+    return;
+  }
+  const double inv = 1.0 / rmax;
+  parallelFor(r.size(), [&](size_t i) {
+    L0.b[i] = float(r[i] * inv);
+    L0.x[i] = 0.0f;
+  }, 4096);
   cycle(0);
-  *z = L0.x;
+  parallelFor(r.size(), [&](size_t i) { zz[i] = double(L0.x[i]) * rmax; }, 4096);
 }
 
 template <int D>
@@ -282,13 +289,14 @@ SolverResult Multigrid<D>::solve(const Vector& bIn, Vector* x, const SolverOptio
     result.converged = true;
     return result;
   }
-  Vector r(b.size());
-  result.residual = fine_.residual(b, *x, &r) / bnorm;
+  r_.resize(b.size());
+  result.residual = fine_.residual(b, *x, &r_) / bnorm;
   while (result.residual > opt.tolerance && result.iterations < opt.maxIterations) {
-    vcycle(b, x);
+    apply(r_, &z_);  // the V-cycle on the defect equation A e = r
+    axpy(1.0, z_, x);
     if (fine_.singular()) fine_.removeNullSpace(x);
     ++result.iterations;
-    result.residual = fine_.residual(b, *x, &r) / bnorm;
+    result.residual = fine_.residual(b, *x, &r_) / bnorm;
     if (interrupter && interrupter->progress(-1.0)) break;
   }
   result.converged = result.residual <= opt.tolerance;

@@ -7,6 +7,10 @@
 // mean of the fine faces it covers (so obstacles coarsen to partial faces),
 // and identity terms are averaged. Smoothing is red-black Gauss-Seidel,
 // black-first after the coarse correction, so the cycle is symmetric.
+//
+// The levels work in single precision (as McAdams et al.): the cycle is
+// bandwidth-bound and a preconditioner needs no more. Accuracy comes from
+// the double-precision outer iteration: PCG, or defect correction in solve().
 #pragma once
 
 #include <array>
@@ -31,9 +35,8 @@ class Multigrid final : public Preconditioner {
  public:
   explicit Multigrid(const LaplaceSystem<D>& fine, const MultigridOptions& options = {});
 
-  // One V-cycle on A x = b, improving *x in place.
-  void vcycle(const Vector& b, Vector* x);
-  // Repeated V-cycles until the relative residual meets the tolerance.
+  // Repeated V-cycles (defect correction: x += cycle(b - A x)) until the
+  // relative residual meets the tolerance.
   SolverResult solve(const Vector& b, Vector* x, const SolverOptions& options,
                      Interrupter* interrupter = nullptr);
   // Preconditioner: z = one V-cycle from zero.
@@ -43,19 +46,20 @@ class Multigrid final : public Preconditioner {
   const LaplaceSystem<D>& level(int l) const { return l == 0 ? fine_ : levels_[size_t(l)].A; }
 
  private:
+  using FVector = std::vector<float>;
   // Per-axis transfer tables between this level (fine) and the next (coarse).
   struct AxisTransfer {
     // Prolongation: fine index f takes w * x_c[lo] + (1 - w) * x_c[hi].
     std::vector<int> lo, hi;
-    std::vector<double> w;
+    std::vector<float> w;
     // Restriction (the transpose): coarse index C gathers up to 4 fine
     // indices with these weights (unused entries weigh 0).
     std::vector<std::array<int, 4>> fine;
-    std::vector<std::array<double, 4>> fineWeight;
+    std::vector<std::array<float, 4>> fineWeight;
   };
   struct Level {
     LaplaceSystem<D> A;  // unused on level 0 (fine_ is used)
-    Vector x, b, r;
+    FVector x, b, r;
     std::array<AxisTransfer, D> transfer;  // to level + 1 (absent on the coarsest)
   };
   void buildTransfer(int l);
@@ -66,6 +70,8 @@ class Multigrid final : public Preconditioner {
   const LaplaceSystem<D>& fine_;
   MultigridOptions options_;
   std::vector<Level> levels_;
+  Vector coarseB_, coarseX_, r_, z_;  // the coarsest solve in double; solve()'s vectors
+  PcgWorkspace coarseWork_;
 };
 
 }  // namespace morphoflow

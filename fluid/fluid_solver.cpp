@@ -1,5 +1,6 @@
 #include "fluid/fluid_solver.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -69,9 +70,12 @@ void FluidSolver<D>::step(double dt) {
   lap(0);
   // 2. advect (velocity through itself, dye through the same field)
   advectVelocity<D>(u_, dt, settings_.advection, &scratch_, &advectionScratch_);
-  advectField<D>(dye_, cellLayout(), u_, dt, settings_.advection, &dyeScratch_, &advectionScratch_);
+  // An all-zero dye (no dye in the scene yet) advects to zero: skip the work.
+  if (std::any_of(dye_.values().begin(), dye_.values().end(), [](float v) { return v != 0.0f; })) {
+    advectField<D>(dye_, cellLayout(), u_, dt, settings_.advection, &dyeScratch_, &advectionScratch_);
+    std::swap(dye_, dyeScratch_);
+  }
   std::swap(u_, scratch_);
-  std::swap(dye_, dyeScratch_);
   constraints_.apply(&u_);
   injectInflowDye();
   lap(1);

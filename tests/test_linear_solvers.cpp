@@ -163,7 +163,8 @@ TEST(LinearSolvers, ObstaclesAndPeriodicAxes) {
 }
 
 TEST(LinearSolvers, MultigridPreconditionerIsSymmetric) {
-  // <M^-1 a, b> == <a, M^-1 b>: required for PCG to converge.
+  // <M^-1 a, b> == <a, M^-1 b>: required for PCG to converge. The cycle
+  // runs in single precision, so symmetric to float round-off.
   IVec<3> dims(16, 12, 10);
   LaplaceSystem<3> A = makeNeumannLaplacian<3>(dims, {false, true, false}, 0.1);
   forEachCell<3>(dims, [&](const IVec<3>& k, size_t i) { if (k[0] == 0) A.c[i] = 1.0f; });
@@ -177,7 +178,7 @@ TEST(LinearSolvers, MultigridPreconditionerIsSymmetric) {
   mg.apply(a, &ma);
   mg.apply(b, &mb);
   double ab = dot(ma, b), ba = dot(a, mb);
-  EXPECT_NEAR(ab, ba, 1e-9 * std::abs(ab));
+  EXPECT_NEAR(ab, ba, 1e-5 * std::abs(ab));
 }
 
 TEST(LinearSolvers, ResultsIndependentOfThreadCount) {
