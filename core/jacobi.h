@@ -19,6 +19,16 @@ class JacobiPreconditioner final : public Preconditioner {
       (*z)[i] = d > 0 ? r[i] * inv / d : 0.0;
     }, 4096);
   }
+  double applyDot(const Vector& r, double, Vector* z) override {
+    z->resize(r.size());
+    const double inv = 1.0 / A_.scale;
+    return deterministicSum(r.size(), [&](size_t i) {
+      float d = A_.diag[i];
+      double zi = d > 0 ? r[i] * inv / d : 0.0;
+      (*z)[i] = zi;
+      return r[i] * zi;
+    });
+  }
 
  private:
   const LaplaceSystem<D>& A_;

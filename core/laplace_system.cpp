@@ -155,33 +155,48 @@ void LaplaceSystem<D>::finalize() {
 
 template <int D>
 template <class T>
-void LaplaceSystem<D>::apply(const std::vector<T>& x, std::vector<T>* yp) const {
-  std::vector<T>& y = *yp;
+double LaplaceSystem<D>::applyRow(size_t row, const T* x, T* y) const {
   const size_t nx = size_t(dims[0]);
   const bool px = periodic[0];
   const T sc = T(scale);
-  parallelForRows<D>(dims, [&](size_t row) {
-    RowStencil<D, T> s = rowStencil<D>(*this, x.data(), zeros<T>(), zerosW_.data(), row);
-    const float* wa[D];
-    for (int a = 0; a < D; ++a) wa[a] = w[a].data() + s.base;
-    const float* cr = c.data() + s.base;
-    const T* xr = x.data() + s.base;
-    T* yr = y.data() + s.base;
-    auto edge = [&](size_t i) {
-      size_t il = i == 0 ? nx - 1 : i - 1, ih = i + 1 == nx ? 0 : i + 1;
-      float wl = (i == 0 && !px) ? 0.0f : wa[0][il];
-      yr[i] = sc * (T(cr[i]) * xr[i] + faceSum<D, T>(s, wa, xr, i, il, ih, wl));
-    };
-    edge(0);
-    if (rowUniform_[row]) {
-      const T c0 = T(cr[1]);
-      for (size_t i = 1; i + 1 < nx; ++i) yr[i] = sc * (c0 * xr[i] + faceSumUniform<D, T>(s, xr, i));
-    } else {
-      for (size_t i = 1; i + 1 < nx; ++i)  // interior: no wrap, no branch
-        yr[i] = sc * (T(cr[i]) * xr[i] + faceSum<D, T>(s, wa, xr, i, i - 1, i + 1, wa[0][i - 1]));
+  RowStencil<D, T> s = rowStencil<D>(*this, x, zeros<T>(), zerosW_.data(), row);
+  const float* wa[D];
+  for (int a = 0; a < D; ++a) wa[a] = w[a].data() + s.base;
+  const float* cr = c.data() + s.base;
+  const T* xr = x + s.base;
+  T* yr = y + s.base;
+  auto edge = [&](size_t i) {
+    size_t il = i == 0 ? nx - 1 : i - 1, ih = i + 1 == nx ? 0 : i + 1;
+    float wl = (i == 0 && !px) ? 0.0f : wa[0][il];
+    yr[i] = sc * (T(cr[i]) * xr[i] + faceSum<D, T>(s, wa, xr, i, il, ih, wl));
+    return double(xr[i]) * double(yr[i]);
+  };
+  double dot = edge(0);
+  if (rowUniform_[row]) {
+    const T c0 = T(cr[1]);
+    for (size_t i = 1; i + 1 < nx; ++i) {
+      yr[i] = sc * (c0 * xr[i] + faceSumUniform<D, T>(s, xr, i));
+      dot += double(xr[i]) * double(yr[i]);
     }
-    if (nx > 1) edge(nx - 1);
-  });
+  } else {
+    for (size_t i = 1; i + 1 < nx; ++i) {  // interior: no wrap, no branch
+      yr[i] = sc * (T(cr[i]) * xr[i] + faceSum<D, T>(s, wa, xr, i, i - 1, i + 1, wa[0][i - 1]));
+      dot += double(xr[i]) * double(yr[i]);
+    }
+  }
+  if (nx > 1) dot += edge(nx - 1);
+  return dot;
+}
+
+template <int D>
+template <class T>
+void LaplaceSystem<D>::apply(const std::vector<T>& x, std::vector<T>* y) const {
+  parallelForRows<D>(dims, [&](size_t row) { applyRow<T>(row, x.data(), y->data()); });
+}
+
+template <int D>
+double LaplaceSystem<D>::applyDot(const Vector& x, Vector* y) const {
+  return deterministicRowSum<D>(dims, [&](size_t row) { return applyRow<double>(row, x.data(), y->data()); });
 }
 
 template <int D>

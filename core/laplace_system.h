@@ -43,6 +43,8 @@ struct LaplaceSystem {
   // multigrid preconditioner's levels, half the memory traffic).
   template <class T>
   void apply(const std::vector<T>& x, std::vector<T>* y) const;
+  // y = A x; returns x . y (one pass instead of two).
+  double applyDot(const Vector& x, Vector* y) const;
   // r = b - A x (0 on inactive cells).
   template <class T>
   void defect(const std::vector<T>& b, const std::vector<T>& x, std::vector<T>* r) const;
@@ -61,6 +63,9 @@ struct LaplaceSystem {
   bool uniformRow(size_t row) const { return rowUniform_[row] != 0; }
 
  private:
+  // y = A x on one row; returns the row's x . y.
+  template <class T>
+  double applyRow(size_t row, const T* x, T* y) const;
   template <class T>
   const T* invDiag() const;
   template <class T>

@@ -14,85 +14,98 @@
 
 namespace morphoflow {
 
+// The two samples that bracket a position along one axis, and the weight of
+// the upper one.
+struct AxisTap {
+  int lo, hi;
+  float t;
+};
+
+// How samples are laid out along one axis.
+struct AxisSamples {
+  int n = 1;            // samples along the axis
+  int period = 1;       // cells along the axis (the wrap period)
+  bool periodic = false;
+  float offset = 0.5f;  // sample k sits at k + offset (cell units)
+
+  AxisSamples() = default;
+  AxisSamples(int samples, int cells, bool wrap, float off) : n(samples), period(cells), periodic(wrap), offset(off) {}
+
+  AxisTap at(float p) const {
+    float g = p - offset;
+    if (!periodic) {
+      g = std::clamp(g, 0.0f, float(n - 1));
+      int i = std::min(int(g), std::max(n - 2, 0));
+      return {i, std::min(i + 1, n - 1), g - float(i)};
+    }
+    float f = std::floor(g);
+    int i = int(f) % period;
+    if (i < 0) i += period;
+    int j = i + 1;
+    if (j == period) j = n > period ? period : 0;
+    return {i, j, g - f};
+  }
+};
+
+// Bi-/trilinear interpolation of `data` (strides s) between the taps; lo/hi
+// (both or neither) receive the stencil's min and max.
+template <int D>
+inline float interpolate(const float* data, const size_t* s, const AxisTap* tap, float* lo = nullptr,
+                         float* hi = nullptr) {
+  const float* b = data + size_t(tap[0].lo);
+  const ptrdiff_t dx = ptrdiff_t(tap[0].hi) - ptrdiff_t(tap[0].lo);  // < 0 across a wrap
+  const float tx = tap[0].t;
+  if constexpr (D == 2) {
+    const float* r0 = b + size_t(tap[1].lo) * s[1];
+    const float* r1 = b + size_t(tap[1].hi) * s[1];
+    float v00 = r0[0], v10 = r0[dx], v01 = r1[0], v11 = r1[dx];
+    float a0 = v00 + tx * (v10 - v00), a1 = v01 + tx * (v11 - v01);
+    if (lo) {
+      *lo = std::min(std::min(v00, v10), std::min(v01, v11));
+      *hi = std::max(std::max(v00, v10), std::max(v01, v11));
+    }
+    return a0 + tap[1].t * (a1 - a0);
+  } else {
+    const size_t y0 = size_t(tap[1].lo) * s[1], y1 = size_t(tap[1].hi) * s[1];
+    const size_t z0 = size_t(tap[2].lo) * s[2], z1 = size_t(tap[2].hi) * s[2];
+    const float *r00 = b + y0 + z0, *r10 = b + y1 + z0, *r01 = b + y0 + z1, *r11 = b + y1 + z1;
+    float v[8] = {r00[0], r00[dx], r10[0], r10[dx], r01[0], r01[dx], r11[0], r11[dx]};
+    float x00 = v[0] + tx * (v[1] - v[0]), x10 = v[2] + tx * (v[3] - v[2]);
+    float x01 = v[4] + tx * (v[5] - v[4]), x11 = v[6] + tx * (v[7] - v[6]);
+    float y0v = x00 + tap[1].t * (x10 - x00), y1v = x01 + tap[1].t * (x11 - x01);
+    if (lo) {
+      float mn = v[0], mx = v[0];
+      for (int k = 1; k < 8; ++k) {
+        mn = std::min(mn, v[k]);
+        mx = std::max(mx, v[k]);
+      }
+      *lo = mn;
+      *hi = mx;
+    }
+    return y0v + tap[2].t * (y1v - y0v);
+  }
+}
+
 template <int D>
 struct LinearSampler {
   const float* data = nullptr;
-  int n[D];             // samples along each axis
-  size_t stride[D];     // flat-array distance between neighbours
-  float offset[D];      // sample k sits at k + offset (cell units)
-  bool periodic[D];
-  int period[D];
+  size_t stride[D];  // flat-array distance between neighbours
+  AxisSamples axis[D];
 
   LinearSampler(const Grid<float, D>& g, const Layout<D>& l) : data(g.data()) {
     size_t s = 1;
     for (int a = 0; a < D; ++a) {
-      n[a] = g.dim(a);
       stride[a] = s;
-      s *= size_t(n[a]);
-      offset[a] = float(l.offset[a]);
-      periodic[a] = l.periodic[a];
-      period[a] = l.period[a];
+      s *= size_t(g.dim(a));
+      axis[a] = AxisSamples(g.dim(a), l.period[a], l.periodic[a], float(l.offset[a]));
     }
-  }
-
-  // Lower sample index (times stride), upper offset and weight along one axis.
-  void axis(int a, float p, size_t* i0, size_t* i1, float* t) const {
-    float g = p - offset[a];
-    int i;
-    if (!periodic[a]) {
-      g = std::clamp(g, 0.0f, float(n[a] - 1));
-      i = std::min(int(g), std::max(n[a] - 2, 0));
-      *t = g - float(i);
-      *i0 = size_t(i) * stride[a];
-      *i1 = size_t(std::min(i + 1, n[a] - 1)) * stride[a];
-      return;
-    }
-    float f = std::floor(g);
-    *t = g - f;
-    i = int(f) % period[a];
-    if (i < 0) i += period[a];
-    int j = i + 1;
-    if (j == period[a]) j = n[a] > period[a] ? period[a] : 0;
-    *i0 = size_t(i) * stride[a];
-    *i1 = size_t(j) * stride[a];
   }
 
   // Value at p; lo/hi (both or neither) receive the stencil's min and max.
   float operator()(const float* p, float* lo = nullptr, float* hi = nullptr) const {
-    size_t i0[D], i1[D];
-    float t[D];
-    for (int a = 0; a < D; ++a) axis(a, p[a], &i0[a], &i1[a], &t[a]);
-    if constexpr (D == 2) {
-      const float* r0 = data + i0[1];
-      const float* r1 = data + i1[1];
-      float v00 = r0[i0[0]], v10 = r0[i1[0]], v01 = r1[i0[0]], v11 = r1[i1[0]];
-      float a0 = v00 + t[0] * (v10 - v00), a1 = v01 + t[0] * (v11 - v01);
-      if (lo) {
-        *lo = std::min(std::min(v00, v10), std::min(v01, v11));
-        *hi = std::max(std::max(v00, v10), std::max(v01, v11));
-      }
-      return a0 + t[1] * (a1 - a0);
-    } else {
-      const float* r00 = data + i0[1] + i0[2];
-      const float* r10 = data + i1[1] + i0[2];
-      const float* r01 = data + i0[1] + i1[2];
-      const float* r11 = data + i1[1] + i1[2];
-      float v[8] = {r00[i0[0]], r00[i1[0]], r10[i0[0]], r10[i1[0]],
-                    r01[i0[0]], r01[i1[0]], r11[i0[0]], r11[i1[0]]};
-      float x00 = v[0] + t[0] * (v[1] - v[0]), x10 = v[2] + t[0] * (v[3] - v[2]);
-      float x01 = v[4] + t[0] * (v[5] - v[4]), x11 = v[6] + t[0] * (v[7] - v[6]);
-      float y0 = x00 + t[1] * (x10 - x00), y1 = x01 + t[1] * (x11 - x01);
-      if (lo) {
-        float mn = v[0], mx = v[0];
-        for (int k = 1; k < 8; ++k) {
-          mn = std::min(mn, v[k]);
-          mx = std::max(mx, v[k]);
-        }
-        *lo = mn;
-        *hi = mx;
-      }
-      return y0 + t[2] * (y1 - y0);
-    }
+    AxisTap t[D];
+    for (int a = 0; a < D; ++a) t[a] = axis[a].at(p[a]);
+    return interpolate<D>(data, stride, t, lo, hi);
   }
 };
 

@@ -51,14 +51,44 @@ class MacVelocity {
   std::array<Layout<D>, D> layout_;
 };
 
-// One LinearSampler per component (for hot loops in cell units).
+// The velocity vector at a point, in cell units, for hot loops. Along each
+// axis a component's samples sit either on faces (its own axis) or at cell
+// centres (the others), so the D components share 2D axis taps instead of
+// computing D^2.
 template <int D>
-std::array<LinearSampler<D>, D> makeVelocitySamplers(const MacVelocity<D>& u) {
-  if constexpr (D == 2)
-    return {LinearSampler<2>(u[0], u.layout(0)), LinearSampler<2>(u[1], u.layout(1))};
-  else
-    return {LinearSampler<3>(u[0], u.layout(0)), LinearSampler<3>(u[1], u.layout(1)),
-            LinearSampler<3>(u[2], u.layout(2))};
-}
+struct MacSampler {
+  const float* data[D];
+  size_t stride[D][D];   // stride[a][b]: component a's distance between neighbours along b
+  AxisSamples face[D];   // along axis b: the faces of component b
+  AxisSamples centre[D]; // along axis b: the cell centres of the other components
+
+  explicit MacSampler(const MacVelocity<D>& u) {
+    for (int a = 0; a < D; ++a) {
+      data[a] = u[a].data();
+      size_t s = 1;
+      for (int b = 0; b < D; ++b) {
+        stride[a][b] = s;
+        s *= size_t(u[a].dim(b));
+      }
+      const int cells = u.cells()[a];
+      const bool periodic = u.periodic()[size_t(a)];
+      face[a] = AxisSamples(cells + 1, cells, periodic, 0.0f);
+      centre[a] = AxisSamples(cells, cells, periodic, 0.5f);
+    }
+  }
+
+  void operator()(const float* p, float* v) const {
+    AxisTap f[D], c[D];
+    for (int b = 0; b < D; ++b) {
+      f[b] = face[b].at(p[b]);
+      c[b] = centre[b].at(p[b]);
+    }
+    for (int a = 0; a < D; ++a) {
+      AxisTap t[D];
+      for (int b = 0; b < D; ++b) t[b] = b == a ? f[b] : c[b];
+      v[a] = interpolate<D>(data[a], stride[a], t);
+    }
+  }
+};
 
 }  // namespace morphoflow

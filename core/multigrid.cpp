@@ -256,24 +256,40 @@ void Multigrid<D>::cycle(int l) {
 }
 
 template <int D>
-void Multigrid<D>::apply(const Vector& r, Vector* z) {
+double Multigrid<D>::scaledCycle(const Vector& r, double rscale, Vector* z, bool withDot) {
   Level& L0 = levels_[0];
   z->resize(r.size());
   Vector& zz = *z;
-  // The cycle is linear: run it on r / max|r| so that single precision
-  // neither underflows nor overflows whatever the scale of r.
-  const double rmax = deterministicMax(r.size(), [&](size_t i) { return std::abs(r[i]); });
-  if (rmax == 0.0 || !std::isfinite(rmax)) {  // zero in, zero out; an overflow stays visible
-    std::fill(zz.begin(), zz.end(), rmax == 0.0 ? 0.0 : std::numeric_limits<double>::quiet_NaN());
-    return;
+  if (rscale == 0.0 || !std::isfinite(rscale)) {  // zero in, zero out; an overflow stays visible
+    std::fill(zz.begin(), zz.end(), rscale == 0.0 ? 0.0 : std::numeric_limits<double>::quiet_NaN());
+    return rscale == 0.0 ? 0.0 : std::numeric_limits<double>::quiet_NaN();
   }
-  const double inv = 1.0 / rmax;
+  const double inv = 1.0 / rscale;
   parallelFor(r.size(), [&](size_t i) {
     L0.b[i] = float(r[i] * inv);
     L0.x[i] = 0.0f;
   }, 4096);
   cycle(0);
-  parallelFor(r.size(), [&](size_t i) { zz[i] = double(L0.x[i]) * rmax; }, 4096);
+  if (!withDot) {
+    parallelFor(r.size(), [&](size_t i) { zz[i] = double(L0.x[i]) * rscale; }, 4096);
+    return 0.0;
+  }
+  return deterministicSum(r.size(), [&](size_t i) {
+    zz[i] = double(L0.x[i]) * rscale;
+    return r[i] * zz[i];
+  });
+}
+
+template <int D>
+void Multigrid<D>::apply(const Vector& r, Vector* z) {
+  // The cycle is linear: run it on r / max|r|.
+  scaledCycle(r, deterministicMax(r.size(), [&](size_t i) { return std::abs(r[i]); }), z, false);
+}
+
+template <int D>
+double Multigrid<D>::applyDot(const Vector& r, double rnorm, Vector* z) {
+  // |r_i| <= ||r||_2: r / ||r||_2 is as safe in float as r / max|r|, and free.
+  return scaledCycle(r, rnorm, z, true);
 }
 
 template <int D>

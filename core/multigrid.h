@@ -41,6 +41,7 @@ class Multigrid final : public Preconditioner {
                      Interrupter* interrupter = nullptr);
   // Preconditioner: z = one V-cycle from zero.
   void apply(const Vector& r, Vector* z) override;
+  double applyDot(const Vector& r, double rnorm, Vector* z) override;
 
   int levels() const { return int(levels_.size()); }
   const LaplaceSystem<D>& level(int l) const { return l == 0 ? fine_ : levels_[size_t(l)].A; }
@@ -64,6 +65,9 @@ class Multigrid final : public Preconditioner {
   };
   void buildTransfer(int l);
   void cycle(int l);
+  // The cycle on r / rscale (single precision must neither underflow nor
+  // overflow), z = rscale * result; returns r . z when `withDot`.
+  double scaledCycle(const Vector& r, double rscale, Vector* z, bool withDot);
   void restrict(int l);   // r of level l -> b of level l + 1
   void prolongAdd(int l); // x of level l + 1 added into x of level l
 

@@ -99,6 +99,25 @@ double deterministicSum(size_t n, Fn&& f) {
   return s;
 }
 
+// Deterministic sum of fn(row) over the rows of a lattice: the rows are cut
+// into fixed groups (as parallelForRows), partials summed in order.
+template <int D, typename Fn>
+double deterministicRowSum(const IVec<D>& dims, Fn&& fn) {
+  size_t rows = 1;
+  for (int a = 1; a < D; ++a) rows *= size_t(dims[a]);
+  const size_t grain = std::max<size_t>(1, 16384 / size_t(dims[0]));
+  const size_t groups = (rows + grain - 1) / grain;
+  std::vector<double> partial(groups, 0.0);
+  parallelFor(groups, [&](size_t g) {
+    double s = 0;
+    for (size_t r = g * grain; r < std::min(rows, (g + 1) * grain); ++r) s += fn(r);
+    partial[g] = s;
+  });
+  double s = 0;
+  for (double p : partial) s += p;
+  return s;
+}
+
 // Deterministic maximum of f(i).
 template <typename Fn>
 double deterministicMax(size_t n, Fn&& f, double init = 0.0) {

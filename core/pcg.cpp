@@ -52,32 +52,40 @@ SolverResult pcg(const Op& A, const Vector& bIn, Vector* xp, Preconditioner* M, 
       for (double& v : x) v /= unit;
     return result;
   }
-  auto precondition = [&] {
-    if (M)
-      M->apply(r, &z);
-    else
+  // z = M^-1 r; returns r . z (fused into the preconditioner's last pass).
+  auto precondition = [&]() -> double {
+    if (!M) {
       z = r;
-    if (A.singular()) A.removeNullSpace(&z);
+      if (A.singular()) A.removeNullSpace(&z);
+      return dot(r, z);
+    }
+    const double rz = M->applyDot(r, rnorm, &z);
+    if (!A.singular()) return rz;
+    A.removeNullSpace(&z);
+    return dot(r, z);
   };
-  precondition();
+  double rz = precondition();
   p = z;
-  double rz = dot(r, z);
   for (int it = 1; it <= opt.maxIterations; ++it) {
-    A.apply(p, &q);
-    double pq = dot(p, q);
+    double pq;
+    if constexpr (requires { A.applyDot(p, &q); })
+      pq = A.applyDot(p, &q);
+    else {
+      A.apply(p, &q);
+      pq = dot(p, q);
+    }
     if (!(pq > 0.0)) break;  // breakdown: A not SPD on this subspace
     double alpha = rz / pq;
-    parallelFor(n, [&](size_t i) {
+    rnorm = std::sqrt(deterministicSum(n, [&](size_t i) {
       x[i] += alpha * p[i];
       r[i] -= alpha * q[i];
-    }, 4096);
-    rnorm = norm2(r);
+      return r[i] * r[i];
+    }));
     result.iterations = it;
     result.residual = rnorm / bnorm;
     if (result.residual <= opt.tolerance) break;
     if (interrupter && interrupter->progress(-1.0)) break;
-    precondition();
-    double rzNew = dot(r, z);
+    double rzNew = precondition();
     double beta = rzNew / rz;
     rz = rzNew;
     parallelFor(n, [&](size_t i) { p[i] = z[i] + beta * p[i]; }, 4096);

@@ -81,9 +81,10 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
       // iterations; above, multigrid keeps the count independent of s.
       C.multigrid = s > 1.0 ? std::make_unique<Multigrid<D>>(C.A) : nullptr;
     }
+    if (s != s_) C.increment.assign(C.A.size(), 0.0);
     forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) {
       size_t gi = g.index(k);
-      C.x[i] = double(g[gi]);
+      C.x[i] = fixed[gi] ? 0.0 : double(g[gi]) + C.increment[i];
       C.b[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * C.boundaryRhs[i];
     });
     JacobiPreconditioner<D> jacobi(C.A);
@@ -91,7 +92,9 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
     SolverResult r = solvePCG<D>(C.A, C.b, &C.x, M, options_, nullptr, &workspace_);
     forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) {
       size_t gi = g.index(k);
-      if (!fixed[gi]) g[gi] = float(C.x[i]);
+      if (fixed[gi]) return;
+      C.increment[i] = C.x[i] - double(g[gi]);
+      g[gi] = float(C.x[i]);
     });
     worst.converged = worst.converged && r.converged;
     worst.iterations = std::max(worst.iterations, r.iterations);

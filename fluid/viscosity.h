@@ -3,7 +3,8 @@
 // (moving walls reflect their velocity), zero gradient at outflow. Solved by
 // CG, preconditioned with multigrid when nu dt / h^2 is large (the system is
 // then Poisson-like) and with its diagonal otherwise. The systems are built
-// once; a new nu dt only rescales their diagonal.
+// once; a new nu dt only rescales their diagonal. Each solve starts from
+// u* plus the previous step's viscous increment, which changes slowly.
 #pragma once
 
 #include <array>
@@ -31,6 +32,7 @@ class ViscositySolver {
     Grid<float, D> cBoundary;   // diagonal terms from walls and prescribed neighbours
     Vector boundaryRhs;         // their prescribed values, times the coupling
     Vector b, x;
+    Vector increment;           // the last solve's x - u*: the next one's warm start
     std::unique_ptr<Multigrid<D>> multigrid;  // rebuilt when nu dt changes
   };
   const VelocityConstraints<D>& vc_;
