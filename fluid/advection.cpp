@@ -95,11 +95,20 @@ bool allClamped(const LinearSampler<D>& field, const MacSampler<D>& vel) {
   return true;
 }
 
+// u(p) at the samples of one grid, kept by a scheme's first pass for the
+// later passes from the same samples through the same u.
+template <int D>
+struct StartVelocity {
+  std::array<Grid<float, D>, D>* v = nullptr;
+  bool reuse = false;  // false: compute and store; true: read
+};
+
 // One semi-Lagrangian pass; optionally records the min/max of each stencil.
 // Works in cell units: p = k + offset, foot = p - (dt/h) u(p - (dt/2h) u(p)).
 template <int D>
 void semiLagrangian(const Grid<float, D>& src, const Layout<D>& layout, const MacVelocity<D>& u,
-                    double dt, Grid<float, D>* dst, Grid<float, D>* lo, Grid<float, D>* hi) {
+                    double dt, Grid<float, D>* dst, Grid<float, D>* lo, Grid<float, D>* hi,
+                    StartVelocity<D> start = {}) {
   const LinearSampler<D> field(src, layout);
   const MacSampler<D> vel(u);
   const float c = float(dt / u.h());
@@ -121,13 +130,19 @@ void semiLagrangian(const Grid<float, D>& src, const Layout<D>& layout, const Ma
       for (int k = 0; k < kLanes; ++k) lane[k] = float(k);
       for (; x + kLanes <= dims[0]; x += kLanes) {
         vp[0] = (splat(float(x)) + lane) + field.axis[0].offset;
-        vvelocity<D>(vel, vp, vv);
+        const size_t i = base + size_t(x);
+        if (start.reuse) {
+          for (int a = 0; a < D; ++a) __builtin_memcpy(&vv[a], &(*start.v)[a][i], sizeof vv[a]);
+        } else {
+          vvelocity<D>(vel, vp, vv);
+          if (start.v)
+            for (int a = 0; a < D; ++a) __builtin_memcpy(&(*start.v)[a][i], &vv[a], sizeof vv[a]);
+        }
         for (int a = 0; a < D; ++a) vm[a] = vp[a] - (0.5f * c) * vv[a];
         vvelocity<D>(vel, vm, vv);
         for (int a = 0; a < D; ++a) vfoot[a] = vp[a] - c * vv[a];
         VTap t[D];
         for (int a = 0; a < D; ++a) t[a] = vtap(field.axis[a], vfoot[a]);
-        const size_t i = base + size_t(x);
         vf4 r;
         if (lo) {
           vf4 l, h;
@@ -142,11 +157,17 @@ void semiLagrangian(const Grid<float, D>& src, const Layout<D>& layout, const Ma
     }
     for (; x < dims[0]; ++x) {
       p[0] = float(x) + field.axis[0].offset;
-      vel(p, v);
+      const size_t i = base + size_t(x);
+      if (start.reuse) {
+        for (int a = 0; a < D; ++a) v[a] = (*start.v)[a][i];
+      } else {
+        vel(p, v);
+        if (start.v)
+          for (int a = 0; a < D; ++a) (*start.v)[a][i] = v[a];
+      }
       for (int a = 0; a < D; ++a) m[a] = p[a] - 0.5f * c * v[a];
       vel(m, v);
       for (int a = 0; a < D; ++a) f[a] = p[a] - c * v[a];
-      size_t i = base + size_t(x);
       if (lo)
         (*dst)[i] = field(f, &(*lo)[i], &(*hi)[i]);
       else
@@ -170,8 +191,8 @@ void advectField(const Grid<float, D>& src, const Layout<D>& layout, const MacVe
   if (scheme == AdvectionScheme::MacCormack) {
     // phi^ = A(phi); phi~ = A^-1(phi^); phi = phi^ + (phi - phi~) / 2, limited.
     Grid<float, D>& fwd = *dst;
-    semiLagrangian<D>(src, layout, u, dt, &fwd, &lo, &hi);
-    semiLagrangian<D>(fwd, layout, u, -dt, &back, nullptr, nullptr);
+    semiLagrangian<D>(src, layout, u, dt, &fwd, &lo, &hi, {&s.start, false});
+    semiLagrangian<D>(fwd, layout, u, -dt, &back, nullptr, nullptr, {&s.start, true});
     parallelFor(src.size(), [&](size_t i) {
       float v = fwd[i] + 0.5f * (src[i] - back[i]);
       // Revert to first order where the correction leaves the stencil's range.
@@ -181,12 +202,12 @@ void advectField(const Grid<float, D>& src, const Layout<D>& layout, const MacVe
   }
   // BFECC: phi_bar = phi + (phi - A^-1 A phi) / 2, then A(phi_bar), limited.
   Grid<float, D>& fwd = s.fwd;
-  semiLagrangian<D>(src, layout, u, dt, &fwd, nullptr, nullptr);
-  semiLagrangian<D>(fwd, layout, u, -dt, &back, nullptr, nullptr);
+  semiLagrangian<D>(src, layout, u, dt, &fwd, nullptr, nullptr, {&s.start, false});
+  semiLagrangian<D>(fwd, layout, u, -dt, &back, nullptr, nullptr, {&s.start, true});
   Grid<float, D>& corrected = fwd;  // fwd is no longer needed
   parallelFor(src.size(), [&](size_t i) { corrected[i] = src[i] + 0.5f * (src[i] - back[i]); }, 4096);
-  semiLagrangian<D>(corrected, layout, u, dt, dst, nullptr, nullptr);
-  semiLagrangian<D>(src, layout, u, dt, &back, &lo, &hi);  // first-order fallback
+  semiLagrangian<D>(corrected, layout, u, dt, dst, nullptr, nullptr, {&s.start, true});
+  semiLagrangian<D>(src, layout, u, dt, &back, &lo, &hi, {&s.start, true});  // first-order fallback
   parallelFor(src.size(), [&](size_t i) {
     if ((*dst)[i] < lo[i] || (*dst)[i] > hi[i]) (*dst)[i] = back[i];
   }, 4096);

@@ -4,6 +4,7 @@
 // stencil so they stay bounded. Unconditionally stable at any CFL number.
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include "core/mac_velocity.h"
@@ -16,6 +17,7 @@ template <int D>
 struct AdvectionScratch {
   struct Set {
     Grid<float, D> lo, hi, back, fwd;
+    std::array<Grid<float, D>, D> start;  // u at the samples, shared by a scheme's passes
   };
   std::vector<Set> sets;  // one per grid shape (each velocity component, cells)
   Set& forShape(const IVec<D>& dims) {
@@ -23,6 +25,7 @@ struct AdvectionScratch {
       if (s.lo.dims() == dims) return s;
     Set& s = sets.emplace_back();
     for (Grid<float, D>* g : {&s.lo, &s.hi, &s.back, &s.fwd}) *g = Grid<float, D>(dims);
+    for (Grid<float, D>& g : s.start) g = Grid<float, D>(dims);
     return s;
   }
 };
