@@ -13,24 +13,22 @@ class JacobiPreconditioner final : public Preconditioner {
   explicit JacobiPreconditioner(const LaplaceSystem<D>& A) : A_(A) {}
   void apply(const Vector& r, Vector* z) override {
     z->resize(r.size());
-    const double inv = 1.0 / A_.scale;
-    parallelFor(r.size(), [&](size_t i) {
-      float d = A_.diag[i];
-      (*z)[i] = d > 0 ? r[i] * inv / d : 0.0;
-    }, 4096);
+    parallelFor(r.size(), [&](size_t i) { (*z)[i] = scaled(r, i); }, 4096);
   }
   double applyDot(const Vector& r, double, Vector* z) override {
     z->resize(r.size());
-    const double inv = 1.0 / A_.scale;
     return deterministicSum(r.size(), [&](size_t i) {
-      float d = A_.diag[i];
-      double zi = d > 0 ? r[i] * inv / d : 0.0;
-      (*z)[i] = zi;
-      return r[i] * zi;
+      (*z)[i] = scaled(r, i);
+      return r[i] * (*z)[i];
     });
   }
 
  private:
+  // z_i = r_i / (scale diag_i), 0 on inactive cells.
+  double scaled(const Vector& r, size_t i) const {
+    float d = A_.diag[i];
+    return d > 0 ? r[i] * (1.0 / A_.scale) / d : 0.0;
+  }
   const LaplaceSystem<D>& A_;
 };
 

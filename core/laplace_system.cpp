@@ -154,7 +154,7 @@ void LaplaceSystem<D>::finalize() {
 }
 
 template <int D>
-template <class T>
+template <class T, bool Dot>
 double LaplaceSystem<D>::applyRow(size_t row, const T* x, T* y) const {
   const size_t nx = size_t(dims[0]);
   const bool px = periodic[0];
@@ -169,19 +169,19 @@ double LaplaceSystem<D>::applyRow(size_t row, const T* x, T* y) const {
     size_t il = i == 0 ? nx - 1 : i - 1, ih = i + 1 == nx ? 0 : i + 1;
     float wl = (i == 0 && !px) ? 0.0f : wa[0][il];
     yr[i] = sc * (T(cr[i]) * xr[i] + faceSum<D, T>(s, wa, xr, i, il, ih, wl));
-    return double(xr[i]) * double(yr[i]);
+    return Dot ? double(xr[i]) * double(yr[i]) : 0.0;
   };
   double dot = edge(0);
   if (rowUniform_[row]) {
     const T c0 = T(cr[1]);
     for (size_t i = 1; i + 1 < nx; ++i) {
       yr[i] = sc * (c0 * xr[i] + faceSumUniform<D, T>(s, xr, i));
-      dot += double(xr[i]) * double(yr[i]);
+      if constexpr (Dot) dot += double(xr[i]) * double(yr[i]);
     }
   } else {
     for (size_t i = 1; i + 1 < nx; ++i) {  // interior: no wrap, no branch
       yr[i] = sc * (T(cr[i]) * xr[i] + faceSum<D, T>(s, wa, xr, i, i - 1, i + 1, wa[0][i - 1]));
-      dot += double(xr[i]) * double(yr[i]);
+      if constexpr (Dot) dot += double(xr[i]) * double(yr[i]);
     }
   }
   if (nx > 1) dot += edge(nx - 1);
@@ -191,12 +191,12 @@ double LaplaceSystem<D>::applyRow(size_t row, const T* x, T* y) const {
 template <int D>
 template <class T>
 void LaplaceSystem<D>::apply(const std::vector<T>& x, std::vector<T>* y) const {
-  parallelForRows<D>(dims, [&](size_t row) { applyRow<T>(row, x.data(), y->data()); });
+  parallelForRows<D>(dims, [&](size_t row) { applyRow<T, false>(row, x.data(), y->data()); });
 }
 
 template <int D>
 double LaplaceSystem<D>::applyDot(const Vector& x, Vector* y) const {
-  return deterministicRowSum<D>(dims, [&](size_t row) { return applyRow<double>(row, x.data(), y->data()); });
+  return deterministicRowSum<D>(dims, [&](size_t row) { return applyRow<double, true>(row, x.data(), y->data()); });
 }
 
 template <int D>
@@ -204,33 +204,10 @@ template <class T>
 void LaplaceSystem<D>::defect(const std::vector<T>& b, const std::vector<T>& x, std::vector<T>* rp) const {
   std::vector<T>& r = *rp;
   const size_t nx = size_t(dims[0]);
-  const bool px = periodic[0];
-  const T sc = T(scale);
   parallelForRows<D>(dims, [&](size_t row) {
-    RowStencil<D, T> s = rowStencil<D>(*this, x.data(), zeros<T>(), zerosW_.data(), row);
-    const float* wa[D];
-    for (int a = 0; a < D; ++a) wa[a] = w[a].data() + s.base;
-    const float* cr = c.data() + s.base;
-    const float* dr = diag.data() + s.base;
-    const T* xr = x.data() + s.base;
-    const T* br = b.data() + s.base;
-    T* rr = r.data() + s.base;
-    auto general = [&](size_t i, size_t il, size_t ih, float wl) {
-      T ax = sc * (T(cr[i]) * xr[i] + faceSum<D, T>(s, wa, xr, i, il, ih, wl));
-      rr[i] = dr[i] > 0 ? br[i] - ax : T(0);
-    };
-    auto edge = [&](size_t i) {
-      size_t il = i == 0 ? nx - 1 : i - 1, ih = i + 1 == nx ? 0 : i + 1;
-      general(i, il, ih, (i == 0 && !px) ? 0.0f : wa[0][il]);
-    };
-    edge(0);
-    if (rowUniform_[row]) {  // every interior diagonal is c + 2D > 0
-      const T c0 = T(cr[1]);
-      for (size_t i = 1; i + 1 < nx; ++i) rr[i] = br[i] - sc * (c0 * xr[i] + faceSumUniform<D, T>(s, xr, i));
-    } else {
-      for (size_t i = 1; i + 1 < nx; ++i) general(i, i - 1, i + 1, wa[0][i - 1]);
-    }
-    if (nx > 1) edge(nx - 1);
+    applyRow<T, false>(row, x.data(), r.data());  // r = A x, then b - A x while the row is in cache
+    const size_t base = row * nx;
+    for (size_t i = base; i < base + nx; ++i) r[i] = diag[i] > 0 ? b[i] - r[i] : T(0);
   });
 }
 

@@ -63,8 +63,8 @@ struct LaplaceSystem {
   bool uniformRow(size_t row) const { return rowUniform_[row] != 0; }
 
  private:
-  // y = A x on one row; returns the row's x . y.
-  template <class T>
+  // y = A x on one row; returns the row's x . y when Dot (else 0).
+  template <class T, bool Dot>
   double applyRow(size_t row, const T* x, T* y) const;
   template <class T>
   const T* invDiag() const;

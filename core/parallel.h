@@ -48,15 +48,20 @@ void parallelFor(size_t n, Fn&& fn, size_t grain = 1) {
 #endif
 }
 
+// Rows per task of a D-dim lattice: tasks of ~16k cells, fixed, independent
+// of the thread count.
+template <int D>
+size_t rowGrain(const IVec<D>& dims) {
+  return std::max<size_t>(1, 16384 / size_t(dims[0]));
+}
+
 // Calls fn(row) for each row of a D-dim lattice (a row = all x for fixed y[, z]);
 // row r covers cells [r * nx, (r + 1) * nx).
 template <int D, typename Fn>
 void parallelForRows(const IVec<D>& dims, Fn&& fn) {
   size_t rows = 1;
   for (int a = 1; a < D; ++a) rows *= size_t(dims[a]);
-  // Aim for tasks of ~16k cells; fixed, independent of the thread count.
-  size_t grain = std::max<size_t>(1, 16384 / size_t(dims[0]));
-  parallelFor(rows, fn, grain);
+  parallelFor(rows, fn, rowGrain<D>(dims));
 }
 
 // Calls fn(cell, index) for every cell, in parallel over rows.
@@ -105,7 +110,7 @@ template <int D, typename Fn>
 double deterministicRowSum(const IVec<D>& dims, Fn&& fn) {
   size_t rows = 1;
   for (int a = 1; a < D; ++a) rows *= size_t(dims[a]);
-  const size_t grain = std::max<size_t>(1, 16384 / size_t(dims[0]));
+  const size_t grain = rowGrain<D>(dims);
   const size_t groups = (rows + grain - 1) / grain;
   std::vector<double> partial(groups, 0.0);
   parallelFor(groups, [&](size_t g) {
