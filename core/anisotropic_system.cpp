@@ -1,5 +1,6 @@
 #include "core/anisotropic_system.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/parallel.h"
@@ -48,8 +49,11 @@ AnisotropicSystem<D> AnisotropicSystem<D>::fromTensor(const IVec<D>& dims, const
                                                       double scale,
                                                       const std::array<const double*, kComponents>& sigma) {
   AnisotropicSystem<D> s(LaplaceSystem<D>(dims, periodic, scale));
-  s.hasCross = true;
-  for (int p = 0; p < kPlanes; ++p) {
+  const size_t n = s.size();
+  // A diagonal tensor (no mixed components anywhere) is a plain LaplaceSystem.
+  for (int p = 0; p < kPlanes && !s.hasCross; ++p)
+    s.hasCross = std::any_of(sigma[size_t(D + p)], sigma[size_t(D + p)] + n, [](double v) { return v != 0.0; });
+  for (int p = 0; p < kPlanes && s.hasCross; ++p) {
     s.up[size_t(p)] = Grid<float, D>(dims, 0.0f);
     s.down[size_t(p)] = Grid<float, D>(dims, 0.0f);
   }
@@ -61,7 +65,7 @@ AnisotropicSystem<D> AnisotropicSystem<D>::fromTensor(const IVec<D>& dims, const
       s.axis.w[a][i] = in ? float(0.5 * (sigma[size_t(a)][i] + sigma[size_t(a)][j])) : 0.0f;
     }
     // Mixed terms: the 2x2 block's two other cells (seed 004 eq. 17, second order).
-    for (int p = 0; p < kPlanes; ++p) {
+    for (int p = 0; p < kPlanes && s.hasCross; ++p) {
       const int a = planeAxis(p, 0), b = planeAxis(p, 1);
       const double* sab = sigma[size_t(D + p)];
       bool inA = true, inUp = true, inDown = true;

@@ -47,6 +47,7 @@ struct AnisotropicSystem {
 
   // -h^2 div(sigma grad) with Neumann (cut) or periodic walls; sigma[k][i] is
   // component k (order of kComponents) of the tensor at cell i. scale = 1/h^2.
+  // A tensor without mixed components anywhere gives hasCross = false.
   static AnisotropicSystem fromTensor(const IVec<D>& dims, const std::array<bool, D>& periodic,
                                       double scale, const std::array<const double*, kComponents>& sigma);
 

@@ -4,31 +4,9 @@
 #include <cmath>
 
 #include "core/parallel.h"
+#include "rd/grid_difference.h"
 
 namespace morphoflow {
-
-namespace {
-
-// Central difference of u along axis a at cell c (the grid spacing cancels in
-// eq. 18's normalised gradient): wrapped if periodic, one-sided at walls.
-template <int D>
-double difference(const Grid<double, D>& u, IVec<D> c, int a, bool periodic) {
-  const int n = u.dim(a);
-  IVec<D> lo = c, hi = c;
-  lo[a] = c[a] - 1;
-  hi[a] = c[a] + 1;
-  double span = 2.0;
-  if (periodic) {
-    lo[a] = (lo[a] + n) % n;
-    hi[a] = hi[a] % n;
-  } else {
-    if (lo[a] < 0) lo[a] = 0, span = 1.0;
-    if (hi[a] >= n) hi[a] = n - 1, span = 1.0;
-  }
-  return (u[u.index(hi)] - u[u.index(lo)]) / span;
-}
-
-}  // namespace
 
 template <int D>
 std::array<std::vector<double>, AnisotropicSystem<D>::kComponents> diffusionTensor(
@@ -56,7 +34,7 @@ std::array<std::vector<double>, AnisotropicSystem<D>::kComponents> diffusionTens
     if (shape) {  // eq. 18-19
       double g[D], g2 = 0.0;
       for (int k = 0; k < D; ++k) {
-        g[k] = difference<D>(*shaped, c, k, periodic);
+        g[k] = centralDifference<D>(*shaped, c, k, periodic);
         g2 += g[k] * g[k];
       }
       if (g2 > 0.0) {

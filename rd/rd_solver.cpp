@@ -93,6 +93,7 @@ void RDSolver<D>::setFixedCells(std::vector<std::vector<uint8_t>> masks, std::ve
 
 template <int D>
 void RDSolver<D>::setDiffusionTensor(DiffusionTensorSpec<D> spec) {
+  if (lobeSpec_) throw std::invalid_argument("rd: a diffusion tensor and cosine lobes cannot be combined");
   const size_t cells = laplacian_.size();
   for (int a = 0; a < D; ++a)
     if (spec.direction[size_t(a)].size() != cells) throw std::invalid_argument("rd: tensor direction has the wrong size");
@@ -112,29 +113,61 @@ void RDSolver<D>::setDiffusionTensor(DiffusionTensorSpec<D> spec) {
   buildTensor();
 }
 
-// sigma from the spec (and the shape species' current gradient), assembled into
-// -h^2 div(sigma grad) with the Dirichlet ghosts weighted by sigma_aa.
 template <int D>
-void RDSolver<D>::buildTensor() {
-  const DiffusionTensorSpec<D>& spec = *tensorSpec_;
-  const bool periodic = settings_.boundary == RDBoundary::Periodic;
-  const auto sigma = diffusionTensor<D>(spec, cells_, periodic, spec.dynamic() ? &x_[size_t(spec.shapeSpecies)] : nullptr);
+void RDSolver<D>::setCosineLobes(CosineLobeSpec spec) {
+  if (tensorSpec_) throw std::invalid_argument("rd: a diffusion tensor and cosine lobes cannot be combined");
+  validateCosineLobes(spec);
+  if (!spec.theta0.empty() && spec.theta0.size() != laplacian_.size())
+    throw std::invalid_argument("rd: the lobes' theta0 field has the wrong size");
+  lobeSpecies_.assign(size_t(species()), spec.species.empty() ? 1 : 0);
+  for (int s : spec.species) {
+    if (s < 0 || s >= species()) throw std::invalid_argument("rd: lobed species out of range");
+    lobeSpecies_[size_t(s)] = 1;
+  }
+  lobeSpec_ = std::make_unique<CosineLobeSpec>(std::move(spec));
+  lobeSystem_.assign(size_t(species()), AnisotropicSystem<D>());
+  lobeBoundary_.assign(size_t(species()), Vector());
+  buildLobes();
+}
+
+// -h^2 div(sigma grad), the Dirichlet ghosts weighted by sigma_aa.
+template <int D>
+void RDSolver<D>::assemble(const std::array<std::vector<double>, AnisotropicSystem<D>::kComponents>& sigma,
+                           AnisotropicSystem<D>* system, Vector* boundary) const {
   std::array<const double*, AnisotropicSystem<D>::kComponents> ptr;
   for (size_t k = 0; k < sigma.size(); ++k) ptr[k] = sigma[k].data();
   std::array<bool, D> per{};
-  per.fill(periodic);
-  tensor_ = AnisotropicSystem<D>::fromTensor(cells_, per, 1.0 / (h_ * h_), ptr);
-  tensorBoundary_.assign(tensor_.size(), 0.0);
+  per.fill(settings_.boundary == RDBoundary::Periodic);
+  *system = AnisotropicSystem<D>::fromTensor(cells_, per, 1.0 / (h_ * h_), ptr);
+  boundary->assign(system->size(), 0.0);
   if (settings_.boundary == RDBoundary::Dirichlet) {
     forEachCell<D>(cells_, [&](const IVec<D>& k, size_t i) {
       double w = 0.0;
       for (int a = 0; a < D; ++a) w += sigma[size_t(a)][i] * ((k[a] == 0) + (k[a] == cells_[a] - 1));
-      tensorBoundary_[i] = w;
-      tensor_.axis.c[i] = float(2.0 * w);
+      (*boundary)[i] = w;
+      system->axis.c[i] = float(2.0 * w);
     });
-    tensor_.axis.finalize();
+    system->axis.finalize();
   }
-  ++tensorVersion_;
+}
+
+// sigma from the spec (and the shape species' current gradient).
+template <int D>
+void RDSolver<D>::buildTensor() {
+  const DiffusionTensorSpec<D>& spec = *tensorSpec_;
+  const bool periodic = settings_.boundary == RDBoundary::Periodic;
+  assemble(diffusionTensor<D>(spec, cells_, periodic, spec.dynamic() ? &x_[size_t(spec.shapeSpecies)] : nullptr),
+           &tensor_, &tensorBoundary_);
+  ++operatorVersion_;
+}
+
+// a(theta) I per lobed species, theta from that species' own gradient (eq. 14, 17).
+template <int D>
+void RDSolver<D>::buildLobes() {
+  const bool periodic = settings_.boundary == RDBoundary::Periodic;
+  for (int s = 0; s < species(); ++s)
+    if (lobed(s)) assemble(lobeTensor<D>(*lobeSpec_, x_[size_t(s)], periodic), &lobeSystem_[size_t(s)], &lobeBoundary_[size_t(s)]);
+  ++operatorVersion_;
 }
 
 template <int D>
@@ -142,7 +175,10 @@ double RDSolver<D>::explicitDiffusionLimit() const {
   double worst = 0.0;
   const double lapBound = laplacian_.maxRowAbsSum();
   const double tensorBound = tensorSpec_ ? tensor_.maxRowAbsSum() : 0.0;
-  for (int s = 0; s < species(); ++s) worst = std::max(worst, d_[size_t(s)] * (anisotropic(s) ? tensorBound : lapBound));
+  // a(theta) <= max a_n, so lobes are bounded by the Laplacian's bound times that.
+  const double lobeBound = lobeSpec_ ? lapBound * maxLobeDiffusivity(*lobeSpec_) : 0.0;
+  for (int s = 0; s < species(); ++s)
+    worst = std::max(worst, d_[size_t(s)] * (lobed(s) ? lobeBound : anisotropic(s) ? tensorBound : lapBound));
   return worst > 0 ? 2.0 * h_ * h_ / worst : INFINITY;
 }
 
@@ -164,7 +200,7 @@ void RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
   if (d == 0.0 || thetaDt == 0.0) return;
   Diffusion& df = *diffusion_[size_t(s)];
   const double scale = thetaDt * d / (h_ * h_);
-  const long version = anisotropic(s) ? tensorVersion_ : 0;
+  const long version = anisotropic(s) || lobed(s) ? operatorVersion_ : 0;
   if (df.thetaDt != thetaDt || df.version != version) {
     // x + scale (c_b x + sum (x_i - x_j)): unit scale with w = scale keeps the
     // identity exact (c = 1 away from Dirichlet walls), so a zero-flux run
@@ -272,6 +308,7 @@ void RDSolver<D>::step(double dt) {
   stats_ = RDStepStats{};
   stats_.diffusion.converged = true;
   if (tensorSpec_ && tensorSpec_->dynamic()) buildTensor();  // eq. 18-19 from the state at the step's start
+  if (lobeSpec_) buildLobes();  // eq. 17: a(theta) from the state at the step's start
   const size_t cells = laplacian_.size();
   // Every integrator is a theta scheme on the diffusion,
   //   (1 - theta dt d lap) x' = x + dt R + (1 - theta) dt d lap x,

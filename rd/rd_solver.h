@@ -13,6 +13,7 @@
 #include "core/grid.h"
 #include "core/pcg.h"
 #include "core/solver_result.h"
+#include "rd/cosine_lobe.h"
 #include "rd/diffusion_tensor.h"
 #include "rd/rd_settings.h"
 #include "rd/reaction_lut.h"
@@ -54,8 +55,15 @@ class RDSolver {
   // sigma from the current state at every step.
   void setDiffusionTensor(DiffusionTensorSpec<D> spec);
   bool anisotropic(int s) const { return !tensorSpecies_.empty() && tensorSpecies_[size_t(s)]; }
+  // Kim & Lin's cosine-lobe anisotropy (seed 001 eq. 14-17): the spec's
+  // species diffuse by div(d a(theta) grad), a(theta) rebuilt from each
+  // species' own gradient at every step. Not combined with a tensor.
+  void setCosineLobes(CosineLobeSpec spec);
+  bool lobed(int s) const { return !lobeSpecies_.empty() && lobeSpecies_[size_t(s)]; }
   // The operator -h^2 div(sigma grad) (or -h^2 lap) that species s diffuses by.
-  const AnisotropicSystem<D>& diffusionOperator(int s) const { return anisotropic(s) ? tensor_ : laplacian_; }
+  const AnisotropicSystem<D>& diffusionOperator(int s) const {
+    return lobed(s) ? lobeSystem_[size_t(s)] : anisotropic(s) ? tensor_ : laplacian_;
+  }
 
   void step(double dt);
   const RDStepStats& lastStats() const { return stats_; }
@@ -74,7 +82,13 @@ class RDSolver {
   void solveDiffusion(int s, double theta_dt, Vector* rhs_to_x);
   void holdFixed();
   void buildTensor();
-  const Vector& boundaryWeights(int s) const { return anisotropic(s) ? tensorBoundary_ : boundaryFaces_; }
+  void buildLobes();
+  // -h^2 div(sigma grad) from sigma's components and its Dirichlet ghost weights.
+  void assemble(const std::array<std::vector<double>, AnisotropicSystem<D>::kComponents>& sigma,
+                AnisotropicSystem<D>* system, Vector* boundary) const;
+  const Vector& boundaryWeights(int s) const {
+    return lobed(s) ? lobeBoundary_[size_t(s)] : anisotropic(s) ? tensorBoundary_ : boundaryFaces_;
+  }
 
   RDSettings settings_;
   const ReactionModel& model_;
@@ -90,7 +104,11 @@ class RDSolver {
   std::vector<uint8_t> tensorSpecies_;
   AnisotropicSystem<D> tensor_;       // -h^2 div(sigma grad), c = 2 sigma_aa per Dirichlet face
   Vector tensorBoundary_;             // sum of sigma_aa over the Dirichlet faces per cell
-  long tensorVersion_ = 0;
+  std::unique_ptr<CosineLobeSpec> lobeSpec_;
+  std::vector<uint8_t> lobeSpecies_;
+  std::vector<AnisotropicSystem<D>> lobeSystem_;  // per species (used where lobed)
+  std::vector<Vector> lobeBoundary_;
+  long operatorVersion_ = 0;          // bumped whenever a tensor or lobe operator is rebuilt
   std::vector<std::unique_ptr<Diffusion>> diffusion_;
   std::vector<Vector> scratch_, rates_;
   std::vector<std::vector<uint8_t>> fixedMasks_;
