@@ -99,6 +99,15 @@ void applyScene(const Scene& scene, RDSolver<D>* rd) {
     spec.shapeSpecies = an.shapeSpecies;
     rd->setDiffusionTensor(std::move(spec));
   }
+  // Kim & Lin's cosine lobes (seed 001 eq. 14-17).
+  if (const RDCosineLobes& lb = scene.rd.lobes; lb.enabled) {
+    CosineLobeSpec spec;
+    spec.speeds = lb.speeds;
+    spec.witkinKass = lb.witkinKass;
+    spec.theta0 = sampleSpatialField<D>(lb.theta0.field, n);
+    spec.species = lb.species;
+    rd->setCosineLobes(std::move(spec));
+  }
   // Fixed regions: held at their values from the start (seed 004 fig. 20).
   if (!scene.rd.fixed.empty()) {
     const size_t ns = size_t(rd->species());

@@ -88,6 +88,16 @@ struct RDAnisotropy {
   int shapeSpecies = 0;               // whose gradient shapes the tensor
 };
 
+// Kim & Lin's cosine-lobe anisotropy, [rd.cosine_lobes] (seed 001 eq. 14-17):
+// a species diffuses by div(d a(theta) grad), theta its own gradient's angle.
+struct RDCosineLobes {
+  bool enabled = false;
+  std::vector<double> speeds;         // a_n per lobe (eq. 16), or a1, a2 (eq. 15)
+  bool witkinKass = false;            // eq. 15
+  SceneField theta0;                  // rotation, radians (a field)
+  std::vector<int> species;           // the lobed species (empty: all)
+};
+
 struct RDScene {
   bool enabled = false;
   RDSettings settings;
@@ -97,6 +107,7 @@ struct RDScene {
   std::vector<std::pair<int, double>> perturb;  // parameter index, Gaussian sigma in percent (seed 004 sec. 3.1)
   std::vector<RDFixedRegion> fixed;
   RDAnisotropy anisotropy;
+  RDCosineLobes lobes;
   int coarseLevels = 0;              // coarse-to-fine: grids 2^L, ..., 2 times coarser first (seed 002, 000)
   long coarseSteps = 0;              // steps on each coarse grid
   bool coarseScaleDt = false;        // a grid 2^l times coarser steps 4^l dt (explicit limits scale with h^2)

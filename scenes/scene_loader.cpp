@@ -694,6 +694,33 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
       const std::string ss = r.string(an, p, "shape_species", species.front(), species);
       A.shapeSpecies = int(std::find(species.begin(), species.end(), ss) - species.begin());
     }
+    // [rd.cosine_lobes]: Kim & Lin's anisotropy function a(theta) (seed 001 eq. 14-17).
+    if (const toml::table* cl = r.table(*rdt, "rd.", "cosine_lobes")) {
+      RDCosineLobes& L = R.lobes;
+      L.enabled = true;
+      const std::string p = "rd.cosine_lobes.";
+      if (R.anisotropy.enabled)
+        r.fail(cl, "rd.cosine_lobes", "[rd.cosine_lobes] and [rd.anisotropy] are two anisotropy models; use one",
+               "drop one of the two tables");
+      L.witkinKass = r.boolean(cl, p, "witkin_kass", false);
+      const toml::node* sn = nullptr;
+      L.speeds = r.numbers(cl, p, "speeds", {}, L.witkinKass ? 2 : 1, L.witkinKass ? 2 : 64, 0.0, 1e6, L.witkinKass, &sn);
+      if (!sn)
+        r.fail(cl, p + "speeds",
+               L.witkinKass ? "Witkin-Kass lobes need speeds = [a1, a2] (along x, along y)"
+                            : "cosine lobes need speeds = [a_1, ..., a_j], one per lobe, e.g. [1.0, 0.25, 1.0, 0.25]");
+      if (std::all_of(L.speeds.begin(), L.speeds.end(), [](double v) { return v == 0.0; }))
+        r.fail(sn, p + "speeds", "every lobe speed is 0, so the lobed species would not diffuse at all",
+               "give at least one lobe a positive speed");
+      if (const toml::node* th = r.node(cl, p, "theta0")) {
+        L.theta0 = r.field(th, p + "theta0", sceneDir);
+      } else {
+        L.theta0.field.expression = "0";
+        L.theta0.where = r.where(cl, p + "theta0");
+        L.theta0.key = p + "theta0";
+      }
+      if (const toml::node* sp = r.node(cl, p, "species")) L.species = speciesList(sp, p + "species", false);
+    }
     // [rd.coarse_to_fine]: grow the pattern on coarser grids first.
     if (const toml::table* cf = r.table(*rdt, "rd.", "coarse_to_fine")) {
       if (!rdOnly)
@@ -776,6 +803,7 @@ Scene loadScene(const std::string& path, const std::vector<std::string>& overrid
       if (A.direction.empty()) check(A.theta, false);
       for (const SceneField& f : A.direction) check(f, false);
     }
+    if (s.rd.lobes.enabled) check(s.rd.lobes.theta0, false);
   }
 
   // [output]
