@@ -1,8 +1,6 @@
 #include "core/pcg.h"
 
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 #include "core/anisotropic_system.h"
 #include "core/parallel.h"
@@ -85,7 +83,6 @@ SolverResult pcg(const Op& A, const Vector& bIn, Vector* xp, Preconditioner* M, 
     }));
     result.iterations = it;
     result.residual = rnorm / bnorm;
-    if (getenv("DBG")) fprintf(stderr, "n=%zu it=%d res=%.3e\n", n, it, result.residual);
     if (result.residual <= opt.tolerance) break;
     if (interrupter && interrupter->progress(-1.0)) break;
     double rzNew = precondition();
