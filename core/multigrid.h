@@ -57,6 +57,10 @@ class Multigrid final : public Preconditioner {
     // indices with these weights (unused entries weigh 0).
     std::vector<std::array<int, 4>> fine;
     std::vector<std::array<float, 4>> fineWeight;
+    // Coarse indices [lo, hi) where the tables hold the interior pattern
+    // (fine 2X-1 .. 2X+2 at 1/4, 3/4, 3/4, 1/4; fine 2X, 2X+1 from X at 3/4
+    // and X -+ 1 at 1/4): those loops run without the tables, same arithmetic.
+    int restrictLo = 0, restrictHi = 0, prolongLo = 0, prolongHi = 0;
   };
   struct Level {
     LaplaceSystem<D> A;  // unused on level 0 (fine_ is used)
