@@ -78,6 +78,7 @@ struct LaplaceSystem {
   Vector zerosX_;               // a row of zeros: the neighbour beyond a wall
   std::vector<float> zerosW_;   // (also the float row of zeros)
   std::vector<uint8_t> rowUniform_;
+  std::vector<std::array<uint32_t, 2>> uniformSpan_;  // per row: [lo, hi) of its longest uniform run
 };
 
 // Builds the plain Laplacian with Neumann walls (periodic where asked) on a
