@@ -169,25 +169,10 @@ void LaplaceSystem<D>::finalize() {
     invDiag_[i] = d > 0 ? 1.0 / double(d) : 0.0;
     invDiagF_[i] = float(invDiag_[i]);
   });
-  // Uniform rows: every interior cell has unit weights on all its faces and
-  // the row's c, hence also the same diagonal.
   const size_t nx = size_t(dims[0]);
-  size_t rows = size() / nx;
-  rowUniform_.assign(rows, 0);
-  parallelForRows<D>(dims, [&](size_t row) {
-    if (nx < 3) return;
-    RowStencil<D, double> s = rowStencil<D>(*this, zerosX_.data(), zerosX_.data(), zerosW_.data(), row);
-    const float* cr = c.data() + s.base;
-    const float* w0 = w[0].data() + s.base;
-    for (size_t i = 1; i + 1 < nx; ++i) {
-      if (cr[i] != cr[1] || w0[i] != 1.0f || w0[i - 1] != 1.0f) return;
-      for (int a = 1; a < D; ++a)
-        if (w[a][s.base + i] != 1.0f || s.wlo[a][i] != 1.0f) return;
-    }
-    rowUniform_[row] = 1;
-  });
-  // The longest run of interior cells that are uniform among themselves
-  // (unit weights on every face, one c), per row, for the smoother.
+  const size_t rows = size() / nx;
+  // The longest run of interior cells per row that are uniform among
+  // themselves (unit weights on every face, one c, hence one diagonal).
   uniformSpan_.assign(rows, {0, 0});
   parallelForRows<D>(dims, [&](size_t row) {
     if (nx < 3) return;
@@ -236,17 +221,24 @@ double LaplaceSystem<D>::applyRow(size_t row, const T* x, T* y) const {
     return Dot ? double(xr[i]) * double(yr[i]) : 0.0;
   };
   double dot = edge(0);
-  if (rowUniform_[row]) {
-    const T c0 = T(cr[1]);
-    for (size_t i = 1; i + 1 < nx; ++i) {
-      yr[i] = sc * (c0 * xr[i] + faceSumUniform<D, T>(s, xr, i));
-      if constexpr (Dot) dot += double(xr[i]) * double(yr[i]);
-    }
-  } else {
-    for (size_t i = 1; i + 1 < nx; ++i) {  // interior: no wrap, no branch
+  auto general = [&](size_t from, size_t to) {
+    for (size_t i = from; i < to; ++i) {  // interior: no wrap, no branch
       yr[i] = sc * (T(cr[i]) * xr[i] + faceSum<D, T>(s, wa, xr, i, i - 1, i + 1, wa[0][i - 1]));
       if constexpr (Dot) dot += double(xr[i]) * double(yr[i]);
     }
+  };
+  // The row's uniform span: the same sums without the weight loads (1 * d = d).
+  const size_t lo = uniformSpan_[row][0], hi = uniformSpan_[row][1];
+  if (lo < hi) {
+    general(1, lo);
+    const T c0 = T(cr[lo]);
+    for (size_t i = lo; i < hi; ++i) {
+      yr[i] = sc * (c0 * xr[i] + faceSumUniform<D, T>(s, xr, i));
+      if constexpr (Dot) dot += double(xr[i]) * double(yr[i]);
+    }
+    general(hi, nx - 1);
+  } else if (nx > 2) {
+    general(1, nx - 1);
   }
   if (nx > 1) dot += edge(nx - 1);
   return dot;

@@ -57,11 +57,6 @@ struct LaplaceSystem {
   // Removes the mean over active cells (for singular systems).
   void removeNullSpace(Vector* x) const;
 
-  // Rows whose interior cells (all but the two x ends) have unit face
-  // weights and one c: the kernels skip the weight loads there (the memory
-  // traffic, not the arithmetic, bounds them), with the same arithmetic.
-  bool uniformRow(size_t row) const { return rowUniform_[row] != 0; }
-
  private:
   // y = A x on one row; returns the row's x . y when Dot (else 0).
   template <class T, bool Dot>
@@ -77,8 +72,10 @@ struct LaplaceSystem {
   std::vector<float> invDiagF_; // the same in float
   Vector zerosX_;               // a row of zeros: the neighbour beyond a wall
   std::vector<float> zerosW_;   // (also the float row of zeros)
-  std::vector<uint8_t> rowUniform_;
-  std::vector<std::array<uint32_t, 2>> uniformSpan_;  // per row: [lo, hi) of its longest uniform run
+  // Each row's longest run [lo, hi) of interior cells with unit face weights
+  // and one c: the kernels skip the weight loads there, with the same
+  // arithmetic (the smoother four cells at a time).
+  std::vector<std::array<uint32_t, 2>> uniformSpan_;
 };
 
 // Builds the plain Laplacian with Neumann walls (periodic where asked) on a
