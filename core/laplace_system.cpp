@@ -2,10 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <type_traits>
 
 #include "core/parallel.h"
+#include "core/simd4.h"
 
 namespace morphoflow {
 
@@ -70,14 +70,6 @@ inline T neighbourSumUniform(const RowStencil<D, T>& s, const T* xr, size_t i) {
 // arithmetic ((b inv + ((x_r + x_l) + (hi + lo) ...)) r0), so the result is
 // bitwise that of the scalar loop. The other colour's lanes are written back
 // unchanged. Returns the next cell of the colour.
-typedef float vf4 __attribute__((vector_size(16)));
-typedef int vi4 __attribute__((vector_size(16)));
-inline vf4 load4(const float* p) {
-  vf4 v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-inline void store4(float* p, vf4 v) { std::memcpy(p, &v, sizeof v); }
 inline vf4 evens(const float* p) { return __builtin_shuffle(load4(p), load4(p + 4), vi4{0, 2, 4, 6}); }
 
 template <int D>

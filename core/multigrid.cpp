@@ -1,24 +1,14 @@
 #include "core/multigrid.h"
 
 #include <cmath>
-#include <cstring>
 #include <limits>
 
 #include "core/parallel.h"
+#include "core/simd4.h"
 
 namespace morphoflow {
 
 namespace {
-
-// Four floats at a time (GCC vector extensions, SSE2 on x86-64).
-typedef float vf4 __attribute__((vector_size(16)));
-typedef int vi4 __attribute__((vector_size(16)));
-inline vf4 load4(const float* p) {
-  vf4 v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-inline void store4(float* p, vf4 v) { std::memcpy(p, &v, sizeof v); }
 
 // Weight of coarse index I in the prolongation of fine index i along one axis.
 inline double prolongWeight1(int i, int I, int nCoarse, bool periodic) {

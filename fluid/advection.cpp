@@ -4,20 +4,16 @@
 
 #include "core/linear_sampler.h"
 #include "core/parallel.h"
+#include "core/simd4.h"
 
 namespace morphoflow {
 
 namespace {
 
-// Four samples at once (GCC vector extensions: one SSE2 register, the
-// x86-64 baseline). Used where every axis clamps (walls, inflow, outflow);
-// periodic domains take the scalar path. The arithmetic is the scalar
-// path's, operation for operation, so both give bitwise the same fields.
-typedef float vf4 __attribute__((vector_size(16)));
-typedef int vi4 __attribute__((vector_size(16)));
-constexpr int kLanes = 4;
-
-inline vf4 splat(float v) { return vf4{} + v; }
+// Four samples at once (core/simd4.h). Used where every axis clamps (walls,
+// inflow, outflow); periodic domains take the scalar path. The arithmetic is
+// the scalar path's, operation for operation, so both give bitwise the same
+// fields.
 inline vf4 gather(const float* d, const vi4& idx) {
   vf4 r;
   for (int k = 0; k < kLanes; ++k) r[k] = d[idx[k]];
@@ -132,11 +128,11 @@ void semiLagrangian(const Grid<float, D>& src, const Layout<D>& layout, const Ma
         vp[0] = (splat(float(x)) + lane) + field.axis[0].offset;
         const size_t i = base + size_t(x);
         if (start.reuse) {
-          for (int a = 0; a < D; ++a) __builtin_memcpy(&vv[a], &(*start.v)[a][i], sizeof vv[a]);
+          for (int a = 0; a < D; ++a) vv[a] = load4(&(*start.v)[a][i]);
         } else {
           vvelocity<D>(vel, vp, vv);
           if (start.v)
-            for (int a = 0; a < D; ++a) __builtin_memcpy(&(*start.v)[a][i], &vv[a], sizeof vv[a]);
+            for (int a = 0; a < D; ++a) store4(&(*start.v)[a][i], vv[a]);
         }
         for (int a = 0; a < D; ++a) vm[a] = vp[a] - (0.5f * c) * vv[a];
         vvelocity<D>(vel, vm, vv);
@@ -147,12 +143,12 @@ void semiLagrangian(const Grid<float, D>& src, const Layout<D>& layout, const Ma
         if (lo) {
           vf4 l, h;
           r = vinterpolate<D>(field.data, field.stride, t, &l, &h);
-          __builtin_memcpy(&(*lo)[i], &l, sizeof l);
-          __builtin_memcpy(&(*hi)[i], &h, sizeof h);
+          store4(&(*lo)[i], l);
+          store4(&(*hi)[i], h);
         } else {
           r = vinterpolate<D>(field.data, field.stride, t);
         }
-        __builtin_memcpy(&(*dst)[i], &r, sizeof r);
+        store4(&(*dst)[i], r);
       }
     }
     for (; x < dims[0]; ++x) {
