@@ -1,6 +1,7 @@
 #include "fluid/advection.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/linear_sampler.h"
 #include "core/parallel.h"
@@ -84,6 +85,63 @@ inline void vvelocity(const MacSampler<D>& vel, const vf4* p, vf4* v) {
   }
 }
 
+// u at the samples of one row of a grid (all axes but x fixed) needs no
+// gathers: along y and z every sample of the row shares its taps, and along x
+// sample x reads the velocity samples x + shift and x + shift + 1 with one
+// weight wherever neither clamp binds. RowVelocity holds those taps per
+// component; at() interpolates four consecutive samples from contiguous
+// loads, with vinterpolate's arithmetic (the taps are the ones vtap gives:
+// the positions are small integers plus 0 or 1/2, exact in float).
+template <int D>
+struct RowVelocity {
+  const float* base[D];  // component a's sample (shift, y tap, z tap)
+  size_t s1[D], s2[D];   // its strides along y and z
+  float t[D][D];         // t[a][b]: component a's weight along b
+  int begin = 0, end = 0;  // x range of the row where every component's x taps are shifted copies
+
+  RowVelocity(const MacSampler<D>& vel, const float* p, float xOffset, int dimX) {
+    begin = 0;
+    end = dimX;
+    for (int a = 0; a < D; ++a) {
+      const AxisSamples& ax = a == 0 ? vel.face[0] : vel.centre[0];
+      const float d = xOffset - ax.offset;  // -1/2, 0 or 1/2
+      const int shift = int(std::floor(d));
+      t[a][0] = d - float(shift);
+      begin = std::max(begin, -shift);  // g = x + d >= 0
+      end = std::min(end, ax.n - 1 - shift);  // floor(g) <= n - 2
+      size_t offset = size_t(ptrdiff_t(shift));
+      for (int b = 1; b < D; ++b) {
+        const AxisTap tb = (b == a ? vel.face[b] : vel.centre[b]).at(p[b]);
+        t[a][b] = tb.t;
+        offset += size_t(tb.lo) * vel.stride[a][b];
+      }
+      base[a] = vel.data[a] + offset;
+      s1[a] = vel.stride[a][1];
+      s2[a] = D == 3 ? vel.stride[a][D - 1] : 0;
+    }
+  }
+
+  void at(int x, vf4* v) const {
+    for (int a = 0; a < D; ++a) {
+      const float* b = base[a] + x;
+      const vf4 t0 = splat(t[a][0]), t1 = splat(t[a][1]);
+      if constexpr (D == 2) {
+        vf4 v00 = load4(b), v10 = load4(b + 1), v01 = load4(b + s1[a]), v11 = load4(b + s1[a] + 1);
+        vf4 a0 = v00 + t0 * (v10 - v00), a1 = v01 + t0 * (v11 - v01);
+        v[a] = a0 + t1 * (a1 - a0);
+      } else {
+        const size_t sy = s1[a], sz = s2[a];
+        vf4 v0 = load4(b), v1 = load4(b + 1), v2 = load4(b + sy), v3 = load4(b + sy + 1);
+        vf4 v4 = load4(b + sz), v5 = load4(b + sz + 1), v6 = load4(b + sz + sy), v7 = load4(b + sz + sy + 1);
+        vf4 x00 = v0 + t0 * (v1 - v0), x10 = v2 + t0 * (v3 - v2);
+        vf4 x01 = v4 + t0 * (v5 - v4), x11 = v6 + t0 * (v7 - v6);
+        vf4 y0v = x00 + t1 * (x10 - x00), y1v = x01 + t1 * (x11 - x01);
+        v[a] = y0v + splat(t[a][D - 1]) * (y1v - y0v);
+      }
+    }
+  }
+};
+
 template <int D>
 bool allClamped(const LinearSampler<D>& field, const MacSampler<D>& vel) {
   for (int a = 0; a < D; ++a)
@@ -124,13 +182,17 @@ void semiLagrangian(const Grid<float, D>& src, const Layout<D>& layout, const Ma
       for (int a = 1; a < D; ++a) vp[a] = splat(p[a]);
       vf4 lane;
       for (int k = 0; k < kLanes; ++k) lane[k] = float(k);
+      const RowVelocity<D> row(vel, p, field.axis[0].offset, dims[0]);
       for (; x + kLanes <= dims[0]; x += kLanes) {
         vp[0] = (splat(float(x)) + lane) + field.axis[0].offset;
         const size_t i = base + size_t(x);
         if (start.reuse) {
           for (int a = 0; a < D; ++a) vv[a] = load4(&(*start.v)[a][i]);
         } else {
-          vvelocity<D>(vel, vp, vv);
+          if (x >= row.begin && x + kLanes <= row.end)
+            row.at(x, vv);
+          else
+            vvelocity<D>(vel, vp, vv);
           if (start.v)
             for (int a = 0; a < D; ++a) store4(&(*start.v)[a][i], vv[a]);
         }
