@@ -30,10 +30,28 @@ class MacVelocity {
   const Grid<float, D>& operator[](int a) const { return u_[a]; }
   const Layout<D>& layout(int a) const { return layout_[a]; }
 
-  // Velocity vector at a world position (each component interpolated on its faces).
+  // Velocity vector at a world position (each component interpolated on its
+  // faces): sampleLinear per component, with the axis stencils shared (along
+  // axis b, component b's samples sit on faces and the others' at centres).
   Vec<D> sample(const Vec<D>& x) const {
+    int f0[D], f1[D], c0[D], c1[D];
+    double ft[D], ct[D];
+    for (int b = 0; b < D; ++b) {
+      const double g = x[b] / h_;  // Layout::toGrid, offset 0 (faces) or 0.5 (centres)
+      detail::axisStencil(g - 0.0, cells_[b] + 1, periodic_[size_t(b)], cells_[b], &f0[b], &f1[b], &ft[b]);
+      detail::axisStencil(g - 0.5, cells_[b], periodic_[size_t(b)], cells_[b], &c0[b], &c1[b], &ct[b]);
+    }
     Vec<D> v;
-    for (int a = 0; a < D; ++a) v[a] = sampleLinear(u_[a], layout_[a], x);
+    for (int a = 0; a < D; ++a) {
+      int i0[D], i1[D];
+      double t[D];
+      for (int b = 0; b < D; ++b) {
+        i0[b] = b == a ? f0[b] : c0[b];
+        i1[b] = b == a ? f1[b] : c1[b];
+        t[b] = b == a ? ft[b] : ct[b];
+      }
+      v[a] = interpolateStencil<float, D>(u_[a], i0, i1, t);
+    }
     return v;
   }
   // Velocity at the centre of a cell (mean of the two faces per axis).

@@ -61,17 +61,12 @@ inline void axisStencil(double g, int n, bool periodic, int period, int* i0, int
 }
 }  // namespace detail
 
-// Sample `g` at world position x. If lo/hi are given, they receive the
-// minimum and maximum of the 2^D samples used (for limiters).
+// Bi-/trilinear interpolation of g between the samples i0 and i1 along each
+// axis, weight t of i1; lo/hi (both or neither) receive the 2^D samples' min
+// and max.
 template <typename T, int D>
-T sampleLinear(const Grid<T, D>& g, const Layout<D>& layout, const Vec<D>& x, T* lo = nullptr,
-               T* hi = nullptr) {
-  Vec<D> gc = layout.toGrid(x);
-  int i0[D], i1[D];
-  double t[D];
-  for (int a = 0; a < D; ++a)
-    detail::axisStencil(gc[a], g.dim(a), layout.periodic[a], layout.period[a], &i0[a], &i1[a],
-                        &t[a]);
+T interpolateStencil(const Grid<T, D>& g, const int* i0, const int* i1, const double* t, T* lo = nullptr,
+                     T* hi = nullptr) {
   size_t s1 = size_t(g.dim(0));
   auto at = [&](int x0, int y0, int z0) -> T {
     size_t idx = size_t(x0) + s1 * size_t(y0);
@@ -111,6 +106,20 @@ T sampleLinear(const Grid<T, D>& g, const Layout<D>& layout, const Vec<D>& x, T*
     *hi = mx;
   }
   return result;
+}
+
+// Sample `g` at world position x. If lo/hi are given, they receive the
+// minimum and maximum of the 2^D samples used (for limiters).
+template <typename T, int D>
+T sampleLinear(const Grid<T, D>& g, const Layout<D>& layout, const Vec<D>& x, T* lo = nullptr,
+               T* hi = nullptr) {
+  Vec<D> gc = layout.toGrid(x);
+  int i0[D], i1[D];
+  double t[D];
+  for (int a = 0; a < D; ++a)
+    detail::axisStencil(gc[a], g.dim(a), layout.periodic[a], layout.period[a], &i0[a], &i1[a],
+                        &t[a]);
+  return interpolateStencil<T, D>(g, i0, i1, t, lo, hi);
 }
 
 }  // namespace morphoflow
