@@ -42,7 +42,7 @@ SolverResult pcg(const Op& A, const Vector& bIn, Vector* xp, Preconditioner* M, 
     bp = &ws.b;
   }
   const Vector& b = *bp;
-  const double bnorm = norm2(b);
+  const double bnorm = unit == 1.0 ? bnorm0 : norm2(b);
   Vector &r = ws.r, &z = ws.z, &p = ws.p, &q = ws.q;
   double rnorm = A.residual(b, x, &r);
   result.residual = rnorm / bnorm;
