@@ -67,8 +67,13 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
   worst.converged = true;
   if (nu <= 0 || dt <= 0) return worst;
   const double s = nu * dt / (vc_.h * vc_.h);
-  for (int a = 0; a < D; ++a) {
-    Component& C = comp_[size_t(a)];
+  // The components' solves are independent: run them side by side (each
+  // still splits into row tasks), so the small loops of the coarse
+  // multigrid levels of one overlap with another's work.
+  std::array<SolverResult, D> results;
+  parallelFor(size_t(D), [&](size_t ai) {
+    const int a = int(ai);
+    Component& C = comp_[ai];
     Grid<float, D>& g = (*u)[a];
     const Grid<uint8_t, D>& fixed = vc_.fixed[a];
     if (s != s_) {  // A = s (c + sum w (x_i - x_j)), c = 1/s + boundary terms
@@ -89,13 +94,15 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
     });
     JacobiPreconditioner<D> jacobi(C.A);
     Preconditioner* M = C.multigrid ? static_cast<Preconditioner*>(C.multigrid.get()) : &jacobi;
-    SolverResult r = solvePCG<D>(C.A, C.b, &C.x, M, options_, nullptr, &workspace_);
+    results[ai] = solvePCG<D>(C.A, C.b, &C.x, M, options_, nullptr, &C.workspace);
     forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) {
       size_t gi = g.index(k);
       if (fixed[gi]) return;
       C.increment[i] = C.x[i] - double(g[gi]);
       g[gi] = float(C.x[i]);
     });
+  });
+  for (const SolverResult& r : results) {
     worst.converged = worst.converged && r.converged;
     worst.iterations = std::max(worst.iterations, r.iterations);
     worst.residual = std::max(worst.residual, r.residual);

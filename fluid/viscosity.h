@@ -34,12 +34,12 @@ class ViscositySolver {
     Vector b, x;
     Vector increment;           // the last solve's x - u*: the next one's warm start
     std::unique_ptr<Multigrid<D>> multigrid;  // rebuilt when nu dt changes
+    PcgWorkspace workspace;
   };
   const VelocityConstraints<D>& vc_;
   SolverOptions options_;
   std::array<Component, D> comp_;
   double s_ = -1.0;  // nu dt / h^2 the diagonals were built for
-  PcgWorkspace workspace_;
 };
 
 }  // namespace morphoflow
