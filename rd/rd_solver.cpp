@@ -195,9 +195,9 @@ void RDSolver<D>::applyLaplacian(int s, const Vector& x, Vector* out) const {
 // Solves (I - theta_dt d lap) x = rhs in place; the Dirichlet ghost adds
 // theta_dt d 2 g / h^2 per boundary face to the right-hand side.
 template <int D>
-void RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
+SolverResult RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
   const double d = d_[size_t(s)];
-  if (d == 0.0 || thetaDt == 0.0) return;
+  if (d == 0.0 || thetaDt == 0.0) return SolverResult{true, 0, 0.0};
   Diffusion& df = *diffusion_[size_t(s)];
   const double scale = thetaDt * d / (h_ * h_);
   const long version = anisotropic(s) || lobed(s) ? operatorVersion_ : 0;
@@ -229,10 +229,7 @@ void RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
   SolverOptions o{settings_.tolerance, 2000};
   SolverResult r = solvePCG<D>(df.A, b, &df.x, df.M.get(), o, nullptr, &df.ws);
   std::swap(b, df.x);
-  SolverResult& w = stats_.diffusion;
-  w.converged = w.converged && r.converged;
-  w.iterations = std::max(w.iterations, r.iterations);
-  w.residual = std::max(w.residual, r.residual);
+  return r;
 }
 
 template <int D>
@@ -317,9 +314,13 @@ void RDSolver<D>::step(double dt) {
   const bool implicitReaction = integ == RDIntegrator::KimLin;
   const double theta = integ == RDIntegrator::ExplicitEuler ? 0.0 : integ == RDIntegrator::CrankNicolson ? 0.5 : 1.0;
   react(dt, implicitReaction);  // Kim & Lin: updates x in place (projected per cell)
-  for (int s = 0; s < n; ++s) {
-    Vector& x = x_[size_t(s)].values();
-    const Vector &L = scratch_[size_t(s)], &R = rates_[size_t(s)];
+  // The species are independent from here on: run them side by side (each
+  // still splits into row tasks).
+  std::vector<SolverResult> solves(size_t(n), SolverResult{true, 0, 0.0});
+  parallelFor(size_t(n), [&](size_t si) {
+    const int s = int(si);
+    Vector& x = x_[si].values();
+    const Vector &L = scratch_[si], &R = rates_[si];
     const double explicitD = (1.0 - theta) * dt * d_[size_t(s)];
     // The explicit part carries its Dirichlet term inside L; the implicit
     // part adds its own through solveDiffusion.
@@ -328,7 +329,13 @@ void RDSolver<D>::step(double dt) {
       parallelFor(cells, [&](size_t i) { x[i] += dt * R[i] + explicitD * L[i]; }, kChunk);
     else if (!implicitReaction)
       parallelFor(cells, [&](size_t i) { x[i] += dt * R[i]; }, kChunk);
-    solveDiffusion(s, theta * dt, &x);
+    solves[si] = solveDiffusion(s, theta * dt, &x);
+  });
+  SolverResult& w = stats_.diffusion;
+  for (const SolverResult& r : solves) {
+    w.converged = w.converged && r.converged;
+    w.iterations = std::max(w.iterations, r.iterations);
+    w.residual = std::max(w.residual, r.residual);
   }
   for (int s : model_.info().clamped) {
     Grid<double, D>& g = x_[size_t(s)];

@@ -79,7 +79,8 @@ class RDSolver {
   struct Diffusion;  // per-species implicit system and its solver state
   void react(double dt, bool implicit);
   void applyLaplacian(int s, const Vector& x, Vector* out) const;  // out = lap x (with boundary terms)
-  void solveDiffusion(int s, double theta_dt, Vector* rhs_to_x);
+  // Returns the solve's result (converged, no iterations when d or theta dt is 0).
+  SolverResult solveDiffusion(int s, double theta_dt, Vector* rhs_to_x);
   void holdFixed();
   void buildTensor();
   void buildLobes();
