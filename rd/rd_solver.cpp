@@ -21,6 +21,7 @@ struct RDSolver<D>::Diffusion {
   std::unique_ptr<Preconditioner> M;
   PcgWorkspace ws;
   Vector x;
+  Vector increment;  // the last solve's x - b: the next one's warm start
   double thetaDt = -1.0;
   long version = -1;  // tensor version it was built from
 };
@@ -225,9 +226,17 @@ SolverResult RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
     const Vector& faces = boundaryWeights(s);
     parallelFor(b.size(), [&](size_t i) { b[i] += k * faces[i]; }, kChunk);
   }
-  df.x = b;  // warm start: the undiffused state
+  // Warm start: the undiffused state plus the last step's diffusive change,
+  // which a slowly evolving pattern repeats (as the fluid's viscosity does).
+  df.x.resize(b.size());
+  if (df.increment.size() == b.size())
+    parallelFor(b.size(), [&](size_t i) { df.x[i] = b[i] + df.increment[i]; }, kChunk);
+  else
+    df.x = b;
   SolverOptions o{settings_.tolerance, 2000};
   SolverResult r = solvePCG<D>(df.A, b, &df.x, df.M.get(), o, nullptr, &df.ws);
+  df.increment.resize(b.size());
+  parallelFor(b.size(), [&](size_t i) { df.increment[i] = df.x[i] - b[i]; }, kChunk);
   std::swap(b, df.x);
   return r;
 }
