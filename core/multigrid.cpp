@@ -37,11 +37,12 @@ bool canCoarsen(const LaplaceSystem<D>& A, int minCells) {
   return true;
 }
 
+// The coarse re-discretisation of F into C (already shaped (F.dims + 1) / 2).
 template <int D>
-LaplaceSystem<D> coarsen(const LaplaceSystem<D>& F) {
-  IVec<D> cd;
-  for (int a = 0; a < D; ++a) cd[a] = (F.dims[a] + 1) / 2;
-  LaplaceSystem<D> C(cd, F.periodic, F.scale / 4.0);
+void coarsenInto(const LaplaceSystem<D>& F, LaplaceSystem<D>* Cp) {
+  LaplaceSystem<D>& C = *Cp;
+  const IVec<D> cd = C.dims;
+  C.scale = F.scale / 4.0;
   const double inv2D = 1.0 / double(1 << D);
   forEachCell<D>(cd, [&](const IVec<D>& cc, size_t ci) {
     // Identity terms: Galerkin mean (scaled: coarse scale is fine scale / 4).
@@ -75,6 +76,14 @@ LaplaceSystem<D> coarsen(const LaplaceSystem<D>& F) {
     }
   });
   C.finalize();
+}
+
+template <int D>
+LaplaceSystem<D> coarsen(const LaplaceSystem<D>& F) {
+  IVec<D> cd;
+  for (int a = 0; a < D; ++a) cd[a] = (F.dims[a] + 1) / 2;
+  LaplaceSystem<D> C(cd, F.periodic, F.scale / 4.0);
+  coarsenInto(F, &C);
   return C;
 }
 
@@ -98,6 +107,11 @@ Multigrid<D>::Multigrid(const LaplaceSystem<D>& fine, const MultigridOptions& op
     levels_[l].b.assign(n, 0.0f);
     levels_[l].r.assign(n, 0.0f);
   }
+}
+
+template <int D>
+void Multigrid<D>::refresh() {
+  for (size_t l = 1; l < levels_.size(); ++l) coarsenInto(level(int(l) - 1), &levels_[l].A);
 }
 
 template <int D>

@@ -43,6 +43,11 @@ class Multigrid final : public Preconditioner {
   void apply(const Vector& r, Vector* z) override;
   double applyDot(const Vector& r, double rnorm, Vector* z) override;
 
+  // The fine system's coefficients changed, not its shape (a new identity
+  // term, say, from a new time step): re-derive the coarse levels in place,
+  // as the constructor would, without reallocating anything.
+  void refresh();
+
   int levels() const { return int(levels_.size()); }
   const LaplaceSystem<D>& level(int l) const { return l == 0 ? fine_ : levels_[size_t(l)].A; }
 
