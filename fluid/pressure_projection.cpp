@@ -57,10 +57,18 @@ template <int D>
 SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double density) {
   divergence(*u, &rhs_);
   parallelFor(rhs_.size(), [&](size_t i) { rhs_[i] = -rhs_[i]; }, 4096);
-  // Warm start: phi scales with dt for the same pressure.
-  if (lastDt_ > 0 && dt != lastDt_) {
-    double s = dt / lastDt_;
-    parallelFor(phi_.size(), [&](size_t i) { phi_[i] *= s; }, 4096);
+  // Warm start: phi / dt (the pressure over the density) linearly
+  // extrapolated from the last two projections, times this dt; after one
+  // projection, the last phi scaled to this dt.
+  if (solves_ >= 1 && lastDt_ > 0) {
+    const double inv = 1.0 / lastDt_;
+    const bool extrapolate = solves_ >= 2;
+    ratePrev_.resize(phi_.size());
+    parallelFor(phi_.size(), [&](size_t i) {
+      const double rate = phi_[i] * inv;
+      phi_[i] = dt * (extrapolate ? 2.0 * rate - ratePrev_[i] : rate);
+      ratePrev_[i] = rate;
+    }, 4096);
   }
   SolverResult r;
   if (solver_ == PressureSolver::Multigrid)
@@ -72,6 +80,7 @@ SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double
                     options_, nullptr, &workspace_);
   lastDt_ = dt;
   lastDensity_ = density;
+  solves_ = dt > 0 ? solves_ + 1 : 0;
   // u -= grad(phi) on every face that is not prescribed.
   const double invH = 1.0 / vc_.h;
   const IVec<D>& n = vc_.cells;

@@ -37,8 +37,10 @@ class PressureProjection {
   std::unique_ptr<Multigrid<D>> multigrid_;
   std::unique_ptr<MIC0Preconditioner<D>> mic_;
   Vector phi_, rhs_;
+  Vector ratePrev_;  // phi / dt of the projection before the last (once solves >= 2)
   PcgWorkspace workspace_;
   double lastDt_ = 0.0, lastDensity_ = 1.0;
+  int solves_ = 0;
 };
 
 }  // namespace morphoflow

@@ -84,23 +84,39 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
       C.A.finalize();
       // Below s ~ 1 the diagonal dominates and Jacobi needs a handful of
       // iterations; above, multigrid keeps the count independent of s.
-      C.multigrid = s > 1.0 ? std::make_unique<Multigrid<D>>(C.A) : nullptr;
+      if (s <= 1.0)
+        C.multigrid.reset();
+      else if (C.multigrid)
+        C.multigrid->refresh();
+      else
+        C.multigrid = std::make_unique<Multigrid<D>>(C.A);
     }
-    if (s != s_) C.increment.assign(C.A.size(), 0.0);
+    // Warm start: the increment's rate, linearly extrapolated in steps.
+    const Vector &r1 = C.rate[0], &r0 = C.rate[1];
+    const int history = C.history;
     forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) {
       size_t gi = g.index(k);
-      C.x[i] = fixed[gi] ? 0.0 : double(g[gi]) + C.increment[i];
+      const double rate = history >= 2 ? 2.0 * r1[i] - r0[i] : history == 1 ? r1[i] : 0.0;
+      C.x[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * rate;
       C.b[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * C.boundaryRhs[i];
     });
     JacobiPreconditioner<D> jacobi(C.A);
     Preconditioner* M = C.multigrid ? static_cast<Preconditioner*>(C.multigrid.get()) : &jacobi;
     results[ai] = solvePCG<D>(C.A, C.b, &C.x, M, options_, nullptr, &C.workspace);
+    std::swap(C.rate[0], C.rate[1]);  // the older slot takes the new rate
+    Vector& rate = C.rate[0];
+    rate.resize(C.A.size());
+    const double invS = 1.0 / s;
     forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) {
       size_t gi = g.index(k);
-      if (fixed[gi]) return;
-      C.increment[i] = C.x[i] - double(g[gi]);
+      if (fixed[gi]) {
+        rate[i] = 0.0;
+        return;
+      }
+      rate[i] = (C.x[i] - double(g[gi])) * invS;
       g[gi] = float(C.x[i]);
     });
+    C.history = std::min(C.history + 1, 2);
   });
   for (const SolverResult& r : results) {
     worst.converged = worst.converged && r.converged;

@@ -3,8 +3,10 @@
 // (moving walls reflect their velocity), zero gradient at outflow. Solved by
 // CG, preconditioned with multigrid when nu dt / h^2 is large (the system is
 // then Poisson-like) and with its diagonal otherwise. The systems are built
-// once; a new nu dt only rescales their diagonal. Each solve starts from
-// u* plus the previous step's viscous increment, which changes slowly.
+// once; a new nu dt (a CFL-limited step) only rescales their diagonal and
+// re-derives the multigrid levels in place. Each solve starts from u* plus
+// the viscous increment extrapolated from the last two steps (per unit
+// nu dt / h^2, so a changing dt keeps it), which changes slowly.
 #pragma once
 
 #include <array>
@@ -32,8 +34,10 @@ class ViscositySolver {
     Grid<float, D> cBoundary;   // diagonal terms from walls and prescribed neighbours
     Vector boundaryRhs;         // their prescribed values, times the coupling
     Vector b, x;
-    Vector increment;           // the last solve's x - u*: the next one's warm start
-    std::unique_ptr<Multigrid<D>> multigrid;  // rebuilt when nu dt changes
+    // The last two solves' (x - u*) / s, newest first: the next warm start.
+    std::array<Vector, 2> rate;
+    int history = 0;            // how many of them are set
+    std::unique_ptr<Multigrid<D>> multigrid;  // present while s > 1
     PcgWorkspace workspace;
   };
   const VelocityConstraints<D>& vc_;
