@@ -210,13 +210,20 @@ SolverResult RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
     // MIC(0) on request; else multigrid once diffusion dominates the identity
     // (scale > 1), Jacobi below, where the system is diagonally dominant. With
     // a tensor they precondition the axis part (the mixed terms are bounded by
-    // it for a positive definite sigma).
+    // it for a positive definite sigma). A multigrid hierarchy of the same
+    // shape (a new dt: only the coefficients changed) is re-derived in place.
+    auto* mg = dynamic_cast<Multigrid<D>*>(df.M.get());
     if (settings_.linearSolver == RDLinearSolver::ICPCG)
       df.M = std::make_unique<MIC0Preconditioner<D>>(df.A.axis);
+    else if (scale > 1.0 && mg)
+      mg->refresh();
     else if (scale > 1.0)
       df.M = std::make_unique<Multigrid<D>>(df.A.axis);
     else
       df.M = std::make_unique<JacobiPreconditioner<D>>(df.A.axis);
+    // The last diffusive change was made over the last theta dt: rescale it.
+    if (df.thetaDt > 0)
+      for (double& v : df.increment) v *= thetaDt / df.thetaDt;
     df.thetaDt = thetaDt;
     df.version = version;
   }
