@@ -1,5 +1,7 @@
 #include "fluid/pressure_projection.h"
 
+#include <algorithm>
+
 #include "core/parallel.h"
 #include "core/pcg.h"
 
@@ -80,7 +82,7 @@ SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double
                     options_, nullptr, &workspace_);
   lastDt_ = dt;
   lastDensity_ = density;
-  solves_ = dt > 0 ? solves_ + 1 : 0;
+  solves_ = dt > 0 ? std::min(solves_ + 1, 2) : 0;
   // u -= grad(phi) on every face that is not prescribed.
   const double invH = 1.0 / vc_.h;
   const IVec<D>& n = vc_.cells;

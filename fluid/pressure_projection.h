@@ -40,7 +40,7 @@ class PressureProjection {
   Vector ratePrev_;  // phi / dt of the projection before the last (once solves >= 2)
   PcgWorkspace workspace_;
   double lastDt_ = 0.0, lastDensity_ = 1.0;
-  int solves_ = 0;
+  int solves_ = 0;  // projections with dt > 0 since the start, capped at 2
 };
 
 }  // namespace morphoflow
