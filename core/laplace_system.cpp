@@ -141,15 +141,20 @@ const T* LaplaceSystem<D>::zeros() const {
 
 template <int D>
 void LaplaceSystem<D>::finalize() {
-  // Zero the couplings that would wrap across a non-periodic edge.
-  for (int a = 0; a < D; ++a) {
-    if (periodic[a]) continue;
-    forEachCell<D>(dims, [&](const IVec<D>& cell, size_t i) {
-      if (cell[a] == dims[a] - 1) w[a][i] = 0.0f;
-    });
-  }
-  invDiag_.assign(size(), 0.0);
-  invDiagF_.assign(size(), 0.0f);
+  // Zero the couplings that would wrap across a non-periodic edge: the last
+  // cell of every row along x, the whole last rows along y (and z).
+  const size_t nxCells = size_t(dims[0]);
+  parallelForRows<D>(dims, [&](size_t row) {
+    if (!periodic[0]) w[0][row * nxCells + nxCells - 1] = 0.0f;
+    size_t rest = row;
+    for (int a = 1; a < D; ++a) {
+      const bool last = int(rest % size_t(dims[a])) == dims[a] - 1;
+      rest /= size_t(dims[a]);
+      if (last && !periodic[a]) std::fill_n(w[a].data() + row * nxCells, nxCells, 0.0f);
+    }
+  });
+  invDiag_.resize(size());  // every entry is written below
+  invDiagF_.resize(size());
   forEachCell<D>(dims, [&](const IVec<D>& cell, size_t i) {
     float d = c[i];
     for (int a = 0; a < D; ++a) {
