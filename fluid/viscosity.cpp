@@ -61,6 +61,10 @@ ViscositySolver<D>::ViscositySolver(const VelocityConstraints<D>& vc, const Solv
   }
 }
 
+namespace {
+constexpr double kMultigridAbove = 0.1;  // nu dt / h^2 from which multigrid preconditions
+}  // namespace
+
 template <int D>
 SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt) {
   SolverResult worst;
@@ -82,9 +86,10 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
         C.A.c[i] = fixed[fixed.index(k)] ? 0.0f : float(1.0 / s + C.cBoundary[i]);
       });
       C.A.finalize();
-      // Below s ~ 1 the diagonal dominates and Jacobi needs a handful of
-      // iterations; above, multigrid keeps the count independent of s.
-      if (s <= 1.0)
+      // Far below s ~ 0.1 the diagonal dominates and Jacobi needs a handful
+      // of iterations; above, multigrid keeps the count independent of s and
+      // is the faster (measured at 512^2 and 64^3: docs/performance.md).
+      if (s <= kMultigridAbove)
         C.multigrid.reset();
       else if (C.multigrid)
         C.multigrid->refresh();

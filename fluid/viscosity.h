@@ -1,8 +1,8 @@
 // Implicit viscosity (Stam 1999): (I - nu dt lap) u = u*, per velocity
 // component on its face grid, no-slip at walls through mirrored ghost values
 // (moving walls reflect their velocity), zero gradient at outflow. Solved by
-// CG, preconditioned with multigrid when nu dt / h^2 is large (the system is
-// then Poisson-like) and with its diagonal otherwise. The systems are built
+// CG, preconditioned with multigrid unless nu dt / h^2 is small (< 0.1: the
+// diagonal then dominates and Jacobi does as well). The systems are built
 // once; a new nu dt (a CFL-limited step) only rescales their diagonal and
 // re-derives the multigrid levels in place. Each solve starts from u* plus
 // the viscous increment extrapolated from the last two steps (per unit

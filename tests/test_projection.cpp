@@ -109,9 +109,9 @@ TEST(Projection, ProjectingTwiceChangesNothing) {
 // systems and re-derives its multigrid levels in place, and both solves start
 // from extrapolated guesses. Each step must still give the flow of a solver
 // that starts cold from the same velocity (to the tolerances), and the warm
-// starts must save iterations (111 against 134 when written). One step
-// crosses s = nu dt / h^2 = 1, where the viscosity switches between Jacobi
-// and multigrid preconditioning, and back.
+// starts must save iterations. One step crosses s = nu dt / h^2 = 0.1, where
+// the viscosity switches between multigrid and Jacobi preconditioning, and
+// back.
 TEST(Projection, WarmStartsAcrossChangingStepsGiveTheColdSolution) {
   FluidSettings s;
   s.resolution = {128, 128};
@@ -123,8 +123,8 @@ TEST(Projection, WarmStartsAcrossChangingStepsGiveTheColdSolution) {
   FluidSolver<2> warm(s);
   const double h = warm.h();
   for (int k = 0; k < 20; ++k) warm.step(h);  // past the impulsive start
-  // A CFL limit moves dt smoothly; one step drops below s = 1 and back.
-  const double factors[] = {1.0, 1.05, 1.1, 1.16, 1.2, 1.22, 0.5, 1.2, 1.15, 1.1, 1.04, 1.0};
+  // A CFL limit moves dt smoothly; one step drops below s = 0.1 and back.
+  const double factors[] = {1.0, 1.05, 1.1, 1.16, 1.2, 1.22, 0.05, 1.2, 1.15, 1.1, 1.04, 1.0};
   int warmIterations = 0, coldIterations = 0;
   double worst = 0.0;
   for (int k = 0; k < 12; ++k) {
