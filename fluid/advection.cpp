@@ -37,16 +37,14 @@ inline VTap vtap(const AxisSamples& ax, vf4 p) {
   return {i, g - __builtin_convertvector(i, vf4)};
 }
 
-// interpolate<D> on four positions; lo/hi receive the stencil's min and max.
-template <int D>
-inline vf4 vinterpolate(const float* data, const size_t* s, const VTap* tap, vf4* lo = nullptr, vf4* hi = nullptr) {
-  vi4 idx = tap[0].lo + tap[1].lo * int(s[1]);
-  if constexpr (D == 3) idx += tap[2].lo * int(s[2]);
-  const vf4 t0 = tap[0].t, t1 = tap[1].t;
-  const int sy = int(s[1]);
+// Bi-/trilinear blend of the 2^D corner values at(offset) (offsets 0, 1,
+// sy, sy + 1, then + sz), x first, as the scalar interpolate<D>; lo/hi
+// receive the corners' min and max.
+template <int D, class At>
+inline vf4 blendCorners(At&& at, size_t sy, size_t sz, const vf4* t, vf4* lo = nullptr, vf4* hi = nullptr) {
+  const vf4 t0 = t[0], t1 = t[1];
   if constexpr (D == 2) {
-    vf4 v00 = gather(data, idx), v10 = gather(data + 1, idx);
-    vf4 v01 = gather(data + sy, idx), v11 = gather(data + sy + 1, idx);
+    vf4 v00 = at(0), v10 = at(1), v01 = at(sy), v11 = at(sy + 1);
     vf4 a0 = v00 + t0 * (v10 - v00), a1 = v01 + t0 * (v11 - v01);
     if (lo) {
       *lo = vmin(vmin(v00, v10), vmin(v01, v11));
@@ -54,11 +52,8 @@ inline vf4 vinterpolate(const float* data, const size_t* s, const VTap* tap, vf4
     }
     return a0 + t1 * (a1 - a0);
   } else {
-    const int sz = int(s[2]);
-    vf4 v0 = gather(data, idx), v1 = gather(data + 1, idx);
-    vf4 v2 = gather(data + sy, idx), v3 = gather(data + sy + 1, idx);
-    vf4 v4 = gather(data + sz, idx), v5 = gather(data + sz + 1, idx);
-    vf4 v6 = gather(data + sz + sy, idx), v7 = gather(data + sz + sy + 1, idx);
+    vf4 v0 = at(0), v1 = at(1), v2 = at(sy), v3 = at(sy + 1);
+    vf4 v4 = at(sz), v5 = at(sz + 1), v6 = at(sz + sy), v7 = at(sz + sy + 1);
     vf4 x00 = v0 + t0 * (v1 - v0), x10 = v2 + t0 * (v3 - v2);
     vf4 x01 = v4 + t0 * (v5 - v4), x11 = v6 + t0 * (v7 - v6);
     vf4 y0v = x00 + t1 * (x10 - x00), y1v = x01 + t1 * (x11 - x01);
@@ -66,8 +61,18 @@ inline vf4 vinterpolate(const float* data, const size_t* s, const VTap* tap, vf4
       *lo = vmin(vmin(vmin(v0, v1), vmin(v2, v3)), vmin(vmin(v4, v5), vmin(v6, v7)));
       *hi = vmax(vmax(vmax(v0, v1), vmax(v2, v3)), vmax(vmax(v4, v5), vmax(v6, v7)));
     }
-    return y0v + tap[2].t * (y1v - y0v);
+    return y0v + t[2] * (y1v - y0v);
   }
+}
+
+// interpolate<D> on four positions; lo/hi receive the stencil's min and max.
+template <int D>
+inline vf4 vinterpolate(const float* data, const size_t* s, const VTap* tap, vf4* lo = nullptr, vf4* hi = nullptr) {
+  vi4 idx = tap[0].lo + tap[1].lo * int(s[1]);
+  if constexpr (D == 3) idx += tap[2].lo * int(s[2]);
+  vf4 t[D];
+  for (int a = 0; a < D; ++a) t[a] = tap[a].t;
+  return blendCorners<D>([data, idx](size_t off) { return gather(data + off, idx); }, s[1], D == 3 ? s[D - 1] : 0, t, lo, hi);
 }
 
 // MacSampler on four positions.
@@ -90,8 +95,9 @@ inline void vvelocity(const MacSampler<D>& vel, const vf4* p, vf4* v) {
 // sample x reads the velocity samples x + shift and x + shift + 1 with one
 // weight wherever neither clamp binds. RowVelocity holds those taps per
 // component; at() interpolates four consecutive samples from contiguous
-// loads, with vinterpolate's arithmetic (the taps are the ones vtap gives:
-// the positions are small integers plus 0 or 1/2, exact in float).
+// loads, blended as vinterpolate blends (blendCorners); the taps are the ones
+// vtap gives, as the positions are small integers plus 0 or 1/2, exact in
+// float.
 template <int D>
 struct RowVelocity {
   const float* base[D];  // component a's sample (shift, y tap, z tap)
@@ -124,20 +130,9 @@ struct RowVelocity {
   void at(int x, vf4* v) const {
     for (int a = 0; a < D; ++a) {
       const float* b = base[a] + x;
-      const vf4 t0 = splat(t[a][0]), t1 = splat(t[a][1]);
-      if constexpr (D == 2) {
-        vf4 v00 = load4(b), v10 = load4(b + 1), v01 = load4(b + s1[a]), v11 = load4(b + s1[a] + 1);
-        vf4 a0 = v00 + t0 * (v10 - v00), a1 = v01 + t0 * (v11 - v01);
-        v[a] = a0 + t1 * (a1 - a0);
-      } else {
-        const size_t sy = s1[a], sz = s2[a];
-        vf4 v0 = load4(b), v1 = load4(b + 1), v2 = load4(b + sy), v3 = load4(b + sy + 1);
-        vf4 v4 = load4(b + sz), v5 = load4(b + sz + 1), v6 = load4(b + sz + sy), v7 = load4(b + sz + sy + 1);
-        vf4 x00 = v0 + t0 * (v1 - v0), x10 = v2 + t0 * (v3 - v2);
-        vf4 x01 = v4 + t0 * (v5 - v4), x11 = v6 + t0 * (v7 - v6);
-        vf4 y0v = x00 + t1 * (x10 - x00), y1v = x01 + t1 * (x11 - x01);
-        v[a] = y0v + splat(t[a][D - 1]) * (y1v - y0v);
-      }
+      vf4 ta[D];
+      for (int c = 0; c < D; ++c) ta[c] = splat(t[a][c]);
+      v[a] = blendCorners<D>([b](size_t off) { return load4(b + off); }, s1[a], s2[a], ta);
     }
   }
 };
