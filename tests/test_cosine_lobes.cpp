@@ -12,6 +12,7 @@
 #include "rd/cosine_lobe.h"
 #include "rd/model_registry.h"
 #include "rd/rd_solver.h"
+#include "tests/rd_test_support.h"
 
 using namespace morphoflow;
 
@@ -166,21 +167,12 @@ TEST(CosineLobes, ConservesMassAndDecays) {
     rd.setCosineLobes(spec);
     EXPECT_NEAR(rd.explicitDiffusionLimit(), 2.0 / (0.7 * 8.0 * 2.0), 1e-12);
     const double dt = integ == RDIntegrator::ExplicitEuler ? 0.95 * rd.explicitDiffusionLimit() : 4.0;
-    double mass0 = 0;
-    for (double v : rd.field(0).values()) mass0 += v;
-    const double energy0 = norm2(rd.field(0).values());
-    double energy = energy0;
-    for (int i = 0; i < 30; ++i) {
-      rd.step(dt);
-      ASSERT_TRUE(rd.lastStats().diffusion.converged);
-      const double e = norm2(rd.field(0).values());
-      EXPECT_LE(e, energy * (1 + 1e-12)) << "integrator " << int(integ) << " step " << i;
-      energy = e;
-    }
-    double mass = 0;
-    for (double v : rd.field(0).values()) mass += v;
-    EXPECT_NEAR(mass, mass0, 1e-10 * mass0) << "integrator " << int(integ);
-    EXPECT_LT(energy, 0.9 * energy0) << "the noise must have diffused";
+    const morphoflow::testing::MassAndNorm m = morphoflow::testing::stepExpectingDecay<2>(
+        rd, dt, 30, "integrator " + std::to_string(int(integ)) + " ",
+        [&] { ASSERT_TRUE(rd.lastStats().diffusion.converged); });
+    if (HasFatalFailure()) return;
+    EXPECT_NEAR(m.mass, m.mass0, 1e-10 * m.mass0) << "integrator " << int(integ);
+    EXPECT_LT(m.norm, 0.9 * m.norm0) << "the noise must have diffused";
   }
   RDSettings s = pureDiffusion<2>(20, RDBoundary::Dirichlet);
   s.dirichletValues = {1.0, 0.0};
