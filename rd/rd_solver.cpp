@@ -22,6 +22,7 @@ struct RDSolver<D>::Diffusion {
   PcgWorkspace ws;
   Vector x;
   Vector increment;  // the last solve's x - b: the next one's warm start
+  double incrementThetaDt = 0.0;  // the theta dt it was made over
   double thetaDt = -1.0;
   long version = -1;  // tensor version it was built from
 };
@@ -221,9 +222,6 @@ SolverResult RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
       df.M = std::make_unique<Multigrid<D>>(df.A.axis);
     else
       df.M = std::make_unique<JacobiPreconditioner<D>>(df.A.axis);
-    // The last diffusive change was made over the last theta dt: rescale it.
-    if (df.thetaDt > 0)
-      for (double& v : df.increment) v *= thetaDt / df.thetaDt;
     df.thetaDt = thetaDt;
     df.version = version;
   }
@@ -233,17 +231,21 @@ SolverResult RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
     const Vector& faces = boundaryWeights(s);
     parallelFor(b.size(), [&](size_t i) { b[i] += k * faces[i]; }, kChunk);
   }
-  // Warm start: the undiffused state plus the last step's diffusive change,
-  // which a slowly evolving pattern repeats (as the fluid's viscosity does).
+  // Warm start: the undiffused state plus the last step's diffusive change
+  // (rescaled to this theta dt), which a slowly evolving pattern repeats, as
+  // the fluid's viscosity does.
   df.x.resize(b.size());
-  if (df.increment.size() == b.size())
-    parallelFor(b.size(), [&](size_t i) { df.x[i] = b[i] + df.increment[i]; }, kChunk);
-  else
+  if (df.increment.size() == b.size()) {
+    const double ratio = thetaDt / df.incrementThetaDt;
+    parallelFor(b.size(), [&](size_t i) { df.x[i] = b[i] + ratio * df.increment[i]; }, kChunk);
+  } else {
     df.x = b;
+  }
   SolverOptions o{settings_.tolerance, 2000};
   SolverResult r = solvePCG<D>(df.A, b, &df.x, df.M.get(), o, nullptr, &df.ws);
   df.increment.resize(b.size());
   parallelFor(b.size(), [&](size_t i) { df.increment[i] = df.x[i] - b[i]; }, kChunk);
+  df.incrementThetaDt = thetaDt;
   std::swap(b, df.x);
   return r;
 }
