@@ -6,6 +6,11 @@
 
 #include "core/parallel.h"
 #include "core/simd4.h"
+#include "core/simd_dispatch.h"
+
+#if MORPHOFLOW_AVX2_KERNELS
+#include <immintrin.h>
+#endif
 
 namespace morphoflow {
 
@@ -91,6 +96,43 @@ size_t sweepUniform4(const RowStencil<D, float>& s, const float* br, float* xr, 
   }
   return i;
 }
+
+#if MORPHOFLOW_AVX2_KERNELS
+// The same eight cells of one colour at a time (cells i, i + 2, .., i + 14,
+// all < end) on AVX2. The lanes hold the cells in the order that the
+// in-lane shuffles give (i + 0, 2, 8, 10 | 4, 6, 12, 14), the same for every
+// operand, and unpacking with the other colour restores memory order; each
+// lane's arithmetic is sweepUniform4's.
+__attribute__((target("avx2"), always_inline)) inline __m256 evens8(const float* p) {
+  return _mm256_shuffle_ps(_mm256_loadu_ps(p), _mm256_loadu_ps(p + 8), 0x88);
+}
+
+template <int D>
+__attribute__((target("avx2"))) size_t sweepUniform8(const RowStencil<D, float>& s, const float* br, float* xr,
+                                                     size_t i, size_t end, float inv, float r0) {
+  if (i + 15 > end) return i;
+  const __m256 vinv = _mm256_set1_ps(inv), vr0 = _mm256_set1_ps(r0);
+  // The odd cells (i + 1, 3, 9, 11 | 5, 7, 13, 15) rotated onto the even
+  // cells' left neighbours (i + 15, 1, 7, 9 | 3, 5, 11, 13): lane 0 is taken
+  // from the previous block's rotation (its i + 15 is this block's i - 1).
+  const __m256i rotate = _mm256_setr_epi32(7, 0, 5, 2, 1, 4, 3, 6);
+  __m256 before = _mm256_set1_ps(xr[i - 1]);
+  for (; i + 15 <= end; i += 16) {
+    const __m256 here = _mm256_loadu_ps(xr + i), next = _mm256_loadu_ps(xr + i + 8);
+    const __m256 right = _mm256_shuffle_ps(here, next, 0xDD);
+    const __m256 rotated = _mm256_permutevar8x32_ps(right, rotate);
+    const __m256 left = _mm256_blend_ps(rotated, before, 0x01);
+    before = rotated;
+    __m256 sum = _mm256_add_ps(right, left);
+    for (int a = 1; a < D; ++a)
+      sum = _mm256_add_ps(sum, _mm256_add_ps(evens8(s.xhi[a] + i), evens8(s.xlo[a] + i)));
+    const __m256 r = _mm256_mul_ps(_mm256_add_ps(_mm256_mul_ps(evens8(br + i), vinv), sum), vr0);
+    _mm256_storeu_ps(xr + i, _mm256_unpacklo_ps(r, right));
+    _mm256_storeu_ps(xr + i + 8, _mm256_unpackhi_ps(r, right));
+  }
+  return i;
+}
+#endif
 
 // Face sum sum_f w_f (x_i - x_j(f)): with the c term this is A x, written so
 // that every face's two contributions cancel to round-off (mass conservation
@@ -270,6 +312,11 @@ double LaplaceSystem<D>::residual(const Vector& b, const Vector& x, Vector* r) c
   return norm2(*r);
 }
 
+namespace {
+constexpr size_t kSlabPlanes = 8;  // the smoother's slabs: at least this many planes
+constexpr size_t kSlabCells = 16384;  // and cells
+}  // namespace
+
 template <int D>
 template <class T>
 void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, bool reverse) const {
@@ -283,49 +330,95 @@ void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, 
   for (int a = 1; a < D; ++a) serial |= periodic[a] && (dims[a] % 2 == 1);
   size_t rows = 1;
   for (int a = 1; a < D; ++a) rows *= size_t(dims[a]);
-  for (int pass = 0; pass < 2; ++pass) {
-    int colour = reverse ? 1 - pass : pass;
-    auto sweepRow = [&](size_t row) {
-      RowStencil<D, T> s = rowStencil<D>(*this, x.data(), zeros<T>(), zerosW_.data(), row);
-      size_t parity = row % size_t(dims[1]);
-      if constexpr (D == 3) parity += row / size_t(dims[1]);
-      const float* wa[D];
-      for (int a = 0; a < D; ++a) wa[a] = w[a].data() + s.base;
-      const T* rd = invDiag<T>() + s.base;
-      const T* br = b.data() + s.base;
-      T* xr = x.data() + s.base;
-      // x_i = (b_i / scale + sum_f w_f x_j) / diag_i; invDiag is 0 on inactive cells.
-      auto edge = [&](size_t i) {
-        size_t il = i == 0 ? nx - 1 : i - 1, ih = i + 1 == nx ? 0 : i + 1;
-        float wl = (i == 0 && !px) ? 0.0f : wa[0][il];
-        xr[i] = (br[i] * inv + neighbourSum<D, T>(s, wa, xr, i, il, ih, wl)) * rd[i];
-      };
-      size_t i = (size_t(colour) + parity) & 1;
-      if (i == 0) {
-        edge(0);
-        i = 2;
-      }
-      auto general = [&](size_t end) {
-        for (; i < end; i += 2)
-          xr[i] = (br[i] * inv + neighbourSum<D, T>(s, wa, xr, i, i - 1, i + 1, wa[0][i - 1])) * rd[i];
-      };
-      // The row's uniform span (unit weights, one c): the same sums without
-      // the weight loads (w x = x for w = 1), four cells at a time in float.
-      const size_t lo = uniformSpan_[row][0], hi = uniformSpan_[row][1];
-      general(std::min(lo, nx - 1));
-      if (lo < hi) {
-        const T r0 = rd[lo];
-        if constexpr (std::is_same_v<T, float>) i = sweepUniform4<D>(s, br, xr, i, hi, inv, r0);
-        for (; i < hi; i += 2) xr[i] = (br[i] * inv + neighbourSumUniform<D, T>(s, xr, i)) * r0;
-      }
-      general(nx - 1);
-      if (i + 1 == nx && nx > 1) edge(i);
+  [[maybe_unused]] const bool wide = useAvx2();
+  auto sweepRow = [&](size_t row, int colour) {
+    RowStencil<D, T> s = rowStencil<D>(*this, x.data(), zeros<T>(), zerosW_.data(), row);
+    size_t parity = row % size_t(dims[1]);
+    if constexpr (D == 3) parity += row / size_t(dims[1]);
+    const float* wa[D];
+    for (int a = 0; a < D; ++a) wa[a] = w[a].data() + s.base;
+    const T* rd = invDiag<T>() + s.base;
+    const T* br = b.data() + s.base;
+    T* xr = x.data() + s.base;
+    // x_i = (b_i / scale + sum_f w_f x_j) / diag_i; invDiag is 0 on inactive cells.
+    auto edge = [&](size_t i) {
+      size_t il = i == 0 ? nx - 1 : i - 1, ih = i + 1 == nx ? 0 : i + 1;
+      float wl = (i == 0 && !px) ? 0.0f : wa[0][il];
+      xr[i] = (br[i] * inv + neighbourSum<D, T>(s, wa, xr, i, il, ih, wl)) * rd[i];
     };
-    if (serial)
-      for (size_t r = 0; r < rows; ++r) sweepRow(r);
-    else
-      parallelForRows<D>(dims, sweepRow);
+    size_t i = (size_t(colour) + parity) & 1;
+    if (i == 0) {
+      edge(0);
+      i = 2;
+    }
+    auto general = [&](size_t end) {
+      for (; i < end; i += 2)
+        xr[i] = (br[i] * inv + neighbourSum<D, T>(s, wa, xr, i, i - 1, i + 1, wa[0][i - 1])) * rd[i];
+    };
+    // The row's uniform span (unit weights, one c): the same sums without
+    // the weight loads (w x = x for w = 1), four or eight cells at a time in float.
+    const size_t lo = uniformSpan_[row][0], hi = uniformSpan_[row][1];
+    general(std::min(lo, nx - 1));
+    if (lo < hi) {
+      const T r0 = rd[lo];
+      if constexpr (std::is_same_v<T, float>) {
+        // The colour's last cells of the span in one more block, placed to
+        // end at the span's end: the cells it repeats get the same values
+        // again (a cell's update reads the other colour only).
+        const size_t first = i;
+        auto lastBlock = [&](size_t cells) {
+          const size_t j = hi - (cells - 1);
+          return j - ((j - first) & 1);
+        };
+#if MORPHOFLOW_AVX2_KERNELS
+        if (wide) {
+          i = sweepUniform8<D>(s, br, xr, i, hi, inv, r0);
+          if (i < hi && hi >= first + 15) i = sweepUniform8<D>(s, br, xr, lastBlock(16), hi, inv, r0);
+        }
+#endif
+        i = sweepUniform4<D>(s, br, xr, i, hi, inv, r0);
+        if (i < hi && hi >= first + 7) i = sweepUniform4<D>(s, br, xr, lastBlock(8), hi, inv, r0);
+      }
+      for (; i < hi; i += 2) xr[i] = (br[i] * inv + neighbourSumUniform<D, T>(s, xr, i)) * r0;
+    }
+    general(nx - 1);
+    if (i + 1 == nx && nx > 1) edge(i);
+  };
+  const int first = reverse ? 1 : 0, second = 1 - first;
+  if (serial) {
+    for (int colour : {first, second})
+      for (size_t r = 0; r < rows; ++r) sweepRow(r, colour);
+    return;
   }
+  // Both colours in one pass over memory: planes (rows in 2D) along the last
+  // axis are cut into slabs, and a slab updates the first colour on plane p,
+  // then the second on plane p - 1, whose neighbours then all hold the first
+  // colour's new values. The second colour on a slab's first and last planes
+  // waits for the neighbouring slabs' first colour (a second, short loop).
+  // A cell's update reads the other colour only, so any order and any cut
+  // give bitwise the sweep of two whole passes; slabs never write a plane
+  // that another slab reads at the same time, save to store back the other
+  // colour's unchanged values.
+  const size_t planes = size_t(dims[D - 1]), rowsPerPlane = rows / planes;
+  auto plane = [&](size_t p, int colour) {
+    for (size_t r = p * rowsPerPlane; r < (p + 1) * rowsPerPlane; ++r) sweepRow(r, colour);
+  };
+  // Slabs of at least kSlabPlanes planes and kSlabCells cells, a few per thread.
+  const size_t slabs = std::max<size_t>(
+      1, std::min({4 * size_t(hardwareThreads()), planes / kSlabPlanes, size() / kSlabCells}));
+  auto slabBegin = [&](size_t j) { return j * planes / slabs; };
+  parallelFor(slabs, [&](size_t j) {
+    const size_t lo = slabBegin(j), hi = slabBegin(j + 1);
+    for (size_t p = lo; p < hi; ++p) {
+      plane(p, first);
+      if (p >= lo + 2) plane(p - 1, second);
+    }
+  });
+  parallelFor(slabs, [&](size_t j) {
+    const size_t lo = slabBegin(j), hi = slabBegin(j + 1);
+    plane(lo, second);
+    if (hi - 1 > lo) plane(hi - 1, second);
+  });
 }
 
 template <int D>

@@ -1,0 +1,28 @@
+// Wider x86 kernels chosen at run time. The build targets x86-64-v2 (four
+// float lanes, SSE); a few compute-bound kernels also have an eight-lane
+// AVX2 variant, compiled for that target alone (a function attribute, not a
+// flag on a whole translation unit, so no inline function elsewhere is ever
+// built for AVX2) and used when the CPU has it. A wide kernel does each
+// lane's arithmetic in the scalar loop's order and without FMA, so both
+// variants give bitwise the same fields: the choice is one of speed only.
+// MORPHOFLOW_SIMD=4 in the environment keeps the four-lane kernels.
+#pragma once
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define MORPHOFLOW_AVX2_KERNELS 1
+#else
+#define MORPHOFLOW_AVX2_KERNELS 0
+#endif
+
+namespace morphoflow {
+
+// True when the CPU (and this build) can run the AVX2 kernels.
+bool cpuHasAvx2();
+// Whether the kernels use their AVX2 variants now: cpuHasAvx2(), unless
+// MORPHOFLOW_SIMD=4 or setUseAvx2(false).
+bool useAvx2();
+// Tests compare the two variants; asking for AVX2 on a CPU without it keeps
+// the four-lane kernels.
+void setUseAvx2(bool on);
+
+}  // namespace morphoflow
