@@ -16,6 +16,11 @@
 
 namespace morphoflow {
 
+// Eight float lanes (GCC vector extensions, as core/simd4.h's four): one
+// AVX2 register inside a target("avx2") kernel.
+typedef float vf8 __attribute__((vector_size(32)));
+typedef int vi8 __attribute__((vector_size(32)));
+
 // True when the CPU (and this build) can run the AVX2 kernels.
 bool cpuHasAvx2();
 // Whether the kernels use their AVX2 variants now: cpuHasAvx2(), unless
