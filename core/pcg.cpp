@@ -59,10 +59,10 @@ SolverResult pcg(const Op& A, const Vector& bIn, Vector* xp, Preconditioner* M, 
       if (A.singular()) A.removeNullSpace(&z);
       return dot(r, z);
     }
-    const double rz = M->applyDot(r, rnorm, &z);
-    if (!A.singular()) return rz;
-    A.removeNullSpace(&z);
-    return dot(r, z);
+    // A singular system's z may carry a constant, left in place: A maps it
+    // to zero and the mean-free r is orthogonal to it, so the iteration is
+    // the same; x's resulting drift is removed at the end.
+    return M->applyDot(r, rnorm, &z);
   };
   double rz = precondition();
   p = z;
