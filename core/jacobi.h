@@ -16,11 +16,22 @@ class JacobiPreconditioner final : public Preconditioner {
     parallelFor(r.size(), [&](size_t i) { (*z)[i] = scaled(r, i); }, 4096);
   }
   double applyDot(const Vector& r, double, Vector* z) override {
+    last_ = &r;
+    if (!z) return deterministicSum(r.size(), [&](size_t i) { return r[i] * scaled(r, i); });
     z->resize(r.size());
     return deterministicSum(r.size(), [&](size_t i) {
       (*z)[i] = scaled(r, i);
       return r[i] * (*z)[i];
     });
+  }
+  bool recomputesZ() const override { return true; }
+  void direction(double beta, bool first, Vector* pp) override {
+    Vector& p = *pp;
+    const Vector& r = *last_;
+    if (first)
+      parallelFor(r.size(), [&](size_t i) { p[i] = scaled(r, i); }, 4096);
+    else
+      parallelFor(r.size(), [&](size_t i) { p[i] = scaled(r, i) + beta * p[i]; }, 4096);
   }
 
  private:
@@ -30,6 +41,7 @@ class JacobiPreconditioner final : public Preconditioner {
     return d > 0 ? r[i] * (1.0 / A_.scale) / d : 0.0;
   }
   const LaplaceSystem<D>& A_;
+  const Vector* last_ = nullptr;  // the last applyDot's r
 };
 
 }  // namespace morphoflow

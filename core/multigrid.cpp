@@ -328,26 +328,38 @@ void Multigrid<D>::cycle(int l) {
 template <int D>
 double Multigrid<D>::scaledCycle(const Vector& r, double rscale, Vector* z, bool withDot) {
   Level& L0 = levels_[0];
+  if (rscale == 0.0 || !std::isfinite(rscale)) {  // zero in, zero out; an overflow stays visible
+    std::fill(L0.x.begin(), L0.x.end(), 0.0f);
+    zScale_ = rscale == 0.0 ? 0.0 : std::numeric_limits<double>::quiet_NaN();  // z = 0 x: 0 or NaN
+  } else {
+    const double inv = 1.0 / rscale;
+    parallelFor(r.size(), [&](size_t i) {
+      L0.b[i] = float(r[i] * inv);
+      L0.x[i] = 0.0f;
+    }, 4096);
+    cycle(0);
+    zScale_ = rscale;
+  }
+  if (!z) return deterministicSum(r.size(), [&](size_t i) { return r[i] * zAt(i); });
   z->resize(r.size());
   Vector& zz = *z;
-  if (rscale == 0.0 || !std::isfinite(rscale)) {  // zero in, zero out; an overflow stays visible
-    std::fill(zz.begin(), zz.end(), rscale == 0.0 ? 0.0 : std::numeric_limits<double>::quiet_NaN());
-    return rscale == 0.0 ? 0.0 : std::numeric_limits<double>::quiet_NaN();
-  }
-  const double inv = 1.0 / rscale;
-  parallelFor(r.size(), [&](size_t i) {
-    L0.b[i] = float(r[i] * inv);
-    L0.x[i] = 0.0f;
-  }, 4096);
-  cycle(0);
   if (!withDot) {
-    parallelFor(r.size(), [&](size_t i) { zz[i] = double(L0.x[i]) * rscale; }, 4096);
+    parallelFor(r.size(), [&](size_t i) { zz[i] = zAt(i); }, 4096);
     return 0.0;
   }
   return deterministicSum(r.size(), [&](size_t i) {
-    zz[i] = double(L0.x[i]) * rscale;
+    zz[i] = zAt(i);
     return r[i] * zz[i];
   });
+}
+
+template <int D>
+void Multigrid<D>::direction(double beta, bool first, Vector* pp) {
+  Vector& p = *pp;
+  if (first)
+    parallelFor(p.size(), [&](size_t i) { p[i] = zAt(i); }, 4096);
+  else
+    parallelFor(p.size(), [&](size_t i) { p[i] = zAt(i) + beta * p[i]; }, 4096);
 }
 
 template <int D>

@@ -42,6 +42,9 @@ class Multigrid final : public Preconditioner {
   // Preconditioner: z = one V-cycle from zero.
   void apply(const Vector& r, Vector* z) override;
   double applyDot(const Vector& r, double rnorm, Vector* z) override;
+  // z is the fine level's x times the last cycle's scale.
+  bool recomputesZ() const override { return true; }
+  void direction(double beta, bool first, Vector* p) override;
 
   // The fine system's coefficients changed, not its shape (a new identity
   // term, say, from a new time step): re-derive the coarse levels in place,
@@ -75,8 +78,10 @@ class Multigrid final : public Preconditioner {
   void buildTransfer(int l);
   void cycle(int l);
   // The cycle on r / rscale (single precision must neither underflow nor
-  // overflow), z = rscale * result; returns r . z when `withDot`.
+  // overflow), z = rscale * result (unless z is null); returns r . z when
+  // `withDot`.
   double scaledCycle(const Vector& r, double rscale, Vector* z, bool withDot);
+  double zAt(size_t i) const { return double(levels_[0].x[i]) * zScale_; }
   void restrict(int l);   // r of level l -> b of level l + 1
   void prolongAdd(int l); // x of level l + 1 added into x of level l
 
@@ -85,6 +90,7 @@ class Multigrid final : public Preconditioner {
   std::vector<Level> levels_;
   Vector coarseB_, coarseX_, r_, z_;  // the coarsest solve in double; solve()'s vectors
   PcgWorkspace coarseWork_;
+  double zScale_ = 0.0;  // the last cycle's rscale (z = zScale_ x on level 0)
 };
 
 }  // namespace morphoflow

@@ -19,7 +19,9 @@ SolverResult pcg(const Op& A, const Vector& bIn, Vector* xp, Preconditioner* M, 
   SolverResult result;
   PcgWorkspace local;
   PcgWorkspace& ws = workspace ? *workspace : local;
-  for (Vector* v : {&ws.r, &ws.z, &ws.p, &ws.q}) v->resize(n);
+  const bool recompute = M && M->recomputesZ();  // z is then never stored
+  for (Vector* v : {&ws.r, &ws.p, &ws.q}) v->resize(n);
+  if (!recompute) ws.z.resize(n);
   const Vector* bp = &bIn;
   if (A.singular()) {  // keep the system consistent
     ws.b = bIn;
@@ -62,10 +64,13 @@ SolverResult pcg(const Op& A, const Vector& bIn, Vector* xp, Preconditioner* M, 
     // A singular system's z may carry a constant, left in place: A maps it
     // to zero and the mean-free r is orthogonal to it, so the iteration is
     // the same; x's resulting drift is removed at the end.
-    return M->applyDot(r, rnorm, &z);
+    return M->applyDot(r, rnorm, recompute ? nullptr : &z);
   };
   double rz = precondition();
-  p = z;
+  if (recompute)
+    M->direction(0.0, true, &p);
+  else
+    p = z;
   for (int it = 1; it <= opt.maxIterations; ++it) {
     double pq;
     if constexpr (requires { A.applyDot(p, &q); })
@@ -88,7 +93,10 @@ SolverResult pcg(const Op& A, const Vector& bIn, Vector* xp, Preconditioner* M, 
     double rzNew = precondition();
     double beta = rzNew / rz;
     rz = rzNew;
-    parallelFor(n, [&](size_t i) { p[i] = z[i] + beta * p[i]; }, 4096);
+    if (recompute)
+      M->direction(beta, false, &p);
+    else
+      parallelFor(n, [&](size_t i) { p[i] = z[i] + beta * p[i]; }, 4096);
   }
   // Report the true residual, not the recursively updated one.
   result.residual = A.residual(b, x, &r) / bnorm;

@@ -16,6 +16,15 @@ class Preconditioner {
     apply(r, z);
     return dot(r, *z);
   }
+  // A preconditioner that can form the last applyDot's z again from its own
+  // state (while that r is unchanged) says so here: PCG then passes z = null
+  // to applyDot, which returns r . z only, and forms its search direction
+  // through direction(), one vector fewer written and read per iteration.
+  virtual bool recomputesZ() const { return false; }
+  // p = z + beta p, or p = z when `first`, with the last applyDot's z.
+  virtual void direction(double beta, bool first, Vector* p) {
+    (void)beta, (void)first, (void)p;
+  }
 };
 
 }  // namespace morphoflow
