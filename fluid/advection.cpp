@@ -121,8 +121,18 @@ MF_INLINE V vinterpolate(const float* data, const size_t* s, const VTap<V>* tap,
   if constexpr (D == 3) idx += tap[2].lo * int(s[2]);
   V t[D];
   for (int a = 0; a < D; ++a) t[a] = tap[a].t;
+  const size_t sy = s[1], sz = D == 3 ? s[D - 1] : 0;
+  // Where the lanes' stencils are consecutive cells of one row (a smooth
+  // flow moves neighbours alike), every corner is one contiguous load.
+  bool consecutive = true;
+  for (int k = 1; k < Lanes<V>::n; ++k) consecutive &= idx[k] == idx[0] + k;
+  if (consecutive) {
+    const float* d = data + idx[0];
+    return blendCorners<D, V>([d](size_t off) __attribute__((always_inline)) { return vload<V>(d + off); }, sy, sz,
+                              t, lo, hi);
+  }
   return blendCorners<D, V>([data, idx](size_t off) __attribute__((always_inline)) { return gather<V>(data + off, idx); },
-                            s[1], D == 3 ? s[D - 1] : 0, t, lo, hi);
+                            sy, sz, t, lo, hi);
 }
 
 // MacSampler on a vector of positions.
