@@ -80,11 +80,18 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
     Component& C = comp_[ai];
     Grid<float, D>& g = (*u)[a];
     const Grid<uint8_t, D>& fixed = vc_.fixed[a];
+    // Unknown i is face gi of the component's grid: the same index unless a
+    // periodic axis drops the duplicate face layer.
+    const bool sameIndex = C.dims == g.dims();
+    auto eachUnknown = [&](auto&& fn) {
+      if (sameIndex)
+        parallelFor(C.A.size(), [&](size_t i) { fn(i, i); }, 4096);
+      else
+        forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) { fn(i, g.index(k)); });
+    };
     if (s != s_) {  // A = s (c + sum w (x_i - x_j)), c = 1/s + boundary terms
       C.A.scale = s;
-      forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) {
-        C.A.c[i] = fixed[fixed.index(k)] ? 0.0f : float(1.0 / s + C.cBoundary[i]);
-      });
+      eachUnknown([&](size_t i, size_t gi) { C.A.c[i] = fixed[gi] ? 0.0f : float(1.0 / s + C.cBoundary[i]); });
       C.A.finalize();
       // Far below s ~ 0.1 the diagonal dominates and Jacobi needs a handful
       // of iterations; above, multigrid keeps the count independent of s and
@@ -99,8 +106,7 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
     // Warm start: the increment's rate, linearly extrapolated in steps.
     const Vector &r1 = C.rate[0], &r0 = C.rate[1];
     const int history = C.history;
-    forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) {
-      size_t gi = g.index(k);
+    eachUnknown([&](size_t i, size_t gi) {
       const double rate = history >= 2 ? 2.0 * r1[i] - r0[i] : history == 1 ? r1[i] : 0.0;
       C.x[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * rate;
       C.b[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * C.boundaryRhs[i];
@@ -112,8 +118,7 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
     Vector& rate = C.rate[0];
     rate.resize(C.A.size());
     const double invS = 1.0 / s;
-    forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) {
-      size_t gi = g.index(k);
+    eachUnknown([&](size_t i, size_t gi) {
       if (fixed[gi]) {
         rate[i] = 0.0;
         return;

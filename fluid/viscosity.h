@@ -37,7 +37,7 @@ class ViscositySolver {
     // The last two solves' (x - u*) / s, newest first: the next warm start.
     std::array<Vector, 2> rate;
     int history = 0;            // how many of them are set
-    std::unique_ptr<Multigrid<D>> multigrid;  // present while s > 1
+    std::unique_ptr<Multigrid<D>> multigrid;  // present while s > 0.1
     PcgWorkspace workspace;
   };
   const VelocityConstraints<D>& vc_;
