@@ -90,7 +90,7 @@ SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double
     Grid<float, D>& g = (*u)[a];
     const Grid<uint8_t, D>& fixed = vc_.fixed[a];
     const bool periodic = vc_.boundaries.periodic(a);
-    forEachCell<D>(g.dims(), [&](const IVec<D>& k, size_t i) {
+    auto update = [&](const IVec<D>& k, size_t i) {
       if (fixed[i]) return;
       IVec<D> lo = k - unitVector<D>(a), hi = k;
       if (periodic) {
@@ -109,6 +109,41 @@ SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double
         ph = phi_[A_.diag.index(hi)];
       }
       g[i] = float(double(g[i]) - (ph - pl) * invH);
+    };
+    // Rows of faces between two cells inside the domain take their cells'
+    // phi from two rows of cells (one row shifted by one along x); the
+    // faces on the domain's sides (wrapped or mirrored) take update().
+    const IVec<D> gd = g.dims();
+    parallelForRows<D>(gd, [&](size_t row) {
+      IVec<D> k(0);
+      size_t rest = row, cellRow = 0, stride = 1;
+      for (int b = 1; b < D; ++b) {
+        k[b] = int(rest % size_t(gd[b]));
+        rest /= size_t(gd[b]);
+      }
+      for (int b = D - 1; b >= 1; --b) cellRow = cellRow * size_t(n[b]) + size_t(std::min(k[b], n[b] - 1));
+      for (int b = 1; b <= a; ++b) stride *= size_t(n[b - 1]);
+      const size_t base = row * size_t(gd[0]);
+      if (a > 0 && (k[a] == 0 || k[a] == n[a])) {
+        for (int x = 0; x < gd[0]; ++x) {
+          k[0] = x;
+          update(k, base + size_t(x));
+        }
+        return;
+      }
+      const size_t nx = size_t(n[0]);
+      const double* ph = phi_.data() + cellRow * nx;  // the cell at or after each face
+      const double* pl = ph - stride;                 // the cell before it along a
+      float* gr = g.data() + base;
+      const uint8_t* fr = fixed.data() + base;
+      const int x0 = a == 0 ? 1 : 0, x1 = n[0];
+      for (int x = x0; x < x1; ++x)
+        if (!fr[x]) gr[x] = float(double(gr[x]) - (ph[x] - pl[x]) * invH);
+      for (int x : {0, gd[0] - 1})
+        if (x < x0 || x >= x1) {
+          k[0] = x;
+          update(k, base + size_t(x));
+        }
     });
   }
   vc_.apply(u);
