@@ -26,13 +26,14 @@ struct RowStencil {
   const float* wlo[D];  // w[a] of the row below (coupling to this row)
 };
 
+// Row `row` at coordinates y (and z) along axes 1 (and 2).
 template <int D, class T>
-RowStencil<D, T> rowStencil(const LaplaceSystem<D>& A, const T* x, const T* zx, const float* zw, size_t row) {
+RowStencil<D, T> rowStencil(const LaplaceSystem<D>& A, const T* x, const T* zx, const float* zw, size_t row,
+                            size_t y, size_t z) {
   RowStencil<D, T> s{};
   const IVec<D>& dims = A.dims;
   size_t nx = size_t(dims[0]), ny = size_t(dims[1]);
   s.base = row * nx;
-  size_t y = row % ny, z = D == 3 ? row / ny : 0;
   for (int a = 1; a < D; ++a) {
     size_t k = a == 1 ? y : z, n = size_t(dims[a]);
     size_t stride = a == 1 ? nx : nx * ny;
@@ -51,6 +52,12 @@ RowStencil<D, T> rowStencil(const LaplaceSystem<D>& A, const T* x, const T* zx, 
       s.xhi[a] = zx;
   }
   return s;
+}
+
+template <int D, class T>
+RowStencil<D, T> rowStencil(const LaplaceSystem<D>& A, const T* x, const T* zx, const float* zw, size_t row) {
+  const size_t ny = size_t(A.dims[1]);
+  return rowStencil<D, T>(A, x, zx, zw, row, row % ny, D == 3 ? row / ny : 0);
 }
 
 // Neighbour sum sum_f w_f x_j(f) of cell i of a row; il/ih are the x
@@ -213,6 +220,7 @@ void LaplaceSystem<D>::finalize() {
   // The longest run of interior cells per row that are uniform among
   // themselves (unit weights on every face, one c, hence one diagonal).
   uniformSpan_.assign(rows, {0, 0});
+  sweepSpan_.assign(rows, {0, 0});
   parallelForRows<D>(dims, [&](size_t row) {
     if (nx < 3) return;
     RowStencil<D, double> s = rowStencil<D>(*this, zerosX_.data(), zerosX_.data(), zerosW_.data(), row);
@@ -224,18 +232,40 @@ void LaplaceSystem<D>::finalize() {
         if (w[a][s.base + i] != 1.0f || s.wlo[a][i] != 1.0f) return false;
       return true;
     };
-    uint32_t bestLo = 0, bestHi = 0;
-    for (size_t i = 1; i + 1 < nx;) {
-      if (!unit(i)) {
-        ++i;
-        continue;
-      }
-      size_t e = i + 1;
-      while (e + 1 < nx && unit(e) && cr[e] == cr[i]) ++e;
-      if (e - i > bestHi - bestLo) bestLo = uint32_t(i), bestHi = uint32_t(e);
-      i = e;
+    // The smoother also takes a face across a non-periodic domain edge:
+    // there the general sum adds 0 * 0 from the row of zeros, and the
+    // uniform one adds that row's 0 (bitwise the same; not so A x, whose
+    // face sum would add x_i - 0).
+    bool edgeLo[D] = {}, edgeHi[D] = {};
+    const int k[3] = {0, int(row % size_t(dims[1])), D == 3 ? int(row / size_t(dims[1])) : 0};
+    for (int a = 1; a < D; ++a) {
+      edgeLo[a] = k[a] == 0 && !periodic[a];
+      edgeHi[a] = k[a] == dims[a] - 1 && !periodic[a];
     }
-    uniformSpan_[row] = {bestLo, bestHi};
+    auto sweepUnit = [&](size_t i) {
+      if (w0[i] != 1.0f || w0[i - 1] != 1.0f) return false;
+      for (int a = 1; a < D; ++a) {
+        const float hi = w[a][s.base + i];
+        if (!(hi == 1.0f || (edgeHi[a] && hi == 0.0f)) || !(s.wlo[a][i] == 1.0f || edgeLo[a])) return false;
+      }
+      return true;
+    };
+    auto longest = [&](auto&& ok) -> std::array<uint32_t, 2> {
+      uint32_t bestLo = 0, bestHi = 0;
+      for (size_t i = 1; i + 1 < nx;) {
+        if (!ok(i)) {
+          ++i;
+          continue;
+        }
+        size_t e = i + 1;
+        while (e + 1 < nx && ok(e) && cr[e] == cr[i]) ++e;
+        if (e - i > bestHi - bestLo) bestLo = uint32_t(i), bestHi = uint32_t(e);
+        i = e;
+      }
+      return {bestLo, bestHi};
+    };
+    uniformSpan_[row] = longest(unit);
+    sweepSpan_[row] = longest(sweepUnit);
   });
   active_ = size_t(deterministicSum(diag.size(), [&](size_t i) { return diag[i] > 0 ? 1.0 : 0.0; }));
   singular_ = deterministicMax(c.size(), [&](size_t i) { return c[i]; }) <= 0.0;
@@ -331,10 +361,9 @@ void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, 
   size_t rows = 1;
   for (int a = 1; a < D; ++a) rows *= size_t(dims[a]);
   [[maybe_unused]] const bool wide = useAvx2();
-  auto sweepRow = [&](size_t row, int colour) {
-    RowStencil<D, T> s = rowStencil<D>(*this, x.data(), zeros<T>(), zerosW_.data(), row);
-    size_t parity = row % size_t(dims[1]);
-    if constexpr (D == 3) parity += row / size_t(dims[1]);
+  auto sweepRow = [&](size_t row, size_t y, size_t z, int colour) {
+    RowStencil<D, T> s = rowStencil<D, T>(*this, x.data(), zeros<T>(), zerosW_.data(), row, y, z);
+    const size_t parity = y + z;
     const float* wa[D];
     for (int a = 0; a < D; ++a) wa[a] = w[a].data() + s.base;
     const T* rd = invDiag<T>() + s.base;
@@ -357,7 +386,7 @@ void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, 
     };
     // The row's uniform span (unit weights, one c): the same sums without
     // the weight loads (w x = x for w = 1), four or eight cells at a time in float.
-    const size_t lo = uniformSpan_[row][0], hi = uniformSpan_[row][1];
+    const size_t lo = sweepSpan_[row][0], hi = sweepSpan_[row][1];
     general(std::min(lo, nx - 1));
     if (lo < hi) {
       const T r0 = rd[lo];
@@ -385,9 +414,10 @@ void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, 
     if (i + 1 == nx && nx > 1) edge(i);
   };
   const int first = reverse ? 1 : 0, second = 1 - first;
+  const size_t ny = size_t(dims[1]);
   if (serial) {
     for (int colour : {first, second})
-      for (size_t r = 0; r < rows; ++r) sweepRow(r, colour);
+      for (size_t r = 0; r < rows; ++r) sweepRow(r, r % ny, D == 3 ? r / ny : 0, colour);
     return;
   }
   // Both colours in one pass over memory: planes (rows in 2D) along the last
@@ -401,7 +431,10 @@ void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, 
   // colour's unchanged values.
   const size_t planes = size_t(dims[D - 1]), rowsPerPlane = rows / planes;
   auto plane = [&](size_t p, int colour) {
-    for (size_t r = p * rowsPerPlane; r < (p + 1) * rowsPerPlane; ++r) sweepRow(r, colour);
+    if constexpr (D == 2)
+      sweepRow(p, p, 0, colour);
+    else
+      for (size_t y = 0; y < ny; ++y) sweepRow(p * rowsPerPlane + y, y, p, colour);
   };
   // Slabs of at least kSlabPlanes planes and kSlabCells cells, a few per thread.
   const size_t slabs = std::max<size_t>(

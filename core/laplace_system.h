@@ -76,6 +76,9 @@ struct LaplaceSystem {
   // and one c: the kernels skip the weight loads there, with the same
   // arithmetic (the smoother four cells at a time).
   std::vector<std::array<uint32_t, 2>> uniformSpan_;
+  // The same for the smoother, which may also take faces across a
+  // non-periodic domain edge (there its sums match the general ones too).
+  std::vector<std::array<uint32_t, 2>> sweepSpan_;
 };
 
 // Builds the plain Laplacian with Neumann walls (periodic where asked) on a
