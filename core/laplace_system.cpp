@@ -69,24 +69,33 @@ inline T neighbourSum(const RowStencil<D, T>& s, const float* const* wa, const T
   for (int a = 1; a < D; ++a) sum += T(wa[a][i]) * s.xhi[a][i] + T(s.wlo[a][i]) * s.xlo[a][i];
   return sum;
 }
-// The same on a uniform row's interior (every w = 1: the same sums).
-template <int D, class T>
-inline T neighbourSumUniform(const RowStencil<D, T>& s, const T* xr, size_t i) {
-  T sum = xr[i + 1] + xr[i - 1];
-  for (int a = 1; a < D; ++a) sum += s.xhi[a][i] + s.xlo[a][i];
+// w x on a uniform span, whose faces all weigh wu: skipped where wu = 1
+// (1 x = x exactly), so both forms give the general sums' values.
+template <bool Weighted, class V, class W>
+inline V times(W wu, V x) {
+  if constexpr (Weighted)
+    return wu * x;
+  else
+    return x;
+}
+// The same on a uniform row's interior (every face weighs wu: the same sums).
+template <int D, bool Weighted, class T>
+inline T neighbourSumUniform(const RowStencil<D, T>& s, const T* xr, size_t i, T wu) {
+  T sum = times<Weighted>(wu, xr[i + 1]) + times<Weighted>(wu, xr[i - 1]);
+  for (int a = 1; a < D; ++a) sum += times<Weighted>(wu, s.xhi[a][i]) + times<Weighted>(wu, s.xlo[a][i]);
   return sum;
 }
 
 // Four cells of one colour of a uniform single-precision span at a time:
 // cells i, i + 2, i + 4, i + 6 (all < end), each with the scalar loop's
-// arithmetic ((b inv + ((x_r + x_l) + (hi + lo) ...)) r0), so the result is
+// arithmetic ((b inv + ((w x_r + w x_l) + (w hi + w lo) ...)) r0), so the result is
 // bitwise that of the scalar loop. The other colour's lanes are written back
 // unchanged. Returns the next cell of the colour.
 inline vf4 evens(const float* p) { return __builtin_shuffle(load4(p), load4(p + 4), vi4{0, 2, 4, 6}); }
 
-template <int D>
+template <int D, bool Weighted>
 size_t sweepUniform4(const RowStencil<D, float>& s, const float* br, float* xr, size_t i, size_t end, float inv,
-                     float r0) {
+                     float r0, float wu) {
   // x_{i-1} comes from the previous block's registers, not from memory just
   // stored (an overlapping load would stall store-to-load forwarding).
   vf4 before = {0.0f, 0.0f, 0.0f, i + 7 <= end ? xr[i - 1] : 0.0f};
@@ -95,8 +104,8 @@ size_t sweepUniform4(const RowStencil<D, float>& s, const float* br, float* xr, 
     const vf4 right = __builtin_shuffle(here, next, vi4{1, 3, 5, 7});
     const vf4 left = __builtin_shuffle(before, right, vi4{3, 4, 5, 6});
     before = right;
-    vf4 sum = right + left;
-    for (int a = 1; a < D; ++a) sum += evens(s.xhi[a] + i) + evens(s.xlo[a] + i);
+    vf4 sum = times<Weighted>(wu, right) + times<Weighted>(wu, left);
+    for (int a = 1; a < D; ++a) sum += times<Weighted>(wu, evens(s.xhi[a] + i)) + times<Weighted>(wu, evens(s.xlo[a] + i));
     const vf4 r = (evens(br + i) * inv + sum) * r0;
     store4(xr + i, __builtin_shuffle(r, here, vi4{0, 5, 1, 7}));
     store4(xr + i + 4, __builtin_shuffle(r, next, vi4{2, 5, 3, 7}));
@@ -114,11 +123,15 @@ __attribute__((target("avx2"), always_inline)) inline __m256 evens8(const float*
   return _mm256_shuffle_ps(_mm256_loadu_ps(p), _mm256_loadu_ps(p + 8), 0x88);
 }
 
-template <int D>
+__attribute__((target("avx2"), always_inline)) inline __m256 times8(bool weighted, __m256 wu, __m256 x) {
+  return weighted ? _mm256_mul_ps(wu, x) : x;
+}
+
+template <int D, bool Weighted>
 __attribute__((target("avx2"))) size_t sweepUniform8(const RowStencil<D, float>& s, const float* br, float* xr,
-                                                     size_t i, size_t end, float inv, float r0) {
+                                                     size_t i, size_t end, float inv, float r0, float wu) {
   if (i + 15 > end) return i;
-  const __m256 vinv = _mm256_set1_ps(inv), vr0 = _mm256_set1_ps(r0);
+  const __m256 vinv = _mm256_set1_ps(inv), vr0 = _mm256_set1_ps(r0), vw = _mm256_set1_ps(wu);
   // The odd cells (i + 1, 3, 9, 11 | 5, 7, 13, 15) rotated onto the even
   // cells' left neighbours (i + 15, 1, 7, 9 | 3, 5, 11, 13): lane 0 is taken
   // from the previous block's rotation (its i + 15 is this block's i - 1).
@@ -130,9 +143,10 @@ __attribute__((target("avx2"))) size_t sweepUniform8(const RowStencil<D, float>&
     const __m256 rotated = _mm256_permutevar8x32_ps(right, rotate);
     const __m256 left = _mm256_blend_ps(rotated, before, 0x01);
     before = rotated;
-    __m256 sum = _mm256_add_ps(right, left);
+    __m256 sum = _mm256_add_ps(times8(Weighted, vw, right), times8(Weighted, vw, left));
     for (int a = 1; a < D; ++a)
-      sum = _mm256_add_ps(sum, _mm256_add_ps(evens8(s.xhi[a] + i), evens8(s.xlo[a] + i)));
+      sum = _mm256_add_ps(sum, _mm256_add_ps(times8(Weighted, vw, evens8(s.xhi[a] + i)),
+                                             times8(Weighted, vw, evens8(s.xlo[a] + i))));
     const __m256 r = _mm256_mul_ps(_mm256_add_ps(_mm256_mul_ps(evens8(br + i), vinv), sum), vr0);
     _mm256_storeu_ps(xr + i, _mm256_unpacklo_ps(r, right));
     _mm256_storeu_ps(xr + i + 8, _mm256_unpackhi_ps(r, right));
@@ -152,11 +166,11 @@ inline T faceSum(const RowStencil<D, T>& s, const float* const* wa, const T* xr,
   for (int a = 1; a < D; ++a) sum += T(wa[a][i]) * (xi - s.xhi[a][i]) + T(s.wlo[a][i]) * (xi - s.xlo[a][i]);
   return sum;
 }
-template <int D, class T>
-inline T faceSumUniform(const RowStencil<D, T>& s, const T* xr, size_t i) {
+template <int D, bool Weighted, class T>
+inline T faceSumUniform(const RowStencil<D, T>& s, const T* xr, size_t i, T wu) {
   const T xi = xr[i];
-  T sum = (xi - xr[i + 1]) + (xi - xr[i - 1]);
-  for (int a = 1; a < D; ++a) sum += (xi - s.xhi[a][i]) + (xi - s.xlo[a][i]);
+  T sum = times<Weighted>(wu, xi - xr[i + 1]) + times<Weighted>(wu, xi - xr[i - 1]);
+  for (int a = 1; a < D; ++a) sum += times<Weighted>(wu, xi - s.xhi[a][i]) + times<Weighted>(wu, xi - s.xlo[a][i]);
   return sum;
 }
 
@@ -218,51 +232,52 @@ void LaplaceSystem<D>::finalize() {
   const size_t nx = size_t(dims[0]);
   const size_t rows = size() / nx;
   // The longest run of interior cells per row that are uniform among
-  // themselves (unit weights on every face, one c, hence one diagonal).
-  uniformSpan_.assign(rows, {0, 0});
-  sweepSpan_.assign(rows, {0, 0});
+  // themselves (one weight wu > 0 on every face, one c, hence one diagonal).
+  uniformSpan_.assign(rows, {});
+  sweepSpan_.assign(rows, {});
   parallelForRows<D>(dims, [&](size_t row) {
     if (nx < 3) return;
     RowStencil<D, double> s = rowStencil<D>(*this, zerosX_.data(), zerosX_.data(), zerosW_.data(), row);
     const float* cr = c.data() + s.base;
     const float* w0 = w[0].data() + s.base;
-    auto unit = [&](size_t i) {
-      if (w0[i] != 1.0f || w0[i - 1] != 1.0f) return false;
+    auto unit = [&](size_t i, float wu) {
+      if (w0[i] != wu || w0[i - 1] != wu) return false;
       for (int a = 1; a < D; ++a)
-        if (w[a][s.base + i] != 1.0f || s.wlo[a][i] != 1.0f) return false;
+        if (w[a][s.base + i] != wu || s.wlo[a][i] != wu) return false;
       return true;
     };
     // The smoother also takes a face across a non-periodic domain edge:
     // there the general sum adds 0 * 0 from the row of zeros, and the
-    // uniform one adds that row's 0 (bitwise the same; not so A x, whose
-    // face sum would add x_i - 0).
+    // uniform one wu times that row's 0 (bitwise the same; not so A x, whose
+    // face sum would add 0 (x_i - 0) against wu (x_i - 0)).
     bool edgeLo[D] = {}, edgeHi[D] = {};
     const int k[3] = {0, int(row % size_t(dims[1])), D == 3 ? int(row / size_t(dims[1])) : 0};
     for (int a = 1; a < D; ++a) {
       edgeLo[a] = k[a] == 0 && !periodic[a];
       edgeHi[a] = k[a] == dims[a] - 1 && !periodic[a];
     }
-    auto sweepUnit = [&](size_t i) {
-      if (w0[i] != 1.0f || w0[i - 1] != 1.0f) return false;
+    auto sweepUnit = [&](size_t i, float wu) {
+      if (w0[i] != wu || w0[i - 1] != wu) return false;
       for (int a = 1; a < D; ++a) {
         const float hi = w[a][s.base + i];
-        if (!(hi == 1.0f || (edgeHi[a] && hi == 0.0f)) || !(s.wlo[a][i] == 1.0f || edgeLo[a])) return false;
+        if (!(hi == wu || (edgeHi[a] && hi == 0.0f)) || !(s.wlo[a][i] == wu || edgeLo[a])) return false;
       }
       return true;
     };
-    auto longest = [&](auto&& ok) -> std::array<uint32_t, 2> {
-      uint32_t bestLo = 0, bestHi = 0;
+    auto longest = [&](auto&& ok) -> Span {
+      Span best;
       for (size_t i = 1; i + 1 < nx;) {
-        if (!ok(i)) {
+        const float wu = w0[i];
+        if (!(wu > 0.0f) || !ok(i, wu)) {
           ++i;
           continue;
         }
         size_t e = i + 1;
-        while (e + 1 < nx && ok(e) && cr[e] == cr[i]) ++e;
-        if (e - i > bestHi - bestLo) bestLo = uint32_t(i), bestHi = uint32_t(e);
+        while (e + 1 < nx && ok(e, wu) && cr[e] == cr[i]) ++e;
+        if (e - i > best.hi - best.lo) best = {uint32_t(i), uint32_t(e), wu};
         i = e;
       }
-      return {bestLo, bestHi};
+      return best;
     };
     uniformSpan_[row] = longest(unit);
     sweepSpan_[row] = longest(sweepUnit);
@@ -297,14 +312,21 @@ double LaplaceSystem<D>::applyRow(size_t row, const T* x, T* y) const {
     }
   };
   // The row's uniform span: the same sums without the weight loads (1 * d = d).
-  const size_t lo = uniformSpan_[row][0], hi = uniformSpan_[row][1];
+  const Span& span = uniformSpan_[row];
+  const size_t lo = span.lo, hi = span.hi;
   if (lo < hi) {
     general(1, lo);
-    const T c0 = T(cr[lo]);
-    for (size_t i = lo; i < hi; ++i) {
-      yr[i] = sc * (c0 * xr[i] + faceSumUniform<D, T>(s, xr, i));
-      if constexpr (Dot) dot += double(xr[i]) * double(yr[i]);
-    }
+    const T c0 = T(cr[lo]), wu = T(span.w);
+    auto run = [&](auto weighted) {
+      for (size_t i = lo; i < hi; ++i) {
+        yr[i] = sc * (c0 * xr[i] + faceSumUniform<D, decltype(weighted)::value, T>(s, xr, i, wu));
+        if constexpr (Dot) dot += double(xr[i]) * double(yr[i]);
+      }
+    };
+    if (span.w == 1.0f)
+      run(std::false_type{});
+    else
+      run(std::true_type{});
     general(hi, nx - 1);
   } else if (nx > 2) {
     general(1, nx - 1);
@@ -384,12 +406,13 @@ void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, 
       for (; i < end; i += 2)
         xr[i] = (br[i] * inv + neighbourSum<D, T>(s, wa, xr, i, i - 1, i + 1, wa[0][i - 1])) * rd[i];
     };
-    // The row's uniform span (unit weights, one c): the same sums without
-    // the weight loads (w x = x for w = 1), four or eight cells at a time in float.
-    const size_t lo = sweepSpan_[row][0], hi = sweepSpan_[row][1];
-    general(std::min(lo, nx - 1));
-    if (lo < hi) {
-      const T r0 = rd[lo];
+    // The row's uniform span (one weight wu, one c): the same sums without
+    // the weight loads, four or eight cells at a time in float.
+    auto uniform = [&](const Span& span, auto weighted) {
+      constexpr bool W = decltype(weighted)::value;
+      const size_t hi = span.hi;
+      if (span.lo >= hi) return;
+      const T r0 = rd[span.lo], wu = T(span.w);
       if constexpr (std::is_same_v<T, float>) {
         // The colour's last cells of the span in one more block, placed to
         // end at the span's end: the cells it repeats get the same values
@@ -401,15 +424,21 @@ void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, 
         };
 #if MORPHOFLOW_AVX2_KERNELS
         if (wide) {
-          i = sweepUniform8<D>(s, br, xr, i, hi, inv, r0);
-          if (i < hi && hi >= first + 15) i = sweepUniform8<D>(s, br, xr, lastBlock(16), hi, inv, r0);
+          i = sweepUniform8<D, W>(s, br, xr, i, hi, inv, r0, wu);
+          if (i < hi && hi >= first + 15) i = sweepUniform8<D, W>(s, br, xr, lastBlock(16), hi, inv, r0, wu);
         }
 #endif
-        i = sweepUniform4<D>(s, br, xr, i, hi, inv, r0);
-        if (i < hi && hi >= first + 7) i = sweepUniform4<D>(s, br, xr, lastBlock(8), hi, inv, r0);
+        i = sweepUniform4<D, W>(s, br, xr, i, hi, inv, r0, wu);
+        if (i < hi && hi >= first + 7) i = sweepUniform4<D, W>(s, br, xr, lastBlock(8), hi, inv, r0, wu);
       }
-      for (; i < hi; i += 2) xr[i] = (br[i] * inv + neighbourSumUniform<D, T>(s, xr, i)) * r0;
-    }
+      for (; i < hi; i += 2) xr[i] = (br[i] * inv + neighbourSumUniform<D, W, T>(s, xr, i, wu)) * r0;
+    };
+    const Span& span = sweepSpan_[row];
+    general(std::min(size_t(span.lo), nx - 1));
+    if (span.w == 1.0f)
+      uniform(span, std::false_type{});
+    else
+      uniform(span, std::true_type{});
     general(nx - 1);
     if (i + 1 == nx && nx > 1) edge(i);
   };

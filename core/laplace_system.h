@@ -72,13 +72,17 @@ struct LaplaceSystem {
   std::vector<float> invDiagF_; // the same in float
   Vector zerosX_;               // a row of zeros: the neighbour beyond a wall
   std::vector<float> zerosW_;   // (also the float row of zeros)
-  // Each row's longest run [lo, hi) of interior cells with unit face weights
-  // and one c: the kernels skip the weight loads there, with the same
-  // arithmetic (the smoother four cells at a time).
-  std::vector<std::array<uint32_t, 2>> uniformSpan_;
+  // Each row's longest run [lo, hi) of interior cells whose faces all weigh
+  // w (> 0) and which share one c: the kernels skip the weight loads there,
+  // with the same arithmetic (the smoother four or eight cells at a time).
+  struct Span {
+    uint32_t lo = 0, hi = 0;
+    float w = 1.0f;
+  };
+  std::vector<Span> uniformSpan_;
   // The same for the smoother, which may also take faces across a
   // non-periodic domain edge (there its sums match the general ones too).
-  std::vector<std::array<uint32_t, 2>> sweepSpan_;
+  std::vector<Span> sweepSpan_;
 };
 
 // Builds the plain Laplacian with Neumann walls (periodic where asked) on a
