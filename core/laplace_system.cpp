@@ -311,7 +311,7 @@ double LaplaceSystem<D>::applyRow(size_t row, const T* x, T* y) const {
       if constexpr (Dot) dot += double(xr[i]) * double(yr[i]);
     }
   };
-  // The row's uniform span: the same sums without the weight loads (1 * d = d).
+  // The row's uniform span: the same sums without the weight loads (every face weighs wu).
   const Span& span = uniformSpan_[row];
   const size_t lo = span.lo, hi = span.hi;
   if (lo < hi) {
