@@ -90,12 +90,13 @@ inline T neighbourSumUniform(const RowStencil<D, T>& s, const T* xr, size_t i, T
 // cells i, i + 2, i + 4, i + 6 (all < end), each with the scalar loop's
 // arithmetic ((b inv + ((w x_r + w x_l) + (w hi + w lo) ...)) r0), so the result is
 // bitwise that of the scalar loop. The other colour's lanes are written back
-// unchanged. Returns the next cell of the colour.
+// unchanged, unless `shared` (another task may be reading them): then only
+// the colour's cells are stored. Returns the next cell of the colour.
 inline vf4 evens(const float* p) { return __builtin_shuffle(load4(p), load4(p + 4), vi4{0, 2, 4, 6}); }
 
 template <int D, bool Weighted>
 size_t sweepUniform4(const RowStencil<D, float>& s, const float* br, float* xr, size_t i, size_t end, float inv,
-                     float r0, float wu) {
+                     float r0, float wu, bool shared) {
   // x_{i-1} comes from the previous block's registers, not from memory just
   // stored (an overlapping load would stall store-to-load forwarding).
   vf4 before = {0.0f, 0.0f, 0.0f, i + 7 <= end ? xr[i - 1] : 0.0f};
@@ -107,8 +108,12 @@ size_t sweepUniform4(const RowStencil<D, float>& s, const float* br, float* xr, 
     vf4 sum = times<Weighted>(wu, right) + times<Weighted>(wu, left);
     for (int a = 1; a < D; ++a) sum += times<Weighted>(wu, evens(s.xhi[a] + i)) + times<Weighted>(wu, evens(s.xlo[a] + i));
     const vf4 r = (evens(br + i) * inv + sum) * r0;
-    store4(xr + i, __builtin_shuffle(r, here, vi4{0, 5, 1, 7}));
-    store4(xr + i + 4, __builtin_shuffle(r, next, vi4{2, 5, 3, 7}));
+    if (shared) {
+      for (int k = 0; k < 4; ++k) xr[i + 2 * size_t(k)] = r[k];
+    } else {
+      store4(xr + i, __builtin_shuffle(r, here, vi4{0, 5, 1, 7}));
+      store4(xr + i + 4, __builtin_shuffle(r, next, vi4{2, 5, 3, 7}));
+    }
   }
   return i;
 }
@@ -129,7 +134,8 @@ __attribute__((target("avx2"), always_inline)) inline __m256 times8(bool weighte
 
 template <int D, bool Weighted>
 __attribute__((target("avx2"))) size_t sweepUniform8(const RowStencil<D, float>& s, const float* br, float* xr,
-                                                     size_t i, size_t end, float inv, float r0, float wu) {
+                                                     size_t i, size_t end, float inv, float r0, float wu,
+                                                     bool shared) {
   if (i + 15 > end) return i;
   const __m256 vinv = _mm256_set1_ps(inv), vr0 = _mm256_set1_ps(r0), vw = _mm256_set1_ps(wu);
   // The odd cells (i + 1, 3, 9, 11 | 5, 7, 13, 15) rotated onto the even
@@ -148,8 +154,14 @@ __attribute__((target("avx2"))) size_t sweepUniform8(const RowStencil<D, float>&
       sum = _mm256_add_ps(sum, _mm256_add_ps(times8(Weighted, vw, evens8(s.xhi[a] + i)),
                                              times8(Weighted, vw, evens8(s.xlo[a] + i))));
     const __m256 r = _mm256_mul_ps(_mm256_add_ps(_mm256_mul_ps(evens8(br + i), vinv), sum), vr0);
-    _mm256_storeu_ps(xr + i, _mm256_unpacklo_ps(r, right));
-    _mm256_storeu_ps(xr + i + 8, _mm256_unpackhi_ps(r, right));
+    if (shared) {  // the even lanes only: the colour's cells
+      const __m256i even = _mm256_setr_epi32(-1, 0, -1, 0, -1, 0, -1, 0);
+      _mm256_maskstore_ps(xr + i, even, _mm256_unpacklo_ps(r, right));
+      _mm256_maskstore_ps(xr + i + 8, even, _mm256_unpackhi_ps(r, right));
+    } else {
+      _mm256_storeu_ps(xr + i, _mm256_unpacklo_ps(r, right));
+      _mm256_storeu_ps(xr + i + 8, _mm256_unpackhi_ps(r, right));
+    }
   }
   return i;
 }
@@ -383,7 +395,7 @@ void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, 
   size_t rows = 1;
   for (int a = 1; a < D; ++a) rows *= size_t(dims[a]);
   [[maybe_unused]] const bool wide = useAvx2();
-  auto sweepRow = [&](size_t row, size_t y, size_t z, int colour) {
+  auto sweepRow = [&](size_t row, size_t y, size_t z, int colour, bool shared) {
     RowStencil<D, T> s = rowStencil<D, T>(*this, x.data(), zeros<T>(), zerosW_.data(), row, y, z);
     const size_t parity = y + z;
     const float* wa[D];
@@ -424,12 +436,12 @@ void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, 
         };
 #if MORPHOFLOW_AVX2_KERNELS
         if (wide) {
-          i = sweepUniform8<D, W>(s, br, xr, i, hi, inv, r0, wu);
-          if (i < hi && hi >= first + 15) i = sweepUniform8<D, W>(s, br, xr, lastBlock(16), hi, inv, r0, wu);
+          i = sweepUniform8<D, W>(s, br, xr, i, hi, inv, r0, wu, shared);
+          if (i < hi && hi >= first + 15) i = sweepUniform8<D, W>(s, br, xr, lastBlock(16), hi, inv, r0, wu, shared);
         }
 #endif
-        i = sweepUniform4<D, W>(s, br, xr, i, hi, inv, r0, wu);
-        if (i < hi && hi >= first + 7) i = sweepUniform4<D, W>(s, br, xr, lastBlock(8), hi, inv, r0, wu);
+        i = sweepUniform4<D, W>(s, br, xr, i, hi, inv, r0, wu, shared);
+        if (i < hi && hi >= first + 7) i = sweepUniform4<D, W>(s, br, xr, lastBlock(8), hi, inv, r0, wu, shared);
       }
       for (; i < hi; i += 2) xr[i] = (br[i] * inv + neighbourSumUniform<D, W, T>(s, xr, i, wu)) * r0;
     };
@@ -446,7 +458,7 @@ void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, 
   const size_t ny = size_t(dims[1]);
   if (serial) {
     for (int colour : {first, second})
-      for (size_t r = 0; r < rows; ++r) sweepRow(r, r % ny, D == 3 ? r / ny : 0, colour);
+      for (size_t r = 0; r < rows; ++r) sweepRow(r, r % ny, D == 3 ? r / ny : 0, colour, false);
     return;
   }
   // Both colours in one pass over memory: planes (rows in 2D) along the last
@@ -455,15 +467,16 @@ void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, 
   // colour's new values. The second colour on a slab's first and last planes
   // waits for the neighbouring slabs' first colour (a second, short loop).
   // A cell's update reads the other colour only, so any order and any cut
-  // give bitwise the sweep of two whole passes; slabs never write a plane
-  // that another slab reads at the same time, save to store back the other
-  // colour's unchanged values.
+  // give bitwise the sweep of two whole passes. Where another slab may be
+  // reading a plane's other colour at the same time (a slab's first and
+  // last planes), the vector kernels store the updated colour's cells only,
+  // so no cell is ever written while another task reads it.
   const size_t planes = size_t(dims[D - 1]), rowsPerPlane = rows / planes;
-  auto plane = [&](size_t p, int colour) {
+  auto plane = [&](size_t p, int colour, bool shared) {
     if constexpr (D == 2)
-      sweepRow(p, p, 0, colour);
+      sweepRow(p, p, 0, colour, shared);
     else
-      for (size_t y = 0; y < ny; ++y) sweepRow(p * rowsPerPlane + y, y, p, colour);
+      for (size_t y = 0; y < ny; ++y) sweepRow(p * rowsPerPlane + y, y, p, colour, shared);
   };
   // Slabs of at least kSlabPlanes planes and kSlabCells cells, a few per thread.
   const size_t slabs = std::max<size_t>(
@@ -472,14 +485,14 @@ void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, 
   parallelFor(slabs, [&](size_t j) {
     const size_t lo = slabBegin(j), hi = slabBegin(j + 1);
     for (size_t p = lo; p < hi; ++p) {
-      plane(p, first);
-      if (p >= lo + 2) plane(p - 1, second);
+      plane(p, first, slabs > 1 && (p == lo || p + 1 == hi));
+      if (p >= lo + 2) plane(p - 1, second, false);
     }
   });
   parallelFor(slabs, [&](size_t j) {
     const size_t lo = slabBegin(j), hi = slabBegin(j + 1);
-    plane(lo, second);
-    if (hi - 1 > lo) plane(hi - 1, second);
+    plane(lo, second, slabs > 1);
+    if (hi - 1 > lo) plane(hi - 1, second, slabs > 1);
   });
 }
 

@@ -301,6 +301,10 @@ std::vector<double> referenceSweep(const LaplaceSystem<D>& A, const std::vector<
         IVec<D> lo = k, hi = k;
         lo[a] -= 1;
         hi[a] += 1;
+        if (A.periodic[size_t(a)]) {
+          lo[a] = (lo[a] + A.dims[a]) % A.dims[a];
+          hi[a] %= A.dims[a];
+        }
         if (hi[a] < A.dims[a]) sum += double(A.w[a][i]) * xd[A.c.index(hi)];
         if (lo[a] >= 0) sum += double(A.w[a][A.c.index(lo)]) * xd[A.c.index(lo)];
       }
@@ -311,13 +315,15 @@ std::vector<double> referenceSweep(const LaplaceSystem<D>& A, const std::vector<
 }
 
 template <int D>
-void checkSmoother(const IVec<D>& dims, float weight = 1.0f) {
-  LaplaceSystem<D> A(dims, {}, 3.0);
+void checkSmoother(const IVec<D>& dims, float weight = 1.0f, bool periodicLast = false) {
+  std::array<bool, D> periodic{};
+  periodic[D - 1] = periodicLast;
+  LaplaceSystem<D> A(dims, periodic, 3.0);
   for (int a = 0; a < D; ++a) A.w[a].fill(weight);
   forEachCell<D>(dims, [&](const IVec<D>& k, size_t i) {
     A.c[i] = 0.5f;
     for (int a = 0; a < D; ++a) {
-      if (k[a] == dims[a] - 1) A.w[a][i] = 0.0f;  // walls
+      if (k[a] == dims[a] - 1 && !periodic[size_t(a)]) A.w[a][i] = 0.0f;  // walls
       // A partial face and a heavier diagonal inside some rows break them
       // into several uniform spans.
       if (k[0] == 9 && k[1] % 3 == 0) A.w[a][i] = 0.5f * weight;
@@ -366,4 +372,9 @@ TEST(LinearSolvers, SmootherMatchesAPlainRedBlackSweep) {
   // Faces that all weigh 0.3, as the RD diffusion systems' do.
   checkSmoother<2>(IVec<2>(64, 9), 0.3f);
   checkSmoother<3>(IVec<3>(71, 6, 5), 0.3f);
+  // Large enough to be cut into slabs (two or more, each with first and
+  // last planes another slab reads), walled and periodic along the cut.
+  checkSmoother<2>(IVec<2>(64, 600));
+  checkSmoother<3>(IVec<3>(64, 16, 40));
+  checkSmoother<3>(IVec<3>(64, 16, 40), 0.3f, true);
 }
