@@ -90,9 +90,12 @@ inline T neighbourSumUniform(const RowStencil<D, T>& s, const T* xr, size_t i, T
 // cells i, i + 2, i + 4, i + 6 (all < end), each with the scalar loop's
 // arithmetic ((b inv + ((w x_r + w x_l) + (w hi + w lo) ...)) r0), so the result is
 // bitwise that of the scalar loop. The other colour's lanes are written back
-// unchanged, unless `shared` (another task may be reading them): then only
-// the colour's cells are stored. Returns the next cell of the colour.
+// unchanged, unless `shared`: another task may then be reading this row's
+// other colour and writing this colour in the rows beyond the last axis's
+// neighbours, so only the colour's cells are stored here and only the
+// other colour's cells are loaded there. Returns the next cell of the colour.
 inline vf4 evens(const float* p) { return __builtin_shuffle(load4(p), load4(p + 4), vi4{0, 2, 4, 6}); }
+inline vf4 evensOnly(const float* p) { return vf4{p[0], p[2], p[4], p[6]}; }
 
 template <int D, bool Weighted>
 size_t sweepUniform4(const RowStencil<D, float>& s, const float* br, float* xr, size_t i, size_t end, float inv,
@@ -106,7 +109,12 @@ size_t sweepUniform4(const RowStencil<D, float>& s, const float* br, float* xr, 
     const vf4 left = __builtin_shuffle(before, right, vi4{3, 4, 5, 6});
     before = right;
     vf4 sum = times<Weighted>(wu, right) + times<Weighted>(wu, left);
-    for (int a = 1; a < D; ++a) sum += times<Weighted>(wu, evens(s.xhi[a] + i)) + times<Weighted>(wu, evens(s.xlo[a] + i));
+    for (int a = 1; a < D; ++a) {
+      const bool only = shared && a == D - 1;
+      const vf4 hi = only ? evensOnly(s.xhi[a] + i) : evens(s.xhi[a] + i);
+      const vf4 lo = only ? evensOnly(s.xlo[a] + i) : evens(s.xlo[a] + i);
+      sum += times<Weighted>(wu, hi) + times<Weighted>(wu, lo);
+    }
     const vf4 r = (evens(br + i) * inv + sum) * r0;
     if (shared) {
       for (int k = 0; k < 4; ++k) xr[i + 2 * size_t(k)] = r[k];
@@ -126,6 +134,10 @@ size_t sweepUniform4(const RowStencil<D, float>& s, const float* br, float* xr, 
 // lane's arithmetic is sweepUniform4's.
 __attribute__((target("avx2"), always_inline)) inline __m256 evens8(const float* p) {
   return _mm256_shuffle_ps(_mm256_loadu_ps(p), _mm256_loadu_ps(p + 8), 0x88);
+}
+// The same lanes from the even cells alone (`shared`, as sweepUniform4).
+__attribute__((target("avx2"), always_inline)) inline __m256 evensOnly8(const float* p) {
+  return _mm256_setr_ps(p[0], p[2], p[8], p[10], p[4], p[6], p[12], p[14]);
 }
 
 __attribute__((target("avx2"), always_inline)) inline __m256 times8(bool weighted, __m256 wu, __m256 x) {
@@ -150,9 +162,12 @@ __attribute__((target("avx2"))) size_t sweepUniform8(const RowStencil<D, float>&
     const __m256 left = _mm256_blend_ps(rotated, before, 0x01);
     before = rotated;
     __m256 sum = _mm256_add_ps(times8(Weighted, vw, right), times8(Weighted, vw, left));
-    for (int a = 1; a < D; ++a)
-      sum = _mm256_add_ps(sum, _mm256_add_ps(times8(Weighted, vw, evens8(s.xhi[a] + i)),
-                                             times8(Weighted, vw, evens8(s.xlo[a] + i))));
+    for (int a = 1; a < D; ++a) {
+      const bool only = shared && a == D - 1;
+      const __m256 hi = only ? evensOnly8(s.xhi[a] + i) : evens8(s.xhi[a] + i);
+      const __m256 lo = only ? evensOnly8(s.xlo[a] + i) : evens8(s.xlo[a] + i);
+      sum = _mm256_add_ps(sum, _mm256_add_ps(times8(Weighted, vw, hi), times8(Weighted, vw, lo)));
+    }
     const __m256 r = _mm256_mul_ps(_mm256_add_ps(_mm256_mul_ps(evens8(br + i), vinv), sum), vr0);
     if (shared) {  // the even lanes only: the colour's cells
       const __m256i even = _mm256_setr_epi32(-1, 0, -1, 0, -1, 0, -1, 0);
