@@ -25,13 +25,9 @@ class JacobiPreconditioner final : public Preconditioner {
     });
   }
   bool recomputesZ() const override { return true; }
-  void direction(double beta, bool first, Vector* pp) override {
-    Vector& p = *pp;
+  void direction(double beta, bool first, Vector* p) override {
     const Vector& r = *last_;
-    if (first)
-      parallelFor(r.size(), [&](size_t i) { p[i] = scaled(r, i); }, 4096);
-    else
-      parallelFor(r.size(), [&](size_t i) { p[i] = scaled(r, i) + beta * p[i]; }, 4096);
+    formDirection([&](size_t i) { return scaled(r, i); }, beta, first, p);
   }
 
  private:

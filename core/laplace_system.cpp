@@ -267,12 +267,6 @@ void LaplaceSystem<D>::finalize() {
     RowStencil<D, double> s = rowStencil<D>(*this, zerosX_.data(), zerosX_.data(), zerosW_.data(), row);
     const float* cr = c.data() + s.base;
     const float* w0 = w[0].data() + s.base;
-    auto unit = [&](size_t i, float wu) {
-      if (w0[i] != wu || w0[i - 1] != wu) return false;
-      for (int a = 1; a < D; ++a)
-        if (w[a][s.base + i] != wu || s.wlo[a][i] != wu) return false;
-      return true;
-    };
     // The smoother also takes a face across a non-periodic domain edge:
     // there the general sum adds 0 * 0 from the row of zeros, and the
     // uniform one wu times that row's 0 (bitwise the same; not so A x, whose
@@ -283,31 +277,34 @@ void LaplaceSystem<D>::finalize() {
       edgeLo[a] = k[a] == 0 && !periodic[a];
       edgeHi[a] = k[a] == dims[a] - 1 && !periodic[a];
     }
-    auto sweepUnit = [&](size_t i, float wu) {
+    // Every face of cell i weighs wu (with `edges`, a face across a
+    // non-periodic domain edge may weigh 0 instead).
+    auto uniform = [&](size_t i, float wu, bool edges) {
       if (w0[i] != wu || w0[i - 1] != wu) return false;
       for (int a = 1; a < D; ++a) {
         const float hi = w[a][s.base + i];
-        if (!(hi == wu || (edgeHi[a] && hi == 0.0f)) || !(s.wlo[a][i] == wu || edgeLo[a])) return false;
+        if (!(hi == wu || (edges && edgeHi[a] && hi == 0.0f)) || !(s.wlo[a][i] == wu || (edges && edgeLo[a])))
+          return false;
       }
       return true;
     };
-    auto longest = [&](auto&& ok) -> Span {
+    auto longest = [&](bool edges) -> Span {
       Span best;
       for (size_t i = 1; i + 1 < nx;) {
         const float wu = w0[i];
-        if (!(wu > 0.0f) || !ok(i, wu)) {
+        if (!(wu > 0.0f) || !uniform(i, wu, edges)) {
           ++i;
           continue;
         }
         size_t e = i + 1;
-        while (e + 1 < nx && ok(e, wu) && cr[e] == cr[i]) ++e;
+        while (e + 1 < nx && uniform(e, wu, edges) && cr[e] == cr[i]) ++e;
         if (e - i > best.hi - best.lo) best = {uint32_t(i), uint32_t(e), wu};
         i = e;
       }
       return best;
     };
-    uniformSpan_[row] = longest(unit);
-    sweepSpan_[row] = longest(sweepUnit);
+    uniformSpan_[row] = longest(false);
+    sweepSpan_[row] = longest(true);
   });
   active_ = size_t(deterministicSum(diag.size(), [&](size_t i) { return diag[i] > 0 ? 1.0 : 0.0; }));
   singular_ = deterministicMax(c.size(), [&](size_t i) { return c[i]; }) <= 0.0;

@@ -354,12 +354,8 @@ double Multigrid<D>::scaledCycle(const Vector& r, double rscale, Vector* z, bool
 }
 
 template <int D>
-void Multigrid<D>::direction(double beta, bool first, Vector* pp) {
-  Vector& p = *pp;
-  if (first)
-    parallelFor(p.size(), [&](size_t i) { p[i] = zAt(i); }, 4096);
-  else
-    parallelFor(p.size(), [&](size_t i) { p[i] = zAt(i) + beta * p[i]; }, 4096);
+void Multigrid<D>::direction(double beta, bool first, Vector* p) {
+  formDirection([&](size_t i) { return zAt(i); }, beta, first, p);
 }
 
 template <int D>

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "core/laplace_system.h"
+#include "core/parallel.h"
 
 namespace morphoflow {
 
@@ -24,6 +25,17 @@ class Preconditioner {
   // p = z + beta p, or p = z when `first`, with the last applyDot's z.
   virtual void direction(double beta, bool first, Vector* p) {
     (void)beta, (void)first, (void)p;
+  }
+
+ protected:
+  // direction() for a preconditioner that forms z_i as zAt(i).
+  template <class ZAt>
+  static void formDirection(ZAt&& zAt, double beta, bool first, Vector* pp) {
+    Vector& p = *pp;
+    if (first)
+      parallelFor(p.size(), [&](size_t i) { p[i] = zAt(i); }, 4096);
+    else
+      parallelFor(p.size(), [&](size_t i) { p[i] = zAt(i) + beta * p[i]; }, 4096);
   }
 };
 

@@ -133,11 +133,7 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
     });
     C.history = std::min(C.history + 1, 2);
   });
-  for (const SolverResult& r : results) {
-    worst.converged = worst.converged && r.converged;
-    worst.iterations = std::max(worst.iterations, r.iterations);
-    worst.residual = std::max(worst.residual, r.residual);
-  }
+  for (const SolverResult& r : results) foldWorst(&worst, r);
   s_ = s;
   vc_.apply(u);
   return worst;

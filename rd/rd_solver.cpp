@@ -349,12 +349,7 @@ void RDSolver<D>::step(double dt) {
       parallelFor(cells, [&](size_t i) { x[i] += dt * R[i]; }, kChunk);
     solves[si] = solveDiffusion(s, theta * dt, &x);
   });
-  SolverResult& w = stats_.diffusion;
-  for (const SolverResult& r : solves) {
-    w.converged = w.converged && r.converged;
-    w.iterations = std::max(w.iterations, r.iterations);
-    w.residual = std::max(w.residual, r.residual);
-  }
+  for (const SolverResult& r : solves) foldWorst(&stats_.diffusion, r);
   for (int s : model_.info().clamped) {
     Grid<double, D>& g = x_[size_t(s)];
     parallelFor(cells, [&](size_t i) { g[i] = std::max(g[i], 0.0); }, kChunk);
