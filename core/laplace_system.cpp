@@ -378,7 +378,12 @@ void LaplaceSystem<D>::defect(const std::vector<T>& b, const std::vector<T>& x, 
   parallelForRows<D>(dims, [&](size_t row) {
     applyRow<T, false>(row, x.data(), r.data());  // r = A x, then b - A x while the row is in cache
     const size_t base = row * nx;
-    for (size_t i = base; i < base + nx; ++i) r[i] = diag[i] > 0 ? b[i] - r[i] : T(0);
+    // Raw pointers: through the vectors, every store would reload their data
+    // pointers and the loop would stay scalar.
+    T* __restrict rr = r.data() + base;
+    const T* __restrict br = b.data() + base;
+    const float* __restrict dr = diag.data() + base;
+    for (size_t i = 0; i < nx; ++i) rr[i] = dr[i] > 0 ? br[i] - rr[i] : T(0);
   });
 }
 

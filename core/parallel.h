@@ -82,23 +82,31 @@ void forEachCell(const IVec<D>& dims, Fn&& fn) {
   });
 }
 
+// Sum of f(i), i in [begin, end), in a fixed order: four running sums
+// (i mod 4 relative to begin) added pairwise at the end, so the additions
+// do not wait on one another (one running sum is bound by the add latency).
+template <typename Fn>
+double orderedSum(size_t begin, size_t end, Fn& f) {
+  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+  size_t i = begin;
+  for (; i + 4 <= end; i += 4) {
+    s0 += f(i);
+    s1 += f(i + 1);
+    s2 += f(i + 2);
+    s3 += f(i + 3);
+  }
+  for (; i < end; ++i) s0 += f(i);
+  return (s0 + s1) + (s2 + s3);
+}
+
 // Deterministic sum of f(i), i in [0, n): fixed chunks, partials summed in order.
 template <typename Fn>
 double deterministicSum(size_t n, Fn&& f) {
   constexpr size_t kChunk = 8192;
   size_t chunks = (n + kChunk - 1) / kChunk;
-  if (chunks <= 1) {
-    double s = 0;
-    for (size_t i = 0; i < n; ++i) s += f(i);
-    return s;
-  }
+  if (chunks <= 1) return orderedSum(0, n, f);
   std::vector<double> partial(chunks, 0.0);
-  parallelFor(chunks, [&](size_t k) {
-    double s = 0;
-    size_t end = std::min(n, (k + 1) * kChunk);
-    for (size_t i = k * kChunk; i < end; ++i) s += f(i);
-    partial[k] = s;
-  });
+  parallelFor(chunks, [&](size_t k) { partial[k] = orderedSum(k * kChunk, std::min(n, (k + 1) * kChunk), f); });
   double s = 0;
   for (double p : partial) s += p;
   return s;
