@@ -1,6 +1,7 @@
 #include "fluid/viscosity.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/jacobi.h"
 #include "core/parallel.h"
@@ -72,31 +73,32 @@ const MultigridOptions kViscosityCycle{3, 3, 4};
 
 template <int D>
 SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt) {
-  SolverResult worst;
-  worst.converged = true;
-  if (nu <= 0 || dt <= 0) return worst;
+  SolverResult result;
+  result.converged = true;
+  if (nu <= 0 || dt <= 0) return result;
   const double s = nu * dt / (vc_.h * vc_.h);
-  // The components' solves are independent: run them side by side (each
-  // still splits into row tasks), so the small loops of the coarse
-  // multigrid levels of one overlap with another's work.
-  std::array<SolverResult, D> results;
+  // Unknown i is face gi of component a's grid: the same index unless a
+  // periodic axis drops the duplicate face layer.
+  auto eachUnknown = [&](int a, auto&& fn) {
+    const Component& C = comp_[size_t(a)];
+    const Grid<float, D>& g = (*u)[a];
+    if (C.dims == g.dims())
+      parallelFor(C.A.size(), [&](size_t i) { fn(i, i); }, 4096);
+    else
+      forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) { fn(i, g.index(k)); });
+  };
+  // The components' systems are independent: set up and solve them side by
+  // side (each still splits into row tasks), so the small loops of the
+  // coarse multigrid levels of one overlap with another's work.
+  std::array<double, D> bb{};  // ||b_a||^2
   parallelFor(size_t(D), [&](size_t ai) {
     const int a = int(ai);
     Component& C = comp_[ai];
-    Grid<float, D>& g = (*u)[a];
+    const Grid<float, D>& g = (*u)[a];
     const Grid<uint8_t, D>& fixed = vc_.fixed[a];
-    // Unknown i is face gi of the component's grid: the same index unless a
-    // periodic axis drops the duplicate face layer.
-    const bool sameIndex = C.dims == g.dims();
-    auto eachUnknown = [&](auto&& fn) {
-      if (sameIndex)
-        parallelFor(C.A.size(), [&](size_t i) { fn(i, i); }, 4096);
-      else
-        forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) { fn(i, g.index(k)); });
-    };
     if (s != s_) {  // A = s (c + sum w (x_i - x_j)), c = 1/s + boundary terms
       C.A.scale = s;
-      eachUnknown([&](size_t i, size_t gi) { C.A.c[i] = fixed[gi] ? 0.0f : float(1.0 / s + C.cBoundary[i]); });
+      eachUnknown(a, [&](size_t i, size_t gi) { C.A.c[i] = fixed[gi] ? 0.0f : float(1.0 / s + C.cBoundary[i]); });
       C.A.finalize();
       // Far below s ~ 0.1 the diagonal dominates and Jacobi needs a handful
       // of iterations; above, multigrid keeps the count independent of s and
@@ -111,19 +113,41 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
     // Warm start: the increment's rate, linearly extrapolated in steps.
     const Vector &r1 = C.rate[0], &r0 = C.rate[1];
     const int history = C.history;
-    eachUnknown([&](size_t i, size_t gi) {
+    eachUnknown(a, [&](size_t i, size_t gi) {
       const double rate = history >= 2 ? 2.0 * r1[i] - r0[i] : history == 1 ? r1[i] : 0.0;
       C.x[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * rate;
       C.b[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * C.boundaryRhs[i];
     });
+    bb[ai] = dot(C.b, C.b);
+  });
+  // The D systems are blocks of one linear system, (I - nu dt lap) u = u*
+  // on the MAC velocity, solved to a relative residual of that system:
+  // sum_a ||r_a||^2 <= tol^2 sum_a ||b_a||^2. Block a may leave
+  // ||r_a||^2 <= tol^2 (||b_a||^2 + ||b||^2 / D) / 2 (these budgets add up
+  // to tol^2 ||b||^2), so a component much smaller than the flow (the
+  // cross-flow of a lid that has just started) is not solved to 1e-6 of its
+  // own size, which would cost iterations and buy nothing.
+  double bAll = 0.0;
+  for (double v : bb) bAll += v;
+  std::array<SolverResult, D> results;
+  std::array<double, D> rr{};  // ||r_a||^2 at the end
+  parallelFor(size_t(D), [&](size_t ai) {
+    const int a = int(ai);
+    Component& C = comp_[ai];
+    Grid<float, D>& g = (*u)[a];
+    const Grid<uint8_t, D>& fixed = vc_.fixed[a];
+    SolverOptions options = options_;
+    if (bb[ai] > 0.0)
+      options.tolerance = options_.tolerance * std::sqrt(0.5 * (bb[ai] + bAll / D) / bb[ai]);
     JacobiPreconditioner<D> jacobi(C.A);
     Preconditioner* M = C.multigrid ? static_cast<Preconditioner*>(C.multigrid.get()) : &jacobi;
-    results[ai] = solvePCG<D>(C.A, C.b, &C.x, M, options_, nullptr, &C.workspace);
+    results[ai] = solvePCG<D>(C.A, C.b, &C.x, M, options, nullptr, &C.workspace);
+    rr[ai] = results[ai].residual * results[ai].residual * bb[ai];
     std::swap(C.rate[0], C.rate[1]);  // the older slot takes the new rate
     Vector& rate = C.rate[0];
     rate.resize(C.A.size());
     const double invS = 1.0 / s;
-    eachUnknown([&](size_t i, size_t gi) {
+    eachUnknown(a, [&](size_t i, size_t gi) {
       if (fixed[gi]) {
         rate[i] = 0.0;
         return;
@@ -133,10 +157,16 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
     });
     C.history = std::min(C.history + 1, 2);
   });
-  for (const SolverResult& r : results) foldWorst(&worst, r);
+  double rAll = 0.0;
+  for (int a = 0; a < D; ++a) {
+    rAll += rr[size_t(a)];
+    result.iterations = std::max(result.iterations, results[size_t(a)].iterations);
+  }
+  result.residual = bAll > 0.0 ? std::sqrt(rAll / bAll) : 0.0;
+  result.converged = result.residual <= options_.tolerance * 1.0001;
   s_ = s;
   vc_.apply(u);
-  return worst;
+  return result;
 }
 
 template class ViscositySolver<2>;
