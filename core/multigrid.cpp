@@ -1,5 +1,6 @@
 #include "core/multigrid.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -194,9 +195,13 @@ void Multigrid<D>::restrict(int l) {
   parallelForRows<D>(C.dims, [&](size_t row) {
     int cc[3];
     rowCoords<D>(C.dims, row, cc);
-    float* br = b.data() + row * ncx;
-    for (size_t X = 0; X < ncx; ++X) br[X] = 0.0f;
-    // Sum the fine rows that touch this coarse row, each with its weight.
+    // Restriction is separable: first the (up to) 4^(D-1) fine rows that
+    // touch this coarse row, summed with their y (and z) weights along the
+    // whole fine row, then the x stencil once on that sum.
+    thread_local std::vector<float> combined;
+    combined.resize(nfx);
+    float* __restrict cy = combined.data();
+    bool any = false;
     for (int mz = 0; mz < (D == 3 ? 4 : 1); ++mz) {
       float wz = 1.0f;
       size_t fz = 0;
@@ -206,21 +211,28 @@ void Multigrid<D>::restrict(int l) {
         if (wz == 0.0f) continue;
       }
       for (int my = 0; my < 4; ++my) {
-        float wy = wz * T[1].fineWeight[size_t(cc[1])][size_t(my)];
+        const float wy = wz * T[1].fineWeight[size_t(cc[1])][size_t(my)];
         if (wy == 0.0f) continue;
-        const float* fr = r.data() + (fz * nfy + size_t(T[1].fine[size_t(cc[1])][size_t(my)])) * nfx;
-        auto table = [&](size_t X) {
-          const std::array<int, 4>& fx = T[0].fine[X];
-          const std::array<float, 4>& wx = T[0].fineWeight[X];
-          br[X] += wy * (wx[0] * fr[fx[0]] + wx[1] * fr[fx[1]] + wx[2] * fr[fx[2]] + wx[3] * fr[fx[3]]);
-        };
-        const size_t lo = size_t(T[0].restrictLo), hi = size_t(T[0].restrictHi);
-        for (size_t X = 0; X < lo; ++X) table(X);
-        for (size_t X = lo; X < hi; ++X)  // the same sum without the tables
-          br[X] += wy * (0.25f * fr[2 * X - 1] + 0.75f * fr[2 * X] + 0.75f * fr[2 * X + 1] + 0.25f * fr[2 * X + 2]);
-        for (size_t X = hi; X < ncx; ++X) table(X);
+        const float* __restrict fr = r.data() + (fz * nfy + size_t(T[1].fine[size_t(cc[1])][size_t(my)])) * nfx;
+        if (any)
+          for (size_t i = 0; i < nfx; ++i) cy[i] += wy * fr[i];
+        else
+          for (size_t i = 0; i < nfx; ++i) cy[i] = wy * fr[i];
+        any = true;
       }
     }
+    if (!any) std::fill_n(cy, nfx, 0.0f);
+    float* __restrict br = b.data() + row * ncx;
+    auto table = [&](size_t X) {
+      const std::array<int, 4>& fx = T[0].fine[X];
+      const std::array<float, 4>& wx = T[0].fineWeight[X];
+      br[X] = wx[0] * cy[fx[0]] + wx[1] * cy[fx[1]] + wx[2] * cy[fx[2]] + wx[3] * cy[fx[3]];
+    };
+    const size_t lo = size_t(T[0].restrictLo), hi = size_t(T[0].restrictHi);
+    for (size_t X = 0; X < lo; ++X) table(X);
+    for (size_t X = lo; X < hi; ++X)  // the same sum without the tables
+      br[X] = 0.25f * cy[2 * X - 1] + 0.75f * cy[2 * X] + 0.75f * cy[2 * X + 1] + 0.25f * cy[2 * X + 2];
+    for (size_t X = hi; X < ncx; ++X) table(X);
     const float* cd = C.diag.data() + row * ncx;
     for (size_t X = 0; X < ncx; ++X) br[X] = cd[X] > 0 ? br[X] * inv2D : 0.0f;
   });
