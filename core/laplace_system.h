@@ -61,6 +61,9 @@ struct LaplaceSystem {
   // y = A x on one row; returns the row's x . y when Dot (else 0).
   template <class T, bool Dot>
   double applyRow(size_t row, const T* x, T* y) const;
+  // r = b - A x on one row; returns the row's r . r when SumSquares (else 0).
+  template <class T, bool SumSquares>
+  double defectRow(size_t row, const T* b, const T* x, T* r) const;
   template <class T>
   const T* invDiag() const;
   template <class T>

@@ -81,11 +81,18 @@ SolverResult pcg(const Op& A, const Vector& bIn, Vector* xp, Preconditioner* M, 
     }
     if (!(pq > 0.0)) break;  // breakdown: A not SPD on this subspace
     double alpha = rz / pq;
-    rnorm = std::sqrt(deterministicSum(n, [&](size_t i) {
-      x[i] += alpha * p[i];
-      r[i] -= alpha * q[i];
-      return r[i] * r[i];
-    }));
+    {
+      // Raw pointers: through the vectors, each store would reload their data pointers.
+      double* __restrict xd = x.data();
+      double* __restrict rd = r.data();
+      const double* __restrict pd = p.data();
+      const double* __restrict qd = q.data();
+      rnorm = std::sqrt(deterministicSum(n, [&](size_t i) {
+        xd[i] += alpha * pd[i];
+        rd[i] -= alpha * qd[i];
+        return rd[i] * rd[i];
+      }));
+    }
     result.iterations = it;
     result.residual = rnorm / bnorm;
     if (result.residual <= opt.tolerance) break;
