@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 #include <cstring>
 #include <functional>
 
@@ -358,7 +359,106 @@ void checkSmoother(const IVec<D>& dims, float weight = 1.0f, bool periodicLast =
   }
 }
 
+// A x written plainly in double (every face through its weight, walls by
+// skipping): the reference for the operator's fast paths.
+template <int D>
+std::vector<double> referenceApply(const LaplaceSystem<D>& A, const std::vector<double>& x) {
+  std::vector<double> y(A.size(), 0.0);
+  for (size_t i = 0; i < A.size(); ++i) {
+    const IVec<D> k = A.c.coord(i);
+    double sum = double(A.c[i]) * x[i];
+    for (int a = 0; a < D; ++a) {
+      IVec<D> lo = k, hi = k;
+      lo[a] -= 1;
+      hi[a] += 1;
+      if (A.periodic[size_t(a)]) {
+        lo[a] = (lo[a] + A.dims[a]) % A.dims[a];
+        hi[a] %= A.dims[a];
+      }
+      if (hi[a] < A.dims[a]) sum += double(A.w[a][i]) * (x[i] - x[A.c.index(hi)]);
+      if (lo[a] >= 0) sum += double(A.w[a][A.c.index(lo)]) * (x[i] - x[A.c.index(lo)]);
+    }
+    y[i] = A.scale * sum;
+  }
+  return y;
+}
+
+template <int D>
+void checkOperator(const IVec<D>& dims, float weight = 1.0f, bool periodicLast = false) {
+  std::array<bool, D> periodic{};
+  periodic[D - 1] = periodicLast;
+  LaplaceSystem<D> A(dims, periodic, 3.0);
+  for (int a = 0; a < D; ++a) A.w[a].fill(weight);
+  forEachCell<D>(dims, [&](const IVec<D>& k, size_t i) {
+    A.c[i] = 0.5f;
+    for (int a = 0; a < D; ++a) {
+      if (k[a] == dims[a] - 1 && !periodic[size_t(a)]) A.w[a][i] = 0.0f;  // walls
+      if (k[0] == 9 && k[1] % 3 == 0) A.w[a][i] = 0.5f * weight;      // spans broken
+      if (k[0] == 17 && k[1] % 4 == 1) A.c[i] = 2.0f;
+    }
+  });
+  A.finalize();
+  Vector x(A.size()), b(A.size());
+  for (size_t i = 0; i < x.size(); ++i) {
+    x[i] = std::cos(0.11 * double(i)) + 0.3 * std::sin(0.013 * double(i));
+    b[i] = std::sin(0.37 * double(i));
+  }
+  const std::vector<double> ref = referenceApply<D>(A, x);
+  double scale = 0.0;
+  for (double v : ref) scale = std::max(scale, std::abs(v));
+  const std::string where = "dims " + std::to_string(dims[0]) + "x" + std::to_string(dims[1]);
+  const bool wide = useAvx2();
+  for (bool narrow : {false, true}) {
+    if (narrow) setUseAvx2(false);
+    Vector y, r;
+    y.resize(A.size());
+    r.resize(A.size());
+    const double xy = A.applyDot(x, &y);
+    const double rnorm = A.residual(b, x, &r);
+    std::vector<float> xf(x.begin(), x.end()), bf(b.begin(), b.end()), yf(A.size()), rf(A.size());
+    A.apply(xf, &yf);
+    A.defect(bf, xf, &rf);
+    setUseAvx2(wide);
+    double refXY = 0.0, refRR = 0.0;
+    for (size_t i = 0; i < x.size(); ++i) {
+      EXPECT_NEAR(y[i], ref[i], 1e-12 * scale) << where << " cell " << i;
+      EXPECT_NEAR(r[i], b[i] - ref[i], 1e-12 * scale) << where << " cell " << i;
+      EXPECT_NEAR(yf[i], ref[i], 1e-5 * scale) << where << " cell " << i;
+      EXPECT_NEAR(rf[i], b[i] - ref[i], 1e-5 * scale) << where << " cell " << i;
+      refXY += x[i] * ref[i];
+      refRR += (b[i] - ref[i]) * (b[i] - ref[i]);
+    }
+    EXPECT_NEAR(xy, refXY, 1e-12 * std::abs(refXY) + 1e-12) << where;
+    EXPECT_NEAR(rnorm, std::sqrt(refRR), 1e-12 * std::sqrt(refRR)) << where;
+    if (!narrow) continue;
+    // The 256-bit kernels give bitwise the results of the narrow ones.
+    Vector yw(A.size()), rw(A.size());
+    std::vector<float> yfw(A.size()), rfw(A.size());
+    const double xyw = A.applyDot(x, &yw), rnormw = A.residual(b, x, &rw);
+    A.apply(xf, &yfw);
+    A.defect(bf, xf, &rfw);
+    EXPECT_EQ(xy, xyw) << where;
+    EXPECT_EQ(rnorm, rnormw) << where;
+    EXPECT_EQ(0, std::memcmp(y.data(), yw.data(), y.size() * sizeof(double))) << where;
+    EXPECT_EQ(0, std::memcmp(r.data(), rw.data(), r.size() * sizeof(double))) << where;
+    EXPECT_EQ(0, std::memcmp(yf.data(), yfw.data(), yf.size() * sizeof(float))) << where;
+    EXPECT_EQ(0, std::memcmp(rf.data(), rfw.data(), rf.size() * sizeof(float))) << where;
+  }
+}
+
 }  // namespace
+
+// A x, x . A x, b - A x and ||b - A x|| through the fast paths (uniform
+// spans, 256-bit where the CPU has AVX2) against the plain stencil, with
+// spans broken by partial faces and other diagonals, walls, periodic axes,
+// faces that all weigh 0.3 (the RD diffusion systems').
+TEST(LinearSolvers, OperatorMatchesThePlainStencil) {
+  checkOperator<2>(IVec<2>(37, 12));
+  checkOperator<2>(IVec<2>(64, 9), 0.3f);
+  checkOperator<3>(IVec<3>(29, 10, 7));
+  checkOperator<3>(IVec<3>(71, 6, 5), 0.3f);
+  checkOperator<3>(IVec<3>(64, 16, 40), 1.0f, true);
+}
 
 // The smoother's float fast paths (uniform spans, four or eight cells at a time) give
 // a red-black Gauss-Seidel sweep: odd and even rows, spans broken by partial
