@@ -409,7 +409,12 @@ double LaplaceSystem<D>::applyRow(size_t row, const T* x, T* y) const {
       constexpr bool W = decltype(weighted)::value;
       size_t i = lo;
 #if MORPHOFLOW_AVX2_KERNELS
-      if (useAvx2()) i = applyUniformAvx<D, W, T>(s, xr, yr, i, hi, sc, c0, wu);
+      if (useAvx2() && hi - lo >= Avx<T>::kLanes) {
+        i = applyUniformAvx<D, W, T>(s, xr, yr, i, hi, sc, c0, wu);
+        // The last cells in one more vector placed to end at hi (the cells
+        // it repeats get the same values again: y depends on x only).
+        if (i < hi) i = applyUniformAvx<D, W, T>(s, xr, yr, hi - Avx<T>::kLanes, hi, sc, c0, wu);
+      }
 #endif
       for (; i < hi; ++i) yr[i] = sc * (c0 * xr[i] + faceSumUniform<D, W, T>(s, xr, i, wu));
       if constexpr (Dot) {  // four running sums: the adds need not wait on one another
