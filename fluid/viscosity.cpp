@@ -111,10 +111,10 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
         C.multigrid = std::make_unique<Multigrid<D>>(C.A, kViscosityCycle);
     }
     // Warm start: the increment's rate, linearly extrapolated in steps.
-    const Vector &r1 = C.rate[0], &r0 = C.rate[1];
+    const std::vector<float> &r1 = C.rate[0], &r0 = C.rate[1];
     const int history = C.history;
     eachUnknown(a, [&](size_t i, size_t gi) {
-      const double rate = history >= 2 ? 2.0 * r1[i] - r0[i] : history == 1 ? r1[i] : 0.0;
+      const double rate = history >= 2 ? 2.0 * double(r1[i]) - double(r0[i]) : history == 1 ? double(r1[i]) : 0.0;
       C.x[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * rate;
       C.b[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * C.boundaryRhs[i];
     });
@@ -144,15 +144,15 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
     results[ai] = solvePCG<D>(C.A, C.b, &C.x, M, options, nullptr, &C.workspace);
     rr[ai] = results[ai].residual * results[ai].residual * bb[ai];
     std::swap(C.rate[0], C.rate[1]);  // the older slot takes the new rate
-    Vector& rate = C.rate[0];
+    std::vector<float>& rate = C.rate[0];
     rate.resize(C.A.size());
     const double invS = 1.0 / s;
     eachUnknown(a, [&](size_t i, size_t gi) {
       if (fixed[gi]) {
-        rate[i] = 0.0;
+        rate[i] = 0.0f;
         return;
       }
-      rate[i] = (C.x[i] - double(g[gi])) * invS;
+      rate[i] = float((C.x[i] - double(g[gi])) * invS);
       g[gi] = float(C.x[i]);
     });
     C.history = std::min(C.history + 1, 2);

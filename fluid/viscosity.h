@@ -12,6 +12,7 @@
 #include <array>
 
 #include <memory>
+#include <vector>
 
 #include "core/multigrid.h"
 #include "core/pcg.h"
@@ -34,8 +35,9 @@ class ViscositySolver {
     Grid<float, D> cBoundary;   // diagonal terms from walls and prescribed neighbours
     Vector boundaryRhs;         // their prescribed values, times the coupling
     Vector b, x;
-    // The last two solves' (x - u*) / s, newest first: the next warm start.
-    std::array<Vector, 2> rate;
+    // The last two solves' (x - u*) / s, newest first: the next warm start
+    // (a guess only, so single precision: half the memory traffic).
+    std::array<std::vector<float>, 2> rate;
     int history = 0;            // how many of them are set
     std::unique_ptr<Multigrid<D>> multigrid;  // present while s > 0.1
     PcgWorkspace workspace;
