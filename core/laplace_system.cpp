@@ -204,9 +204,9 @@ inline T faceSumUniform(const RowStencil<D, T>& s, const T* xr, size_t i, T wu) 
 }
 
 #if MORPHOFLOW_AVX2_KERNELS
-// y = sc (c0 x + faceSumUniform) on a uniform span, one 256-bit vector of
-// cells at a time (eight floats or four doubles), each lane with the scalar
-// loop's arithmetic. Returns the first cell not done.
+// y = sc (c0 x + faceSumUniform) (b - y where b is given) on a uniform span,
+// one 256-bit vector of cells at a time (eight floats or four doubles), each
+// lane with the scalar loop's arithmetic. Returns the first cell not done.
 template <class T>
 struct Avx;
 template <>
@@ -247,8 +247,8 @@ struct Avx<double> {
 };
 
 template <int D, bool Weighted, class T>
-__attribute__((target("avx2"))) size_t applyUniformAvx(const RowStencil<D, T>& s, const T* xr, T* yr, size_t i,
-                                                       size_t end, T sc, T c0, T wu) {
+__attribute__((target("avx2"))) size_t applyUniformAvx(const RowStencil<D, T>& s, const T* xr, T* yr, const T* br,
+                                                       size_t i, size_t end, T sc, T c0, T wu) {
   using A = Avx<T>;
   using V = typename A::V;
   const V vsc = A::set1(sc), vc0 = A::set1(c0), vw = A::set1(wu);
@@ -259,7 +259,8 @@ __attribute__((target("avx2"))) size_t applyUniformAvx(const RowStencil<D, T>& s
     for (int a = 1; a < D; ++a)
       sum = A::add(sum, A::add(A::template times<Weighted>(vw, A::sub(xi, A::load(s.xhi[a] + i))),
                                A::template times<Weighted>(vw, A::sub(xi, A::load(s.xlo[a] + i)))));
-    A::store(yr + i, A::mul(vsc, A::add(A::mul(vc0, xi), sum)));
+    const V y = A::mul(vsc, A::add(A::mul(vc0, xi), sum));
+    A::store(yr + i, br ? A::sub(A::load(br + i), y) : y);  // b - A x for a defect
   }
   return i;
 }
@@ -376,7 +377,7 @@ void LaplaceSystem<D>::finalize() {
 
 template <int D>
 template <class T, bool Dot>
-double LaplaceSystem<D>::applyRow(size_t row, const T* x, T* y) const {
+double LaplaceSystem<D>::applyRow(size_t row, const T* x, T* y, const T* b) const {
   const size_t nx = size_t(dims[0]);
   const bool px = periodic[0];
   const T sc = T(scale);
@@ -408,15 +409,19 @@ double LaplaceSystem<D>::applyRow(size_t row, const T* x, T* y) const {
     auto run = [&](auto weighted) {
       constexpr bool W = decltype(weighted)::value;
       size_t i = lo;
+      const T* br = b ? b + s.base : nullptr;
 #if MORPHOFLOW_AVX2_KERNELS
       if (useAvx2() && hi - lo >= Avx<T>::kLanes) {
-        i = applyUniformAvx<D, W, T>(s, xr, yr, i, hi, sc, c0, wu);
+        i = applyUniformAvx<D, W, T>(s, xr, yr, br, i, hi, sc, c0, wu);
         // The last cells in one more vector placed to end at hi (the cells
-        // it repeats get the same values again: y depends on x only).
-        if (i < hi) i = applyUniformAvx<D, W, T>(s, xr, yr, hi - Avx<T>::kLanes, hi, sc, c0, wu);
+        // it repeats get the same values again: y depends on x and b only).
+        if (i < hi) i = applyUniformAvx<D, W, T>(s, xr, yr, br, hi - Avx<T>::kLanes, hi, sc, c0, wu);
       }
 #endif
-      for (; i < hi; ++i) yr[i] = sc * (c0 * xr[i] + faceSumUniform<D, W, T>(s, xr, i, wu));
+      for (; i < hi; ++i) {
+        const T y = sc * (c0 * xr[i] + faceSumUniform<D, W, T>(s, xr, i, wu));
+        yr[i] = br ? br[i] - y : y;
+      }
       if constexpr (Dot) {  // four running sums: the adds need not wait on one another
         double d[4] = {0.0, 0.0, 0.0, 0.0};
         size_t k = lo;
@@ -452,7 +457,9 @@ double LaplaceSystem<D>::applyDot(const Vector& x, Vector* y) const {
 template <int D>
 template <class T, bool SumSquares>
 double LaplaceSystem<D>::defectRow(size_t row, const T* b, const T* x, T* r) const {
-  applyRow<T, false>(row, x, r);  // r = A x, then b - A x while the row is in cache
+  // r = b - A x on the uniform span (all active), A x elsewhere; then b - A x
+  // there too while the row is in cache.
+  applyRow<T, false>(row, x, r, b);
   const size_t nx = size_t(dims[0]), base = row * nx;
   T* __restrict rr = r + base;
   const T* __restrict br = b + base;
@@ -460,9 +467,18 @@ double LaplaceSystem<D>::defectRow(size_t row, const T* b, const T* x, T* r) con
   // b - A x where the cell is active, else 0, as a bit mask: a branch (or
   // a select GCC must assume may trap) would keep the loop scalar.
   using Bits = std::conditional_t<sizeof(T) == 4, uint32_t, uint64_t>;
-  for (size_t i = 0; i < nx; ++i) {
-    const Bits active = Bits(0) - Bits(dr[i] > 0.0f);
-    rr[i] = std::bit_cast<T>(std::bit_cast<Bits>(T(br[i] - rr[i])) & active);
+  auto finish = [&](size_t from, size_t to) {
+    for (size_t i = from; i < to; ++i) {
+      const Bits active = Bits(0) - Bits(dr[i] > 0.0f);
+      rr[i] = std::bit_cast<T>(std::bit_cast<Bits>(T(br[i] - rr[i])) & active);
+    }
+  };
+  const Span& span = uniformSpan_[row];
+  if (span.lo < span.hi) {
+    finish(0, span.lo);
+    finish(span.hi, nx);
+  } else {
+    finish(0, nx);
   }
   if constexpr (!SumSquares) return 0.0;
   double s[4] = {0.0, 0.0, 0.0, 0.0};  // four running sums: the adds need not wait on one another

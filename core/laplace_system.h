@@ -58,9 +58,10 @@ struct LaplaceSystem {
   void removeNullSpace(Vector* x) const;
 
  private:
-  // y = A x on one row; returns the row's x . y when Dot (else 0).
+  // y = A x on one row; returns the row's x . y when Dot (else 0). With b,
+  // the row's uniform span gets b - A x instead (its cells are all active).
   template <class T, bool Dot>
-  double applyRow(size_t row, const T* x, T* y) const;
+  double applyRow(size_t row, const T* x, T* y, const T* b = nullptr) const;
   // r = b - A x on one row; returns the row's r . r when SumSquares (else 0).
   template <class T, bool SumSquares>
   double defectRow(size_t row, const T* b, const T* x, T* r) const;
