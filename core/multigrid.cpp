@@ -345,29 +345,40 @@ double Multigrid<D>::scaledCycle(const Vector& r, double rscale, Vector* z, bool
     zScale_ = rscale == 0.0 ? 0.0 : std::numeric_limits<double>::quiet_NaN();  // z = 0 x: 0 or NaN
   } else {
     const double inv = 1.0 / rscale;
+    // Raw pointers here and below: through the vectors, each store would
+    // reload their data pointers and the loops would stay scalar.
+    const double* __restrict rd = r.data();
+    float* __restrict b = L0.b.data();
+    float* __restrict x = L0.x.data();
     parallelFor(r.size(), [&](size_t i) {
-      L0.b[i] = float(r[i] * inv);
-      L0.x[i] = 0.0f;
+      b[i] = float(rd[i] * inv);
+      x[i] = 0.0f;
     }, 4096);
     cycle(0);
     zScale_ = rscale;
   }
-  if (!z) return deterministicSum(r.size(), [&](size_t i) { return r[i] * zAt(i); });
+  const double* __restrict rd = r.data();
+  const float* __restrict x = L0.x.data();
+  const double scale = zScale_;
+  auto zi = [&](size_t i) { return double(x[i]) * scale; };  // zAt(i)
+  if (!z) return deterministicSum(r.size(), [&](size_t i) { return rd[i] * zi(i); });
   z->resize(r.size());
-  Vector& zz = *z;
+  double* __restrict zz = z->data();
   if (!withDot) {
-    parallelFor(r.size(), [&](size_t i) { zz[i] = zAt(i); }, 4096);
+    parallelFor(r.size(), [&](size_t i) { zz[i] = zi(i); }, 4096);
     return 0.0;
   }
   return deterministicSum(r.size(), [&](size_t i) {
-    zz[i] = zAt(i);
-    return r[i] * zz[i];
+    zz[i] = zi(i);
+    return rd[i] * zz[i];
   });
 }
 
 template <int D>
 void Multigrid<D>::direction(double beta, bool first, Vector* p) {
-  formDirection([&](size_t i) { return zAt(i); }, beta, first, p);
+  const float* __restrict x = levels_[0].x.data();
+  const double scale = zScale_;
+  formDirection([=](size_t i) { return double(x[i]) * scale; }, beta, first, p);
 }
 
 template <int D>

@@ -31,11 +31,11 @@ class Preconditioner {
   // direction() for a preconditioner that forms z_i as zAt(i).
   template <class ZAt>
   static void formDirection(ZAt&& zAt, double beta, bool first, Vector* pp) {
-    Vector& p = *pp;
+    double* __restrict p = pp->data();  // raw: stores through the vector would reload its data pointer
     if (first)
-      parallelFor(p.size(), [&](size_t i) { p[i] = zAt(i); }, 4096);
+      parallelFor(pp->size(), [&](size_t i) { p[i] = zAt(i); }, 4096);
     else
-      parallelFor(p.size(), [&](size_t i) { p[i] = zAt(i) + beta * p[i]; }, 4096);
+      parallelFor(pp->size(), [&](size_t i) { p[i] = zAt(i) + beta * p[i]; }, 4096);
   }
 };
 
