@@ -42,23 +42,47 @@ PressureProjection<D>::PressureProjection(const VelocityConstraints<D>& vc, Pres
 
 template <int D>
 void PressureProjection<D>::divergence(const MacVelocity<D>& u, Vector* div) const {
+  divergenceTimes(u, 1.0 / vc_.h, div);
+}
+
+template <int D>
+void PressureProjection<D>::divergenceTimes(const MacVelocity<D>& u, double factor, Vector* div) const {
   div->resize(A_.size());
-  const double invH = 1.0 / vc_.h;
-  forEachCell<D>(vc_.cells, [&](const IVec<D>& k, size_t i) {
-    if (vc_.solid[i]) {
-      (*div)[i] = 0.0;
-      return;
+  const IVec<D>& n = vc_.cells;
+  const size_t nx = size_t(n[0]);
+  // Row by row: cell (x, row) has faces x and x + 1 of u_0's row and, along
+  // each other axis a, the faces of u_a's rows k_a and k_a + 1.
+  parallelForRows<D>(n, [&](size_t row) {
+    size_t k[3] = {0, 0, 0}, rest = row;
+    for (int a = 1; a < D; ++a) {
+      k[a] = rest % size_t(n[a]);
+      rest /= size_t(n[a]);
     }
-    double d = 0.0;
-    for (int a = 0; a < D; ++a) d += double(u[a](k + unitVector<D>(a))) - double(u[a](k));
-    (*div)[i] = d * invH;
+    const float* lo[D];
+    const float* hi[D];
+    lo[0] = u[0].data() + row * (nx + 1);
+    hi[0] = lo[0] + 1;
+    for (int a = 1; a < D; ++a) {
+      // u_a's grid has n_a + 1 layers along a: its row index of (k_1, k_2).
+      size_t r = 0;
+      for (int b = D - 1; b >= 1; --b) r = r * size_t(n[b] + (b == a ? 1 : 0)) + k[b];
+      const size_t layer = a == 1 ? 1 : size_t(n[1]);  // rows between layers k_a and k_a + 1
+      lo[a] = u[a].data() + r * nx;
+      hi[a] = lo[a] + layer * nx;
+    }
+    const uint8_t* solid = vc_.solid.data() + row * nx;
+    double* out = div->data() + row * nx;
+    for (size_t x = 0; x < nx; ++x) {
+      double d = 0.0;
+      for (int a = 0; a < D; ++a) d += double(hi[a][x]) - double(lo[a][x]);
+      out[x] = solid[x] ? 0.0 : d * factor;
+    }
   });
 }
 
 template <int D>
 SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double density) {
-  divergence(*u, &rhs_);
-  parallelFor(rhs_.size(), [&](size_t i) { rhs_[i] = -rhs_[i]; }, 4096);
+  divergenceTimes(*u, -1.0 / vc_.h, &rhs_);  // rhs = -div u
   // Warm start: phi / dt (the pressure over the density) linearly
   // extrapolated from the last two projections, times this dt; after one
   // projection, the last phi scaled to this dt.

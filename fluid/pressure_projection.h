@@ -30,6 +30,8 @@ class PressureProjection {
   const LaplaceSystem<D>& system() const { return A_; }
 
  private:
+  // div = factor * (cell divergence of u, without the 1/h), 0 on solid cells.
+  void divergenceTimes(const MacVelocity<D>& u, double factor, Vector* div) const;
   const VelocityConstraints<D>& vc_;
   PressureSolver solver_;
   SolverOptions options_;
