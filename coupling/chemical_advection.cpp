@@ -114,7 +114,7 @@ ChemicalAdvector<D>::ChemicalAdvector(ChemicalDomain<D> domain, ChemicalInterpol
     : domain_(std::move(domain)), interpolation_(interpolation), scratch_(domain_.cells) {
   const size_t n = scratch_.size();
   if (!domain_.solid.empty() && domain_.solid.size() != n) throw std::invalid_argument("coupling: solid mask has the wrong size");
-  feet_.assign(n, Vec<D>(0.0));
+  for (auto& f : feet_) f.assign(n, 0.0f);
   fromInflow_.assign(n, 0);
 }
 
@@ -132,22 +132,26 @@ template <int D>
 void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::vector<Grid<double, D>*>& species) {
   const ChemicalDomain<D>& d = domain_;
   const bool inflow = !d.inflowValues.empty();
-  // Feet once for all species (seed 001 eq. 19: x* = x - dt u).
-  forEachCell<D>(d.cells, [&](const IVec<D>& k, size_t i) {
-    Vec<D> x = (Vec<D>(k) + 0.5) * d.h;
-    Vec<D> foot = traceBack<D>(u, x, dt);
-    const Vec<D> c = foot / d.h - Vec<D>(0.5);
-    // Beyond the outermost cell centre of an inflow side the value blends
-    // into the inflow concentration, reached at the wall itself.
-    double in = 0.0;
-    if (inflow)
+  // Feet once for all species (seed 001 eq. 19: x* = x - dt u), with the
+  // fluid's vector kernels; periodic domains trace cell by cell.
+  if (!traceCellFeet<D>(u, dt, d.cells, d.h, &feet_))
+    forEachCell<D>(d.cells, [&](const IVec<D>& k, size_t i) {
+      const Vec<D> x = (Vec<D>(k) + 0.5) * d.h;
+      const Vec<D> c = traceBack<D>(u, x, dt) / d.h - Vec<D>(0.5);
+      for (int a = 0; a < D; ++a) feet_[size_t(a)][i] = float(c[a]);
+    });
+  // Beyond the outermost cell centre of an inflow side the value blends
+  // into the inflow concentration, reached at the wall itself.
+  if (inflow)
+    parallelFor(fromInflow_.size(), [&](size_t i) {
+      double in = 0.0;
       for (int a = 0; a < D; ++a) {
-        if (d.inflow[size_t(a)][0]) in = std::max(in, std::clamp(-2.0 * c[a], 0.0, 1.0));
-        if (d.inflow[size_t(a)][1]) in = std::max(in, std::clamp(2.0 * (c[a] - (d.cells[a] - 1)), 0.0, 1.0));
+        const double c = feet_[size_t(a)][i];
+        if (d.inflow[size_t(a)][0]) in = std::max(in, std::clamp(-2.0 * c, 0.0, 1.0));
+        if (d.inflow[size_t(a)][1]) in = std::max(in, std::clamp(2.0 * (c - (d.cells[a] - 1)), 0.0, 1.0));
       }
-    fromInflow_[i] = in;
-    feet_[i] = c;
-  });
+      fromInflow_[i] = in;
+    }, 4096);
   for (size_t s = 0; s < species.size(); ++s) {
     Grid<double, D>& g = *species[s];
     const double inValue = inflow ? d.inflowValues[s] : 0.0;
@@ -158,8 +162,9 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
         scratch_[i] = inValue;
         return;
       }
-      const double v = linear ? sampleLinearChemical<D>(g, d.periodic, feet_[i])
-                              : sampleChemical<D>(g, d.periodic, feet_[i], interpolation_);
+      Vec<D> c;
+      for (int a = 0; a < D; ++a) c[a] = feet_[size_t(a)][i];
+      const double v = linear ? sampleLinearChemical<D>(g, d.periodic, c) : sampleChemical<D>(g, d.periodic, c, interpolation_);
       scratch_[i] = w * inValue + (1.0 - w) * v;
     }, 1024);
     std::swap(g.values(), scratch_.values());

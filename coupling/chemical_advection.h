@@ -49,7 +49,9 @@ class ChemicalAdvector {
  private:
   ChemicalDomain<D> domain_;
   ChemicalInterpolation interpolation_;
-  std::vector<Vec<D>> feet_;       // foot of every cell (grid coordinates)
+  // Foot of every cell (grid coordinates, per axis; single precision, as
+  // the fluid's own traces: 1e-7 of the domain, far below a cell).
+  std::array<std::vector<float>, D> feet_;
   std::vector<double> fromInflow_;  // weight of the inflow value (1: the foot left through an inflow side)
   Grid<double, D> scratch_;
 };

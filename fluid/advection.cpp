@@ -1,6 +1,7 @@
 #include "fluid/advection.h"
 
 #include <algorithm>
+#include <optional>
 #include <cmath>
 #include <cstring>
 
@@ -279,6 +280,52 @@ __attribute__((target("avx2"))) int simdRow8(const SimdRow<D>& j, int x) {
 }
 #endif
 
+// The feet of one row of another grid's cell centres (cell size r fluid
+// cells; centre x at (x + 1/2) r): samples x, x + 1, .. in groups of V's
+// lanes while a whole group fits; returns the first sample left.
+template <int D>
+struct FeetRow {
+  const MacSampler<D>& vel;
+  const RowVelocity<D>* row;  // when r = 1: the gather-free first velocity
+  const float* p;             // the row's position along axes 1.. (fluid cell units)
+  float r, c;                 // cell size ratio, dt / h (fluid)
+  int nx;
+  size_t base;
+  float* out[D];              // feet in the grid's cell coordinates
+};
+
+template <int D, class V>
+MF_INLINE int feetRow(const FeetRow<D>& j, int x) {
+  constexpr int n = Lanes<V>::n;
+  V vp[D], vm[D], vv[D];
+  for (int a = 1; a < D; ++a) vp[a] = vsplat<V>(j.p[a]);
+  V lane;
+  for (int k = 0; k < n; ++k) lane[k] = float(k);
+  const float invR = 1.0f / j.r;
+  for (; x + n <= j.nx; x += n) {
+    vp[0] = ((vsplat<V>(float(x)) + lane) + 0.5f) * j.r;
+    if (j.row && x >= j.row->begin && x + n <= j.row->end)
+      j.row->at(x, vv);
+    else
+      vvelocity<D, V>(j.vel, vp, vv);
+    for (int a = 0; a < D; ++a) vm[a] = vp[a] - (0.5f * j.c) * vv[a];
+    vvelocity<D, V>(j.vel, vm, vv);
+    for (int a = 0; a < D; ++a) vstore(j.out[a] + j.base + size_t(x), (vp[a] - j.c * vv[a]) * invR - 0.5f);
+  }
+  return x;
+}
+
+template <int D>
+int feetRow4(const FeetRow<D>& j, int x) {
+  return feetRow<D, vf4>(j, x);
+}
+#if MORPHOFLOW_AVX2_KERNELS
+template <int D>
+__attribute__((target("avx2"))) int feetRow8(const FeetRow<D>& j, int x) {
+  return feetRow<D, vf8>(j, x);
+}
+#endif
+
 // One semi-Lagrangian pass; optionally records the min/max of each stencil.
 // Works in cell units: p = k + offset, foot = p - (dt/h) u(p - (dt/2h) u(p)).
 template <int D>
@@ -378,5 +425,52 @@ template void advectField<3>(const Grid<float, 3>&, const Layout<3>&, const MacV
                              AdvectionScheme, Grid<float, 3>*, AdvectionScratch<3>*);
 template void advectVelocity<2>(const MacVelocity<2>&, double, AdvectionScheme, MacVelocity<2>*, AdvectionScratch<2>*);
 template void advectVelocity<3>(const MacVelocity<3>&, double, AdvectionScheme, MacVelocity<3>*, AdvectionScratch<3>*);
+
+template <int D>
+bool traceCellFeet(const MacVelocity<D>& u, double dt, const IVec<D>& cells, double h,
+                   std::array<std::vector<float>, D>* feet) {
+  const MacSampler<D> vel(u);
+  for (int a = 0; a < D; ++a)
+    if (vel.face[a].periodic || vel.centre[a].n < 2) return false;
+  const float r = float(h / u.h()), c = float(dt / u.h());
+  size_t n = 1;
+  for (int a = 0; a < D; ++a) n *= size_t(cells[a]);
+  for (auto& f : *feet) f.resize(n);
+  // On the velocity's own cells the first velocity needs no gathers.
+  bool same = true;
+  for (int a = 0; a < D; ++a) same = same && cells[a] == u.cells()[a];
+  [[maybe_unused]] const bool wide = useAvx2();
+  parallelForRows<D>(cells, [&](size_t row) {
+    float p[D], m[D], v[D];
+    size_t rest = row;
+    for (int a = 1; a < D; ++a) {
+      p[a] = (float(int(rest % size_t(cells[a]))) + 0.5f) * r;
+      rest /= size_t(cells[a]);
+    }
+    const size_t base = row * size_t(cells[0]);
+    std::optional<RowVelocity<D>> rv;
+    if (same) rv.emplace(vel, p, 0.5f, cells[0]);
+    FeetRow<D> job{vel, rv ? &*rv : nullptr, p, r, c, cells[0], base, {}};
+    for (int a = 0; a < D; ++a) job.out[a] = (*feet)[size_t(a)].data();
+    int x = 0;
+#if MORPHOFLOW_AVX2_KERNELS
+    if (wide) x = feetRow8<D>(job, x);
+#endif
+    x = feetRow4<D>(job, x);
+    for (; x < cells[0]; ++x) {  // the row's last samples, one lane's arithmetic
+      p[0] = (float(x) + 0.5f) * r;
+      vel(p, v);
+      for (int a = 0; a < D; ++a) m[a] = p[a] - 0.5f * c * v[a];
+      vel(m, v);
+      for (int a = 0; a < D; ++a) (*feet)[size_t(a)][base + size_t(x)] = (p[a] - c * v[a]) * (1.0f / r) - 0.5f;
+    }
+  });
+  return true;
+}
+
+template bool traceCellFeet<2>(const MacVelocity<2>&, double, const IVec<2>&, double,
+                               std::array<std::vector<float>, 2>*);
+template bool traceCellFeet<3>(const MacVelocity<3>&, double, const IVec<3>&, double,
+                               std::array<std::vector<float>, 3>*);
 
 }  // namespace morphoflow

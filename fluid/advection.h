@@ -42,6 +42,15 @@ template <int D>
 void advectVelocity(const MacVelocity<D>& u, double dt, AdvectionScheme scheme, MacVelocity<D>* dst,
                     AdvectionScratch<D>* scratch = nullptr);
 
+// The feet of traceBack (the same midpoint rule, in single precision with
+// the semi-Lagrangian row kernels) from the cell centres of a grid of
+// `cells` cells of size h over u's domain, in that grid's cell coordinates
+// (centre k at k). Returns false, leaving feet alone, when u has a periodic
+// axis (which these kernels do not take).
+template <int D>
+bool traceCellFeet(const MacVelocity<D>& u, double dt, const IVec<D>& cells, double h,
+                   std::array<std::vector<float>, D>* feet);
+
 // Foot of the characteristic through x over a step dt (midpoint rule).
 template <int D>
 inline Vec<D> traceBack(const MacVelocity<D>& u, const Vec<D>& x, double dt) {
