@@ -22,7 +22,7 @@ struct FluidSettings {
   PressureSolver pressureSolver = PressureSolver::MGPCG;
   double pressureTolerance = 1e-6;         // relative residual
   int pressureMaxIterations = 500;
-  double viscosityTolerance = 1e-6;
+  double viscosityTolerance = 1e-6;        // relative residual of the whole velocity system
   std::array<double, 3> force{0.0, 0.0, 0.0};     // constant body acceleration
   std::array<double, 3> buoyancyDirection{0.0, 1.0, 0.0};
   double buoyancy = 0.0;                   // acceleration per unit dye along buoyancyDirection

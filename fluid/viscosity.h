@@ -6,7 +6,9 @@
 // once; a new nu dt (a CFL-limited step) only rescales their diagonal and
 // re-derives the multigrid levels in place. Each solve starts from u* plus
 // the viscous increment extrapolated from the last two steps (per unit
-// nu dt / h^2, so a changing dt keeps it), which changes slowly.
+// nu dt / h^2, so a changing dt keeps it), which changes slowly. The
+// tolerance is a relative residual of the whole velocity system, not of
+// each component: sum_a ||r_a||^2 <= tol^2 sum_a ||b_a||^2.
 #pragma once
 
 #include <array>
