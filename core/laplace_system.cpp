@@ -422,13 +422,9 @@ double LaplaceSystem<D>::applyRow(size_t row, const T* x, T* y, const T* b) cons
         const T y = sc * (c0 * xr[i] + faceSumUniform<D, W, T>(s, xr, i, wu));
         yr[i] = br ? br[i] - y : y;
       }
-      if constexpr (Dot) {  // four running sums: the adds need not wait on one another
-        double d[4] = {0.0, 0.0, 0.0, 0.0};
-        size_t k = lo;
-        for (; k + 4 <= hi; k += 4)
-          for (int j = 0; j < 4; ++j) d[j] += double(xr[k + size_t(j)]) * double(yr[k + size_t(j)]);
-        for (; k < hi; ++k) d[0] += double(xr[k]) * double(yr[k]);
-        dot += (d[0] + d[1]) + (d[2] + d[3]);
+      if constexpr (Dot) {
+        auto xy = [&](size_t k) { return double(xr[k]) * double(yr[k]); };
+        dot += orderedSum(lo, hi, xy);
       }
     };
     if (span.w == 1.0f)
@@ -481,12 +477,8 @@ double LaplaceSystem<D>::defectRow(size_t row, const T* b, const T* x, T* r) con
     finish(0, nx);
   }
   if constexpr (!SumSquares) return 0.0;
-  double s[4] = {0.0, 0.0, 0.0, 0.0};  // four running sums: the adds need not wait on one another
-  size_t i = 0;
-  for (; i + 4 <= nx; i += 4)
-    for (int j = 0; j < 4; ++j) s[j] += double(rr[i + size_t(j)]) * double(rr[i + size_t(j)]);
-  for (; i < nx; ++i) s[0] += double(rr[i]) * double(rr[i]);
-  return (s[0] + s[1]) + (s[2] + s[3]);
+  auto square = [&](size_t i) { return double(rr[i]) * double(rr[i]); };
+  return orderedSum(size_t(0), nx, square);
 }
 
 template <int D>
