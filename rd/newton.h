@@ -12,6 +12,23 @@ namespace morphoflow {
 // Solves the n x n system A y = b in place (partial pivoting); false if singular.
 template <int N>
 bool solveDense(double (&A)[N][N], double (&b)[N], int n) {
+  if constexpr (N >= 2) {
+    if (n == 2) {  // the loops below unrolled for two species: the same arithmetic
+      if (std::abs(A[1][0]) > std::abs(A[0][0])) {
+        std::swap(A[0][0], A[1][0]);
+        std::swap(A[0][1], A[1][1]);
+        std::swap(b[0], b[1]);
+      }
+      if (!(std::abs(A[0][0]) > 1e-300)) return false;
+      const double f = A[1][0] / A[0][0];
+      A[1][1] -= f * A[0][1];
+      b[1] -= f * b[0];
+      if (!(std::abs(A[1][1]) > 1e-300)) return false;
+      b[1] = b[1] / A[1][1];
+      b[0] = (b[0] - A[0][1] * b[1]) / A[0][0];
+      return true;
+    }
+  }
   for (int c = 0; c < n; ++c) {
     int piv = c;
     for (int r = c + 1; r < n; ++r)
