@@ -208,59 +208,35 @@ inline T faceSumUniform(const RowStencil<D, T>& s, const T* xr, size_t i, T wu) 
 // one 256-bit vector of cells at a time (eight floats or four doubles), each
 // lane with the scalar loop's arithmetic. Returns the first cell not done.
 template <class T>
-struct Avx;
-template <>
-struct Avx<float> {
-  using V = __m256;
-  static constexpr size_t kLanes = 8;
-  __attribute__((target("avx2"), always_inline)) static V set1(float v) { return _mm256_set1_ps(v); }
-  __attribute__((target("avx2"), always_inline)) static V load(const float* p) { return _mm256_loadu_ps(p); }
-  __attribute__((target("avx2"), always_inline)) static void store(float* p, V v) { _mm256_storeu_ps(p, v); }
-  __attribute__((target("avx2"), always_inline)) static V add(V a, V b) { return _mm256_add_ps(a, b); }
-  __attribute__((target("avx2"), always_inline)) static V sub(V a, V b) { return _mm256_sub_ps(a, b); }
-  __attribute__((target("avx2"), always_inline)) static V mul(V a, V b) { return _mm256_mul_ps(a, b); }
-  template <bool Weighted>
-  __attribute__((target("avx2"), always_inline)) static V times(V w, V x) {
-    if constexpr (Weighted)
-      return mul(w, x);
-    else
-      return x;
-  }
+struct Wide {  // a 256-bit vector of T; in a target("avx2") function its operators are AVX
+  typedef T V __attribute__((vector_size(32)));
+  static constexpr size_t kLanes = 32 / sizeof(T);
 };
-template <>
-struct Avx<double> {
-  using V = __m256d;
-  static constexpr size_t kLanes = 4;
-  __attribute__((target("avx2"), always_inline)) static V set1(double v) { return _mm256_set1_pd(v); }
-  __attribute__((target("avx2"), always_inline)) static V load(const double* p) { return _mm256_loadu_pd(p); }
-  __attribute__((target("avx2"), always_inline)) static void store(double* p, V v) { _mm256_storeu_pd(p, v); }
-  __attribute__((target("avx2"), always_inline)) static V add(V a, V b) { return _mm256_add_pd(a, b); }
-  __attribute__((target("avx2"), always_inline)) static V sub(V a, V b) { return _mm256_sub_pd(a, b); }
-  __attribute__((target("avx2"), always_inline)) static V mul(V a, V b) { return _mm256_mul_pd(a, b); }
-  template <bool Weighted>
-  __attribute__((target("avx2"), always_inline)) static V times(V w, V x) {
-    if constexpr (Weighted)
-      return mul(w, x);
-    else
-      return x;
-  }
-};
+template <class T>
+__attribute__((target("avx2"), always_inline)) inline typename Wide<T>::V loadWide(const T* p) {
+  typename Wide<T>::V v;
+  __builtin_memcpy(&v, p, sizeof v);
+  return v;
+}
 
 template <int D, bool Weighted, class T>
 __attribute__((target("avx2"))) size_t applyUniformAvx(const RowStencil<D, T>& s, const T* xr, T* yr, const T* br,
                                                        size_t i, size_t end, T sc, T c0, T wu) {
-  using A = Avx<T>;
-  using V = typename A::V;
-  const V vsc = A::set1(sc), vc0 = A::set1(c0), vw = A::set1(wu);
-  for (; i + A::kLanes <= end; i += A::kLanes) {
-    const V xi = A::load(xr + i);
-    V sum = A::add(A::template times<Weighted>(vw, A::sub(xi, A::load(xr + i + 1))),
-                   A::template times<Weighted>(vw, A::sub(xi, A::load(xr + i - 1))));
-    for (int a = 1; a < D; ++a)
-      sum = A::add(sum, A::add(A::template times<Weighted>(vw, A::sub(xi, A::load(s.xhi[a] + i))),
-                               A::template times<Weighted>(vw, A::sub(xi, A::load(s.xlo[a] + i)))));
-    const V y = A::mul(vsc, A::add(A::mul(vc0, xi), sum));
-    A::store(yr + i, br ? A::sub(A::load(br + i), y) : y);  // b - A x for a defect
+  using V = typename Wide<T>::V;
+  for (; i + Wide<T>::kLanes <= end; i += Wide<T>::kLanes) {
+    const V xi = loadWide(xr + i);
+    V d[2 * D] = {xi - loadWide(xr + i + 1), xi - loadWide(xr + i - 1)};
+    for (int a = 1; a < D; ++a) {
+      d[2 * a] = xi - loadWide(s.xhi[a] + i);
+      d[2 * a + 1] = xi - loadWide(s.xlo[a] + i);
+    }
+    if constexpr (Weighted)
+      for (V& v : d) v = wu * v;
+    V sum = d[0] + d[1];
+    for (int a = 1; a < D; ++a) sum = sum + (d[2 * a] + d[2 * a + 1]);
+    V y = sc * (c0 * xi + sum);
+    if (br) y = loadWide(br + i) - y;  // b - A x for a defect
+    __builtin_memcpy(yr + i, &y, sizeof y);
   }
   return i;
 }
@@ -411,11 +387,11 @@ double LaplaceSystem<D>::applyRow(size_t row, const T* x, T* y, const T* b) cons
       size_t i = lo;
       const T* br = b ? b + s.base : nullptr;
 #if MORPHOFLOW_AVX2_KERNELS
-      if (useAvx2() && hi - lo >= Avx<T>::kLanes) {
+      if (useAvx2() && hi - lo >= Wide<T>::kLanes) {
         i = applyUniformAvx<D, W, T>(s, xr, yr, br, i, hi, sc, c0, wu);
         // The last cells in one more vector placed to end at hi (the cells
         // it repeats get the same values again: y depends on x and b only).
-        if (i < hi) i = applyUniformAvx<D, W, T>(s, xr, yr, br, hi - Avx<T>::kLanes, hi, sc, c0, wu);
+        if (i < hi) i = applyUniformAvx<D, W, T>(s, xr, yr, br, hi - Wide<T>::kLanes, hi, sc, c0, wu);
       }
 #endif
       for (; i < hi; ++i) {

@@ -358,9 +358,7 @@ double Multigrid<D>::scaledCycle(const Vector& r, double rscale, Vector* z, bool
     zScale_ = rscale;
   }
   const double* __restrict rd = r.data();
-  const float* __restrict x = L0.x.data();
-  const double scale = zScale_;
-  auto zi = [&](size_t i) { return double(x[i]) * scale; };  // zAt(i)
+  const auto zi = zOf();
   if (!z) return deterministicSum(r.size(), [&](size_t i) { return rd[i] * zi(i); });
   z->resize(r.size());
   double* __restrict zz = z->data();
@@ -376,9 +374,7 @@ double Multigrid<D>::scaledCycle(const Vector& r, double rscale, Vector* z, bool
 
 template <int D>
 void Multigrid<D>::direction(double beta, bool first, Vector* p) {
-  const float* __restrict x = levels_[0].x.data();
-  const double scale = zScale_;
-  formDirection([=](size_t i) { return double(x[i]) * scale; }, beta, first, p);
+  formDirection(zOf(), beta, first, p);
 }
 
 template <int D>

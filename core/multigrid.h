@@ -81,7 +81,13 @@ class Multigrid final : public Preconditioner {
   // overflow), z = rscale * result (unless z is null); returns r . z when
   // `withDot`.
   double scaledCycle(const Vector& r, double rscale, Vector* z, bool withDot);
-  double zAt(size_t i) const { return double(levels_[0].x[i]) * zScale_; }
+  // z_i = zScale_ x_i on level 0, through a raw pointer (so the loops that
+  // use it vectorise; stores through the vectors would reload their data).
+  auto zOf() const {
+    const float* x = levels_[0].x.data();
+    const double scale = zScale_;
+    return [x, scale](size_t i) { return double(x[i]) * scale; };
+  }
   void restrict(int l);   // r of level l -> b of level l + 1
   void prolongAdd(int l); // x of level l + 1 added into x of level l
 

@@ -283,6 +283,45 @@ TEST(LinearSolvers, SinglePrecisionMultigridSolvesAnyScale) {
 
 namespace {
 
+// Calls fn(j, w) for each face neighbour j of cell k (index i) with the
+// face's weight w, along each axis the upper then the lower one; periodic
+// axes wrap, walls are skipped.
+template <int D, class Fn>
+void eachNeighbour(const LaplaceSystem<D>& A, const IVec<D>& k, size_t i, Fn&& fn) {
+  for (int a = 0; a < D; ++a) {
+    IVec<D> lo = k, hi = k;
+    lo[a] -= 1;
+    hi[a] += 1;
+    if (A.periodic[size_t(a)]) {
+      lo[a] = (lo[a] + A.dims[a]) % A.dims[a];
+      hi[a] %= A.dims[a];
+    }
+    if (hi[a] < A.dims[a]) fn(A.c.index(hi), double(A.w[a][i]));
+    if (lo[a] >= 0) fn(A.c.index(lo), double(A.w[a][A.c.index(lo)]));
+  }
+}
+
+// A system whose rows break into several uniform spans (a partial face and
+// a heavier diagonal inside some rows), faces of weight `weight`, walls on
+// the upper sides (the last axis periodic if asked): the fast paths' test bed.
+template <int D>
+LaplaceSystem<D> brokenSpanSystem(const IVec<D>& dims, float weight, bool periodicLast) {
+  std::array<bool, D> periodic{};
+  periodic[D - 1] = periodicLast;
+  LaplaceSystem<D> A(dims, periodic, 3.0);
+  for (int a = 0; a < D; ++a) A.w[a].fill(weight);
+  forEachCell<D>(dims, [&](const IVec<D>& k, size_t i) {
+    A.c[i] = 0.5f;
+    for (int a = 0; a < D; ++a) {
+      if (k[a] == dims[a] - 1 && !periodic[size_t(a)]) A.w[a][i] = 0.0f;  // walls
+      if (k[0] == 9 && k[1] % 3 == 0) A.w[a][i] = 0.5f * weight;
+      if (k[0] == 17 && k[1] % 4 == 1) A.c[i] = 2.0f;
+    }
+  });
+  A.finalize();
+  return A;
+}
+
 // One red-black Gauss-Seidel sweep written plainly (double arithmetic, every
 // neighbour through its weight, walls by skipping): the reference for the
 // smoother's fast paths (uniform spans four cells at a time in float).
@@ -298,17 +337,7 @@ std::vector<double> referenceSweep(const LaplaceSystem<D>& A, const std::vector<
       for (int a = 0; a < D; ++a) parity += k[a];
       if ((parity & 1) != colour || !(A.diag[i] > 0)) continue;
       double sum = 0.0;
-      for (int a = 0; a < D; ++a) {
-        IVec<D> lo = k, hi = k;
-        lo[a] -= 1;
-        hi[a] += 1;
-        if (A.periodic[size_t(a)]) {
-          lo[a] = (lo[a] + A.dims[a]) % A.dims[a];
-          hi[a] %= A.dims[a];
-        }
-        if (hi[a] < A.dims[a]) sum += double(A.w[a][i]) * xd[A.c.index(hi)];
-        if (lo[a] >= 0) sum += double(A.w[a][A.c.index(lo)]) * xd[A.c.index(lo)];
-      }
+      eachNeighbour<D>(A, k, i, [&](size_t j, double w) { sum += w * xd[j]; });
       xd[i] = (double(b[i]) / A.scale + sum) / double(A.diag[i]);
     }
   }
@@ -317,21 +346,7 @@ std::vector<double> referenceSweep(const LaplaceSystem<D>& A, const std::vector<
 
 template <int D>
 void checkSmoother(const IVec<D>& dims, float weight = 1.0f, bool periodicLast = false) {
-  std::array<bool, D> periodic{};
-  periodic[D - 1] = periodicLast;
-  LaplaceSystem<D> A(dims, periodic, 3.0);
-  for (int a = 0; a < D; ++a) A.w[a].fill(weight);
-  forEachCell<D>(dims, [&](const IVec<D>& k, size_t i) {
-    A.c[i] = 0.5f;
-    for (int a = 0; a < D; ++a) {
-      if (k[a] == dims[a] - 1 && !periodic[size_t(a)]) A.w[a][i] = 0.0f;  // walls
-      // A partial face and a heavier diagonal inside some rows break them
-      // into several uniform spans.
-      if (k[0] == 9 && k[1] % 3 == 0) A.w[a][i] = 0.5f * weight;
-      if (k[0] == 17 && k[1] % 4 == 1) A.c[i] = 2.0f;
-    }
-  });
-  A.finalize();
+  const LaplaceSystem<D> A = brokenSpanSystem<D>(dims, weight, periodicLast);
   std::vector<float> b(A.size()), x(A.size());
   for (size_t i = 0; i < b.size(); ++i) {
     b[i] = float(std::sin(0.37 * double(i)));
@@ -367,17 +382,7 @@ std::vector<double> referenceApply(const LaplaceSystem<D>& A, const std::vector<
   for (size_t i = 0; i < A.size(); ++i) {
     const IVec<D> k = A.c.coord(i);
     double sum = double(A.c[i]) * x[i];
-    for (int a = 0; a < D; ++a) {
-      IVec<D> lo = k, hi = k;
-      lo[a] -= 1;
-      hi[a] += 1;
-      if (A.periodic[size_t(a)]) {
-        lo[a] = (lo[a] + A.dims[a]) % A.dims[a];
-        hi[a] %= A.dims[a];
-      }
-      if (hi[a] < A.dims[a]) sum += double(A.w[a][i]) * (x[i] - x[A.c.index(hi)]);
-      if (lo[a] >= 0) sum += double(A.w[a][A.c.index(lo)]) * (x[i] - x[A.c.index(lo)]);
-    }
+    eachNeighbour<D>(A, k, i, [&](size_t j, double w) { sum += w * (x[i] - x[j]); });
     y[i] = A.scale * sum;
   }
   return y;
@@ -385,19 +390,7 @@ std::vector<double> referenceApply(const LaplaceSystem<D>& A, const std::vector<
 
 template <int D>
 void checkOperator(const IVec<D>& dims, float weight = 1.0f, bool periodicLast = false) {
-  std::array<bool, D> periodic{};
-  periodic[D - 1] = periodicLast;
-  LaplaceSystem<D> A(dims, periodic, 3.0);
-  for (int a = 0; a < D; ++a) A.w[a].fill(weight);
-  forEachCell<D>(dims, [&](const IVec<D>& k, size_t i) {
-    A.c[i] = 0.5f;
-    for (int a = 0; a < D; ++a) {
-      if (k[a] == dims[a] - 1 && !periodic[size_t(a)]) A.w[a][i] = 0.0f;  // walls
-      if (k[0] == 9 && k[1] % 3 == 0) A.w[a][i] = 0.5f * weight;      // spans broken
-      if (k[0] == 17 && k[1] % 4 == 1) A.c[i] = 2.0f;
-    }
-  });
-  A.finalize();
+  const LaplaceSystem<D> A = brokenSpanSystem<D>(dims, weight, periodicLast);
   Vector x(A.size()), b(A.size());
   for (size_t i = 0; i < x.size(); ++i) {
     x[i] = std::cos(0.11 * double(i)) + 0.3 * std::sin(0.013 * double(i));
