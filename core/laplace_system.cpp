@@ -7,6 +7,7 @@
 #include <type_traits>
 
 #include "core/parallel.h"
+#include "core/row_stencil.h"
 #include "core/simd4.h"
 #include "core/simd_dispatch.h"
 
@@ -18,59 +19,6 @@ namespace morphoflow {
 
 namespace {
 
-// Neighbour rows along axes >= 1 of one row. Periodic axes wrap; across a
-// non-periodic edge the neighbour row is a row of zeros (no race, no branch).
-template <int D, class T>
-struct RowStencil {
-  size_t base;
-  const T* xlo[D];
-  const T* xhi[D];
-  const float* wlo[D];  // w[a] of the row below (coupling to this row)
-};
-
-// Row `row` at coordinates y (and z) along axes 1 (and 2).
-template <int D, class T>
-RowStencil<D, T> rowStencil(const LaplaceSystem<D>& A, const T* x, const T* zx, const float* zw, size_t row,
-                            size_t y, size_t z) {
-  RowStencil<D, T> s{};
-  const IVec<D>& dims = A.dims;
-  size_t nx = size_t(dims[0]), ny = size_t(dims[1]);
-  s.base = row * nx;
-  for (int a = 1; a < D; ++a) {
-    size_t k = a == 1 ? y : z, n = size_t(dims[a]);
-    size_t stride = a == 1 ? nx : nx * ny;
-    bool p = A.periodic[a];
-    if (k > 0 || p) {
-      size_t lo = k > 0 ? s.base - stride : s.base + (n - 1) * stride;
-      s.xlo[a] = x + lo;
-      s.wlo[a] = A.w[a].data() + lo;
-    } else {
-      s.xlo[a] = zx;
-      s.wlo[a] = zw;
-    }
-    if (k + 1 < n || p)
-      s.xhi[a] = x + (k + 1 < n ? s.base + stride : s.base - (n - 1) * stride);
-    else
-      s.xhi[a] = zx;
-  }
-  return s;
-}
-
-template <int D, class T>
-RowStencil<D, T> rowStencil(const LaplaceSystem<D>& A, const T* x, const T* zx, const float* zw, size_t row) {
-  const size_t ny = size_t(A.dims[1]);
-  return rowStencil<D, T>(A, x, zx, zw, row, row % ny, D == 3 ? row / ny : 0);
-}
-
-// Neighbour sum sum_f w_f x_j(f) of cell i of a row; il/ih are the x
-// neighbours (wrapped) and wl the weight of the low x face.
-template <int D, class T>
-inline T neighbourSum(const RowStencil<D, T>& s, const float* const* wa, const T* xr, size_t i, size_t il,
-                      size_t ih, float wl) {
-  T sum = T(wa[0][i]) * xr[ih] + T(wl) * xr[il];
-  for (int a = 1; a < D; ++a) sum += T(wa[a][i]) * s.xhi[a][i] + T(s.wlo[a][i]) * s.xlo[a][i];
-  return sum;
-}
 // w x on a uniform span, whose faces all weigh wu: skipped where wu = 1
 // (1 x = x exactly), so both forms give the general sums' values.
 template <bool Weighted, class V, class W>
@@ -250,15 +198,6 @@ LaplaceSystem<D>::LaplaceSystem(const IVec<D>& d, const std::array<bool, D>& p, 
   for (int a = 0; a < D; ++a) w[a] = Grid<float, D>(d, 0.0f);
   zerosX_.assign(size_t(d[0]), 0.0);
   zerosW_.assign(size_t(d[0]), 0.0f);
-}
-
-template <int D>
-template <class T>
-const T* LaplaceSystem<D>::invDiag() const {
-  if constexpr (std::is_same_v<T, double>)
-    return invDiag_.data();
-  else
-    return invDiagF_.data();
 }
 
 template <int D>

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <array>
+#include <type_traits>
 #include <vector>
 
 #include "core/grid.h"
@@ -57,6 +58,26 @@ struct LaplaceSystem {
   // Removes the mean over active cells (for singular systems).
   void removeNullSpace(Vector* x) const;
 
+  // Each row's longest run [lo, hi) of interior cells whose faces all weigh
+  // w (> 0) and which share one c: the kernels skip the weight loads there,
+  // with the same arithmetic (the smoother four or eight cells at a time).
+  struct Span {
+    uint32_t lo = 0, hi = 0;
+    float w = 1.0f;
+  };
+  // 1 / diag per cell (0 on inactive cells), in double or float.
+  template <class T>
+  const T* invDiag() const {
+    if constexpr (std::is_same_v<T, double>)
+      return invDiag_.data();
+    else
+      return invDiagF_.data();
+  }
+  // A row's span for sweeps that read the neighbours' values only (the
+  // smoother, the Chebyshev iteration): its faces across a non-periodic
+  // domain edge may weigh 0, as the row of zeros beyond adds 0 either way.
+  const Span& sweepSpan(size_t row) const { return sweepSpan_[row]; }
+
  private:
   // y = A x on one row; returns the row's x . y when Dot (else 0). With b,
   // the row's uniform span gets b - A x instead (its cells are all active).
@@ -66,8 +87,6 @@ struct LaplaceSystem {
   template <class T, bool SumSquares>
   double defectRow(size_t row, const T* b, const T* x, T* r) const;
   template <class T>
-  const T* invDiag() const;
-  template <class T>
   const T* zeros() const;
 
   bool singular_ = false;
@@ -76,13 +95,6 @@ struct LaplaceSystem {
   std::vector<float> invDiagF_; // the same in float
   Vector zerosX_;               // a row of zeros: the neighbour beyond a wall
   std::vector<float> zerosW_;   // (also the float row of zeros)
-  // Each row's longest run [lo, hi) of interior cells whose faces all weigh
-  // w (> 0) and which share one c: the kernels skip the weight loads there,
-  // with the same arithmetic (the smoother four or eight cells at a time).
-  struct Span {
-    uint32_t lo = 0, hi = 0;
-    float w = 1.0f;
-  };
   std::vector<Span> uniformSpan_;
   // The same for the smoother, which may also take faces across a
   // non-periodic domain edge (there its sums match the general ones too).
