@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "core/jacobi.h"
 #include "core/parallel.h"
 
 namespace morphoflow {
@@ -63,7 +62,12 @@ ViscositySolver<D>::ViscositySolver(const VelocityConstraints<D>& vc, const Solv
 }
 
 namespace {
-constexpr double kMultigridAbove = 0.1;  // nu dt / h^2 from which multigrid preconditions
+// The Chebyshev iteration solves while a 1e4 reduction takes at most this
+// many steps; beyond, multigrid-preconditioned CG is the faster (steps grow
+// as sqrt(nu dt) / h, its iterations do not). Measured on the cavity at
+// 512^2 and 64^3: Chebyshev 1.4-1.6x faster at about 20 and 40 steps per
+// solve, level at about 60 to 70, slower at 95 (docs/performance.md).
+constexpr int kChebyshevSteps = 80;
 // Three smoothing sweeps each way: the identity term makes the viscous
 // systems better conditioned than the pressure's, and with the sweeps in one
 // pass over memory a third sweep costs less than the outer iteration it
@@ -100,10 +104,11 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
       C.A.scale = s;
       eachUnknown(a, [&](size_t i, size_t gi) { C.A.c[i] = fixed[gi] ? 0.0f : float(1.0 / s + C.cBoundary[i]); });
       C.A.finalize();
-      // Far below s ~ 0.1 the diagonal dominates and Jacobi needs a handful
-      // of iterations; above, multigrid keeps the count independent of s and
-      // is the faster (measured at 512^2 and 64^3: docs/performance.md).
-      if (s <= kMultigridAbove)
+      if (C.chebyshev)
+        C.chebyshev->refresh();
+      else
+        C.chebyshev = std::make_unique<Chebyshev<D>>(C.A);
+      if (C.chebyshev->stepsFor(1e4) <= kChebyshevSteps)
         C.multigrid.reset();
       else if (C.multigrid)
         C.multigrid->refresh();
@@ -139,9 +144,10 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
     SolverOptions options = options_;
     if (bb[ai] > 0.0)
       options.tolerance = options_.tolerance * std::sqrt(0.5 * (bb[ai] + bAll / D) / bb[ai]);
-    JacobiPreconditioner<D> jacobi(C.A);
-    Preconditioner* M = C.multigrid ? static_cast<Preconditioner*>(C.multigrid.get()) : &jacobi;
-    results[ai] = solvePCG<D>(C.A, C.b, &C.x, M, options, nullptr, &C.workspace);
+    if (C.multigrid)
+      results[ai] = solvePCG<D>(C.A, C.b, &C.x, C.multigrid.get(), options, nullptr, &C.workspace);
+    else
+      results[ai] = C.chebyshev->solve(C.b, &C.x, options);
     rr[ai] = results[ai].residual * results[ai].residual * bb[ai];
     std::swap(C.rate[0], C.rate[1]);  // the older slot takes the new rate
     std::vector<float>& rate = C.rate[0];
