@@ -11,6 +11,9 @@ namespace morphoflow {
 
 namespace {
 
+template <int D>
+constexpr size_t kPacked = 2 * D + 1;  // floats per cell outside a uniform span
+
 // The interval [1 - rho, 1 + rho] is centred on 1 (theta = 1), so a step is
 // e_k = e_{k-2} + w_k (J e_{k-1} - e_{k-2}), with the Jacobi map
 // J e = g + D^-1 W e (the e_{k-1} terms of g - M e cancel), e_1 = g and
@@ -52,56 +55,49 @@ __attribute__((target("avx2"))) void uniformStepsAvx(size_t lo, size_t hi, const
 #endif
 
 // Step `First ? 2 : k` on one row, cur = e_{k-1}, e = e_{k-2} (overwritten).
+// The cells outside the row's uniform span take their coefficients from
+// `packed`: per cell, 1 / diag and the face weights in neighbourSum's order
+// (x high, x low, then high and low along each further axis), contiguous, so
+// a row end costs one short read rather than a cache line from each of D + 1
+// full-size grids.
 template <int D, bool First>
 void stepRow(const LaplaceSystem<D>& A, size_t row, size_t y, size_t z, const float* cur, float* e,
-             const float* g, const float* zeros, float omega) {
+             const float* g, const float* zeros, const float* packed, float omega) {
   const size_t nx = size_t(A.dims[0]);
-  const bool px = A.periodic[0];
   const RowStencil<D, float> s = rowStencil<D, float>(A, cur, zeros, zeros, row, y, z);
-  const float* wa[D];
-  for (int a = 0; a < D; ++a) wa[a] = A.w[a].data() + s.base;
-  const float* ir = A.template invDiag<float>() + s.base;
   const float* cr = cur + s.base;
   const float* gr = g + s.base;
   float* er = e + s.base;
-  auto update = [&](size_t i, float nb) {
-    const float jacobi = gr[i] + ir[i] * nb;  // inactive: 1 / diag = 0 and g = 0 keep e = 0
-    er[i] = First ? omega * jacobi : er[i] + omega * (jacobi - er[i]);
-  };
-  auto edge = [&](size_t i) {
-    const size_t il = i == 0 ? nx - 1 : i - 1, ih = i + 1 == nx ? 0 : i + 1;
-    const float wl = (i == 0 && !px) ? 0.0f : wa[0][il];
-    update(i, neighbourSum<D, float>(s, wa, cr, i, il, ih, wl));
-  };
   auto general = [&](size_t from, size_t to) {
-    for (size_t i = from; i < to; ++i) update(i, neighbourSum<D, float>(s, wa, cr, i, i - 1, i + 1, wa[0][i - 1]));
-  };
-  edge(0);
-  if (nx == 1) return;
-  const auto& span = A.sweepSpan(row);
-  if (span.lo < span.hi) {
-    general(1, span.lo);
-    const float* yl = s.xlo[1];  // the neighbour rows (their cell 0)
-    const float* yh = s.xhi[1];
-    const float* zl = s.xlo[D - 1];
-    const float* zh = s.xhi[D - 1];
-    const float inv = ir[span.lo];
-    const bool weighted = span.w != 1.0f;
-#if MORPHOFLOW_AVX2_KERNELS
-    if (useAvx2()) {
-      (weighted ? uniformStepsAvx<D, First, true> : uniformStepsAvx<D, First, false>)(
-          span.lo, span.hi, cr, yl, yh, zl, zh, gr, er, span.w, inv, omega);
-    } else
-#endif
-    {
-      (weighted ? uniformStepsSse<D, First, true> : uniformStepsSse<D, First, false>)(
-          span.lo, span.hi, cr, yl, yh, zl, zh, gr, er, span.w, inv, omega);
+    for (size_t i = from; i < to; ++i, packed += kPacked<D>) {
+      const size_t il = i == 0 ? nx - 1 : i - 1, ih = i + 1 == nx ? 0 : i + 1;  // weight 0 unless periodic
+      float nb = packed[1] * cr[ih] + packed[2] * cr[il];
+      for (int a = 1; a < D; ++a) nb += packed[2 * a + 1] * s.xhi[a][i] + packed[2 * a + 2] * s.xlo[a][i];
+      const float jacobi = gr[i] + packed[0] * nb;  // inactive: 1 / diag = 0 and g = 0 keep e = 0
+      er[i] = First ? omega * jacobi : er[i] + omega * (jacobi - er[i]);
     }
-    general(span.hi, nx - 1);
-  } else {
-    general(1, nx - 1);
+  };
+  const auto& span = A.sweepSpan(row);
+  if (span.lo >= span.hi) {
+    general(0, nx);
+    return;
   }
-  edge(nx - 1);
+  general(0, span.lo);
+  const float inv = A.template invDiag<float>()[s.base + span.lo];
+  const bool weighted = span.w != 1.0f;
+  // The neighbour rows (their cell 0); in 2D the z pair repeats the y pair, unused.
+  const float *yl = s.xlo[1], *yh = s.xhi[1], *zl = s.xlo[D - 1], *zh = s.xhi[D - 1];
+#if MORPHOFLOW_AVX2_KERNELS
+  if (useAvx2()) {
+    (weighted ? uniformStepsAvx<D, First, true> : uniformStepsAvx<D, First, false>)(
+        span.lo, span.hi, cr, yl, yh, zl, zh, gr, er, span.w, inv, omega);
+  } else
+#endif
+  {
+    (weighted ? uniformStepsSse<D, First, true> : uniformStepsSse<D, First, false>)(
+        span.lo, span.hi, cr, yl, yh, zl, zh, gr, er, span.w, inv, omega);
+  }
+  general(span.hi, nx);
 }
 
 }  // namespace
@@ -110,7 +106,8 @@ template <int D>
 Chebyshev<D>::Chebyshev(const LaplaceSystem<D>& A, const ChebyshevLayout& layout) : A_(A), layout_(layout) {
   layout_.stepsPerPass = std::max(1, layout_.stepsPerPass);
   if (layout_.slabs <= 0) layout_.slabs = hardwareThreads();
-  refresh();  // the vectors wait for the first solve: a caller may only want the bound
+  zeros_.assign(size_t(A.dims[0]), 0.0f);
+  refresh();  // the other vectors wait for the first solve: a caller may only want the bound
 }
 
 template <int D>
@@ -130,6 +127,31 @@ void Chebyshev<D>::refresh() {
     return d > 0 ? 1.0 / d : 0.0;
   });
   diagRatio_ = dmax > 0 ? dmax * dminInv : 1.0;
+  // The coefficients of the cells outside each row's uniform span, packed.
+  const size_t nx = size_t(A_.dims[0]), rows = n / nx;
+  packedStart_.assign(rows + 1, 0);
+  for (size_t row = 0; row < rows; ++row) {
+    const auto& span = A_.sweepSpan(row);
+    packedStart_[row + 1] = packedStart_[row] + (nx - (span.hi - span.lo)) * kPacked<D>;
+  }
+  packed_.resize(packedStart_[rows]);
+  const float* invDiag = A_.template invDiag<float>();
+  parallelForRows<D>(A_.dims, [&](size_t row) {
+    const RowStencil<D, float> s = rowStencil<D, float>(A_, zerosOf(), zerosOf(), zerosOf(), row);
+    const auto& span = A_.sweepSpan(row);
+    float* out = packed_.data() + packedStart_[row];
+    for (size_t i = 0; i < nx; ++i) {
+      if (i >= span.lo && i < span.hi) continue;
+      const size_t il = i == 0 ? nx - 1 : i - 1;
+      *out++ = invDiag[s.base + i];
+      *out++ = A_.w[0][s.base + i];
+      *out++ = (i == 0 && !A_.periodic[0]) ? 0.0f : A_.w[0][s.base + il];
+      for (int a = 1; a < D; ++a) {
+        *out++ = A_.w[a][s.base + i];
+        *out++ = s.wlo[a][i];
+      }
+    }
+  });
   // w_1 = 1, w_2 = 1 / (1 - rho^2 / 2), w_k = 1 / (1 - rho^2 w_{k-1} / 4).
   omega_.assign(2, 1.0f);
   double w = 1.0;
@@ -148,81 +170,98 @@ int Chebyshev<D>::stepsFor(double factor) const {
 }
 
 template <int D>
-void Chebyshev<D>::plane(int level, size_t q, const Vector& r, double rscale) {
-  const LaplaceSystem<D>& A = A_;
-  const size_t nx = size_t(A.dims[0]);
-  const size_t rows = D == 3 ? size_t(A.dims[1]) : 1;
-  for (size_t k = 0; k < rows; ++k) {
-    const size_t row = q * rows + k, y = D == 3 ? k : q, z = D == 3 ? q : 0;
-    if (level == 1) {  // e_1 = g = rscale D^-1 r / scale
-      const size_t base = row * nx;
-      const double sc = rscale / A.scale;
-      const double* __restrict inv = A.template invDiag<double>() + base;
-      const double* __restrict rr = r.data() + base;
-      float* __restrict g = g_.data() + base;
-      float* __restrict e = e_[1].data() + base;
-      for (size_t i = 0; i < nx; ++i) {
-        g[i] = float(rr[i] * sc * inv[i]);
-        e[i] = g[i];
-      }
-    } else {
-      const float* cur = e_[(level - 1) & 1].data();
-      float* e = e_[level & 1].data();
-      if (level == 2)
-        stepRow<D, true>(A, row, y, z, cur, e, g_.data(), zeros_.data(), omega_[2]);
-      else
-        stepRow<D, false>(A, row, y, z, cur, e, g_.data(), zeros_.data(),
-                          omega_[std::min(size_t(level), omega_.size() - 1)]);
-    }
+template <class Op>
+void Chebyshev<D>::pipeline(const int m, Op&& op) {
+  const size_t planes = size_t(A_.dims[D - 1]);
+  const bool wrap = A_.periodic[D - 1];
+  if (m == 1 || (wrap && planes < size_t(2 * m + 2))) {  // a periodic cut needs the room below
+    // Each step in a pass of its own: a plane then reads finished planes only.
+    for (int t = 1; t <= m; ++t)
+      parallelFor(planes, [&](size_t q) { op(t, q); }, std::max<size_t>(1, 16384 / (A_.size() / planes)));
+    return;
   }
+  // Slabs at least 2m + 2 planes thick, so the triangles around two cuts
+  // neither overlap nor read what the other writes.
+  const size_t slabs = std::max<size_t>(1, std::min(size_t(layout_.slabs), planes / size_t(2 * m + 2)));
+  auto begin = [&](size_t j) { return j * planes / slabs; };
+  // Step t shrinks t planes away from each cut (a slab edge that is not
+  // the domain's, or the periodic wrap); within a slab, step t on plane
+  // p - t + 1 follows step t - 1 on plane p.
+  parallelFor(slabs, [&](size_t j) {
+    const size_t lo = begin(j), hi = begin(j + 1);
+    const bool cutLo = j > 0 || wrap, cutHi = j + 1 < slabs || wrap;
+    for (size_t p = lo; p < hi + size_t(m) - 1; ++p)
+      for (int t = 1; t <= m; ++t) {
+        if (p < lo + size_t(t) - 1) break;
+        const size_t q = p - size_t(t - 1);
+        if ((cutLo && q < lo + size_t(t)) || (cutHi && q + size_t(t) >= hi) || q >= hi) continue;
+        op(t, q);
+      }
+  });
+  // The triangles: step t on the 2t planes around each cut.
+  const size_t cuts = wrap ? slabs : slabs - 1;
+  parallelFor(cuts, [&](size_t j) {
+    const size_t cut = wrap ? begin(j) : begin(j + 1);
+    for (int t = 1; t <= m; ++t)
+      for (size_t d = 0; d < size_t(2 * t); ++d) op(t, (cut + planes - size_t(t) + d) % planes);
+  });
 }
 
 template <int D>
-void Chebyshev<D>::run(int steps, const Vector& r, double rscale) {
-  const size_t planes = size_t(A_.dims[D - 1]);
-  const bool wrap = A_.periodic[D - 1];
-  for (int done = 0; done < steps;) {
-    int m = std::min(layout_.stepsPerPass, steps - done);
-    // Slabs at least 2m + 2 planes thick, so the triangles around two cuts
-    // neither overlap nor read what the other writes.
-    const size_t slabs = std::max<size_t>(1, std::min(size_t(layout_.slabs), planes / size_t(2 * m + 2)));
-    if (wrap && planes < size_t(2 * m + 2)) m = 1;  // a periodic cut needs the room as well
-    const int first = done + 1;
-    if (m == 1) {  // one step: each plane reads the other vector only
-      parallelFor(planes, [&](size_t q) { plane(first, q, r, rscale); }, std::max<size_t>(1, 16384 / (A_.size() / planes)));
-      done += 1;
-      continue;
+void Chebyshev<D>::rows(size_t q, auto&& fn) const {
+  const size_t perPlane = D == 3 ? size_t(A_.dims[1]) : 1;
+  for (size_t k = 0; k < perPlane; ++k) fn(q * perPlane + k, D == 3 ? k : q, D == 3 ? q : 0);
+}
+
+template <int D>
+void Chebyshev<D>::step(int level, size_t q) {
+  const float* cur = e_[(level - 1) & 1].data();
+  float* e = e_[level & 1].data();
+  const float omega = omega_[std::min(size_t(level), omega_.size() - 1)];
+  rows(q, [&](size_t row, size_t y, size_t z) {
+    if (level == 2)
+      stepRow<D, true>(A_, row, y, z, cur, e, g_.data(), zeros_.data(), packedRow(row), omega);
+    else
+      stepRow<D, false>(A_, row, y, z, cur, e, g_.data(), zeros_.data(), packedRow(row), omega);
+  });
+}
+
+template <int D>
+void Chebyshev<D>::residualPlane(const Vector& b, const Vector& x, size_t q) {
+  // r = b - A x row by row into a row buffer (r itself never goes to
+  // memory), then step 1: e_1 = g = rscale D^-1 r / scale.
+  const size_t nx = size_t(A_.dims[0]);
+  thread_local std::vector<double> buffer;
+  buffer.resize(nx);
+  const double sc = rscale_ / A_.scale;
+  double sum = 0.0;
+  rows(q, [&](size_t row, size_t, size_t) {
+    sum += A_.residualRow(row, b, x, buffer.data());
+    const size_t base = row * nx;
+    const double* __restrict inv = A_.template invDiag<double>() + base;
+    const double* __restrict rr = buffer.data();
+    float* __restrict g = g_.data() + base;
+    float* __restrict e = e_[1].data() + base;
+    for (size_t i = 0; i < nx; ++i) {
+      g[i] = float(rr[i] * sc * inv[i]);
+      e[i] = g[i];
     }
-    auto begin = [&](size_t j) { return j * planes / slabs; };
-    // Step t shrinks t planes away from each cut (a slab edge that is not
-    // the domain's, or the periodic wrap).
-    parallelFor(slabs, [&](size_t j) {
-      const size_t lo = begin(j), hi = begin(j + 1);
-      const bool cutLo = j > 0 || wrap, cutHi = j + 1 < slabs || wrap;
-      for (size_t p = lo; p < hi + size_t(m) - 1; ++p)
-        for (int t = 1; t <= m; ++t) {
-          if (p < lo + size_t(t) - 1) break;
-          const size_t q = p - size_t(t - 1);
-          if ((cutLo && q < lo + size_t(t)) || (cutHi && q + size_t(t) >= hi) || q >= hi) continue;
-          plane(first + t - 1, q, r, rscale);
-        }
-    });
-    // The triangles: step t on the 2t planes around each cut.
-    const size_t cuts = wrap ? slabs : slabs - 1;
-    parallelFor(cuts, [&](size_t j) {
-      const size_t cut = wrap ? begin(j) : begin(j + 1);
-      for (int t = 1; t <= m; ++t)
-        for (size_t d = 0; d < size_t(2 * t); ++d) plane(first + t - 1, (cut + planes - size_t(t) + d) % planes, r, rscale);
-    });
-    done += m;
-  }
+  });
+  planeSquares_[q] = sum;
+}
+
+template <int D>
+double Chebyshev<D>::residualNorm() const {
+  double sum = 0.0;  // in plane order: independent of how the planes were scheduled
+  for (double v : planeSquares_) sum += v;
+  return std::sqrt(sum);
 }
 
 template <int D>
 SolverResult Chebyshev<D>::solve(const Vector& b, Vector* xp, const SolverOptions& options) {
   if (!applicable()) return solvePCG<D>(A_, b, xp, nullptr, options);  // no bound: plain CG
   Vector& x = *xp;
-  const size_t n = A_.size();
+  const size_t n = A_.size(), nx = size_t(A_.dims[0]);
   x.resize(n, 0.0);
   SolverResult result;
   const double bnorm = norm2(b);
@@ -233,10 +272,12 @@ SolverResult Chebyshev<D>::solve(const Vector& b, Vector* xp, const SolverOption
   }
   for (auto& v : e_) v.resize(n);
   g_.resize(n);
-  zeros_.assign(size_t(A_.dims[0]), 0.0f);
-  r_.resize(n);
+  planeSquares_.assign(size_t(A_.dims[D - 1]), 0.0);
+  // g of order 1 in float for any residual from 1e-30 ||b|| up.
+  rscale_ = std::sqrt(double(n)) / bnorm;
   const double budget = options.tolerance * bnorm;
-  double rnorm = A_.residual(b, x, &r_);
+  pipeline(1, [&](int, size_t q) { residualPlane(b, x, q); });
+  double rnorm = residualNorm();
   // Rounds of at most 1e4 each: the float steps resolve that much of the
   // correction with digits to spare.
   constexpr double kRoundFactor = 1e4;
@@ -244,13 +285,25 @@ SolverResult Chebyshev<D>::solve(const Vector& b, Vector* xp, const SolverOption
   while (rnorm > budget && result.iterations < options.maxIterations && rounds < 16) {
     const int steps =
         std::min(stepsFor(std::min(rnorm / budget, kRoundFactor)), options.maxIterations - result.iterations);
-    const double rscale = std::sqrt(double(n)) / rnorm;  // g of order 1 in float
-    run(steps, r_, rscale);
-    const float* __restrict e = e_[steps & 1].data();
-    double* __restrict xd = x.data();
-    const double inv = 1.0 / rscale;
-    parallelFor(n, [&](size_t i) { xd[i] += double(e[i]) * inv; }, 4096);
-    rnorm = A_.residual(b, x, &r_);
+    // Steps 2.. (step 1 came with the residual), layoutSteps per pass.
+    for (int done = 1; done < steps;) {
+      const int m = std::min(layout_.stepsPerPass, steps - done);
+      pipeline(m, [&](int t, size_t q) { step(done + t, q); });
+      done += m;
+    }
+    // x += e / rscale on plane q, then the new residual (and the next
+    // round's g) on plane q - 1, whose neighbours are then all updated.
+    const float* e = e_[steps & 1].data();
+    const double inv = 1.0 / rscale_;
+    pipeline(2, [&](int t, size_t q) {
+      if (t == 2) return residualPlane(b, x, q);
+      rows(q, [&](size_t row, size_t, size_t) {
+        const float* __restrict er = e + row * nx;
+        double* __restrict xr = x.data() + row * nx;
+        for (size_t i = 0; i < nx; ++i) xr[i] += double(er[i]) * inv;
+      });
+    });
+    rnorm = residualNorm();
     result.iterations += steps;
     ++rounds;
   }

@@ -56,10 +56,19 @@ class Chebyshev {
   SolverResult solve(const Vector& b, Vector* x, const SolverOptions& options);
 
  private:
-  // e = `steps` Chebyshev steps from 0 on M e = g, g = rscale D^-1 r / scale.
-  void run(int steps, const Vector& r, double rscale);
-  // Step `level` (>= 1; the first forms g) on plane q along the last axis.
-  void plane(int level, size_t q, const Vector& r, double rscale);
+  // Runs op(t, q), t = 1..m, on every plane q along the last axis, step t
+  // on a plane after step t - 1 on the plane and its neighbours, m steps
+  // in one pass over memory (see above).
+  template <class Op>
+  void pipeline(int m, Op&& op);
+  // fn(row, y, z) for each row of plane q.
+  void rows(size_t q, auto&& fn) const;
+  // Chebyshev step `level` (>= 2) on plane q.
+  void step(int level, size_t q);
+  // r = b - A x on plane q; writes step 1 (e_1 = g = rscale D^-1 r / scale)
+  // and the plane's ||r||^2.
+  void residualPlane(const Vector& b, const Vector& x, size_t q);
+  double residualNorm() const;  // of the last residual, from the planes' sums
 
   const LaplaceSystem<D>& A_;
   ChebyshevLayout layout_;
@@ -68,8 +77,15 @@ class Chebyshev {
   std::vector<float> e_[2];   // step k lives in e_[k & 1]
   std::vector<float> g_;      // D^-1 r, scaled
   std::vector<float> zeros_;  // a row of zeros: beyond a non-periodic edge
+  const float* zerosOf() const { return zeros_.data(); }
+  // Per row, from packedStart_[row]: the coefficients of its cells outside
+  // the uniform span (1 / diag, then the face weights), 2D + 1 floats each.
+  std::vector<size_t> packedStart_;
+  std::vector<float> packed_;
+  const float* packedRow(size_t row) const { return packed_.data() + packedStart_[row]; }
   std::vector<float> omega_;  // omega_[k] of step k
-  Vector r_;
+  std::vector<double> planeSquares_;
+  double rscale_ = 1.0;
 };
 
 }  // namespace morphoflow

@@ -301,7 +301,7 @@ double LaplaceSystem<D>::applyRow(size_t row, const T* x, T* y, const T* b) cons
   for (int a = 0; a < D; ++a) wa[a] = w[a].data() + s.base;
   const float* cr = c.data() + s.base;
   const T* xr = x + s.base;
-  T* yr = y + s.base;
+  T* yr = y;  // the row's own values
   auto edge = [&](size_t i) {
     size_t il = i == 0 ? nx - 1 : i - 1, ih = i + 1 == nx ? 0 : i + 1;
     float wl = (i == 0 && !px) ? 0.0f : wa[0][il];
@@ -357,12 +357,15 @@ double LaplaceSystem<D>::applyRow(size_t row, const T* x, T* y, const T* b) cons
 template <int D>
 template <class T>
 void LaplaceSystem<D>::apply(const std::vector<T>& x, std::vector<T>* y) const {
-  parallelForRows<D>(dims, [&](size_t row) { applyRow<T, false>(row, x.data(), y->data()); });
+  const size_t nx = size_t(dims[0]);
+  parallelForRows<D>(dims, [&](size_t row) { applyRow<T, false>(row, x.data(), y->data() + row * nx); });
 }
 
 template <int D>
 double LaplaceSystem<D>::applyDot(const Vector& x, Vector* y) const {
-  return deterministicRowSum<D>(dims, [&](size_t row) { return applyRow<double, true>(row, x.data(), y->data()); });
+  const size_t nx = size_t(dims[0]);
+  return deterministicRowSum<D>(dims,
+                                [&](size_t row) { return applyRow<double, true>(row, x.data(), y->data() + row * nx); });
 }
 
 template <int D>
@@ -372,7 +375,7 @@ double LaplaceSystem<D>::defectRow(size_t row, const T* b, const T* x, T* r) con
   // there too while the row is in cache.
   applyRow<T, false>(row, x, r, b);
   const size_t nx = size_t(dims[0]), base = row * nx;
-  T* __restrict rr = r + base;
+  T* __restrict rr = r;
   const T* __restrict br = b + base;
   const float* __restrict dr = diag.data() + base;
   // b - A x where the cell is active, else 0, as a bit mask: a branch (or
@@ -399,14 +402,22 @@ double LaplaceSystem<D>::defectRow(size_t row, const T* b, const T* x, T* r) con
 template <int D>
 template <class T>
 void LaplaceSystem<D>::defect(const std::vector<T>& b, const std::vector<T>& x, std::vector<T>* r) const {
-  parallelForRows<D>(dims, [&](size_t row) { defectRow<T, false>(row, b.data(), x.data(), r->data()); });
+  const size_t nx = size_t(dims[0]);
+  parallelForRows<D>(dims, [&](size_t row) { defectRow<T, false>(row, b.data(), x.data(), r->data() + row * nx); });
 }
 
 template <int D>
 double LaplaceSystem<D>::residual(const Vector& b, const Vector& x, Vector* r) const {
   // The norm while each row is in cache, rather than a second pass over r.
   return std::sqrt(
-      deterministicRowSum<D>(dims, [&](size_t row) { return defectRow<double, true>(row, b.data(), x.data(), r->data()); }));
+      deterministicRowSum<D>(dims, [&](size_t row) {
+        return defectRow<double, true>(row, b.data(), x.data(), r->data() + row * size_t(dims[0]));
+      }));
+}
+
+template <int D>
+double LaplaceSystem<D>::residualRow(size_t row, const Vector& b, const Vector& x, double* r) const {
+  return defectRow<double, true>(row, b.data(), x.data(), r);
 }
 
 namespace {

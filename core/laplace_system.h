@@ -51,6 +51,8 @@ struct LaplaceSystem {
   void defect(const std::vector<T>& b, const std::vector<T>& x, std::vector<T>* r) const;
   // r = b - A x; returns ||r||_2.
   double residual(const Vector& b, const Vector& x, Vector* r) const;
+  // r = b - A x on one row (r: that row's nx values); returns its ||r||^2.
+  double residualRow(size_t row, const Vector& b, const Vector& x, double* r) const;
   // One red-black Gauss-Seidel sweep; `reverse` runs black first (so a
   // reversed post-smoother makes a symmetric V-cycle).
   template <class T>
@@ -79,11 +81,13 @@ struct LaplaceSystem {
   const Span& sweepSpan(size_t row) const { return sweepSpan_[row]; }
 
  private:
-  // y = A x on one row; returns the row's x . y when Dot (else 0). With b,
-  // the row's uniform span gets b - A x instead (its cells are all active).
+  // y = A x on one row (y: the row's nx values, x and b: whole vectors);
+  // returns the row's x . y when Dot (else 0). With b, the row's uniform
+  // span gets b - A x instead (its cells are all active).
   template <class T, bool Dot>
   double applyRow(size_t row, const T* x, T* y, const T* b = nullptr) const;
-  // r = b - A x on one row; returns the row's r . r when SumSquares (else 0).
+  // r = b - A x on one row (r: the row's values); returns the row's r . r
+  // when SumSquares (else 0).
   template <class T, bool SumSquares>
   double defectRow(size_t row, const T* b, const T* x, T* r) const;
   template <class T>
