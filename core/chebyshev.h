@@ -50,6 +50,14 @@ class Chebyshev {
   // Steps that reduce the residual's 2-norm by `factor` in exact arithmetic:
   // the least k with T_k(1 / rho) >= factor sqrt(max diag / min diag).
   int stepsFor(double factor) const;
+  // Whether it beats multigrid-preconditioned CG on this system: while a
+  // 1e4 reduction takes at most kQuickSteps steps. The steps grow as
+  // sqrt(nu dt) / h, CG's multigrid iterations do not. Measured on the
+  // cavity's viscosity at 512^2 and 64^3: 1.4-1.6x faster at 20 to 40 steps
+  // per solve, level at 60 to 70, slower at 95 (docs/performance.md); so up
+  // to nu dt / h^2 of about 30 in 2D and 20 in 3D.
+  static constexpr int kQuickSteps = 80;
+  bool quick() const { return applicable() && stepsFor(1e4) <= kQuickSteps; }
 
   // Solves A x = b from *x to the relative residual options.tolerance;
   // iterations counts the Chebyshev steps (plain CG where not applicable).

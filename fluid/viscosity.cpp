@@ -62,12 +62,6 @@ ViscositySolver<D>::ViscositySolver(const VelocityConstraints<D>& vc, const Solv
 }
 
 namespace {
-// The Chebyshev iteration solves while a 1e4 reduction takes at most this
-// many steps; beyond, multigrid-preconditioned CG is the faster (steps grow
-// as sqrt(nu dt) / h, its iterations do not). Measured on the cavity at
-// 512^2 and 64^3: Chebyshev 1.4-1.6x faster at about 20 and 40 steps per
-// solve, level at about 60 to 70, slower at 95 (docs/performance.md).
-constexpr int kChebyshevSteps = 80;
 // Three smoothing sweeps each way: the identity term makes the viscous
 // systems better conditioned than the pressure's, and with the sweeps in one
 // pass over memory a third sweep costs less than the outer iteration it
@@ -108,7 +102,7 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
         C.chebyshev->refresh();
       else
         C.chebyshev = std::make_unique<Chebyshev<D>>(C.A);
-      if (C.chebyshev->stepsFor(1e4) <= kChebyshevSteps)
+      if (C.chebyshev->quick())
         C.multigrid.reset();
       else if (C.multigrid)
         C.multigrid->refresh();

@@ -2,9 +2,9 @@
 // component on its face grid, no-slip at walls through mirrored ghost values
 // (moving walls reflect their velocity), zero gradient at outflow. Solved by
 // the Chebyshev iteration (core/chebyshev.h) while the identity term keeps
-// the system well conditioned (up to nu dt / h^2 of about 30 in 2D and 20 in
-// 3D: a 1e4 reduction within kChebyshevSteps steps), else by multigrid-
-// preconditioned CG, whose count does not grow with nu dt. The systems are built
+// the system well conditioned (Chebyshev::quick(): nu dt / h^2 up to about
+// 30 in 2D and 20 in 3D), else by multigrid-preconditioned CG, whose
+// iteration count does not grow with nu dt. The systems are built
 // once; a new nu dt (a CFL-limited step) only rescales their diagonal and
 // re-derives the multigrid levels in place. Each solve starts from u* plus
 // the viscous increment extrapolated from the last two steps (per unit

@@ -6,6 +6,7 @@
 
 #include "core/jacobi.h"
 #include "core/mic0.h"
+#include "core/chebyshev.h"
 #include "core/multigrid.h"
 #include "core/parallel.h"
 
@@ -18,6 +19,8 @@ constexpr size_t kChunk = 4096;  // cells per reaction task (fixed: results do n
 template <int D>
 struct RDSolver<D>::Diffusion {
   AnisotropicSystem<D> A;  // I - theta dt d lap, as c x + sum w (x_i - x_j) (+ diagonal pairs)
+  std::unique_ptr<Chebyshev<D>> chebyshev;  // for an operator without mixed terms
+  bool useChebyshev = false;                 // it solves instead of PCG: it is the quicker
   std::unique_ptr<Preconditioner> M;
   PcgWorkspace ws;
   Vector x;
@@ -223,7 +226,18 @@ SolverResult RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
     // it for a positive definite sigma). A multigrid hierarchy of the same
     // shape (a new dt: only the coefficients changed) is re-derived in place.
     auto* mg = dynamic_cast<Multigrid<D>*>(df.M.get());
-    if (settings_.linearSolver == RDLinearSolver::ICPCG)
+    // The default solver takes the Chebyshev iteration where it is the
+    // quicker (an isotropic operator, diffusion not too far beyond the
+    // identity: core/chebyshev.h).
+    const bool chebyshev = settings_.linearSolver == RDLinearSolver::MGPCG && !df.A.hasCross;
+    if (chebyshev && df.chebyshev)
+      df.chebyshev->refresh();  // it reads df.A.axis, assigned in place above
+    else if (chebyshev)
+      df.chebyshev = std::make_unique<Chebyshev<D>>(df.A.axis);
+    df.useChebyshev = chebyshev && df.chebyshev->quick();
+    if (df.useChebyshev)
+      df.M.reset();
+    else if (settings_.linearSolver == RDLinearSolver::ICPCG)
       df.M = std::make_unique<MIC0Preconditioner<D>>(df.A.axis);
     else if (scale > 1.0 && mg)
       mg->refresh();
@@ -251,7 +265,8 @@ SolverResult RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
     df.x = b;
   }
   SolverOptions o{settings_.tolerance, 2000};
-  SolverResult r = solvePCG<D>(df.A, b, &df.x, df.M.get(), o, nullptr, &df.ws);
+  SolverResult r =
+      df.useChebyshev ? df.chebyshev->solve(b, &df.x, o) : solvePCG<D>(df.A, b, &df.x, df.M.get(), o, nullptr, &df.ws);
   df.increment.resize(b.size());
   parallelFor(b.size(), [&](size_t i) { df.increment[i] = df.x[i] - b[i]; }, kChunk);
   df.incrementThetaDt = thetaDt;
