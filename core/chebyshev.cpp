@@ -258,13 +258,13 @@ double Chebyshev<D>::residualNorm() const {
 }
 
 template <int D>
-SolverResult Chebyshev<D>::solve(const Vector& b, Vector* xp, const SolverOptions& options) {
+SolverResult Chebyshev<D>::solve(const Vector& b, Vector* xp, const SolverOptions& options, double bnorm) {
   if (!applicable()) return solvePCG<D>(A_, b, xp, nullptr, options);  // no bound: plain CG
   Vector& x = *xp;
   const size_t n = A_.size(), nx = size_t(A_.dims[0]);
   x.resize(n, 0.0);
   SolverResult result;
-  const double bnorm = norm2(b);
+  if (bnorm < 0.0) bnorm = norm2(b);
   if (bnorm == 0.0) {
     std::fill(x.begin(), x.end(), 0.0);
     result.converged = true;

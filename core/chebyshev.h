@@ -61,7 +61,8 @@ class Chebyshev {
 
   // Solves A x = b from *x to the relative residual options.tolerance;
   // iterations counts the Chebyshev steps (plain CG where not applicable).
-  SolverResult solve(const Vector& b, Vector* x, const SolverOptions& options);
+  // bnorm, when known (>= 0), saves a pass: ||b||_2.
+  SolverResult solve(const Vector& b, Vector* x, const SolverOptions& options, double bnorm = -1.0);
 
  private:
   // Runs op(t, q), t = 1..m, on every plane q along the last axis, step t

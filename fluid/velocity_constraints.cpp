@@ -37,6 +37,8 @@ VelocityConstraints<D>::VelocityConstraints(const IVec<D>& c, double hh, const D
         value[a][i] = 0.0f;
       }
     });
+    for (size_t i = 0; i < fixed[a].size(); ++i)
+      if (fixed[a][i]) fixedFaces[a].push_back(i);
   }
 }
 
@@ -65,15 +67,18 @@ template <int D>
 void VelocityConstraints<D>::apply(MacVelocity<D>* u) const {
   for (int a = 0; a < D; ++a) {
     Grid<float, D>& g = (*u)[a];
-    const Grid<uint8_t, D>& f = fixed[a];
     const Grid<float, D>& v = value[a];
-    parallelFor(g.size(), [&](size_t i) {
-      if (f[i]) g[i] = v[i];
-    }, 8192);
-    if (boundaries.periodic(a)) {
-      size_t stride = g.stride(a);
-      forEachCell<D>(g.dims(), [&](const IVec<D>& k, size_t i) {
-        if (k[a] == cells[a]) g[i] = g[i - stride * size_t(cells[a])];
+    const std::vector<size_t>& faces = fixedFaces[a];
+    parallelFor(faces.size(), [&](size_t k) { g[faces[k]] = v[faces[k]]; }, 8192);
+    if (boundaries.periodic(a)) {  // the layer k_a = n_a only
+      const size_t stride = g.stride(a);
+      IVec<D> layer = g.dims();
+      layer[a] = 1;
+      forEachCell<D>(layer, [&](const IVec<D>& k, size_t) {
+        IVec<D> top = k;
+        top[a] = cells[a];
+        const size_t i = g.index(top);
+        g[i] = g[i - stride * size_t(cells[a])];
       });
     }
   }

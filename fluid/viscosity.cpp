@@ -112,12 +112,18 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
     // Warm start: the increment's rate, linearly extrapolated in steps.
     const std::vector<float> &r1 = C.rate[0], &r0 = C.rate[1];
     const int history = C.history;
-    eachUnknown(a, [&](size_t i, size_t gi) {
+    auto setUp = [&](size_t i, size_t gi) {
       const double rate = history >= 2 ? 2.0 * double(r1[i]) - double(r0[i]) : history == 1 ? double(r1[i]) : 0.0;
       C.x[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * rate;
       C.b[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * C.boundaryRhs[i];
-    });
-    bb[ai] = dot(C.b, C.b);
+      return C.b[i] * C.b[i];
+    };
+    if (C.dims == g.dims())  // ||b||^2 in the same pass (the same sum as dot(b, b))
+      bb[ai] = deterministicSum(C.A.size(), [&](size_t i) { return setUp(i, i); });
+    else {
+      eachUnknown(a, setUp);
+      bb[ai] = dot(C.b, C.b);
+    }
   });
   // The D systems are blocks of one linear system, (I - nu dt lap) u = u*
   // on the MAC velocity, solved to a relative residual of that system:
@@ -141,7 +147,7 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
     if (C.multigrid)
       results[ai] = solvePCG<D>(C.A, C.b, &C.x, C.multigrid.get(), options, nullptr, &C.workspace);
     else
-      results[ai] = C.chebyshev->solve(C.b, &C.x, options);
+      results[ai] = C.chebyshev->solve(C.b, &C.x, options, std::sqrt(bb[ai]));
     rr[ai] = results[ai].residual * results[ai].residual * bb[ai];
     std::swap(C.rate[0], C.rate[1]);  // the older slot takes the new rate
     std::vector<float>& rate = C.rate[0];
