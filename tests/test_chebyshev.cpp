@@ -259,3 +259,21 @@ TEST(Chebyshev, ResidualIsTheChebyshevPolynomialAtTheSpectrumsEnds) {
   checkExtremalModes<2>(IVec<2>(16, 40), 8.0);
   checkExtremalModes<3>(IVec<3>(16, 12, 30), 1.28);
 }
+
+// The steps run in single precision on a scaled correction: right-hand
+// sides far outside float's range (1e-150, 1e+150: a decaying or exploding
+// species) solve to scale, as those of order 1 do.
+TEST(Chebyshev, SolvesAnyScale) {
+  const LaplaceSystem<2> A = viscousSystem<2>(IVec<2>(40, 36), 2.0, false);
+  const Vector unit = wavyVector<2>(A, 0.2);
+  const SolverOptions o{1e-9, 2000};
+  Vector x1(A.size(), 0.0);
+  ASSERT_TRUE(Chebyshev<2>(A).solve(unit, &x1, o).converged);
+  for (double scale : {1e-150, 1e150}) {
+    Vector b(unit.size()), x(A.size(), 0.0);
+    for (size_t i = 0; i < b.size(); ++i) b[i] = scale * unit[i];
+    const SolverResult r = Chebyshev<2>(A).solve(b, &x, o);
+    ASSERT_TRUE(r.converged) << scale << " " << r.residual;
+    for (size_t i = 0; i < x.size(); ++i) EXPECT_NEAR(x[i] / scale, x1[i], 1e-7 * std::abs(x1[i]) + 1e-9) << scale;
+  }
+}
