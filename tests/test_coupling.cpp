@@ -222,10 +222,13 @@ TEST(CoupledStepper, LargeTimeStepStaysBounded) {
 
 // The trace shows the schedule: with tbb the ARD step of step n runs on
 // another thread while the fluid computes step n + 1; serial never overlaps.
+// 160^2 keeps each stage long (a few ms) against scheduling jitter: at 96^2
+// the faster solvers left too short a window on a loaded machine (ctest -j2),
+// where 3 to 6 of 12 steps overlapped.
 TEST(CoupledStepper, TraceShowsTheOverlap) {
   auto overlaps = [](CouplingBackend backend, int* threads) {
     StageTrace trace;
-    runCavity(backend, 2, 12, 0.02, 96, &trace);
+    runCavity(backend, 2, 12, 0.02, 160, &trace);
     const std::vector<StageTrace::Event> events = trace.events();
     std::set<int> used;
     for (const auto& e : events) used.insert(e.thread);
