@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/parallel.h"
 #include "core/row_stencil.h"
@@ -165,6 +166,7 @@ void Chebyshev<D>::refresh() {
 template <int D>
 int Chebyshev<D>::stepsFor(double factor) const {
   if (rho_ <= 0.0) return 1;  // M = I: one step is exact
+  if (!applicable()) return std::numeric_limits<int>::max();  // no bound
   const double target = std::max(1.0, factor * std::sqrt(diagRatio_));
   return std::max(1, int(std::ceil(std::acosh(target) / std::acosh(1.0 / rho_))));
 }
@@ -285,7 +287,7 @@ SolverResult Chebyshev<D>::solve(const Vector& b, Vector* xp, const SolverOption
   while (rnorm > budget && result.iterations < options.maxIterations && rounds < 16) {
     const int steps =
         std::min(stepsFor(std::min(rnorm / budget, kRoundFactor)), options.maxIterations - result.iterations);
-    // Steps 2.. (step 1 came with the residual), layoutSteps per pass.
+    // Steps 2.. (step 1 came with the residual), layout_.stepsPerPass per pass.
     for (int done = 1; done < steps;) {
       const int m = std::min(layout_.stepsPerPass, steps - done);
       pipeline(m, [&](int t, size_t q) { step(done + t, q); });
