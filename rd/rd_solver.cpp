@@ -220,15 +220,15 @@ SolverResult RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
     // identity exact (c = 1 away from Dirichlet walls), so a zero-flux run
     // conserves mass to round-off.
     df.A = diffusionOperator(s).shifted(thetaDt * d);
-    // MIC(0) on request; else multigrid once diffusion dominates the identity
-    // (scale > 1), Jacobi below, where the system is diagonally dominant. With
-    // a tensor they precondition the axis part (the mixed terms are bounded by
-    // it for a positive definite sigma). A multigrid hierarchy of the same
-    // shape (a new dt: only the coefficients changed) is re-derived in place.
-    auto* mg = dynamic_cast<Multigrid<D>*>(df.M.get());
     // The default solver takes the Chebyshev iteration where it is the
     // quicker (an isotropic operator, diffusion not too far beyond the
-    // identity: core/chebyshev.h).
+    // identity: core/chebyshev.h). Else PCG: with MIC(0) on request; else
+    // multigrid once diffusion dominates the identity (scale > 1), Jacobi
+    // below, where the system is diagonally dominant. With a tensor they
+    // precondition the axis part (the mixed terms are bounded by it for a
+    // positive definite sigma). A multigrid hierarchy of the same shape (a
+    // new dt: only the coefficients changed) is re-derived in place.
+    auto* mg = dynamic_cast<Multigrid<D>*>(df.M.get());
     const bool chebyshev = settings_.linearSolver == RDLinearSolver::MGPCG && !df.A.hasCross;
     if (chebyshev && df.chebyshev)
       df.chebyshev->refresh();  // it reads df.A.axis, assigned in place above
