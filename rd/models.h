@@ -2,6 +2,10 @@
 //   N species, P parameters, info() (names, defaults, equations), and
 //   static rates(x, p, r) / jacobian(x, p, J) for one cell (J row-major,
 //   J[s * N + t] = dR_s / dx_t).
+// The two-species models take x as T: a double, or a vector of doubles for
+// several cells at once (rd/newton_batch.h), each lane with the double's
+// arithmetic. So a constant is written c - T() (exactly c in every lane, -0
+// included) and a max as a select.
 // Diffusion defaults assume the units the source uses (cell size 1 unless
 // the scene's domain says otherwise); every default is overridable.
 #pragma once
@@ -24,11 +28,13 @@ struct Turing {
             {{"s", 1.0 / 128, "reaction rate"}, {"alpha", 16.0, "growth of a"}, {"beta", 12.0, "decay of b"}},
             {0.25, 0.0625}, {4.0, 4.0}, 0.0, 16.0, true, {1}};
   }
-  static void rates(const double* x, const double* p, double* r) {
+  template <class T>
+  static void rates(const T* x, const double* p, T* r) {
     r[0] = p[0] * (p[1] - x[0] * x[1]);
     r[1] = p[0] * (x[0] * x[1] - x[1] - p[2]);
   }
-  static void jacobian(const double* x, const double* p, double* J) {
+  template <class T>
+  static void jacobian(const T* x, const double* p, T* J) {
     J[0] = -p[0] * x[1], J[1] = -p[0] * x[0];
     J[2] = p[0] * x[1], J[3] = p[0] * (x[0] - 1.0);
   }
@@ -45,11 +51,13 @@ struct TuringSanderson {
             {{"s", 1.0 / 128, "reaction rate"}, {"alpha", 12.0, "decay of a"}, {"beta", 16.0, "growth of b"}},
             {1.0 / 16, 1.0 / 4}, {4.0, 4.0}, 0.0, 16.0, true, {0}};
   }
-  static void rates(const double* x, const double* p, double* r) {
+  template <class T>
+  static void rates(const T* x, const double* p, T* r) {
     r[0] = p[0] * (x[0] * x[1] - x[0] - p[1]);
     r[1] = p[0] * (p[2] - x[0] * x[1]);
   }
-  static void jacobian(const double* x, const double* p, double* J) {
+  template <class T>
+  static void jacobian(const T* x, const double* p, T* J) {
     J[0] = p[0] * (x[1] - 1.0), J[1] = p[0] * x[0];
     J[2] = -p[0] * x[1], J[3] = -p[0] * x[0];
   }
@@ -66,12 +74,14 @@ struct GrayScott {
             {{"F", 0.04, "feed rate"}, {"k", 0.06, "kill rate"}},
             {2e-5, 1e-5}, {1.0, 0.0}, 0.0, 1.0, false, {}};
   }
-  static void rates(const double* x, const double* p, double* r) {
-    double uvv = x[0] * x[1] * x[1];
+  template <class T>
+  static void rates(const T* x, const double* p, T* r) {
+    const T uvv = x[0] * x[1] * x[1];
     r[0] = -uvv + p[0] * (1.0 - x[0]);
     r[1] = uvv - (p[0] + p[1]) * x[1];
   }
-  static void jacobian(const double* x, const double* p, double* J) {
+  template <class T>
+  static void jacobian(const T* x, const double* p, T* J) {
     J[0] = -x[1] * x[1] - p[0], J[1] = -2.0 * x[0] * x[1];
     J[2] = x[1] * x[1], J[3] = 2.0 * x[0] * x[1] - (p[0] + p[1]);
   }
@@ -87,12 +97,14 @@ struct GrayScottSanderson {
             {{"s", 1.0, "reaction rate"}, {"F", 0.04, "feed rate"}, {"k", 0.06, "kill rate"}},
             {1e-5, 2e-5}, {0.0, 1.0}, 0.0, 1.0, false, {}};
   }
-  static void rates(const double* x, const double* p, double* r) {
-    double aab = x[0] * x[0] * x[1];
+  template <class T>
+  static void rates(const T* x, const double* p, T* r) {
+    const T aab = x[0] * x[0] * x[1];
     r[0] = p[0] * (aab - (p[1] + p[2]) * x[0]);
     r[1] = p[0] * (-aab + p[1] * (1.0 - x[1]));
   }
-  static void jacobian(const double* x, const double* p, double* J) {
+  template <class T>
+  static void jacobian(const T* x, const double* p, T* J) {
     J[0] = p[0] * (2.0 * x[0] * x[1] - (p[1] + p[2])), J[1] = p[0] * x[0] * x[0];
     J[2] = -2.0 * p[0] * x[0] * x[1], J[3] = -p[0] * (x[0] * x[0] + p[1]);
   }
@@ -108,13 +120,15 @@ struct FitzHughNagumo {
             {{"eps", 0.02, "time-scale ratio"}, {"a0", -0.8, "offset"}, {"a1", 1.0, "recovery slope"}},
             {1.0, 0.0}, {-0.9283, -0.1283}, -2.0, 2.0, false, {}};
   }
-  static void rates(const double* x, const double* p, double* r) {
+  template <class T>
+  static void rates(const T* x, const double* p, T* r) {
     r[0] = x[0] - x[0] * x[0] * x[0] - x[1];
     r[1] = p[0] * (x[0] - p[2] * x[1] - p[1]);
   }
-  static void jacobian(const double* x, const double* p, double* J) {
-    J[0] = 1.0 - 3.0 * x[0] * x[0], J[1] = -1.0;
-    J[2] = p[0], J[3] = -p[0] * p[2];
+  template <class T>
+  static void jacobian(const T* x, const double* p, T* J) {
+    J[0] = 1.0 - 3.0 * x[0] * x[0], J[1] = -1.0 - T();
+    J[2] = p[0] - T(), J[3] = -p[0] * p[2] - T();
   }
 };
 
@@ -132,16 +146,25 @@ struct BarkleyT {
             {{"a", 0.75, "excitation threshold slope"}, {"b", 0.02, "threshold offset"}, {"eps", 0.02, "stiffness"}},
             {1.0, 0.0}, {0.0, 0.0}, 0.0, 1.0, false, {}};
   }
-  static void rates(const double* x, const double* p, double* r) {
-    double th = (x[1] + p[1]) / p[0];
+  template <class T>
+  static void rates(const T* x, const double* p, T* r) {
+    const T th = (x[1] + p[1]) / p[0];
     r[0] = x[0] * (1.0 - x[0]) * (x[0] - th) / p[2];
-    r[1] = (Turbulent ? x[0] * x[0] * x[0] : x[0]) - x[1];
+    if constexpr (Turbulent)
+      r[1] = x[0] * x[0] * x[0] - x[1];
+    else
+      r[1] = x[0] - x[1];
   }
-  static void jacobian(const double* x, const double* p, double* J) {
-    double A = x[0], th = (x[1] + p[1]) / p[0], g = A - A * A;
+  template <class T>
+  static void jacobian(const T* x, const double* p, T* J) {
+    const T A = x[0], th = (x[1] + p[1]) / p[0], g = A - A * A;
     J[0] = ((1.0 - 2.0 * A) * (A - th) + g) / p[2];
     J[1] = -g / (p[0] * p[2]);
-    J[2] = Turbulent ? 3.0 * A * A : 1.0, J[3] = -1.0;
+    if constexpr (Turbulent)
+      J[2] = 3.0 * A * A;
+    else
+      J[2] = 1.0 - T();
+    J[3] = -1.0 - T();
   }
 };
 using Barkley = BarkleyT<false>;
@@ -160,16 +183,18 @@ struct MeinhardtSpots {
              {"p2", -0.08, "decay of B"}, {"p3", 0.001, "basic production of A"}},
             {0.1, 4.0}, {2.025, 0.5126}, 0.0, 8.0, true, {0}};
   }
-  static void rates(const double* x, const double* p, double* r) {
-    double B = std::max(x[1], kFloor), aa = 0.01 * p[1] * x[0] * x[0];
+  template <class T>
+  static void rates(const T* x, const double* p, T* r) {
+    const T B = x[1] < kFloor ? kFloor - T() : x[1], aa = 0.01 * p[1] * x[0] * x[0];
     r[0] = p[0] * (p[2] * x[0] + aa / B + p[4]);
     r[1] = p[0] * (p[3] * x[1] + aa);
   }
-  static void jacobian(const double* x, const double* p, double* J) {
-    double B = std::max(x[1], kFloor), aa = 0.01 * p[1] * x[0] * x[0];
+  template <class T>
+  static void jacobian(const T* x, const double* p, T* J) {
+    const T B = x[1] < kFloor ? kFloor - T() : x[1], aa = 0.01 * p[1] * x[0] * x[0];
     J[0] = p[0] * (p[2] + 0.02 * p[1] * x[0] / B);
-    J[1] = x[1] > kFloor ? -p[0] * aa / (B * B) : 0.0;
-    J[2] = p[0] * 0.02 * p[1] * x[0], J[3] = p[0] * p[3];
+    J[1] = x[1] > kFloor ? -p[0] * aa / (B * B) : T();
+    J[2] = p[0] * 0.02 * p[1] * x[0], J[3] = p[0] * p[3] - T();
   }
 };
 
@@ -184,12 +209,14 @@ struct Brusselator {
             {{"s", 1.0, "reaction rate"}, {"alpha", 3.0, "feed"}, {"beta", 9.0, "conversion"}},
             {49.5, 117.6}, {3.0, 3.0}, 0.0, 8.0, false, {}};
   }
-  static void rates(const double* x, const double* p, double* r) {
-    double aab = x[0] * x[0] * x[1];
+  template <class T>
+  static void rates(const T* x, const double* p, T* r) {
+    const T aab = x[0] * x[0] * x[1];
     r[0] = p[0] * (p[1] - (1.0 + p[2]) * x[0] + aab);
     r[1] = p[0] * (p[2] * x[0] - aab);
   }
-  static void jacobian(const double* x, const double* p, double* J) {
+  template <class T>
+  static void jacobian(const T* x, const double* p, T* J) {
     J[0] = p[0] * (2.0 * x[0] * x[1] - (1.0 + p[2])), J[1] = p[0] * x[0] * x[0];
     J[2] = p[0] * (p[2] - 2.0 * x[0] * x[1]), J[3] = -p[0] * x[0] * x[0];
   }
@@ -207,16 +234,18 @@ struct GiererMeinhardt {
              {"gamma", 0.1, "basic production of a"}},
             {1.0, 40.0}, {2.2, 4.84}, 0.0, 10.0, true, {0}};
   }
-  static void rates(const double* x, const double* p, double* r) {
-    double b = std::max(x[1], kFloor);
+  template <class T>
+  static void rates(const T* x, const double* p, T* r) {
+    const T b = x[1] < kFloor ? kFloor - T() : x[1];
     r[0] = p[0] * (p[3] + x[0] * x[0] / b - p[1] * x[0]);
     r[1] = p[0] * (x[0] * x[0] - p[2] * x[1]);
   }
-  static void jacobian(const double* x, const double* p, double* J) {
-    double b = std::max(x[1], kFloor);
+  template <class T>
+  static void jacobian(const T* x, const double* p, T* J) {
+    const T b = x[1] < kFloor ? kFloor - T() : x[1];
     J[0] = p[0] * (2.0 * x[0] / b - p[1]);
-    J[1] = x[1] > kFloor ? -p[0] * x[0] * x[0] / (b * b) : 0.0;
-    J[2] = 2.0 * p[0] * x[0], J[3] = -p[0] * p[2];
+    J[1] = x[1] > kFloor ? -p[0] * x[0] * x[0] / (b * b) : T();
+    J[2] = 2.0 * p[0] * x[0], J[3] = -p[0] * p[2] - T();
   }
 };
 
@@ -232,16 +261,18 @@ struct Oregonator {
             {{"eps", 0.05, "time-scale ratio"}, {"f", 1.4, "stoichiometry"}, {"q", 0.002, "scaling"}},
             {1.0, 0.6}, {0.0, 0.0}, 0.0, 1.0, false, {}};
   }
-  static void rates(const double* x, const double* p, double* r) {
-    double a = std::max(x[0], 0.0);
+  template <class T>
+  static void rates(const T* x, const double* p, T* r) {
+    const T a = x[0] < 0.0 ? T() : x[0];
     r[0] = (x[0] - x[0] * x[0] - p[1] * x[1] * (a - p[2]) / (a + p[2])) / p[0];
     r[1] = x[0] - x[1];
   }
-  static void jacobian(const double* x, const double* p, double* J) {
-    double a = std::max(x[0], 0.0), aq = a + p[2];
-    J[0] = (1.0 - 2.0 * x[0] - (x[0] > 0 ? p[1] * x[1] * 2.0 * p[2] / (aq * aq) : 0.0)) / p[0];
+  template <class T>
+  static void jacobian(const T* x, const double* p, T* J) {
+    const T a = x[0] < 0.0 ? T() : x[0], aq = a + p[2];
+    J[0] = (1.0 - 2.0 * x[0] - (x[0] > 0.0 ? p[1] * x[1] * 2.0 * p[2] / (aq * aq) : T())) / p[0];
     J[1] = -p[1] * (a - p[2]) / aq / p[0];
-    J[2] = 1.0, J[3] = -1.0;
+    J[2] = 1.0 - T(), J[3] = -1.0 - T();
   }
 };
 

@@ -52,6 +52,9 @@ bool solveDense(double (&A)[N][N], double (&b)[N], int n) {
   return true;
 }
 
+// Newton iterations per attempt (each start or continuation stage).
+constexpr int kNewtonMaxIterations = 60;
+
 struct NewtonResult {
   bool converged = false;
   int iterations = 0;
@@ -126,7 +129,7 @@ NewtonResult newtonFrom(int n, const double* x0, double dt, double* x, Rates&& r
 // (tau = 1/2, 3/4, ...), then try a few deterministic restarts.
 template <int N, typename Rates, typename Jacobian>
 NewtonResult newtonImplicit(int n, const double* x0, double dt, double* x, Rates&& rates, Jacobian&& jacobian,
-                            unsigned fixed = 0, int maxIterations = 60) {
+                            unsigned fixed = 0, int maxIterations = kNewtonMaxIterations) {
   double start[N];
   for (int s = 0; s < n; ++s) {
     if (!((fixed >> s) & 1u)) x[s] = x0[s];
@@ -202,7 +205,7 @@ NewtonResult implicitReactionCell(int n, const double* x0, double dt, double* x,
     double y[N];
     for (int s = 0; s < n; ++s)
       y[s] = (violated >> s) & 1u ? (std::abs(x0[s]) + 1.0) * std::ldexp(1.0, 2 * j - 14) : x[s];
-    NewtonResult f = newtonFrom<N>(n, x0, dt, y, rates, jacobian, held, 60);
+    NewtonResult f = newtonFrom<N>(n, x0, dt, y, rates, jacobian, held, kNewtonMaxIterations);
     c.iterations += f.iterations;
     bool admissible = f.converged;
     for (int s = 0; s < n; ++s)
