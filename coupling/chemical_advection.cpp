@@ -56,28 +56,36 @@ inline LinearAxis linearAxis(double c, int n, bool periodic) {
   return {size_t(i), size_t(std::min(i + 1, n - 1)), 1.0 - t, t};
 }
 
+// The 2^D cells and weights of the linear sample at c, in sampleChemical's
+// order (x fastest), each weight the product wx wy (wz) in that order: so
+// sum_k w_k g[i_k] is bitwise the general sampler's linear value.
 template <int D>
-double sampleLinearChemical(const Grid<double, D>& g, const std::array<bool, D>& periodic, const Vec<D>& c) {
+void linearStencil(const IVec<D>& dims, const std::array<bool, D>& periodic, const Vec<D>& c,
+                   size_t (&index)[1 << D], double (&weight)[1 << D]) {
   LinearAxis ax[D];
-  for (int a = 0; a < D; ++a) ax[a] = linearAxis(c[a], g.dim(a), periodic[size_t(a)]);
-  const size_t nx = size_t(g.dim(0));
+  for (int a = 0; a < D; ++a) ax[a] = linearAxis(c[a], dims[a], periodic[size_t(a)]);
+  const size_t nx = size_t(dims[0]);
   const size_t y[2] = {nx * ax[1].lo, nx * ax[1].hi};
   const double wy[2] = {ax[1].wlo, ax[1].whi};
   const size_t x[2] = {ax[0].lo, ax[0].hi};
   const double wx[2] = {ax[0].wlo, ax[0].whi};
-  double sum = 0.0;
   if constexpr (D == 2) {
     for (int ky = 0; ky < 2; ++ky)
-      for (int kx = 0; kx < 2; ++kx) sum += wx[kx] * wy[ky] * g[x[kx] + y[ky]];
+      for (int kx = 0; kx < 2; ++kx) {
+        index[2 * ky + kx] = x[kx] + y[ky];
+        weight[2 * ky + kx] = wx[kx] * wy[ky];
+      }
   } else {
-    const size_t plane = nx * size_t(g.dim(1));
+    const size_t plane = nx * size_t(dims[1]);
     const size_t z[2] = {plane * ax[2].lo, plane * ax[2].hi};
     const double wz[2] = {ax[2].wlo, ax[2].whi};
     for (int kz = 0; kz < 2; ++kz)
       for (int ky = 0; ky < 2; ++ky)
-        for (int kx = 0; kx < 2; ++kx) sum += wx[kx] * wy[ky] * wz[kz] * g[x[kx] + y[ky] + z[kz]];
+        for (int kx = 0; kx < 2; ++kx) {
+          index[4 * kz + 2 * ky + kx] = x[kx] + y[ky] + z[kz];
+          weight[4 * kz + 2 * ky + kx] = wx[kx] * wy[ky] * wz[kz];
+        }
   }
-  return sum;
 }
 
 }  // namespace
@@ -111,8 +119,9 @@ double sampleChemical(const Grid<double, D>& g, const std::array<bool, D>& perio
 
 template <int D>
 ChemicalAdvector<D>::ChemicalAdvector(ChemicalDomain<D> domain, ChemicalInterpolation interpolation)
-    : domain_(std::move(domain)), interpolation_(interpolation), scratch_(domain_.cells) {
-  const size_t n = scratch_.size();
+    : domain_(std::move(domain)), interpolation_(interpolation) {
+  size_t n = 1;
+  for (int a = 0; a < D; ++a) n *= size_t(domain_.cells[a]);
   if (!domain_.solid.empty() && domain_.solid.size() != n) throw std::invalid_argument("coupling: solid mask has the wrong size");
   for (auto& f : feet_) f.assign(n, 0.0f);
   fromInflow_.assign(n, 0);
@@ -152,23 +161,42 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
       }
       fromInflow_[i] = in;
     }, 4096);
-  for (size_t s = 0; s < species.size(); ++s) {
-    Grid<double, D>& g = *species[s];
-    const double inValue = inflow ? d.inflowValues[s] : 0.0;
-    const bool linear = interpolation_ == ChemicalInterpolation::Linear;
-    parallelFor(g.size(), [&](size_t i) {
-      const double w = fromInflow_[i];
-      if (w >= 1.0) {
-        scratch_[i] = inValue;
-        return;
-      }
-      Vec<D> c;
-      for (int a = 0; a < D; ++a) c[a] = feet_[size_t(a)][i];
-      const double v = linear ? sampleLinearChemical<D>(g, d.periodic, c) : sampleChemical<D>(g, d.periodic, c, interpolation_);
-      scratch_[i] = w * inValue + (1.0 - w) * v;
-    }, 1024);
-    std::swap(g.values(), scratch_.values());
+  // Every species from one stencil per cell (one set of weights, 2^D
+  // loads per species).
+  const size_t ns = species.size();
+  while (scratch_.size() < ns) scratch_.emplace_back(d.cells);
+  std::vector<double> in(ns, 0.0);
+  std::vector<const double*> src(ns);
+  std::vector<double*> dst(ns);
+  for (size_t s = 0; s < ns; ++s) {
+    in[s] = inflow ? d.inflowValues[s] : 0.0;
+    src[s] = species[s]->data();
+    dst[s] = scratch_[s].data();
   }
+  const bool linear = interpolation_ == ChemicalInterpolation::Linear;
+  parallelFor(fromInflow_.size(), [&](size_t i) {
+    const double w = inflow ? fromInflow_[i] : 0.0;
+    if (w >= 1.0) {
+      for (size_t s = 0; s < ns; ++s) dst[s][i] = in[s];
+      return;
+    }
+    Vec<D> c;
+    for (int a = 0; a < D; ++a) c[a] = feet_[size_t(a)][i];
+    if (linear) {
+      size_t index[1 << D];
+      double weight[1 << D];
+      linearStencil<D>(d.cells, d.periodic, c, index, weight);
+      for (size_t s = 0; s < ns; ++s) {
+        double v = 0.0;
+        for (int k = 0; k < (1 << D); ++k) v += weight[k] * src[s][index[k]];
+        dst[s][i] = w * in[s] + (1.0 - w) * v;
+      }
+    } else {
+      for (size_t s = 0; s < ns; ++s)
+        dst[s][i] = w * in[s] + (1.0 - w) * sampleChemical<D>(*species[s], d.periodic, c, interpolation_);
+    }
+  }, 1024);
+  for (size_t s = 0; s < ns; ++s) std::swap(species[s]->values(), scratch_[s].values());
   emptySolids(species);
 }
 

@@ -53,7 +53,7 @@ class ChemicalAdvector {
   // the fluid's own traces: 1e-7 of the domain, far below a cell).
   std::array<std::vector<float>, D> feet_;
   std::vector<double> fromInflow_;  // weight of the inflow value (1: the foot left through an inflow side)
-  Grid<double, D> scratch_;
+  std::vector<Grid<double, D>> scratch_;  // one per species
 };
 
 // Value of g at continuous grid coordinate c (cell centres at integers),
