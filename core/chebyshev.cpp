@@ -280,9 +280,12 @@ SolverResult Chebyshev<D>::solve(const Vector& b, Vector* xp, const SolverOption
   const double budget = options.tolerance * bnorm;
   pipeline(1, [&](int, size_t q) { residualPlane(b, x, q); });
   double rnorm = residualNorm();
-  // Rounds of at most 1e4 each: the float steps resolve that much of the
-  // correction with digits to spare.
-  constexpr double kRoundFactor = 1e4;
+  // Rounds of at most 1e5 each: the float steps resolve that much of the
+  // correction. A well conditioned operator (a 1e6 reduction in at most 48
+  // steps: nu dt / h^2 up to about 5 in 2D) takes 1e6, saving a round and
+  // its residual pass; further out the float rounding, which grows with the
+  // steps, would fall short of 1e6 and cost steps (docs/performance.md).
+  const double kRoundFactor = stepsFor(1e6) <= 48 ? 1e6 : 1e5;
   int rounds = 0;
   while (rnorm > budget && result.iterations < options.maxIterations && rounds < 16) {
     const int steps =
