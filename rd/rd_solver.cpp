@@ -257,16 +257,22 @@ SolverResult RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
   // Warm start: the undiffused state plus the last step's diffusive change
   // (rescaled to this theta dt), which a slowly evolving pattern repeats, as
   // the fluid's viscosity does.
+  // The Chebyshev iteration also takes ||b|| from this pass (the sum
+  // norm2 forms, so bitwise its value).
   df.x.resize(b.size());
+  double bnorm = -1.0;  // not known: the solver computes it
   if (df.increment.size() == b.size()) {
     const double ratio = thetaDt / df.incrementThetaDt;
-    parallelFor(b.size(), [&](size_t i) { df.x[i] = b[i] + ratio * df.increment[i]; }, kChunk);
+    bnorm = std::sqrt(deterministicSum(b.size(), [&](size_t i) {
+      df.x[i] = b[i] + ratio * df.increment[i];
+      return b[i] * b[i];
+    }));
   } else {
     df.x = b;
   }
   SolverOptions o{settings_.tolerance, 2000};
-  SolverResult r =
-      df.useChebyshev ? df.chebyshev->solve(b, &df.x, o) : solvePCG<D>(df.A, b, &df.x, df.M.get(), o, nullptr, &df.ws);
+  SolverResult r = df.useChebyshev ? df.chebyshev->solve(b, &df.x, o, bnorm)
+                                   : solvePCG<D>(df.A, b, &df.x, df.M.get(), o, nullptr, &df.ws);
   df.increment.resize(b.size());
   parallelFor(b.size(), [&](size_t i) { df.increment[i] = df.x[i] - b[i]; }, kChunk);
   df.incrementThetaDt = thetaDt;
