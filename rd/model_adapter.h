@@ -2,6 +2,9 @@
 // the per-cell loops compiled against M's inline rates and Jacobian.
 #pragma once
 
+#include <algorithm>
+#include <cstring>
+
 #include "core/simd_dispatch.h"
 #include "rd/newton.h"
 #include "rd/newton_batch.h"
@@ -43,7 +46,8 @@ class ModelAdapter final : public ReactionModel {
     size_t i = begin;
 #if MORPHOFLOW_AVX2_KERNELS
     // Four cells at a time in AVX2 registers (bitwise the scalar result).
-    // The batch is no quicker than the scalar code in four-lane SSE.
+    // Compiled for SSE the same batch is slower than the scalar loop
+    // (docs/performance.md), so without AVX2 every cell takes the loop below.
     if (kBatched && uniform && useAvx2()) i = updateBatchesAvx2(x, p, dt, begin, end, &st);
 #endif
     for (; i < end; ++i) {

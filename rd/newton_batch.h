@@ -13,7 +13,6 @@
 #pragma once
 
 #include <cstddef>
-#include <cstring>
 
 namespace morphoflow {
 
@@ -71,7 +70,7 @@ template <class M>
   NewtonLanes F[2], fnorm, q;
   residual<M>(x, x0, p, dt, F, &fnorm, &q);
   NewtonMask active = NewtonMask{} - 1, scalar{}, iterations{};
-  NewtonLanes J[4] = {};
+  NewtonLanes J[4] = {};  // the model sets it; zeroed, or GCC 12 warns it may be used unset
   for (int it = 0;; ++it) {
     const NewtonLanes tol = 1e-12 * scale;
     const NewtonMask more = fnorm > tol;  // false on NaN, as the scalar test
