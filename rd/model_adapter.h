@@ -92,8 +92,7 @@ class ModelAdapter final : public ReactionModel {
         newtonBatch<M>(x0, p, dt, clampMask_, kNewtonMaxIterations, xn, &b);
         for (int s = 0; s < 2; ++s) std::memcpy(x[s] + i, &xn[s], sizeof(NewtonLanes));
         for (int l = 0; l < kNewtonLanes; ++l) {
-          if ((b.scalar >> l) & 1u) {
-            for (int s = 0; s < 2; ++s) x[s][i + size_t(l)] = x0[s][l];
+          if ((b.scalar >> l) & 1u) {  // its x is still x0
             updateCell(x, p, dt, i + size_t(l), st);
             continue;
           }

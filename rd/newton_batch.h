@@ -51,7 +51,8 @@ template <class M>
 }  // namespace newton_batch_detail
 
 // x <- the root of x - x0 - dt R(x) = 0 for the four cells in x0's lanes,
-// started from x0 (newtonImplicit's first attempt). `clamped` marks species
+// started from x0 (newtonImplicit's first attempt); lanes handed back to
+// the scalar code keep x0. `clamped` marks species
 // that must end >= 0 (implicitReactionCell's rule); `maxIterations` as
 // newtonFrom's.
 template <class M>
@@ -122,6 +123,7 @@ template <class M>
   }
   for (int s = 0; s < 2; ++s)
     if ((clamped >> s) & 1u) scalar |= x[s] < 0.0;
+  for (int s = 0; s < 2; ++s) x[s] = scalar ? x0[s] : x[s];  // the scalar code starts those cells over
   out->scalar = 0;
   for (int l = 0; l < kNewtonLanes; ++l) {
     if (scalar[l]) out->scalar |= 1u << l;

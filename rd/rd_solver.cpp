@@ -256,9 +256,8 @@ SolverResult RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
   }
   // Warm start: the undiffused state plus the last step's diffusive change
   // (rescaled to this theta dt), which a slowly evolving pattern repeats, as
-  // the fluid's viscosity does.
-  // The Chebyshev iteration also takes ||b|| from this pass (the sum
-  // norm2 forms, so bitwise its value).
+  // the fluid's viscosity does. The same pass forms ||b|| for the Chebyshev
+  // iteration (norm2's sum, so bitwise its value).
   df.x.resize(b.size());
   double bnorm = -1.0;  // not known: the solver computes it
   if (df.increment.size() == b.size()) {
