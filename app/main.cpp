@@ -2,11 +2,11 @@
 // Exit status: 0 success, 2 user error (file:line:col on stderr), 1 internal error.
 #include <filesystem>
 #include <iostream>
-#include <thread>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "app/batch.h"
 #include "app/run_options.h"
 #include "app/texture_commands.h"
 #include "app/version.h"
@@ -72,15 +72,12 @@ int main(int argc, char** argv) {
   runCmd->add_flag("--resume", resume, "continue an interrupted run");
   runCmd->add_flag("--quiet", run.quiet, "no progress output");
 
-  std::vector<std::string> batchScenes;
-  std::string shard;
-  int jobs = 1;
-  std::string batchOut = "out";
+  BatchOptions batch;
   CLI::App* batchCmd = app.add_subcommand("batch", "run several scenes, each into OUT/<scene name>");
-  batchCmd->add_option("scenes", batchScenes, "scene files")->required();
-  batchCmd->add_option("--jobs", jobs, "scenes run at once")->check(CLI::Range(1, 256));
-  batchCmd->add_option("--shard", shard, "I/N: run only every N-th scene starting at I (0-based)");
-  batchCmd->add_option("--out", batchOut, "output root")->capture_default_str();
+  batchCmd->add_option("scenes", batch.scenes, "scene files")->required();
+  batchCmd->add_option("--jobs", batch.jobs, "scenes run at once")->check(CLI::Range(1, 256));
+  batchCmd->add_option("--shard", batch.shard, "I/N: run only every N-th scene starting at I (0-based)");
+  batchCmd->add_option("--out", batch.out, "output root")->capture_default_str();
 
   std::vector<std::string> validateScenes;
   CLI::App* validateCmd = app.add_subcommand("validate", "parse and check scenes; no simulation");
@@ -142,44 +139,7 @@ int main(int argc, char** argv) {
       if (!frames.empty()) parseFrames(frames, &run);
       return runScene(run);
     }
-    if (*batchCmd) {
-      int shardI = 0, shardN = 1;
-      if (!shard.empty() && (std::sscanf(shard.c_str(), "%d/%d", &shardI, &shardN) != 2 || shardN < 1 ||
-                             shardI < 0 || shardI >= shardN))
-        throw UserError({"--shard", 0, 0}, "", "expected I/N with 0 <= I < N, got '" + shard + "'");
-      // Check every scene first: a batch fails fast, before any simulation.
-      std::vector<std::string> mine;
-      for (size_t i = 0; i < batchScenes.size(); ++i)
-        if (int(i % size_t(shardN)) == shardI) {
-          loadScene(batchScenes[i]);
-          mine.push_back(batchScenes[i]);
-        }
-      std::vector<int> status(mine.size(), 0);
-      std::vector<std::string> errors(mine.size());
-      auto work = [&](size_t i) {
-        RunOptions o;
-        o.scene = mine[i];
-        o.out = (fs::path(batchOut) / fs::path(mine[i]).stem()).string();
-        o.quiet = true;
-        try {
-          status[i] = runScene(o);
-        } catch (const std::exception& e) {
-          errors[i] = e.what();
-          status[i] = dynamic_cast<const UserError*>(&e) ? 2 : 1;
-        }
-      };
-      for (size_t start = 0; start < mine.size(); start += size_t(jobs)) {
-        std::vector<std::thread> pool;
-        for (size_t i = start; i < std::min(mine.size(), start + size_t(jobs)); ++i) pool.emplace_back(work, i);
-        for (auto& t : pool) t.join();
-      }
-      int worst = 0;
-      for (size_t i = 0; i < mine.size(); ++i) {
-        std::cerr << fmt::format("{}: {}\n", mine[i], status[i] == 0 ? "ok" : errors[i]);
-        worst = std::max(worst, status[i]);
-      }
-      return worst;
-    }
+    if (*batchCmd) return runBatch(batch);
     if (*validateCmd) {
       for (const std::string& s : validateScenes) {
         Scene sc = loadScene(s);

@@ -1,12 +1,12 @@
-// How long a fluid run lasts and how large each step is: a fixed step count,
-// or a duration whose last step is clipped to end on it; dt shrinks to the
-// CFL limit when time.cfl > 0. Shared by the fluid and the coupled runners.
+// How long a run lasts and how large each step is: a fixed step count, or a
+// duration whose last step is clipped to end on it; dt shrinks to the CFL
+// limit when time.cfl > 0.
 #pragma once
 
 #include <algorithm>
 #include <limits>
 
-#include "fluid/fluid_solver.h"
+#include "core/simulation.h"
 #include "scenes/scene.h"
 
 namespace morphoflow {
@@ -18,14 +18,14 @@ class RunClock {
         steps_(t.steps > 0 ? t.steps : std::numeric_limits<long>::max()),
         endTime_(t.steps > 0 ? 1e300 : t.duration) {}
 
-  // Whether step `step` (0-based) still runs at fluid time `time`.
+  // Whether step `step` (0-based) still runs at simulated time `time`.
   bool running(long step, double time) const { return step < steps_ && time < endTime_ - 1e-12; }
 
   template <int D>
-  double dt(const FluidSolver<D>& fluid) const {
+  double dt(const Simulation<D>& sim) const {
     double dt = time_.dt;
-    if (time_.cfl > 0) dt = fluid.cflTimeStep(time_.cfl, time_.dt);
-    if (time_.steps == 0) dt = std::min(dt, endTime_ - fluid.time());
+    if (time_.cfl > 0) dt = sim.cflTimeStep(time_.cfl, time_.dt);
+    if (time_.steps == 0) dt = std::min(dt, endTime_ - sim.time());
     return dt;
   }
 

@@ -124,6 +124,26 @@ double FluidSolver<D>::cflTimeStep(double cfl, double dtMax) const {
   return std::min(dtMax, cfl * h_ / umax);
 }
 
+template <int D>
+void FluidSolver<D>::save(StateWriter* out) const {
+  for (int a = 0; a < D; ++a) out->putGrid("fluid.u" + std::to_string(a), u_[a]);
+  out->putGrid("fluid.dye", dye_);
+  out->put("fluid.time", time_);
+  out->put("fluid.steps", steps_);
+  projection_->save(out);
+  viscosity_->save(out);
+}
+
+template <int D>
+void FluidSolver<D>::load(const StateReader& in) {
+  for (int a = 0; a < D; ++a) in.getGrid("fluid.u" + std::to_string(a), &u_[a]);
+  in.getGrid("fluid.dye", &dye_);
+  in.get("fluid.time", &time_);
+  in.get("fluid.steps", &steps_);
+  projection_->load(in);
+  viscosity_->load(in);
+}
+
 template class FluidSolver<2>;
 template class FluidSolver<3>;
 

@@ -8,6 +8,7 @@
 #include <string>
 
 #include "core/mac_velocity.h"
+#include "core/state_archive.h"
 #include "fluid/advection.h"
 #include "fluid/fluid_settings.h"
 #include "fluid/pressure_projection.h"
@@ -49,6 +50,10 @@ class FluidSolver {
   Grid<float, D> pressure() const { return projection_->pressure(); }
   const FluidStepStats& lastStats() const { return stats_; }
   PressureProjection<D>& projection() { return *projection_; }
+  // Everything step() reads besides the settings (velocity, dye, time,
+  // the solvers' warm starts), so that load(save()) continues bit for bit.
+  void save(StateWriter* out) const;
+  void load(const StateReader& in);
   Layout<D> cellLayout() const { return Layout<D>::cellCentred(h_, cells_, constraints_.periodic()); }
 
  private:

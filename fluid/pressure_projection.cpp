@@ -183,6 +183,28 @@ Grid<float, D> PressureProjection<D>::pressure() const {
   return p;
 }
 
+template <int D>
+void PressureProjection<D>::save(StateWriter* out) const {
+  out->putVector("pressure.phi", phi_);
+  out->put("pressure.rate_prev_size", ratePrev_.size());
+  out->putVector("pressure.rate_prev", ratePrev_);
+  out->put("pressure.last_dt", lastDt_);
+  out->put("pressure.last_density", lastDensity_);
+  out->put("pressure.solves", solves_);
+}
+
+template <int D>
+void PressureProjection<D>::load(const StateReader& in) {
+  in.getVector("pressure.phi", &phi_);
+  size_t n = 0;
+  in.get("pressure.rate_prev_size", &n);
+  ratePrev_.resize(n == 0 ? 0 : phi_.size());
+  in.getVector("pressure.rate_prev", &ratePrev_);
+  in.get("pressure.last_dt", &lastDt_);
+  in.get("pressure.last_density", &lastDensity_);
+  in.get("pressure.solves", &solves_);
+}
+
 template class PressureProjection<2>;
 template class PressureProjection<3>;
 

@@ -11,6 +11,7 @@
 #include "core/multigrid.h"
 #include "core/mic0.h"
 #include "core/solver_result.h"
+#include "core/state_archive.h"
 #include "fluid/fluid_settings.h"
 #include "fluid/velocity_constraints.h"
 
@@ -28,6 +29,9 @@ class PressureProjection {
   // Pressure of the last projection, p = rho phi / dt.
   Grid<float, D> pressure() const;
   const LaplaceSystem<D>& system() const { return A_; }
+  // The warm start of the next projection (checkpoints).
+  void save(StateWriter* out) const;
+  void load(const StateReader& in);
 
  private:
   // div = factor * (cell divergence of u, without the 1/h), 0 on solid cells.

@@ -175,6 +175,28 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
   return result;
 }
 
+template <int D>
+void ViscositySolver<D>::save(StateWriter* out) const {
+  for (int a = 0; a < D; ++a) {
+    const std::string p = "viscosity." + std::to_string(a) + ".";
+    out->put(p + "history", comp_[size_t(a)].history);
+    for (int k = 0; k < comp_[size_t(a)].history; ++k) out->putVector(p + "rate" + std::to_string(k), comp_[size_t(a)].rate[size_t(k)]);
+  }
+}
+
+template <int D>
+void ViscositySolver<D>::load(const StateReader& in) {
+  for (int a = 0; a < D; ++a) {
+    Component& C = comp_[size_t(a)];
+    const std::string p = "viscosity." + std::to_string(a) + ".";
+    in.get(p + "history", &C.history);
+    for (int k = 0; k < C.history; ++k) {
+      C.rate[size_t(k)].resize(C.A.size());
+      in.getVector(p + "rate" + std::to_string(k), &C.rate[size_t(k)]);
+    }
+  }
+}
+
 template class ViscositySolver<2>;
 template class ViscositySolver<3>;
 

@@ -22,6 +22,7 @@
 #include "core/multigrid.h"
 #include "core/pcg.h"
 #include "core/solver_result.h"
+#include "core/state_archive.h"
 #include "fluid/velocity_constraints.h"
 
 namespace morphoflow {
@@ -32,6 +33,9 @@ class ViscositySolver {
   ViscositySolver(const VelocityConstraints<D>& constraints, const SolverOptions& options);
   // Diffuses u in place; returns the worst of the component solves.
   SolverResult diffuse(MacVelocity<D>* u, double viscosity, double dt);
+  // The warm starts of the next solve (checkpoints).
+  void save(StateWriter* out) const;
+  void load(const StateReader& in);
 
  private:
   struct Component {

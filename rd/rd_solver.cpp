@@ -388,6 +388,42 @@ void RDSolver<D>::step(double dt) {
   ++steps_;
 }
 
+template <int D>
+void RDSolver<D>::save(StateWriter* out) const {
+  out->put("rd.time", time_);
+  out->put("rd.steps", steps_);
+  for (int s = 0; s < species(); ++s) {
+    const std::string p = "rd." + std::to_string(s) + ".";
+    const Diffusion& df = *diffusion_[size_t(s)];
+    out->putGrid(p + "x", x_[size_t(s)]);
+    out->put(p + "increment_size", df.increment.size());
+    out->putVector(p + "increment", df.increment);
+    out->put(p + "increment_theta_dt", df.incrementThetaDt);
+    out->put(p + "frozen_size", s < int(frozenValues_.size()) ? frozenValues_[size_t(s)].size() : size_t(0));
+    if (s < int(frozenValues_.size())) out->putVector(p + "frozen", frozenValues_[size_t(s)]);
+  }
+}
+
+template <int D>
+void RDSolver<D>::load(const StateReader& in) {
+  in.get("rd.time", &time_);
+  in.get("rd.steps", &steps_);
+  frozenValues_.assign(size_t(species()), {});
+  for (int s = 0; s < species(); ++s) {
+    const std::string p = "rd." + std::to_string(s) + ".";
+    Diffusion& df = *diffusion_[size_t(s)];
+    in.getGrid(p + "x", &x_[size_t(s)]);
+    size_t n = 0;
+    in.get(p + "increment_size", &n);
+    df.increment.assign(n == 0 ? 0 : laplacian_.size(), 0.0);
+    in.getVector(p + "increment", &df.increment);
+    in.get(p + "increment_theta_dt", &df.incrementThetaDt);
+    in.get(p + "frozen_size", &n);
+    frozenValues_[size_t(s)].assign(n == 0 ? 0 : laplacian_.size(), 0.0);
+    if (n) in.getVector(p + "frozen", &frozenValues_[size_t(s)]);
+  }
+}
+
 template class RDSolver<2>;
 template class RDSolver<3>;
 

@@ -13,6 +13,7 @@
 #include "core/grid.h"
 #include "core/pcg.h"
 #include "core/solver_result.h"
+#include "core/state_archive.h"
 #include "rd/cosine_lobe.h"
 #include "rd/diffusion_tensor.h"
 #include "rd/rd_settings.h"
@@ -67,6 +68,11 @@ class RDSolver {
 
   void step(double dt);
   const RDStepStats& lastStats() const { return stats_; }
+  // Everything step() reads besides the settings and the scene's maps (the
+  // species, time, held values, the diffusion solves' warm starts), so that
+  // load(save()) continues bit for bit.
+  void save(StateWriter* out) const;
+  void load(const StateReader& in);
   double time() const { return time_; }
   long steps() const { return steps_; }
 

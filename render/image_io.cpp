@@ -57,7 +57,11 @@ bool writeImageAtomically(const std::string& path, const OIIO::ImageSpec& spec, 
     *error = "no image writer for " + path + ": " + OIIO::geterror();
     return false;
   }
-  if (!out->open(tmp.string(), spec) || !out->write_image(type, pixels) || !out->close()) {
+  // No write time in the file (OpenImageIO stamps one otherwise): the same
+  // fields give the same bytes, in a rerun or a resumed run.
+  OIIO::ImageSpec stamped = spec;
+  stamped.attribute("DateTime", "");
+  if (!out->open(tmp.string(), stamped) || !out->write_image(type, pixels) || !out->close()) {
     *error = out->geterror();
     std::error_code ec;
     std::filesystem::remove(tmp, ec);

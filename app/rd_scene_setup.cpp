@@ -1,29 +1,18 @@
-// Steps an RDSolver from the scene's initial state and writes colormapped
-// frames of one species plus run.json (solver statistics).
-#include "app/rd_runner.h"
+#include "app/rd_scene_setup.h"
 
 #include <chrono>
 #include <cmath>
-#include <filesystem>
-#include <iostream>
-#include <limits>
 #include <memory>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
-#include "app/frame_writer.h"
-#include "app/output_files.h"
-#include "app/run_report.h"
 #include "core/parallel.h"
 #include "core/spatial_field.h"
 #include "core/random.h"
 #include "rd/coarse_to_fine.h"
 #include "rd/model_registry.h"
-#include "render/colormap.h"
 #include "rd/rd_solver.h"
-
-namespace fs = std::filesystem;
 
 namespace morphoflow {
 
@@ -156,17 +145,16 @@ void prolongateState(const RDSolver<D>& coarse, RDSolver<D>* fine) {
     prolongate<D>(coarse.field(s), &fine->field(s), fine->settings().boundary == RDBoundary::Periodic);
 }
 
-// Coarse-to-fine acceleration (seed 002, seed 000 sec. 6): grows the pattern on
-// grids 2^L, ..., 2 times coarser over the same domain, each started from the
-// previous one prolongated; returns the last (2 times coarser) grid, or null.
+}  // namespace
+
 template <int D>
-std::unique_ptr<RDSolver<D>> growCoarse(const Scene& scene, const ReactionModel& model, bool quiet,
-                                        nlohmann::json* report) {
+bool growCoarseToFine(const Scene& scene, RDSolver<D>* rd, const std::function<void(const std::string&)>& log,
+                      nlohmann::json* report) {
   std::unique_ptr<RDSolver<D>> prev;
   for (int level = scene.rd.coarseLevels; level >= 1; --level) {
     RDSettings st = scene.rd.settings;
     for (int& r : st.resolution) r >>= level;
-    auto cur = std::make_unique<RDSolver<D>>(st, model);
+    auto cur = std::make_unique<RDSolver<D>>(st, rd->model());
     if (prev) prolongateState<D>(*prev, cur.get());
     else initialState<D>(scene, cur.get());
     applyScene<D>(scene, cur.get());
@@ -175,100 +163,19 @@ std::unique_ptr<RDSolver<D>> growCoarse(const Scene& scene, const ReactionModel&
     for (long k = 0; k < scene.rd.coarseSteps; ++k) cur->step(dt);
     checkFinite(*cur, fmt::format("on the coarse grid {}", fmt::join(st.resolution, "x")));
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (!quiet)
-      std::cerr << fmt::format("coarse grid {}: {} steps, {:.2f} s\n", fmt::join(st.resolution, "x"),
-                               scene.rd.coarseSteps, wall);
+    log(fmt::format("coarse grid {}: {} steps, {:.2f} s", fmt::join(st.resolution, "x"), scene.rd.coarseSteps, wall));
     report->push_back({{"resolution", st.resolution}, {"steps", scene.rd.coarseSteps}, {"dt", dt}, {"time", cur->time()},
                        {"wall_seconds", wall}});
     prev = std::move(cur);
   }
-  return prev;
+  if (!prev) return false;
+  prolongateState<D>(*prev, rd);
+  return true;
 }
 
-template <int D>
-int run(const Scene& scene, const RunOptions& opt) {
-  const ReactionModel& model = *findModel(scene.rd.settings.model);
-  nlohmann::json coarseReport = nlohmann::json::array();
-  std::unique_ptr<RDSolver<D>> coarse = growCoarse<D>(scene, model, opt.quiet, &coarseReport);
-  RDSolver<D> rd(scene.rd.settings, model);
-  if (coarse) prolongateState<D>(*coarse, &rd);
-  else initialState<D>(scene, &rd);
-  coarse.reset();
-  applyScene<D>(scene, &rd);
-  const fs::path out(opt.out);
-  fs::create_directories(out);
-  FrameWriter frames(out, scene.output, opt);
-  const std::vector<std::string>& names = model.info().species;
-  const int shown = int(std::find(names.begin(), names.end(), scene.output.field) - names.begin());
-  const long steps = scene.totalSteps();
-  const bool twoSpecies = scene.output.colormap == kTwoSpeciesPalette;
-  auto asFloat = [&](int s) { return toFloat<D>(rd.field(s)); };
-  auto writeFrame = [&](long step) {
-    long frame = frames.frameAt(step);
-    if (frame < 0) return;
-    checkFinite(rd, fmt::format("at step {}", step));
-    if (twoSpecies) {
-      const Grid<float, D> green = asFloat(1);
-      frames.write<D>(frame, asFloat(0), false, &green);
-    } else {
-      frames.write<D>(frame, asFloat(shown), false);
-    }
-    if (scene.output.fields) {
-      std::vector<Grid<float, D>> all;
-      for (int s = 0; s < rd.species(); ++s) all.push_back(asFloat(s));
-      frames.writeFields<D>(frame, names, all, rd.time(), step);
-    }
-  };
-  const auto wall0 = std::chrono::steady_clock::now();
-  NewtonStats newton;
-  long diffusionIterations = 0;
-  int diffusionMax = 0, unconverged = 0;
-  writeFrame(0);
-  long step = 0;
-  for (; step < steps; ++step) {
-    if (opt.lastFrame >= 0 && step >= long(opt.lastFrame + 1) * scene.output.every) break;
-    rd.step(scene.time.dt);
-    const RDStepStats& st = rd.lastStats();
-    newton.merge(st.newton);
-    diffusionIterations += st.diffusion.iterations;
-    diffusionMax = std::max(diffusionMax, st.diffusion.iterations);
-    unconverged += st.diffusion.converged ? 0 : 1;
-    writeFrame(step + 1);
-    if (!opt.quiet && (step + 1) % std::max<long>(1, steps / 20) == 0)
-      std::cerr << fmt::format("\rstep {}/{}  t = {:.4g}", step + 1, steps, rd.time()) << std::flush;
-  }
-  checkFinite(rd, fmt::format("at step {}", step));
-  const double wall = finishRun(scene, opt, &frames, wall0);
-  nlohmann::json j = runReport(scene, opt,
-                               {{"dimension", D},
-                                {"model", model.info().name},
-                                {"species", names},
-                                {"resolution", scene.rd.settings.resolution},
-                                {"size", scene.rd.settings.size},
-                                {"cell_size", rd.h()},
-                                {"diffusion", rd.diffusion()},
-                                {"dt", scene.time.dt},
-                                {"explicit_diffusion_limit", rd.explicitDiffusionLimit()}},
-                               step, rd.time(), frames, wall);
-  j["coarse_to_fine"] = coarseReport;
-  j["solvers"] = {{"newton_cells", newton.cells},
-                  {"newton_failures", newton.failures},
-                  {"newton_iterations_max", newton.maxIterations},
-                  {"newton_residual_max", newton.maxResidual},
-                  {"diffusion_iterations_mean", step ? double(diffusionIterations) / double(step) : 0.0},
-                  {"diffusion_iterations_max", diffusionMax},
-                  {"diffusion_unconverged_steps", unconverged}};
-  writeTextFile(out / "run.json", j.dump(2) + "\n");
-  if (!opt.quiet)
-    std::cerr << fmt::format("done: {} steps, t = {:.4g}, {:.2f} s wall, {} frames -> {}\n", step, rd.time(), wall,
-                             frames.written(), out.string());
-  return 0;
-}
-
-}  // namespace
-
-int runReactionDiffusion(const Scene& scene, const RunOptions& opt) {
-  return scene.dimension == 2 ? run<2>(scene, opt) : run<3>(scene, opt);
-}
+template bool growCoarseToFine<2>(const Scene&, RDSolver<2>*, const std::function<void(const std::string&)>&,
+                                  nlohmann::json*);
+template bool growCoarseToFine<3>(const Scene&, RDSolver<3>*, const std::function<void(const std::string&)>&,
+                                  nlohmann::json*);
 
 }  // namespace morphoflow

@@ -1,0 +1,153 @@
+#include "app/coupled_simulation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "app/fluid_simulation.h"
+#include "app/rd_scene_setup.h"
+#include "core/parallel.h"
+#include "rd/model_registry.h"
+
+namespace morphoflow {
+
+namespace {
+
+// The advection domain of the RD grid: the fluid's walls, inflow sides and
+// obstacles (sampled at RD cell centres).
+template <int D>
+ChemicalDomain<D> chemicalDomain(const Scene& scene, const FluidSolver<D>& fluid, const RDSolver<D>& rd) {
+  ChemicalDomain<D> d;
+  d.cells = rd.cells();
+  d.h = rd.h();
+  d.periodic = fluid.constraints().periodic();
+  for (int a = 0; a < D; ++a)
+    for (int hi = 0; hi < 2; ++hi)
+      d.inflow[size_t(a)][size_t(hi)] = scene.fluid.boundaries.side(a, hi != 0).kind == BoundaryKind::Inflow;
+  d.inflowValues = scene.coupling.inflowValues;
+  d.solidValues = scene.coupling.solidValues;
+  const Grid<uint8_t, D>& solid = fluid.solid();
+  bool any = false;
+  std::vector<uint8_t> mask(rd.field(0).size(), 0);
+  forEachCell<D>(d.cells, [&](const IVec<D>& k, size_t i) {
+    IVec<D> f;
+    for (int a = 0; a < D; ++a)
+      f[a] = std::clamp(int(std::floor((k[a] + 0.5) * d.h / fluid.h())), 0, fluid.cells()[a] - 1);
+    mask[i] = solid(f);
+  });
+  for (uint8_t m : mask) any |= m != 0;
+  if (any) d.solid = std::move(mask);
+  return d;
+}
+
+CouplingMode couplingMode(const std::string& mode) {
+  return mode == "passive" ? CouplingMode::Passive : mode == "rd-only" ? CouplingMode::RDOnly : CouplingMode::ARD;
+}
+
+}  // namespace
+
+template <int D>
+CoupledSimulation<D>::CoupledSimulation(const Scene& scene, CouplingBackend backend)
+    : scene_(scene), backend_(backend), fluid_(scene.fluid), rd_(scene.rd.settings, *findModel(scene.rd.settings.model)) {
+  initialState<D>(scene, &rd_);
+  applyScene<D>(scene, &rd_);
+  const CouplingScene& C = scene.coupling;
+  ard_ = std::make_unique<ARDSolver<D>>(
+      &rd_,
+      ChemicalAdvector<D>(chemicalDomain<D>(scene, fluid_, rd_),
+                          C.interpolation == "cubic" ? ChemicalInterpolation::Cubic : ChemicalInterpolation::Linear),
+      couplingMode(C.mode), C.rdTimeScale);
+  stepper_ = std::make_unique<CoupledStepper<D>>(&fluid_, ard_.get(), backend);
+}
+
+template <int D>
+void CoupledSimulation<D>::step(double dt) {
+  stepper_->step(dt);
+  fluidSeconds_ += stepper_->fluidSeconds();
+  ardSeconds_ += stepper_->ardSeconds();
+  stepSeconds_ += stepper_->stepSeconds();
+  pressureIterations_ += fluid_.lastStats().pressure.iterations;
+  diffusionIterations_ += rd_.lastStats().diffusion.iterations;
+  unconverged_ += fluid_.lastStats().pressure.converged ? 0 : 1;
+  if (!std::isfinite(fluid_.maxSpeed()))
+    throw std::runtime_error(fmt::format("the simulation diverged at step {} (non-finite velocity)", fluid_.steps()));
+}
+
+template <int D>
+std::vector<std::string> CoupledSimulation<D>::fieldNames() const {
+  std::vector<std::string> names = species();
+  for (const std::string& f : fluidFieldNames()) names.push_back(f);
+  return names;
+}
+
+template <int D>
+std::vector<Grid<float, D>> CoupledSimulation<D>::field(const std::string& name) const {
+  const std::vector<std::string> sp = species();
+  if (std::find(sp.begin(), sp.end(), name) != sp.end()) return speciesField<D>(rd_, name);
+  return fluidField<D>(fluid_, name);
+}
+
+template <int D>
+void CoupledSimulation<D>::checkFinite(const std::string& when) const {
+  morphoflow::checkFinite<D>(rd_, when);
+}
+
+template <int D>
+void CoupledSimulation<D>::save(StateWriter* out) const {
+  fluid_.save(out);
+  rd_.save(out);
+  out->put("coupled.stats.seconds", std::array<double, 3>{fluidSeconds_, ardSeconds_, stepSeconds_});
+  out->put("coupled.stats.iterations", std::array<long, 2>{pressureIterations_, diffusionIterations_});
+  out->put("coupled.stats.unconverged", unconverged_);
+}
+
+template <int D>
+void CoupledSimulation<D>::load(const StateReader& in) {
+  fluid_.load(in);
+  rd_.load(in);
+  std::array<double, 3> s{};
+  std::array<long, 2> it{};
+  in.get("coupled.stats.seconds", &s);
+  in.get("coupled.stats.iterations", &it);
+  in.get("coupled.stats.unconverged", &unconverged_);
+  fluidSeconds_ = s[0], ardSeconds_ = s[1], stepSeconds_ = s[2];
+  pressureIterations_ = it[0], diffusionIterations_ = it[1];
+}
+
+template <int D>
+nlohmann::json CoupledSimulation<D>::resolved() const {
+  const CouplingScene& C = scene_.coupling;
+  return {{"dimension", D},
+          {"resolution", scene_.fluid.resolution},
+          {"size", scene_.fluid.size},
+          {"reynolds", scene_.reynolds},
+          {"model", rd_.model().info().name},
+          {"species", species()},
+          {"rd_resolution", scene_.rd.settings.resolution},
+          {"rd_cell_size", rd_.h()},
+          {"diffusion", rd_.diffusion()},
+          {"coupling_mode", C.mode},
+          {"interpolation", C.interpolation},
+          {"rd_time_scale", C.rdTimeScale},
+          {"dt", scene_.time.dt},
+          {"cfl", scene_.time.cfl}};
+}
+
+template <int D>
+void CoupledSimulation<D>::report(nlohmann::json* j) const {
+  const double steps = double(fluid_.steps());
+  (*j)["coupling"] = {{"fluid_seconds", fluidSeconds_},
+                      {"ard_seconds", ardSeconds_},
+                      {"step_seconds", stepSeconds_},
+                      {"overlapped", backend_ != CouplingBackend::Serial}};
+  (*j)["solvers"] = {{"pressure_iterations_mean", steps ? double(pressureIterations_) / steps : 0.0},
+                     {"pressure_unconverged_steps", unconverged_},
+                     {"diffusion_iterations_mean", steps ? double(diffusionIterations_) / steps : 0.0}};
+}
+
+template class CoupledSimulation<2>;
+template class CoupledSimulation<3>;
+
+}  // namespace morphoflow

@@ -1,0 +1,51 @@
+// CoupledSimulation<D>: a scene's stable fluid carrying its
+// advection-reaction-diffusion layer (seed 001 sec. 5, 7), stepped by the
+// serial or tbb-overlap scheduler (coupling/coupled_stepper.h), as a
+// Simulation: species and fluid fields, and the time each side took.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "app/rd_simulation.h"
+#include "core/simulation.h"
+#include "coupling/coupled_stepper.h"
+#include "scenes/scene.h"
+
+namespace morphoflow {
+
+template <int D>
+class CoupledSimulation : public Simulation<D> {
+ public:
+  CoupledSimulation(const Scene& scene, CouplingBackend backend);
+
+  void step(double dt) override;
+  double cflTimeStep(double cfl, double dtMax) const override { return fluid_.cflTimeStep(cfl, dtMax); }
+  double time() const override { return fluid_.time(); }
+  long steps() const override { return fluid_.steps(); }
+  std::vector<std::string> fieldNames() const override;
+  std::vector<std::string> species() const override { return rd_.model().info().species; }
+  std::vector<std::string> dumpFieldNames() const override { return species(); }
+  std::vector<Grid<float, D>> field(const std::string& name) const override;
+  bool symmetric(const std::string& name) const override { return name == "vorticity" && D == 2; }
+  bool hasObstacles() const override { return !scene_.fluid.obstacles.empty(); }
+  void checkFinite(const std::string& when) const override;
+  void save(StateWriter* out) const override;
+  void load(const StateReader& in) override;
+  nlohmann::json resolved() const override;
+  void report(nlohmann::json* run) const override;
+
+ private:
+  const Scene& scene_;
+  CouplingBackend backend_;
+  FluidSolver<D> fluid_;
+  RDSolver<D> rd_;
+  std::unique_ptr<ARDSolver<D>> ard_;
+  std::unique_ptr<CoupledStepper<D>> stepper_;
+  double fluidSeconds_ = 0, ardSeconds_ = 0, stepSeconds_ = 0;
+  long pressureIterations_ = 0, diffusionIterations_ = 0;
+  int unconverged_ = 0;
+};
+
+}  // namespace morphoflow

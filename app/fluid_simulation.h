@@ -1,0 +1,61 @@
+// FluidSimulation<D>: a scene's stable fluid (fluid/fluid_solver.h) as a
+// Simulation, with its dye, probes (centreline profiles, obstacle forces,
+// the Strouhal number) and solver statistics.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "core/simulation.h"
+#include "fluid/fluid_solver.h"
+#include "scenes/scene.h"
+
+namespace morphoflow {
+
+// The scene's initial dye (stripes or a checkerboard), outside the solids.
+template <int D>
+void initialiseDye(const Scene& scene, FluidSolver<D>* fluid);
+
+// The fluid fields every fluid simulation offers.
+std::vector<std::string> fluidFieldNames();
+template <int D>
+std::vector<Grid<float, D>> fluidField(const FluidSolver<D>& fluid, const std::string& name);
+
+template <int D>
+class FluidSimulation : public Simulation<D> {
+ public:
+  using Warn = std::function<void(const std::string&)>;
+  FluidSimulation(const Scene& scene, Warn warn);
+
+  void step(double dt) override;
+  double cflTimeStep(double cfl, double dtMax) const override { return fluid_.cflTimeStep(cfl, dtMax); }
+  double time() const override { return fluid_.time(); }
+  long steps() const override { return fluid_.steps(); }
+  std::vector<std::string> fieldNames() const override { return fluidFieldNames(); }
+  std::vector<std::string> dumpFieldNames() const override { return {"speed", "vorticity", "pressure", "dye"}; }
+  std::vector<Grid<float, D>> field(const std::string& name) const override { return fluidField<D>(fluid_, name); }
+  bool symmetric(const std::string& name) const override { return name == "vorticity" && D == 2; }
+  bool hasObstacles() const override { return !scene_.fluid.obstacles.empty(); }
+  void save(StateWriter* out) const override;
+  void load(const StateReader& in) override;
+  nlohmann::json resolved() const override;
+  void report(nlohmann::json* run) const override;
+  // The probes' files: profiles/*.csv, forces.csv.
+  std::vector<std::pair<std::string, std::string>> measurementFiles() const override;
+
+ private:
+  const Scene& scene_;
+  Warn warn_;
+  FluidSolver<D> fluid_;
+  int flowAxis_ = 0, liftAxis_ = 1;
+  // Statistics over the run, and the force probe's signal.
+  std::array<double, FluidStepStats::kStages> stageTotals_{};
+  long pressureIterations_ = 0, viscosityIterations_ = 0;
+  int maxPressureIterations_ = 0, unconverged_ = 0;
+  double maxPressureResidual_ = 0;
+  std::vector<double> forceTime_, drag_, lift_;
+};
+
+}  // namespace morphoflow

@@ -1,0 +1,67 @@
+// The outputs a run writes at every frame, each a sink the run driver feeds
+// with a Simulation's named fields: image frames (DIR/frames/NNNNNN.png|exr,
+// and the mp4 made of them at the end), field dumps (DIR/fields/NNNNNN.exr).
+// Every file is written to a temporary name and renamed.
+#pragma once
+
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/simulation.h"
+#include "render/video.h"
+#include "scenes/scene.h"
+
+namespace morphoflow {
+
+template <int D>
+class OutputSink {
+ public:
+  virtual ~OutputSink() = default;
+  virtual void write(long frame, long step, const Simulation<D>& sim) = 0;
+  // After the last frame (the video is made here).
+  virtual void finish() {}
+  // Its entries in run.json.
+  virtual void report(nlohmann::json* run) const = 0;
+};
+
+// The scene's field through its palette (or two species in red and green).
+template <int D>
+class ImageSink : public OutputSink<D> {
+ public:
+  ImageSink(const std::filesystem::path& out, const Scene& scene);
+  void write(long frame, long step, const Simulation<D>& sim) override;
+  void finish() override;
+  void report(nlohmann::json* run) const override;
+
+ private:
+  std::filesystem::path dir_;
+  const Scene& scene_;
+  int written_ = 0;
+  long firstWritten_ = -1;
+  bool videoDone_ = false;
+  VideoResult video_;
+  std::filesystem::path videoFile_;
+};
+
+// Every field of the simulation's dump list as full-precision float channels.
+template <int D>
+class FieldDumpSink : public OutputSink<D> {
+ public:
+  explicit FieldDumpSink(const std::filesystem::path& out);
+  void write(long frame, long step, const Simulation<D>& sim) override;
+  void report(nlohmann::json* run) const override;
+
+ private:
+  std::filesystem::path dir_;
+  int written_ = 0;
+};
+
+// The sinks the scene's [output] asks for.
+template <int D>
+std::vector<std::unique_ptr<OutputSink<D>>> makeOutputSinks(const std::filesystem::path& out, const Scene& scene);
+
+}  // namespace morphoflow

@@ -1,0 +1,101 @@
+#include "app/rd_simulation.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include "app/rd_scene_setup.h"
+#include "rd/model_registry.h"
+
+namespace morphoflow {
+
+void RDRunStats::add(const RDStepStats& st) {
+  newton.merge(st.newton);
+  diffusionIterations += st.diffusion.iterations;
+  diffusionMax = std::max(diffusionMax, st.diffusion.iterations);
+  unconverged += st.diffusion.converged ? 0 : 1;
+}
+
+void RDRunStats::save(StateWriter* out) const {
+  out->put("rd.stats.newton", newton);
+  out->put("rd.stats.diffusion_iterations", diffusionIterations);
+  out->put("rd.stats.diffusion_max", diffusionMax);
+  out->put("rd.stats.unconverged", unconverged);
+}
+
+void RDRunStats::load(const StateReader& in) {
+  in.get("rd.stats.newton", &newton);
+  in.get("rd.stats.diffusion_iterations", &diffusionIterations);
+  in.get("rd.stats.diffusion_max", &diffusionMax);
+  in.get("rd.stats.unconverged", &unconverged);
+}
+
+template <int D>
+std::vector<Grid<float, D>> speciesField(const RDSolver<D>& rd, const std::string& name) {
+  const std::vector<std::string>& names = rd.model().info().species;
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it == names.end()) throw std::invalid_argument("no species '" + name + "'");
+  return {toFloat<D>(rd.field(int(it - names.begin())))};
+}
+
+template <int D>
+RDSimulation<D>::RDSimulation(const Scene& scene, const Log& log)
+    : scene_(scene), rd_(scene.rd.settings, *findModel(scene.rd.settings.model)) {
+  if (!growCoarseToFine<D>(scene, &rd_, log, &coarseReport_)) initialState<D>(scene, &rd_);
+  applyScene<D>(scene, &rd_);
+}
+
+template <int D>
+void RDSimulation<D>::step(double dt) {
+  rd_.step(dt);
+  stats_.add(rd_.lastStats());
+}
+
+template <int D>
+void RDSimulation<D>::checkFinite(const std::string& when) const {
+  morphoflow::checkFinite<D>(rd_, when);
+}
+
+template <int D>
+void RDSimulation<D>::save(StateWriter* out) const {
+  rd_.save(out);
+  stats_.save(out);
+}
+
+template <int D>
+void RDSimulation<D>::load(const StateReader& in) {
+  rd_.load(in);
+  stats_.load(in);
+}
+
+template <int D>
+nlohmann::json RDSimulation<D>::resolved() const {
+  return {{"dimension", D},
+          {"model", rd_.model().info().name},
+          {"species", species()},
+          {"resolution", scene_.rd.settings.resolution},
+          {"size", scene_.rd.settings.size},
+          {"cell_size", rd_.h()},
+          {"diffusion", rd_.diffusion()},
+          {"dt", scene_.time.dt},
+          {"explicit_diffusion_limit", rd_.explicitDiffusionLimit()}};
+}
+
+template <int D>
+void RDSimulation<D>::report(nlohmann::json* j) const {
+  const double steps = double(rd_.steps());
+  (*j)["coarse_to_fine"] = coarseReport_;
+  (*j)["solvers"] = {{"newton_cells", stats_.newton.cells},
+                     {"newton_failures", stats_.newton.failures},
+                     {"newton_iterations_max", stats_.newton.maxIterations},
+                     {"newton_residual_max", stats_.newton.maxResidual},
+                     {"diffusion_iterations_mean", steps ? double(stats_.diffusionIterations) / steps : 0.0},
+                     {"diffusion_iterations_max", stats_.diffusionMax},
+                     {"diffusion_unconverged_steps", stats_.unconverged}};
+}
+
+template std::vector<Grid<float, 2>> speciesField<2>(const RDSolver<2>&, const std::string&);
+template std::vector<Grid<float, 3>> speciesField<3>(const RDSolver<3>&, const std::string&);
+template class RDSimulation<2>;
+template class RDSimulation<3>;
+
+}  // namespace morphoflow

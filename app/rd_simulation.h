@@ -1,0 +1,56 @@
+// RDSimulation<D>: a reaction-diffusion-only scene (no [fluid]) as a
+// Simulation: the scene's initial state (grown coarse to fine where the scene
+// asks), its maps and anisotropy, and the solvers' statistics.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "core/simulation.h"
+#include "rd/rd_solver.h"
+#include "scenes/scene.h"
+
+namespace morphoflow {
+
+// Statistics of an RD layer's steps, for run.json.
+struct RDRunStats {
+  NewtonStats newton;
+  long diffusionIterations = 0;
+  int diffusionMax = 0, unconverged = 0;
+  void add(const RDStepStats& st);
+  void save(StateWriter* out) const;
+  void load(const StateReader& in);
+};
+
+// The species of an RD layer as fields.
+template <int D>
+std::vector<Grid<float, D>> speciesField(const RDSolver<D>& rd, const std::string& name);
+
+template <int D>
+class RDSimulation : public Simulation<D> {
+ public:
+  using Log = std::function<void(const std::string&)>;
+  RDSimulation(const Scene& scene, const Log& log);
+
+  void step(double dt) override;
+  double time() const override { return rd_.time(); }
+  long steps() const override { return rd_.steps(); }
+  std::vector<std::string> fieldNames() const override { return species(); }
+  std::vector<std::string> species() const override { return rd_.model().info().species; }
+  std::vector<std::string> dumpFieldNames() const override { return species(); }
+  std::vector<Grid<float, D>> field(const std::string& name) const override { return speciesField<D>(rd_, name); }
+  void checkFinite(const std::string& when) const override;
+  void save(StateWriter* out) const override;
+  void load(const StateReader& in) override;
+  nlohmann::json resolved() const override;
+  void report(nlohmann::json* run) const override;
+
+ private:
+  const Scene& scene_;
+  RDSolver<D> rd_;
+  nlohmann::json coarseReport_ = nlohmann::json::array();
+  RDRunStats stats_;
+};
+
+}  // namespace morphoflow

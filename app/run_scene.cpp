@@ -1,0 +1,46 @@
+// `morphoflow run`: a scene file to its Simulation, through the run driver.
+#include <memory>
+
+#include "app/coupled_simulation.h"
+#include "app/fluid_simulation.h"
+#include "app/rd_simulation.h"
+#include "app/run_driver.h"
+#include "app/run_log.h"
+#include "app/run_options.h"
+#include "core/error.h"
+#include "core/parallel.h"
+#include "scenes/scene_loader.h"
+
+namespace morphoflow {
+
+namespace {
+
+template <int D>
+std::unique_ptr<Simulation<D>> makeSimulation(const Scene& scene, const RunOptions& opt, RunLog* log) {
+  auto say = [log](const std::string& line) { log->say(line); };
+  auto warn = [log](const std::string& line) { log->warn(line); };
+  if (!scene.hasFluid) return std::make_unique<RDSimulation<D>>(scene, say);
+  if (scene.rd.enabled)
+    return std::make_unique<CoupledSimulation<D>>(scene, opt.backend == "serial" ? CouplingBackend::Serial
+                                                                               : CouplingBackend::TBB);
+  return std::make_unique<FluidSimulation<D>>(scene, warn);
+}
+
+template <int D>
+int run(const Scene& scene, const RunOptions& opt) {
+  RunLog log(opt.quiet, stderrIsTerminal());
+  std::unique_ptr<Simulation<D>> sim = makeSimulation<D>(scene, opt, &log);
+  return driveRun<D>(*sim, scene, opt, &log);
+}
+
+}  // namespace
+
+int runScene(const RunOptions& opt) {
+  Scene scene = loadScene(opt.scene, opt.overrides);
+  if (opt.backend == "gpu")
+    throw UserError({"--backend", 0, 0}, "", "the gpu backend is not part of this build yet", "use --backend tbb or serial");
+  ThreadLimit limit(opt.backend == "serial" ? 1 : opt.threads);
+  return scene.dimension == 2 ? run<2>(scene, opt) : run<3>(scene, opt);
+}
+
+}  // namespace morphoflow

@@ -1,0 +1,67 @@
+// Simulation<D>: what the run driver (app/run_driver.h) needs of any
+// simulation, fluid-only, reaction-diffusion-only or coupled, on any backend:
+// advance one step, say where it is, expose named output fields, and save and
+// restore its complete state. The driver owns everything else: the frame
+// schedule, outputs, progress, checkpoints and run.json.
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/grid.h"
+#include "core/state_archive.h"
+
+namespace morphoflow {
+
+template <int D>
+class Simulation {
+ public:
+  virtual ~Simulation() = default;
+
+  // Advances one step of dt.
+  virtual void step(double dt) = 0;
+  // The largest dt with |u|max dt <= cfl h (dtMax when nothing moves).
+  virtual double cflTimeStep(double cfl, double dtMax) const { return dtMax; }
+  virtual double time() const = 0;
+  virtual long steps() const = 0;
+
+  // Every field field() can return: species, then speed, vorticity,
+  // pressure, dye, velocity, obstacle where the simulation has a fluid.
+  virtual std::vector<std::string> fieldNames() const = 0;
+  // The reaction-diffusion species (empty without a layer).
+  virtual std::vector<std::string> species() const { return {}; }
+  // The fields a field dump holds, in order.
+  virtual std::vector<std::string> dumpFieldNames() const = 0;
+  // A named field at cell centres: one grid, or D (x, y[, z]) for "velocity".
+  // Each field is on its own grid (species on the RD grid, the rest on the
+  // fluid's); all of them span the same domain.
+  virtual std::vector<Grid<float, D>> field(const std::string& name) const = 0;
+  // Whether the field is signed around 0 (an automatic image range is then
+  // centred on 0).
+  virtual bool symmetric(const std::string& name) const { return false; }
+  // Whether the scene has solid cells (the "obstacle" field is then nonzero
+  // inside them).
+  virtual bool hasObstacles() const { return false; }
+
+  // Files of the simulation's own measurements (probes), written at the
+  // end: a path relative to the output folder, and the text.
+  virtual std::vector<std::pair<std::string, std::string>> measurementFiles() const { return {}; }
+
+  // Throws std::runtime_error when the state is no longer finite; `when`
+  // says when ("at step 12").
+  virtual void checkFinite(const std::string& when) const {}
+
+  // Everything step() depends on, so that load(save()) continues bit for bit.
+  virtual void save(StateWriter* out) const = 0;
+  virtual void load(const StateReader& in) = 0;
+
+  // run.json: "resolved" values of the scene, and the simulation's own
+  // statistics (solver iterations, stage times) under their own keys.
+  virtual nlohmann::json resolved() const = 0;
+  virtual void report(nlohmann::json* run) const = 0;
+};
+
+}  // namespace morphoflow

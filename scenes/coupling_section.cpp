@@ -1,0 +1,29 @@
+// [coupling]: how the fluid carries the reaction-diffusion layer.
+#include "scenes/scene_reader.h"
+
+namespace morphoflow {
+
+void parseCoupling(SceneContext& c, Scene* sp) {
+  Reader& r = c.r;
+  toml::table& root = c.root;
+  Scene& s = *sp;
+  const std::vector<std::string>& species = c.species;
+  if (const toml::table* ct = r.table(root, "", "coupling")) {
+    if (!s.rd.enabled || !s.hasFluid)
+      r.fail(ct, "coupling", "[coupling] joins a [fluid] and an [rd] layer, and this scene lacks one of them",
+             "add the missing table or drop [coupling]");
+  }
+  if (s.rd.enabled && s.hasFluid) {
+    const toml::table* ct = r.table(root, "", "coupling");
+    CouplingScene& C = s.coupling;
+    C.enabled = true;
+    C.mode = r.string(ct, "coupling.", "mode", "ard", {"ard", "passive", "rd-only"});
+    C.interpolation = r.string(ct, "coupling.", "interpolation", "linear", {"linear", "cubic"});
+    C.rdTimeScale = r.number(ct, "coupling.", "rd_time_scale", 1.0, 0, 1e9, true);
+    const size_t n = species.size();
+    C.inflowValues = r.numbers(ct, "coupling.", "inflow_values", s.rd.initial.values, n, n, -1e12, 1e12);
+    C.solidValues = r.numbers(ct, "coupling.", "solid_values", std::vector<double>(n, 0.0), n, n, -1e12, 1e12);
+  }
+}
+
+}  // namespace morphoflow

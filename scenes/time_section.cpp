@@ -1,0 +1,21 @@
+// [time]: the step, and how many (steps) or how long (duration); the CFL limit.
+#include "scenes/scene_reader.h"
+
+namespace morphoflow {
+
+void parseTime(SceneContext& c, Scene* sp) {
+  Reader& r = c.r;
+  toml::table& root = c.root;
+  Scene& s = *sp;
+  const toml::table* time = r.table(root, "", "time");
+  s.time.dt = r.number(time, "time.", "dt", 0.01, 0, 1e6, true);
+  const toml::node* stepsNode = r.node(time, "time.", "steps");
+  const toml::node* durNode = r.node(time, "time.", "duration");
+  if (stepsNode && durNode) r.fail(durNode, "time.duration", "give either time.steps or time.duration, not both");
+  s.time.steps = r.integer(time, "time.", "steps", 0, 1, 100'000'000);
+  s.time.duration = r.number(time, "time.", "duration", 0.0, 0, 1e9, true);
+  if (!stepsNode && !durNode) s.time.steps = 100;
+  s.time.cfl = r.number(time, "time.", "cfl", 0.0, 0, 1000);
+}
+
+}  // namespace morphoflow
