@@ -59,7 +59,6 @@ int main(int argc, char** argv) {
 
   RunOptions run;
   std::string frames;
-  bool resume = false;
   CLI::App* runCmd = app.add_subcommand("run", "run a scene");
   runCmd->add_option("scene", run.scene, "scene file (.toml)")->required();
   runCmd->add_option("--set", run.overrides, "override a scene key: key.path=value (TOML value)");
@@ -69,7 +68,8 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   runCmd->add_option("--threads", run.threads, "worker threads (0 = all cores)")->check(CLI::Range(0, 1024));
   runCmd->add_option("--frames", frames, "A:B: write frames A to B (inclusive), stop after B");
-  runCmd->add_flag("--resume", resume, "continue an interrupted run");
+  runCmd->add_flag("--resume", run.resume, "continue from the newest intact checkpoint in --out");
+  runCmd->add_flag("--force", run.force, "with --resume: continue even though the scene changed");
   runCmd->add_flag("--quiet", run.quiet, "no progress output");
 
   BatchOptions batch;
@@ -133,9 +133,8 @@ int main(int argc, char** argv) {
 
   try {
     if (*runCmd) {
-      if (resume)
-        throw UserError({"--resume", 0, 0}, "", "this build writes no checkpoints, so there is nothing to resume",
-                        "run the scene again without --resume");
+      if (run.force && !run.resume)
+        throw UserError({"--force", 0, 0}, "", "--force only applies with --resume", "add --resume, or drop --force");
       if (!frames.empty()) parseFrames(frames, &run);
       return runScene(run);
     }

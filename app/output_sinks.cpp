@@ -5,15 +5,27 @@
 
 #include <fmt/format.h>
 
+#include "core/output_file.h"
 #include "render/field_dump.h"
 #include "render/field_image.h"
 #include "render/image_io.h"
 
 namespace morphoflow {
 
+uintmax_t fileBytes(const std::filesystem::path& file) {
+  std::error_code ec;
+  const uintmax_t n = std::filesystem::file_size(file, ec);
+  return ec ? 0 : n;
+}
+
+void addBytes(nlohmann::json* run, const std::string& kind, uintmax_t bytes) {
+  nlohmann::json& b = (*run)["bytes_written"];
+  b[kind] = (b.contains(kind) ? b[kind].get<uintmax_t>() : 0) + bytes;
+}
+
 template <int D>
 ImageSink<D>::ImageSink(const std::filesystem::path& out, const Scene& scene) : dir_(out / "frames"), scene_(scene) {
-  std::filesystem::create_directories(dir_);
+  createOutputFolder(dir_);
 }
 
 template <int D>
@@ -39,6 +51,7 @@ void ImageSink<D>::write(long frame, long step, const Simulation<D>& sim) {
   if (!writeRgb8(file.string(), w, h, rgb, &err)) throw std::runtime_error("writing " + file.string() + ": " + err);
   if (firstWritten_ < 0) firstWritten_ = frame;
   ++written_;
+  bytes_ += fileBytes(file);
 }
 
 template <int D>
@@ -49,7 +62,8 @@ void ImageSink<D>::finish() {
   r.firstFrame = int(std::max<long>(0, firstWritten_));
   r.frameCount = written_;
   r.fps = scene_.output.fps;
-  r.file = dir_.parent_path() / ((scene_.name.empty() ? std::string("animation") : scene_.name) + ".mp4");
+  r.file = dir_.parent_path() / (safeFileStem(scene_.name) + ".mp4");
+  r.cancelled = cancelled;
   video_ = encodeVideo(r);
   videoDone_ = true;
   videoFile_ = r.file;
@@ -58,6 +72,8 @@ void ImageSink<D>::finish() {
 template <int D>
 void ImageSink<D>::report(nlohmann::json* j) const {
   (*j)["frames_written"] = written_;
+  addBytes(j, "frames", bytes_);
+  if (videoDone_ && video_.written) addBytes(j, "video", fileBytes(videoFile_));
   if (videoDone_)
     (*j)["video"] = {{"file", videoFile_.string()},
                      {"written", video_.written},
@@ -66,8 +82,20 @@ void ImageSink<D>::report(nlohmann::json* j) const {
 }
 
 template <int D>
+nlohmann::json ImageSink<D>::state() const {
+  return {{"written", written_}, {"first_written", firstWritten_}, {"bytes", bytes_}};
+}
+
+template <int D>
+void ImageSink<D>::restore(const nlohmann::json& s) {
+  written_ = s.at("written").get<int>();
+  firstWritten_ = s.at("first_written").get<long>();
+  bytes_ = s.at("bytes").get<uintmax_t>();
+}
+
+template <int D>
 FieldDumpSink<D>::FieldDumpSink(const std::filesystem::path& out) : dir_(out / "fields") {
-  std::filesystem::create_directories(dir_);
+  createOutputFolder(dir_);
 }
 
 template <int D>
@@ -83,17 +111,35 @@ void FieldDumpSink<D>::write(long frame, long step, const Simulation<D>& sim) {
   const std::filesystem::path file = dir_ / fmt::format("{:06d}.exr", frame);
   if (!writeFieldDump(file.string(), d, &err)) throw std::runtime_error("writing " + file.string() + ": " + err);
   ++written_;
+  bytes_ += fileBytes(file);
 }
 
 template <int D>
 void FieldDumpSink<D>::report(nlohmann::json* j) const {
   (*j)["fields_written"] = written_;
+  addBytes(j, "fields", bytes_);
 }
 
 template <int D>
-std::vector<std::unique_ptr<OutputSink<D>>> makeOutputSinks(const std::filesystem::path& out, const Scene& scene) {
+nlohmann::json FieldDumpSink<D>::state() const {
+  return {{"written", written_}, {"bytes", bytes_}};
+}
+
+template <int D>
+void FieldDumpSink<D>::restore(const nlohmann::json& s) {
+  written_ = s.at("written").get<int>();
+  bytes_ = s.at("bytes").get<uintmax_t>();
+}
+
+template <int D>
+std::vector<std::unique_ptr<OutputSink<D>>> makeOutputSinks(const std::filesystem::path& out, const Scene& scene,
+                                                            const std::function<bool()>& cancelled) {
   std::vector<std::unique_ptr<OutputSink<D>>> sinks;
-  if (scene.output.images) sinks.push_back(std::make_unique<ImageSink<D>>(out, scene));
+  if (scene.output.images) {
+    auto images = std::make_unique<ImageSink<D>>(out, scene);
+    images->cancelled = cancelled;
+    sinks.push_back(std::move(images));
+  }
   if (scene.output.fields) sinks.push_back(std::make_unique<FieldDumpSink<D>>(out));
   return sinks;
 }
@@ -102,7 +148,9 @@ template class ImageSink<2>;
 template class ImageSink<3>;
 template class FieldDumpSink<2>;
 template class FieldDumpSink<3>;
-template std::vector<std::unique_ptr<OutputSink<2>>> makeOutputSinks<2>(const std::filesystem::path&, const Scene&);
-template std::vector<std::unique_ptr<OutputSink<3>>> makeOutputSinks<3>(const std::filesystem::path&, const Scene&);
+template std::vector<std::unique_ptr<OutputSink<2>>> makeOutputSinks<2>(const std::filesystem::path&, const Scene&,
+                                                                         const std::function<bool()>&);
+template std::vector<std::unique_ptr<OutputSink<3>>> makeOutputSinks<3>(const std::filesystem::path&, const Scene&,
+                                                                         const std::function<bool()>&);
 
 }  // namespace morphoflow

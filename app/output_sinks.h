@@ -4,7 +4,9 @@
 // Every file is written to a temporary name and renamed.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -24,8 +26,11 @@ class OutputSink {
   virtual void write(long frame, long step, const Simulation<D>& sim) = 0;
   // After the last frame (the video is made here).
   virtual void finish() {}
-  // Its entries in run.json.
+  // Its entries in run.json (its counts, and its bytes under "bytes_written").
   virtual void report(nlohmann::json* run) const = 0;
+  // What it must remember across a checkpoint (counts, the first frame).
+  virtual nlohmann::json state() const = 0;
+  virtual void restore(const nlohmann::json& state) = 0;
 };
 
 // The scene's field through its palette (or two species in red and green).
@@ -36,12 +41,17 @@ class ImageSink : public OutputSink<D> {
   void write(long frame, long step, const Simulation<D>& sim) override;
   void finish() override;
   void report(nlohmann::json* run) const override;
+  nlohmann::json state() const override;
+  void restore(const nlohmann::json& state) override;
+  // Polled while the video is encoded: true stops it.
+  std::function<bool()> cancelled;
 
  private:
   std::filesystem::path dir_;
   const Scene& scene_;
   int written_ = 0;
   long firstWritten_ = -1;
+  uintmax_t bytes_ = 0;
   bool videoDone_ = false;
   VideoResult video_;
   std::filesystem::path videoFile_;
@@ -54,14 +64,23 @@ class FieldDumpSink : public OutputSink<D> {
   explicit FieldDumpSink(const std::filesystem::path& out);
   void write(long frame, long step, const Simulation<D>& sim) override;
   void report(nlohmann::json* run) const override;
+  nlohmann::json state() const override;
+  void restore(const nlohmann::json& state) override;
 
  private:
   std::filesystem::path dir_;
   int written_ = 0;
+  uintmax_t bytes_ = 0;
 };
 
-// The sinks the scene's [output] asks for.
+// The sinks the scene's [output] asks for; `cancelled` stops a video encode.
 template <int D>
-std::vector<std::unique_ptr<OutputSink<D>>> makeOutputSinks(const std::filesystem::path& out, const Scene& scene);
+std::vector<std::unique_ptr<OutputSink<D>>> makeOutputSinks(const std::filesystem::path& out, const Scene& scene,
+                                                            const std::function<bool()>& cancelled);
+
+// The bytes of a file just written (0 when it is not there).
+uintmax_t fileBytes(const std::filesystem::path& file);
+// Adds `bytes` to run["bytes_written"][kind].
+void addBytes(nlohmann::json* run, const std::string& kind, uintmax_t bytes);
 
 }  // namespace morphoflow

@@ -80,6 +80,13 @@ void RunLog::endProgress() {
   drawn_ = false;
 }
 
+void RunLog::restore(const std::string& text) {
+  std::vector<std::string> earlier;
+  size_t at = 0;
+  for (size_t nl; (nl = text.find('\n', at)) != std::string::npos; at = nl + 1) earlier.push_back(text.substr(at, nl - at));
+  lines_.insert(lines_.begin(), earlier.begin(), earlier.end());
+}
+
 std::string RunLog::text() const {
   std::string s;
   for (const std::string& l : lines_) s += l + "\n";

@@ -25,6 +25,8 @@ class RunLog {
   void endProgress();
   // The lines so far, as DIR/log.txt holds them.
   std::string text() const;
+  // Puts back the lines of an interrupted run (text()'s output) before this one's.
+  void restore(const std::string& text);
 
  private:
   using Clock = std::chrono::steady_clock;

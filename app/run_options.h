@@ -14,6 +14,8 @@ struct RunOptions {
   int threads = 0;                     // 0 = all cores
   int firstFrame = 0, lastFrame = -1;  // --frames A:B (inclusive; -1 = to the end)
   bool quiet = false;
+  bool resume = false;                 // continue from the newest intact checkpoint in `out`
+  bool force = false;                  // resume even though the scene changed
 };
 
 // Runs one scene; returns the process exit status. Throws UserError on bad input.

@@ -7,7 +7,7 @@
 
 #include <fmt/format.h>
 
-#include "app/output_files.h"
+#include "core/output_file.h"
 #include "core/error.h"
 #include "render/colormap.h"
 #include "render/field_dump.h"
@@ -61,7 +61,7 @@ int analyzeCommand(const AnalyzeOptions& o) {
     std::string s = "lag,v_10,v_01,v_11,v_1m1\n";
     for (size_t l = 0; l < v.v.size(); ++l)
       s += fmt::format("{},{:.8g},{:.8g},{:.8g},{:.8g}\n", l + 1, v.v[l][0], v.v[l][1], v.v[l][2], v.v[l][3]);
-    writeTextFile(o.csv, s);
+    writeFileAtomically(o.csv, s);
   }
   return 0;
 }

@@ -2,7 +2,10 @@
 
 #include <filesystem>
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
+
+#include "core/output_file.h"
 
 #include "render/image_file.h"
 
@@ -49,10 +52,11 @@ bool readGrayImage(const std::string& path, GrayImage* image, std::string* error
 
 bool writeImageAtomically(const std::string& path, const OIIO::ImageSpec& spec, OIIO::TypeDesc type,
                           const void* pixels, std::string* error) {
-  std::filesystem::path final(path);
-  std::filesystem::path tmp = final;
-  tmp += ".tmp" + final.extension().string();
-  auto out = OIIO::ImageOutput::create(final.string());
+  // Encoded in memory, then written by the one checked writer (a full disk
+  // or a missing permission is an OutputError naming the path).
+  std::vector<unsigned char> bytes;
+  OIIO::Filesystem::IOVecOutput memory(bytes);
+  auto out = OIIO::ImageOutput::create(path, &memory);
   if (!out) {
     *error = "no image writer for " + path + ": " + OIIO::geterror();
     return false;
@@ -61,18 +65,11 @@ bool writeImageAtomically(const std::string& path, const OIIO::ImageSpec& spec, 
   // fields give the same bytes, in a rerun or a resumed run.
   OIIO::ImageSpec stamped = spec;
   stamped.attribute("DateTime", "");
-  if (!out->open(tmp.string(), stamped) || !out->write_image(type, pixels) || !out->close()) {
+  if (!out->open(path, stamped) || !out->write_image(type, pixels) || !out->close()) {
     *error = out->geterror();
-    std::error_code ec;
-    std::filesystem::remove(tmp, ec);
     return false;
   }
-  std::error_code ec;
-  std::filesystem::rename(tmp, final, ec);
-  if (ec) {
-    *error = ec.message();
-    return false;
-  }
+  writeFileAtomically(path, std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
   return true;
 }
 

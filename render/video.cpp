@@ -6,10 +6,13 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <csignal>
 #include <cstdlib>
 #include <cstring>
 #include <sstream>
 #include <vector>
+
+#include "core/output_file.h"
 
 extern char** environ;
 
@@ -43,8 +46,11 @@ VideoResult encodeVideo(const VideoRequest& r) {
                      "); install it (apt install ffmpeg) and run again, or set output.video = false";
     return result;
   }
+  checkReplaceable(r.file);
   const fs::path part = r.file.string() + ".part";
+  checkReplaceable(part);
   result.log = r.file.parent_path() / (r.file.stem().string() + ".ffmpeg.log");
+  checkReplaceable(result.log);
   // libx264 in yuv420p needs even sides: pad odd frames by one black pixel.
   std::vector<std::string> args = {ffmpeg.string(), "-nostdin", "-y", "-hide_banner", "-loglevel", "error",
                                    "-framerate", std::to_string(r.fps), "-start_number", std::to_string(r.firstFrame),
@@ -68,9 +74,22 @@ VideoResult encodeVideo(const VideoRequest& r) {
     return result;
   }
   int status = 0;
-  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  bool stopped = false;
+  for (;;) {
+    const pid_t w = waitpid(pid, &status, WNOHANG);
+    if (w == pid || (w < 0 && errno != EINTR)) break;
+    if (!stopped && r.cancelled && r.cancelled()) {
+      kill(pid, SIGTERM);
+      stopped = true;
+    }
+    usleep(20000);
   }
   std::error_code ec;
+  if (stopped) {
+    fs::remove(part, ec);
+    result.warning = "the video was not made: the run was interrupted while ffmpeg encoded it";
+    return result;
+  }
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
     fs::remove(part, ec);
     result.warning = "ffmpeg failed (" +

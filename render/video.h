@@ -5,6 +5,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <string>
 
 namespace morphoflow {
@@ -15,6 +16,8 @@ struct VideoRequest {
   int frameCount = 0;
   int fps = 30;
   std::filesystem::path file;     // the .mp4 to write
+  // Polled while ffmpeg runs: true stops it (SIGTERM) and removes its .part file.
+  std::function<bool()> cancelled;
 };
 
 struct VideoResult {

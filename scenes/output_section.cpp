@@ -20,6 +20,7 @@ void parseOutput(SceneContext& c, Scene* sp) {
   if (r.boolean(out, "output.", "vdb", false))
     r.fail(r.node(out, "output.", "vdb"), "output.vdb", "this build of morphoflow does not write vdb yet",
            "set it to false");
+  s.output.checkpointEvery = int(r.integer(out, "output.", "checkpoint_every", 10, 0, 1'000'000'000));
   s.output.video = r.boolean(out, "output.", "video", false);
   s.output.fps = int(r.integer(out, "output.", "fps", 30, 1, 240));
   if (s.output.video && (!s.output.images || s.output.format != "png"))

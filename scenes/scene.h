@@ -35,6 +35,7 @@ struct OutputSettings {
   bool autoRange = true;
   double range[2] = {0.0, 1.0};
   int slice = -1;                  // 3D: z slice for images (-1 = middle)
+  int checkpointEvery = 10;        // frames between checkpoints (0: only at the end and on a stop)
 };
 
 struct ProbeSettings {

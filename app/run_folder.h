@@ -1,0 +1,16 @@
+// The output folder of a run. A new run into a folder that holds an earlier
+// run's outputs removes those first (only files a run writes, by their
+// names: frames/, fields/, vdb/, checkpoints/, profiles/, run.json, log.txt,
+// forces.csv, the video), so two runs' frames never mix; anything else in
+// the folder is left alone. --resume keeps them and continues.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+namespace morphoflow {
+
+// Removes an earlier run's outputs from `out`; returns how many files went.
+int removeEarlierRun(const std::filesystem::path& out, const std::string& videoStem);
+
+}  // namespace morphoflow
