@@ -1,6 +1,12 @@
 // Helpers for tests that drive the morphoflow executable.
 #pragma once
 
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -9,6 +15,8 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+extern char** environ;
 
 namespace morphoflow::testing {
 
@@ -66,5 +74,41 @@ inline double interpolate(const std::vector<std::pair<double, double>>& rows, do
 }
 
 inline bool fullValidation() { return std::getenv("MORPHOFLOW_FULL_VALIDATION") != nullptr; }
+
+// morphoflow started in the background with an argument vector (stdout and
+// stderr to `log`); its pid.
+inline pid_t startMorphoflow(const std::vector<std::string>& args, const std::filesystem::path& log) {
+  std::vector<std::string> all = {MORPHOFLOW_BINARY};
+  all.insert(all.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t fa;
+  posix_spawn_file_actions_init(&fa);
+  posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_adddup2(&fa, STDOUT_FILENO, STDERR_FILENO);
+  pid_t pid = -1;
+  if (posix_spawn(&pid, MORPHOFLOW_BINARY, &fa, nullptr, argv.data(), environ) != 0) pid = -1;
+  posix_spawn_file_actions_destroy(&fa);
+  return pid;
+}
+
+// Waits for a child; its exit status, or 128 + the signal that ended it.
+inline int waitMorphoflow(pid_t pid) {
+  int st = 0;
+  while (waitpid(pid, &st, 0) < 0 && errno == EINTR) {
+  }
+  return WIFEXITED(st) ? WEXITSTATUS(st) : WIFSIGNALED(st) ? 128 + WTERMSIG(st) : -1;
+}
+
+// Polls until `ready()` holds or `seconds` pass; whether it held.
+template <class F>
+bool waitUntil(F ready, double seconds) {
+  for (int i = 0; i < int(seconds * 200); ++i) {
+    if (ready()) return true;
+    usleep(5000);
+  }
+  return ready();
+}
 
 }  // namespace morphoflow::testing
