@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "app/vdb_sink.h"
 #include "core/output_file.h"
 #include "render/field_dump.h"
 #include "render/field_image.h"
@@ -29,7 +30,8 @@ ImageSink<D>::ImageSink(const std::filesystem::path& out, const Scene& scene) : 
 }
 
 template <int D>
-void ImageSink<D>::write(long frame, long step, const Simulation<D>& sim) {
+void ImageSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
+  const long frame = at.frame;
   const OutputSettings& o = scene_.output;
   FieldImageOptions io;
   io.palette = o.gradient.empty() ? namedPalette(o.colormap) : Palette{o.gradient};
@@ -99,16 +101,16 @@ FieldDumpSink<D>::FieldDumpSink(const std::filesystem::path& out) : dir_(out / "
 }
 
 template <int D>
-void FieldDumpSink<D>::write(long frame, long step, const Simulation<D>& sim) {
+void FieldDumpSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
   FieldDump d;
   d.names = sim.dumpFieldNames();
   for (const std::string& n : d.names) d.channels.push_back(sim.field(n).front().values());
   const Grid<float, D> first = sim.field(d.names.front()).front();
   for (int a = 0; a < D; ++a) d.resolution.push_back(first.dim(a));
   d.time = sim.time();
-  d.step = step;
+  d.step = at.step;
   std::string err;
-  const std::filesystem::path file = dir_ / fmt::format("{:06d}.exr", frame);
+  const std::filesystem::path file = dir_ / fmt::format("{:06d}.exr", at.frame);
   if (!writeFieldDump(file.string(), d, &err)) throw std::runtime_error("writing " + file.string() + ": " + err);
   ++written_;
   bytes_ += fileBytes(file);
@@ -141,6 +143,7 @@ std::vector<std::unique_ptr<OutputSink<D>>> makeOutputSinks(const std::filesyste
     sinks.push_back(std::move(images));
   }
   if (scene.output.fields) sinks.push_back(std::make_unique<FieldDumpSink<D>>(out));
+  if (scene.output.vdb) sinks.push_back(std::make_unique<VdbSink<D>>(out, scene));
   return sinks;
 }
 

@@ -1,6 +1,7 @@
 // The outputs a run writes at every frame, each a sink the run driver feeds
 // with a Simulation's named fields: image frames (DIR/frames/NNNNNN.png|exr,
-// and the mp4 made of them at the end), field dumps (DIR/fields/NNNNNN.exr).
+// and the mp4 made of them at the end), field dumps (DIR/fields/NNNNNN.exr),
+// volumes (DIR/vdb/<name>.NNNNNN.vdb|nvdb, app/vdb_sink.h).
 // Every file is written to a temporary name and renamed.
 #pragma once
 
@@ -19,11 +20,17 @@
 
 namespace morphoflow {
 
+// Which frame a sink is fed, and where the run is.
+struct FrameInfo {
+  long frame = 0, step = 0;
+  double dt = 0.0;  // the last step's (frame 0: the first's)
+};
+
 template <int D>
 class OutputSink {
  public:
   virtual ~OutputSink() = default;
-  virtual void write(long frame, long step, const Simulation<D>& sim) = 0;
+  virtual void write(const FrameInfo& at, const Simulation<D>& sim) = 0;
   // After the last frame (the video is made here).
   virtual void finish() {}
   // Its entries in run.json (its counts, and its bytes under "bytes_written").
@@ -38,7 +45,7 @@ template <int D>
 class ImageSink : public OutputSink<D> {
  public:
   ImageSink(const std::filesystem::path& out, const Scene& scene);
-  void write(long frame, long step, const Simulation<D>& sim) override;
+  void write(const FrameInfo& at, const Simulation<D>& sim) override;
   void finish() override;
   void report(nlohmann::json* run) const override;
   nlohmann::json state() const override;
@@ -62,7 +69,7 @@ template <int D>
 class FieldDumpSink : public OutputSink<D> {
  public:
   explicit FieldDumpSink(const std::filesystem::path& out);
-  void write(long frame, long step, const Simulation<D>& sim) override;
+  void write(const FrameInfo& at, const Simulation<D>& sim) override;
   void report(nlohmann::json* run) const override;
   nlohmann::json state() const override;
   void restore(const nlohmann::json& state) override;

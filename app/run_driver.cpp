@@ -104,7 +104,7 @@ class Driver {
     const long f = schedule_.frameAt(sim_.steps());
     if (f < 0) return -1;
     sim_.checkFinite(fmt::format("at step {}", sim_.steps()));
-    for (const auto& s : sinks_) s->write(f, sim_.steps(), sim_);
+    for (const auto& s : sinks_) s->write(FrameInfo{f, sim_.steps(), lastDt_ > 0 ? lastDt_ : scene_.time.dt}, sim_);
     lastFrame_ = f;
     return f;
   }

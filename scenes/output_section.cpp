@@ -5,6 +5,44 @@
 
 namespace morphoflow {
 
+namespace {
+
+// output.vdb and its options: every named field must be one the scene has.
+void parseVdbOutput(SceneContext& c, const toml::table* out, Scene& s) {
+  Reader& r = c.r;
+  const std::vector<std::string>& species = c.species;
+  OutputSettings& o = s.output;
+  o.vdb = r.boolean(out, "output.", "vdb", false);
+  std::vector<std::string> fields = species;
+  if (s.hasFluid)
+    for (const char* f : {"speed", "vorticity", "pressure", "dye"}) fields.push_back(f);
+  o.vdbDensity = r.string(out, "output.", "vdb_density", o.field, fields);
+  const std::vector<std::string> fluidScalars = {"speed", "vorticity", "pressure", "dye"};
+  if (const toml::node* vf = r.node(out, "output.", "vdb_fields")) {
+    const toml::array* arr = vf->as_array();
+    if (!arr) r.fail(vf, "output.vdb_fields", "expected an array of field names, e.g. [\"speed\", \"vorticity\"]");
+    if (!s.hasFluid && !arr->empty())
+      r.fail(vf, "output.vdb_fields", "this scene has no fluid, so it has none of the fluid fields",
+             "drop output.vdb_fields (its species are written anyway)");
+    for (const toml::node& e : *arr) {
+      auto name = e.value<std::string>();
+      if (!name || std::find(fluidScalars.begin(), fluidScalars.end(), *name) == fluidScalars.end())
+        r.fail(&e, "output.vdb_fields", "expected names of fluid fields: speed, vorticity, pressure, dye",
+               name ? "did you mean '" + nearest(*name, fluidScalars) + "'?" : std::string());
+      o.vdbFields.push_back(*name);
+    }
+  }
+  o.vdbTolerance = r.number(out, "output.", "vdb_tolerance", 0.0, 0.0, 1e30);
+  o.vdbHalf = r.boolean(out, "output.", "vdb_half", false);
+  o.nanovdb = r.boolean(out, "output.", "nanovdb", false);
+  if (!o.vdb)
+    for (const char* k : {"vdb_density", "vdb_fields", "vdb_tolerance", "vdb_half", "nanovdb"})
+      if (const toml::node* n = r.node(out, "output.", k); n && !(n->is_boolean() && !n->value<bool>().value()))
+        r.fail(n, std::string("output.") + k, "only applies with output.vdb = true", "add output.vdb = true or drop it");
+}
+
+}  // namespace
+
 void parseOutput(SceneContext& c, Scene* sp) {
   Reader& r = c.r;
   toml::table& root = c.root;
@@ -17,9 +55,6 @@ void parseOutput(SceneContext& c, Scene* sp) {
   s.output.images = r.boolean(out, "output.", "images", true);
   s.output.fields = r.boolean(out, "output.", "fields", false);
   s.output.format = r.string(out, "output.", "format", "png", {"png", "exr"});
-  if (r.boolean(out, "output.", "vdb", false))
-    r.fail(r.node(out, "output.", "vdb"), "output.vdb", "this build of morphoflow does not write vdb yet",
-           "set it to false");
   s.output.checkpointEvery = int(r.integer(out, "output.", "checkpoint_every", 10, 0, 1'000'000'000));
   s.output.video = r.boolean(out, "output.", "video", false);
   s.output.fps = int(r.integer(out, "output.", "fps", 30, 1, 240));
@@ -35,6 +70,7 @@ void parseOutput(SceneContext& c, Scene* sp) {
     s.output.field = r.string(out, "output.", "field", species.front(), species);
   else
     s.output.field = r.string(out, "output.", "field", "vorticity", {"speed", "vorticity", "dye", "pressure"});
+  parseVdbOutput(c, out, s);
   s.output.colormap = r.string(out, "output.", "colormap", s.output.field == "vorticity" ? "coolwarm" : "viridis",
                                colormapNames());
   if (s.output.colormap == kTwoSpeciesPalette && species.size() < 2)

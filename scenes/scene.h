@@ -25,7 +25,12 @@ struct OutputSettings {
   int every = 10;                  // steps between frames
   bool images = true;
   bool fields = false;
-  bool vdb = false;
+  bool vdb = false;                 // DIR/vdb/<name>.NNNNNN.vdb every frame
+  std::string vdbDensity;           // the field in the "density" grid (default: field)
+  std::vector<std::string> vdbFields;  // fluid scalars as grids of their own
+  double vdbTolerance = 0.0;        // |value| <= this: inactive voxel
+  bool vdbHalf = false;             // floats saved as half
+  bool nanovdb = false;             // also DIR/vdb/<name>.NNNNNN.nvdb
   bool video = false;               // encode the PNG frames into OUT/<name>.mp4 (ffmpeg)
   int fps = 30;                     // video frames per second
   std::string field = "vorticity"; // speed | vorticity | dye | pressure

@@ -2,7 +2,8 @@
 // up) and resumed writes every file bit for bit as an uninterrupted run does,
 // in 2D and 3D, coupled, reaction-diffusion-only and fluid-only; SIGINT and
 // SIGTERM checkpoint and exit 130 / 143; a changed scene, a missing or a
-// damaged checkpoint are clear errors or fall back to an intact one.
+// damaged checkpoint are clear errors or fall back to an intact one. VDB
+// volumes are compared too: their UUID comes from their content.
 #include <gtest/gtest.h>
 
 #include <csignal>
@@ -52,7 +53,7 @@ std::string bytes(const fs::path& p) {
 // Every frame, dump and probe file of `a` is in `b`, byte for byte; their count.
 int expectSameFiles(const fs::path& a, const fs::path& b) {
   int n = 0;
-  for (const char* sub : {"frames", "fields", "profiles"}) {
+  for (const char* sub : {"frames", "fields", "profiles", "vdb"}) {
     std::error_code ec;
     for (const auto& e : fs::directory_iterator(a / sub, ec)) {
       const fs::path rel = fs::path(sub) / e.path().filename();
@@ -119,7 +120,8 @@ INSTANTIATE_TEST_SUITE_P(
                          "output.video=false"},
                         kCheckpointOften)},
         ResumeCase{"coupled_3d", "coupled/cavity_gray_scott_3d.toml",
-                   with({"grid.resolution=[16,16,16]", "time.steps=1500", "output.every=50", "output.video=false"},
+                   with({"grid.resolution=[16,16,16]", "time.steps=1500", "output.every=50", "output.video=false",
+                         "output.vdb=true", "output.nanovdb=true"},
                         kCheckpointOften)},
         ResumeCase{"rd_only_2d", "rd/seeds/kim_lin_lobes3.toml",
                    with({"grid.resolution=[64,64]", "time.steps=3000", "output.every=100"}, kCheckpointOften)},

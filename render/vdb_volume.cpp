@@ -1,0 +1,171 @@
+#include "render/vdb_volume.h"
+
+#include <cstring>
+#include <mutex>
+#include <sstream>
+#include <stdexcept>
+
+#include <openvdb/io/Archive.h>
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/Dense.h>
+#include <openvdb/tools/Prune.h>
+#include <openvdb/tree/LeafManager.h>
+#include <openvdb/tools/TopologyToLevelSet.h>
+#include <nanovdb/util/IO.h>
+#include <nanovdb/util/OpenToNanoVDB.h>
+#include <xxhash.h>
+
+namespace morphoflow {
+
+namespace {
+
+void initialiseOnce() {
+  static std::once_flag once;
+  std::call_once(once, [] { openvdb::initialize(); });
+}
+
+// Index (0,0,0) at the first cell's centre: world = (index + 1/2) h.
+openvdb::math::Transform::Ptr cellTransform(double h) {
+  auto t = openvdb::math::Transform::createLinearTransform(h);
+  t->postTranslate(openvdb::Vec3d(0.5 * h));
+  return t;
+}
+
+openvdb::CoordBBox cellBox(const VolumeGrid& g) {
+  return openvdb::CoordBBox(openvdb::Coord(0, 0, 0), openvdb::Coord(g.cells[0] - 1, g.cells[1] - 1, g.cells[2] - 1));
+}
+
+// Voxels within `tolerance` of the background made inactive (and set to
+// it); the rest keep their values exactly. copyFromDense's own tolerance
+// would also merge nearly equal voxels into one tile, so it copies exactly.
+template <class GridT>
+void deactivateNearBackground(GridT* grid, float tolerance) {
+  if (tolerance <= 0.0f) return;
+  using ValueT = typename GridT::ValueType;
+  const ValueT bg = grid->background();
+  openvdb::tree::LeafManager<typename GridT::TreeType> leaves(grid->tree());
+  leaves.foreach([&](typename GridT::TreeType::LeafNodeType& leaf, size_t) {
+    for (auto it = leaf.beginValueOn(); it; ++it)
+      if (openvdb::math::isApproxEqual(*it, bg, ValueT(tolerance))) leaf.setValueOff(it.pos(), bg);
+  });
+  openvdb::tools::pruneInactive(grid->tree());
+}
+
+openvdb::GridBase::Ptr scalarGrid(const VolumeGrid& g, const VolumeOptions& o) {
+  auto grid = openvdb::FloatGrid::create(0.0f);
+  openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(cellBox(g), const_cast<float*>(g.values[0].data()));
+  openvdb::tools::copyFromDense(dense, *grid, 0.0f);
+  deactivateNearBackground(grid.get(), o.tolerance);
+  if (g.kind == VolumeGrid::Kind::FogVolume) grid->setGridClass(openvdb::GRID_FOG_VOLUME);
+  return grid;
+}
+
+openvdb::GridBase::Ptr vectorGrid(const VolumeGrid& g, const VolumeOptions& o) {
+  std::vector<openvdb::Vec3s> v(g.values[0].size());
+  for (size_t i = 0; i < v.size(); ++i) v[i] = openvdb::Vec3s(g.values[0][i], g.values[1][i], g.values[2][i]);
+  auto grid = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
+  openvdb::tools::Dense<openvdb::Vec3s, openvdb::tools::LayoutXYZ> dense(cellBox(g), v.data());
+  openvdb::tools::copyFromDense(dense, *grid, openvdb::Vec3s(0.0f));
+  deactivateNearBackground(grid.get(), o.tolerance);
+  grid->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
+  return grid;
+}
+
+// The solid cells' outline as a narrow-band signed distance (negative inside).
+openvdb::GridBase::Ptr levelSetGrid(const VolumeGrid& g) {
+  auto mask = openvdb::MaskGrid::create();
+  mask->setTransform(cellTransform(g.voxelSize));
+  auto acc = mask->getAccessor();
+  const std::vector<float>& v = g.values[0];
+  for (int z = 0; z < g.cells[2]; ++z)
+    for (int y = 0; y < g.cells[1]; ++y)
+      for (int x = 0; x < g.cells[0]; ++x)
+        if (v[(size_t(z) * size_t(g.cells[1]) + size_t(y)) * size_t(g.cells[0]) + size_t(x)] != 0.0f)
+          acc.setValueOn(openvdb::Coord(x, y, z));
+  auto ls = openvdb::tools::topologyToLevelSet(*mask, /*halfWidth=*/3, /*closingSteps=*/0);
+  ls->setGridClass(openvdb::GRID_LEVEL_SET);
+  return ls;
+}
+
+openvdb::GridPtrVec buildGrids(const std::vector<VolumeGrid>& grids, const VolumeOptions& o) {
+  initialiseOnce();
+  openvdb::GridPtrVec out;
+  for (const VolumeGrid& g : grids) {
+    openvdb::GridBase::Ptr grid = g.kind == VolumeGrid::Kind::Vector     ? vectorGrid(g, o)
+                                  : g.kind == VolumeGrid::Kind::LevelSet ? levelSetGrid(g)
+                                                                         : scalarGrid(g, o);
+    grid->setName(g.name);
+    grid->setTransform(cellTransform(g.voxelSize));
+    grid->setSaveFloatAsHalf(o.half);
+    out.push_back(grid);
+  }
+  return out;
+}
+
+openvdb::MetaMap metaMap(const VolumeMetadata& m) {
+  openvdb::MetaMap meta;
+  meta.insertMeta("frame", openvdb::Int64Metadata(m.frame));
+  meta.insertMeta("step", openvdb::Int64Metadata(m.step));
+  meta.insertMeta("time", openvdb::DoubleMetadata(m.time));
+  meta.insertMeta("dt", openvdb::DoubleMetadata(m.dt));
+  meta.insertMeta("scene", openvdb::StringMetadata(m.scene));
+  meta.insertMeta("morphoflow_version", openvdb::StringMetadata(m.version));
+  meta.insertMeta("settings_hash", openvdb::StringMetadata(m.settingsHash));
+  meta.insertMeta("units", openvdb::StringMetadata(m.units));
+  return meta;
+}
+
+// Writes to a seekable stream (the in-memory string), as io::File does, so
+// that every reader of .vdb files can open the result.
+class MemoryArchive : public openvdb::io::Archive {
+ public:
+  std::string encode(const openvdb::GridPtrVec& grids, const openvdb::MetaMap& meta) const {
+    std::ostringstream os(std::ios_base::out | std::ios_base::binary);
+    openvdb::GridCPtrVec cgrids(grids.begin(), grids.end());
+    Archive::write(os, cgrids, /*seekable=*/true, meta);
+    return os.str();
+  }
+  openvdb::io::Archive::Ptr copy() const override { return std::make_shared<MemoryArchive>(*this); }
+};
+
+// The header's UUID (36 characters after the magic number, three version
+// numbers and the offsets flag) replaced by one made from the content.
+void deterministicUuid(std::string* bytes) {
+  constexpr size_t at = 8 + 4 + 4 + 4 + 1, n = 36;
+  if (bytes->size() < at + n || (*bytes)[at + 8] != '-') throw std::runtime_error("unexpected VDB header layout");
+  const uint64_t a = XXH64(bytes->data() + at + n, bytes->size() - at - n, 1);
+  const uint64_t b = XXH64(bytes->data() + at + n, bytes->size() - at - n, 2);
+  char uuid[40];
+  std::snprintf(uuid, sizeof uuid, "%08x-%04x-4%03x-%04x-%012llx", unsigned(a >> 32), unsigned(a >> 16) & 0xffffu,
+                unsigned(a) & 0xfffu, unsigned(0x8000u | (unsigned(b >> 48) & 0x3fffu)),
+                static_cast<unsigned long long>(b & 0xffffffffffffULL));
+  std::memcpy(bytes->data() + at, uuid, n);
+}
+
+}  // namespace
+
+std::string encodeVdb(const std::vector<VolumeGrid>& grids, const VolumeMetadata& meta, const VolumeOptions& o) {
+  MemoryArchive archive;
+  archive.setCompression(openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK);
+  std::string bytes = archive.encode(buildGrids(grids, o), metaMap(meta));
+  deterministicUuid(&bytes);
+  return bytes;
+}
+
+std::string encodeNanoVdb(const std::vector<VolumeGrid>& grids, const VolumeMetadata& meta, const VolumeOptions& o) {
+  std::vector<nanovdb::GridHandle<nanovdb::HostBuffer>> handles;
+  for (const openvdb::GridBase::Ptr& g : buildGrids(grids, o)) {
+    handles.push_back(nanovdb::openToNanoVDB(g));
+    if (!handles.back()) throw std::runtime_error("NanoVDB cannot hold the grid '" + g->getName() + "'");
+  }
+  // writeGrids seeks past its header before writing it, which a string
+  // stream allows only over bytes it holds: hold the header's size first.
+  nanovdb::io::Segment segment(nanovdb::io::Codec::NONE);
+  for (const auto& h : handles) segment.add(h);
+  std::stringstream os(std::string(segment.memUsage(), '\0'), std::ios_base::in | std::ios_base::out | std::ios_base::binary);
+  nanovdb::io::writeGrids<nanovdb::HostBuffer, std::vector>(os, handles, nanovdb::io::Codec::NONE);
+  if (!os) throw std::runtime_error("the NanoVDB grids could not be serialised");
+  return os.str();
+}
+
+}  // namespace morphoflow

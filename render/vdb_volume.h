@@ -1,0 +1,47 @@
+// OpenVDB and NanoVDB volumes of a frame, for Blender, Houdini and GPU
+// renderers. Only vdb_volume.cpp includes OpenVDB (it takes long to compile).
+//
+// Every grid has a linear transform with voxel size = its cell size and index
+// (0,0,0) at the first cell's centre, so a grid of n cells fills [0, n h] in
+// world space; a 2D field is one voxel thick. Voxels within `tolerance` of
+// the background (0) are inactive. Files are Blosc-compressed.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace morphoflow {
+
+struct VolumeGrid {
+  enum class Kind {
+    Scalar,     // a FloatGrid
+    FogVolume,  // a FloatGrid of class fog volume (the density)
+    Vector,     // a Vec3SGrid, vector type contravariant-relative (velocity)
+    LevelSet,   // `values` is a solid mask (nonzero inside): written as a narrow-band level set
+  };
+  std::string name;
+  Kind kind = Kind::Scalar;
+  std::array<int, 3> cells{1, 1, 1};        // nz = 1 for a 2D field
+  double voxelSize = 1.0;
+  std::vector<std::vector<float>> values;  // one component (x fastest), or three for a vector
+};
+
+struct VolumeMetadata {
+  long frame = 0, step = 0;
+  double time = 0.0, dt = 0.0;
+  std::string scene, version, settingsHash, units;
+};
+
+struct VolumeOptions {
+  float tolerance = 0.0f;  // |value - background| <= tolerance: inactive
+  bool half = false;       // floats saved as half
+};
+
+// The .vdb file's bytes. Its UUID is derived from its content, so the same
+// fields give the same bytes (a resumed run writes what an uninterrupted one does).
+std::string encodeVdb(const std::vector<VolumeGrid>& grids, const VolumeMetadata& meta, const VolumeOptions& options);
+// The same grids as a NanoVDB file (.nvdb), uncompressed, for GPU renderers.
+std::string encodeNanoVdb(const std::vector<VolumeGrid>& grids, const VolumeMetadata& meta, const VolumeOptions& options);
+
+}  // namespace morphoflow
