@@ -68,6 +68,8 @@ Checkpoint readCheckpoint(const fs::path& file) {
     return UserError({file.string(), 0, 0}, "", "the checkpoint is unusable: " + why,
                      "an older checkpoint is used if one is intact; else run the scene again without --resume");
   };
+  std::error_code ec;
+  if (!fs::is_regular_file(fs::symlink_status(file, ec))) throw bad("it is not a regular file");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw bad("it cannot be opened");
   std::stringstream buf;

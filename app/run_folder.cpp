@@ -38,7 +38,9 @@ int removeEarlierRun(const fs::path& out, const std::string& videoStem) {
   // The earlier run's video may have had another name.
   std::string earlierVideo;
   try {
-    std::ifstream in(out / "run.json");
+    std::error_code ec;
+    std::ifstream in;
+    if (fs::is_regular_file(fs::symlink_status(out / "run.json", ec))) in.open(out / "run.json");  // never a pipe
     if (in) {
       const nlohmann::json j = nlohmann::json::parse(in);
       if (j.contains("video") && j["video"].contains("file"))

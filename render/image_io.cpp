@@ -12,8 +12,13 @@
 namespace morphoflow {
 
 bool readImageFloat(const std::string& path, OIIO::ImageSpec* spec, std::vector<float>* pixels, std::string* error) {
-  if (!std::filesystem::exists(path)) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) {
     *error = "no such file: " + path;
+    return false;
+  }
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    *error = "not a regular file (a folder, device or pipe): " + path;
     return false;
   }
   auto in = OIIO::ImageInput::open(path);

@@ -33,6 +33,9 @@ long Scene::totalSteps() const {
 Scene loadScene(const std::string& path, const std::vector<std::string>& overrides) {
   toml::table root;
   {
+    std::error_code ec;
+    if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
+      throw UserError({path, 0, 0}, "", "the scene is not a regular file (a folder, device or pipe)", "give a .toml file");
     std::ifstream in(path, std::ios::binary);
     if (!in) throw UserError({path, 0, 0}, "", "cannot open the scene file", "check the path");
     std::stringstream buf;
