@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "app/batch.h"
+#include "app/memory_estimate.h"
 #include "app/run_options.h"
 #include "app/texture_commands.h"
 #include "app/version.h"
@@ -142,11 +143,13 @@ int main(int argc, char** argv) {
     if (*validateCmd) {
       for (const std::string& s : validateScenes) {
         Scene sc = loadScene(s);
+        const std::string memory = "needs about " + humanBytes(estimateRunBytes(sc)) + " of memory";
         if (sc.hasFluid)
-          std::cout << fmt::format("{}: ok ({}D, {} steps, Re = {:.4g})\n", s, sc.dimension, sc.totalSteps(), sc.reynolds);
+          std::cout << fmt::format("{}: ok ({}D, {} steps, Re = {:.4g}, {})\n", s, sc.dimension, sc.totalSteps(),
+                                   sc.reynolds, memory);
         else
-          std::cout << fmt::format("{}: ok ({}D, {} steps, reaction-diffusion {})\n", s, sc.dimension, sc.totalSteps(),
-                                   sc.rd.settings.model);
+          std::cout << fmt::format("{}: ok ({}D, {} steps, reaction-diffusion {}, {})\n", s, sc.dimension,
+                                   sc.totalSteps(), sc.rd.settings.model, memory);
       }
       return 0;
     }

@@ -10,6 +10,7 @@
 #include "render/field_dump.h"
 #include "render/field_image.h"
 #include "render/image_io.h"
+#include "render/volume_preview.h"
 
 namespace morphoflow {
 
@@ -42,11 +43,18 @@ void ImageSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
   io.slice = o.slice;
   int w, h;
   std::vector<uint8_t> rgb;
-  if (o.colormap == kTwoSpeciesPalette) {
-    const std::vector<std::string> sp = sim.species();
-    rgb = twoFieldsToRgb<D>(sim.field(sp[0]).front(), sim.field(sp[1]).front(), io, &w, &h);
-  } else {
-    rgb = fieldToRgb<D>(sim.field(o.field).front(), io, &w, &h);
+  const bool two = o.colormap == kTwoSpeciesPalette;
+  const std::vector<std::string> sp = sim.species();
+  const Grid<float, D> shown = sim.field(two ? sp[0] : o.field).front();
+  if constexpr (D == 3) {
+    if (o.view == "volume") {
+      rgb = two ? volumeTwoToRgb(shown, sim.field(sp[1]).front(), io, o.imageSize, &w, &h)
+                : volumeToRgb(shown, io, o.imageSize, &w, &h);
+    }
+  }
+  if (rgb.empty()) {
+    rgb = two ? twoFieldsToRgb<D>(shown, sim.field(sp[1]).front(), io, &w, &h) : fieldToRgb<D>(shown, io, &w, &h);
+    rgb = upscaleToWidth(rgb, &w, &h, o.imageSize);
   }
   std::string err;
   const std::filesystem::path file = dir_ / fmt::format("{:06d}.{}", frame, o.format);

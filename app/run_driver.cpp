@@ -12,6 +12,7 @@
 
 #include "app/checkpoint.h"
 #include "app/frame_schedule.h"
+#include "app/memory_estimate.h"
 #include "app/output_sinks.h"
 #include "app/run_clock.h"
 #include "app/run_folder.h"
@@ -62,7 +63,13 @@ class Driver {
     try {
       return loop();
     } catch (const std::exception& e) {
+      log_.endProgress();
+      log_.keep(std::string("failed: ") + e.what());
       record("failed", e.what());
+      try {
+        writeLog();
+      } catch (const std::exception&) {  // the first error is the one to report
+      }
       throw;
     }
   }
@@ -186,6 +193,7 @@ class Driver {
     if (!error.empty()) j["error"] = error;
     if (!resumedFrom_.empty()) j["resumed_from"] = resumedFrom_;
     j["peak_memory_bytes"] = peakMemoryBytes();
+    j["memory_estimate_bytes"] = estimateRunBytes(scene_);
     j["bytes_written"] = nlohmann::json::object();
     for (const auto& s : sinks_) s->report(&j);
     addBytes(&j, "checkpoints", checkpointBytes_);

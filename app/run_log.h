@@ -18,6 +18,8 @@ class RunLog {
   void say(const std::string& line);
   // A warning: as say(), but shown even with --quiet.
   void warn(const std::string& line);
+  // A line for the log only (the caller reports it otherwise).
+  void keep(const std::string& line) { lines_.push_back(line); }
   // Progress after a step: frame, step (of about `totalSteps`, 0 if not
   // known), simulated time (of `endTime`, 0 if not known).
   void progress(long frame, long step, long totalSteps, double time, double endTime);

@@ -3,6 +3,7 @@
 
 #include "app/coupled_simulation.h"
 #include "app/fluid_simulation.h"
+#include "app/memory_estimate.h"
 #include "app/rd_simulation.h"
 #include "app/run_driver.h"
 #include "app/run_log.h"
@@ -39,6 +40,7 @@ int runScene(const RunOptions& opt) {
   Scene scene = loadScene(opt.scene, opt.overrides);
   if (opt.backend == "gpu")
     throw UserError({"--backend", 0, 0}, "", "the gpu backend is not part of this build yet", "use --backend tbb or serial");
+  checkRunFits(scene);
   ThreadLimit limit(opt.backend == "serial" ? 1 : opt.threads);
   return scene.dimension == 2 ? run<2>(scene, opt) : run<3>(scene, opt);
 }

@@ -19,6 +19,22 @@ size_t sliceOffset(const Grid<float, D>& f, int slice) {
   return 0;
 }
 
+// Fills RGB rows top to bottom (y up) with colour(cell index).
+template <typename Colour>
+std::vector<uint8_t> paint(int nx, int ny, size_t offset, Colour colour) {
+  std::vector<uint8_t> rgb(size_t(nx) * size_t(ny) * 3);
+  parallelFor(size_t(ny), [&](size_t row) {
+    size_t y = size_t(ny) - 1 - row;
+    for (size_t x = 0; x < size_t(nx); ++x) {
+      Rgb8 c = colour(offset + y * size_t(nx) + x);
+      std::copy(c.begin(), c.end(), &rgb[(row * size_t(nx) + x) * 3]);
+    }
+  });
+  return rgb;
+}
+
+}  // namespace
+
 // The value range mapped to [0, 1]: fixed, or the finite min..max of the slice.
 std::array<double, 2> valueRange(const float* v, size_t n, const FieldImageOptions& o) {
   if (!o.autoRange) return {o.range[0], o.range[1]};
@@ -39,22 +55,6 @@ std::array<double, 2> valueRange(const float* v, size_t n, const FieldImageOptio
   }
   return {lo, hi};
 }
-
-// Fills RGB rows top to bottom (y up) with colour(cell index).
-template <typename Colour>
-std::vector<uint8_t> paint(int nx, int ny, size_t offset, Colour colour) {
-  std::vector<uint8_t> rgb(size_t(nx) * size_t(ny) * 3);
-  parallelFor(size_t(ny), [&](size_t row) {
-    size_t y = size_t(ny) - 1 - row;
-    for (size_t x = 0; x < size_t(nx); ++x) {
-      Rgb8 c = colour(offset + y * size_t(nx) + x);
-      std::copy(c.begin(), c.end(), &rgb[(row * size_t(nx) + x) * 3]);
-    }
-  });
-  return rgb;
-}
-
-}  // namespace
 
 template <int D>
 std::vector<uint8_t> fieldToRgb(const Grid<float, D>& f, const FieldImageOptions& o, int* width, int* height) {
@@ -79,6 +79,21 @@ std::vector<uint8_t> twoFieldsToRgb(const Grid<float, D>& red, const Grid<float,
   return paint(nx, ny, offset, [&](size_t i) {
     return Rgb8{byte((red[i] - rlo) / (rhi - rlo)), byte((green[i] - glo) / (ghi - glo)), 0};
   });
+}
+
+std::vector<uint8_t> upscaleToWidth(const std::vector<uint8_t>& rgb, int* width, int* height, int minWidth) {
+  const int k = std::max(1, (minWidth + *width - 1) / *width);
+  if (k == 1) return rgb;
+  const int w = *width * k, h = *height * k;
+  std::vector<uint8_t> out(size_t(w) * size_t(h) * 3);
+  parallelFor(size_t(h), [&](size_t row) {
+    const uint8_t* src = &rgb[(row / size_t(k)) * size_t(*width) * 3];
+    uint8_t* dst = &out[row * size_t(w) * 3];
+    for (size_t x = 0; x < size_t(w); ++x) std::copy_n(src + (x / size_t(k)) * 3, 3, dst + x * 3);
+  });
+  *width = w;
+  *height = h;
+  return out;
 }
 
 template std::vector<uint8_t> fieldToRgb<2>(const Grid<float, 2>&, const FieldImageOptions&, int*, int*);

@@ -19,6 +19,14 @@ struct FieldImageOptions {
   int slice = -1;          // 3D: z index (-1 = middle)
 };
 
+// The value range mapped to [0, 1]: fixed, or the finite min..max of the n
+// values (centred on 0 when symmetric).
+std::array<double, 2> valueRange(const float* values, size_t n, const FieldImageOptions& options);
+
+// Nearest-neighbour enlargement by the smallest whole factor that makes the
+// image at least `minWidth` pixels wide (cells stay crisp squares).
+std::vector<uint8_t> upscaleToWidth(const std::vector<uint8_t>& rgb, int* width, int* height, int minWidth);
+
 template <int D>
 std::vector<uint8_t> fieldToRgb(const Grid<float, D>& field, const FieldImageOptions& options, int* width,
                                 int* height);

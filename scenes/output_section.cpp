@@ -97,6 +97,13 @@ void parseOutput(SceneContext& c, Scene* sp) {
     s.output.range[0] = range[0];
     s.output.range[1] = range[1];
   }
+  // 3D frames show the whole volume by default; a 2D field is its own slice.
+  const toml::node* viewNode = r.node(out, "output.", "view");
+  s.output.view = r.string(out, "output.", "view", D == 3 ? "volume" : "slice", {"volume", "slice"});
+  if (D == 2 && s.output.view == "volume")
+    r.fail(viewNode, "output.view", "a 2D scene's frames show its field itself; \"volume\" is for 3D scenes",
+           "drop output.view, or set it to \"slice\"");
+  s.output.imageSize = int(r.integer(out, "output.", "image_size", 512, 16, 8192));
   s.output.slice = int(r.integer(out, "output.", "slice", -1, -1, D == 3 ? long(res[2]) - 1 : -1));
 }
 

@@ -40,6 +40,8 @@ struct OutputSettings {
   bool autoRange = true;
   double range[2] = {0.0, 1.0};
   int slice = -1;                  // 3D: z slice for images (-1 = middle)
+  std::string view = "slice";      // 3D: "volume" (ray marched, the default) or "slice"; 2D: "slice"
+  int imageSize = 512;             // frames are at least this many pixels wide
   int checkpointEvery = 10;        // frames between checkpoints (0: only at the end and on a stop)
 };
 

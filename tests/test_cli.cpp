@@ -502,7 +502,7 @@ TEST(Cli, VideoWithAndWithoutFfmpeg) {
       ASSERT_EQ(std::system(probe.c_str()), 0);
       std::string line;
       std::getline(std::ifstream(dir / "probe.txt"), line);
-      EXPECT_EQ(line, "32,32,7");  // frames 2..8; 31 x 31 padded to even sides
+      EXPECT_EQ(line, "528,528,7");  // frames 2..8; 31 x 31 cells, 17 pixels each (>= 512), padded to even sides
     }
   }
   // No ffmpeg on the PATH.

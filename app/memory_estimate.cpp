@@ -1,0 +1,80 @@
+#include "app/memory_estimate.h"
+
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+
+namespace morphoflow {
+
+namespace {
+
+// Peak bytes per cell, measured (/usr/bin/time's maximum resident size over
+// 32^3-96^3 and 256^2-1024^2 grids, docs/performance.md "Memory"): the fluid
+// (velocity, its scratch and MacCormack copies, pressure and viscosity
+// systems with their multigrid levels and Krylov vectors) and each species of
+// a reaction-diffusion layer (double state, diffusion system, solver vectors;
+// in a coupled run also its advection scratch).
+constexpr double kFluidBytesPerCell[2] = {455.0, 590.0};  // 2D, 3D
+constexpr double kSpeciesBytesPerCell = 170.0;             // reaction-diffusion only
+constexpr double kCoupledSpeciesBytesPerCell = 230.0;      // carried by a fluid
+constexpr double kFixedBytes = 135.0 * (1 << 20);          // the program, its libraries and thread pools
+
+double cellsOf(const std::vector<int>& res) {
+  double n = 1;
+  for (int r : res) n *= r;
+  return n;
+}
+
+uintmax_t meminfoAvailable() {
+  std::ifstream in("/proc/meminfo");
+  std::string key;
+  uintmax_t kb = 0;
+  std::string unit;
+  while (in >> key >> kb >> unit)
+    if (key == "MemAvailable:") return kb * 1024;
+  return UINTMAX_MAX;
+}
+
+uintmax_t cgroupRoom() {
+  std::ifstream max("/sys/fs/cgroup/memory.max"), cur("/sys/fs/cgroup/memory.current");
+  std::string m;
+  uintmax_t c = 0;
+  if (!(max >> m) || m == "max" || !(cur >> c)) return UINTMAX_MAX;
+  const uintmax_t limit = std::stoull(m);
+  return limit > c ? limit - c : 0;
+}
+
+}  // namespace
+
+uintmax_t estimateRunBytes(const Scene& s) {
+  const int d = s.dimension == 3 ? 1 : 0;
+  double bytes = kFixedBytes;
+  if (s.hasFluid) bytes += cellsOf(s.fluid.resolution) * kFluidBytesPerCell[d];
+  if (s.rd.enabled) {
+    const double species = double(s.rd.initial.values.size());
+    bytes += cellsOf(s.rd.settings.resolution) * species *
+             (s.hasFluid ? kCoupledSpeciesBytesPerCell : kSpeciesBytesPerCell);
+  }
+  return uintmax_t(bytes);
+}
+
+uintmax_t availableBytes() { return std::min(meminfoAvailable(), cgroupRoom()); }
+
+std::string humanBytes(uintmax_t b) {
+  if (b >= (uintmax_t(1) << 30)) return fmt::format("{:.2f} GiB", double(b) / double(1 << 30));
+  return fmt::format("{:.0f} MiB", double(b) / double(1 << 20));
+}
+
+void checkRunFits(const Scene& scene) {
+  const uintmax_t need = estimateRunBytes(scene), have = availableBytes();
+  if (need > have)
+    throw UserError({scene.path, 0, 0}, "grid.resolution",
+                    "this run needs about " + humanBytes(need) + " of memory, and " + humanBytes(have) +
+                        " are available",
+                    "lower grid.resolution or rd.resolution, or run it on a larger machine");
+}
+
+}  // namespace morphoflow

@@ -1,0 +1,99 @@
+// What a run says and records: progress piped to a file is plain lines (no
+// carriage returns) and --quiet silences it; log.txt keeps the lines;
+// run.json records how the run ended, its peak memory against the estimate
+// made before allocating, and the bytes written per output kind; a scene
+// too large for the machine is refused before anything is allocated.
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "test_support.h"
+
+using namespace morphoflow::testing;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string text(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), {});
+}
+
+nlohmann::json runJson(const fs::path& out) { return nlohmann::json::parse(std::ifstream(out / "run.json")); }
+
+}  // namespace
+
+TEST(RunRecords, ProgressToAPipeIsPlainLinesAndQuietIsSilent) {
+  const fs::path dir = tempDir("records_progress");
+  const std::string args = "run " + sceneFile("coupled/cavity_gray_scott.toml") +
+                           " --set grid.resolution=[24,24] --set rd.resolution=[24,24] --set time.steps=20"
+                           " --set output.every=5 --set output.video=false --out ";
+  CommandResult r = runMorphoflow(args + (dir / "loud").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(r.output.find('\r'), std::string::npos);
+  EXPECT_NE(r.output.find("done: 20 steps"), std::string::npos) << r.output;
+  EXPECT_NE(text(dir / "loud" / "log.txt").find("done: 20 steps"), std::string::npos);
+  CommandResult q = runMorphoflow(args + (dir / "quiet").string() + " --quiet");
+  ASSERT_EQ(q.status, 0);
+  EXPECT_EQ(q.output, "");
+  EXPECT_NE(text(dir / "quiet" / "log.txt").find("done: 20 steps"), std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST(RunRecords, RunJsonSaysHowItEndedAndWhatItWrote) {
+  const fs::path dir = tempDir("records_json");
+  CommandResult r = runMorphoflow("run " + sceneFile("coupled/cavity_gray_scott.toml") +
+                                  " --set grid.resolution=[24,24] --set rd.resolution=[24,24] --set time.steps=8"
+                                  " --set output.every=4 --set output.fields=true --set output.vdb=true --quiet --out " +
+                                  (dir / "out").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  const nlohmann::json j = runJson(dir / "out");
+  EXPECT_EQ(j["exit_state"], "completed");
+  EXPECT_EQ(j["settings_hash"].get<std::string>().size(), 16u);
+  EXPECT_GT(j["peak_memory_bytes"].get<double>(), 1e6);
+  // Bytes per kind: what is on disk.
+  auto sum = [&](const fs::path& sub) {
+    uintmax_t n = 0;
+    for (const auto& e : fs::directory_iterator(dir / "out" / sub)) n += fs::file_size(e.path());
+    return n;
+  };
+  EXPECT_EQ(j["bytes_written"]["frames"].get<uintmax_t>(), sum("frames"));
+  EXPECT_EQ(j["bytes_written"]["fields"].get<uintmax_t>(), sum("fields"));
+  EXPECT_EQ(j["bytes_written"]["vdb"].get<uintmax_t>(), sum("vdb"));
+  EXPECT_GT(j["bytes_written"]["checkpoints"].get<uintmax_t>(), 0u);
+  // A run that fails records it, with the message.
+  CommandResult bad = runMorphoflow("run " + sceneFile("rd/turing_lawlor.toml") +
+                                    " --set grid.resolution=[32,32] --set 'rd.integrator=\"explicit\"' --set time.dt=50"
+                                    " --set time.steps=40 --set output.every=10 --quiet --out " + (dir / "bad").string());
+  EXPECT_NE(bad.status, 0);
+  const nlohmann::json f = runJson(dir / "bad");
+  EXPECT_EQ(f["exit_state"], "failed");
+  EXPECT_NE(f["error"].get<std::string>().find("diverged"), std::string::npos) << f.dump();
+  EXPECT_NE(text(dir / "bad" / "log.txt"), "");
+  fs::remove_all(dir);
+}
+
+TEST(RunRecords, TheMemoryEstimateMatchesThePeakAndATooLargeRunIsRefused) {
+  const fs::path dir = tempDir("records_memory");
+  for (const std::string& sets : {std::string(" --set grid.resolution=[64,64,64] --set time.steps=2"),
+                                  std::string(" --set grid.resolution=[48,48,48] --set rd.resolution=[96,96,96] --set time.steps=2")}) {
+    CommandResult r = runMorphoflow("run " + sceneFile("coupled/cavity_gray_scott_3d.toml") + sets +
+                                    " --set output.video=false --set output.images=false --quiet --out " +
+                                    (dir / "out").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    const nlohmann::json j = runJson(dir / "out");
+    const double peak = j["peak_memory_bytes"].get<double>(), estimate = j["memory_estimate_bytes"].get<double>();
+    EXPECT_NEAR(estimate / peak, 1.0, 0.25) << sets << ": estimate " << estimate << ", peak " << peak;
+  }
+  CommandResult v = runMorphoflow("validate " + sceneFile("coupled/cavity_gray_scott_3d.toml"));
+  EXPECT_NE(v.output.find("needs about"), std::string::npos) << v.output;
+  CommandResult big = runMorphoflow("run " + sceneFile("coupled/cavity_gray_scott_3d.toml") +
+                                    " --set grid.resolution=[640,640,640] --out " + (dir / "big").string());
+  EXPECT_EQ(big.status, 2) << big.output;
+  EXPECT_NE(big.output.find("GiB of memory"), std::string::npos) << big.output;
+  EXPECT_NE(big.output.find("available"), std::string::npos) << big.output;
+  EXPECT_FALSE(fs::exists(dir / "big" / "run.json"));
+  fs::remove_all(dir);
+}
