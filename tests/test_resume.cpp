@@ -120,7 +120,7 @@ INSTANTIATE_TEST_SUITE_P(
                          "output.video=false"},
                         kCheckpointOften)},
         ResumeCase{"coupled_3d", "coupled/cavity_gray_scott_3d.toml",
-                   with({"grid.resolution=[16,16,16]", "time.steps=1500", "output.every=50", "output.video=false",
+                   with({"grid.resolution=[16,16,16]", "rd.resolution=[16,16,16]", "time.steps=1500", "output.every=50", "output.video=false",
                          "output.vdb=true", "output.nanovdb=true"},
                         kCheckpointOften)},
         ResumeCase{"rd_only_2d", "rd/seeds/kim_lin_lobes3.toml",

@@ -77,7 +77,7 @@ TEST(RunRecords, RunJsonSaysHowItEndedAndWhatItWrote) {
 
 TEST(RunRecords, TheMemoryEstimateMatchesThePeakAndATooLargeRunIsRefused) {
   const fs::path dir = tempDir("records_memory");
-  for (const std::string& sets : {std::string(" --set grid.resolution=[64,64,64] --set time.steps=2"),
+  for (const std::string& sets : {std::string(" --set grid.resolution=[64,64,64] --set rd.resolution=[64,64,64] --set time.steps=2"),
                                   std::string(" --set grid.resolution=[48,48,48] --set rd.resolution=[96,96,96] --set time.steps=2")}) {
     CommandResult r = runMorphoflow("run " + sceneFile("coupled/cavity_gray_scott_3d.toml") + sets +
                                     " --set output.video=false --set output.images=false --quiet --out " +

@@ -136,7 +136,7 @@ def check_volume(name, out, sets_fluid_fields, tolerance, obstacle, dims3):
 
 # 3D: a coupled scene with an obstacle, fluid scalars, a tolerance.
 d3 = run("coupled_3d", "coupled/obstacle_gray_scott_3d.toml",
-         ["grid.resolution=[10,20,10]", "time.steps=6", "output.every=3", "output.vdb=true", "output.nanovdb=true",
+         ["grid.resolution=[10,20,10]", "rd.resolution=[10,20,10]", "time.steps=6", "output.every=3", "output.vdb=true", "output.nanovdb=true",
           "output.fields=true", "output.video=false", 'output.vdb_fields=["speed","vorticity","pressure","dye"]',
           "output.vdb_tolerance=0.05"])
 check_volume("coupled_3d", d3, ["speed", "vorticity", "pressure", "dye"], 0.05, True, (10, 20, 10))
