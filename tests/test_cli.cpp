@@ -81,6 +81,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadScene{"vdb_density_not_a_field", "[output]\nvdb = true\nvdb_density = \"u\"\n", "3:15", "is not one of"},
         BadScene{"vdb_fields_without_fluid", "[rd]\nmodel = \"gray-scott\"\n[output]\nvdb = true\nvdb_fields = [\"speed\"]\n",
                  "5:14", "has no fluid"},
+        BadScene{"unknown_view", "[output]\nview = \"volum\"\n", "2:8", "did you mean 'volume'"},
+        BadScene{"volume_view_in_2d", "[output]\nview = \"volume\"\n", "2:8", "for 3D scenes"},
         BadScene{"vdb_option_without_vdb", "[output]\nvdb_half = true\n", "2:12", "only applies with output.vdb = true"},
         BadScene{"checkpoint_every_negative", "[output]\ncheckpoint_every = -1\n", "2:20", "output.checkpoint_every"},
         BadScene{"obstacle_outside", "[[obstacles]]\nshape = \"circle\"\ncenter = [2.0, 0.5]\nradius = 0.1\n", "3:10",

@@ -42,6 +42,23 @@ TEST(RunRecords, ProgressToAPipeIsPlainLinesAndQuietIsSilent) {
   fs::remove_all(dir);
 }
 
+TEST(RunRecords, OnATerminalProgressIsOneLineRedrawnInPlace) {
+  if (std::system("command -v script >/dev/null 2>&1") != 0) GTEST_SKIP() << "no script(1) to give the run a terminal";
+  const fs::path dir = tempDir("records_tty");
+  // script(1) runs the command on a pseudo-terminal and copies what it shows.
+  const std::string cmd = "script -qec \"" + std::string(MORPHOFLOW_BINARY) + " run " +
+                          sceneFile("coupled/cavity_gray_scott.toml") +
+                          " --set grid.resolution=[64,64] --set rd.resolution=[96,96] --set time.steps=600"
+                          " --set output.every=100 --set output.video=false --out " + (dir / "out").string() +
+                          "\" " + (dir / "typescript").string() + " > /dev/null 2>&1";
+  ASSERT_EQ(std::system(cmd.c_str()), 0);
+  const std::string shown = text(dir / "typescript");
+  EXPECT_NE(shown.find('\r'), std::string::npos) << "the line is redrawn with carriage returns";
+  for (const char* word : {"frame ", "step ", "t = ", "steps/s", "ETA "})
+    EXPECT_NE(shown.find(word), std::string::npos) << word << " in: " << shown;
+  fs::remove_all(dir);
+}
+
 TEST(RunRecords, RunJsonSaysHowItEndedAndWhatItWrote) {
   const fs::path dir = tempDir("records_json");
   CommandResult r = runMorphoflow("run " + sceneFile("coupled/cavity_gray_scott.toml") +
