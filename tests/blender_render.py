@@ -3,7 +3,7 @@ mode, Cycles on the CPU), as docs/vfx.md shows: a Volume object on the
 sequence, a Principled Volume shading the "density" grid, "vel" as the motion
 blur grid, the scene's y axis up.
 
-blender -b --factory-startup -P blender_render.py -- FIRST.vdb FRAMES FRAME OUT.png [WIDTH SAMPLES DENSITY]"""
+blender -b --factory-startup -P blender_render.py -- FIRST.vdb FRAMES FRAME OUT.png [WIDTH SAMPLES DENSITY EMISSION]"""
 import math
 import sys
 
@@ -36,7 +36,7 @@ nodes.clear()
 shader = nodes.new("ShaderNodeVolumePrincipled")
 shader.inputs["Density"].default_value = float(argv[6]) if len(argv) > 6 else 20.0
 shader.inputs["Color"].default_value = (1.0, 0.45, 0.15, 1.0)
-shader.inputs["Emission Strength"].default_value = 2.0
+shader.inputs["Emission Strength"].default_value = float(argv[7]) if len(argv) > 7 else 2.0
 shader.inputs["Emission Color"].default_value = (1.0, 0.35, 0.1, 1.0)
 output = nodes.new("ShaderNodeOutputMaterial")
 links.new(shader.outputs["Volume"], output.inputs["Volume"])
@@ -68,7 +68,7 @@ track.target = target
 scene.collection.objects.link(camera)
 scene.camera = camera
 sun = bpy.data.objects.new("sun", bpy.data.lights.new("sun", "SUN"))
-sun.data.energy = 3.0
+sun.data.energy = 5.0
 sun.rotation_euler = (0.6, 0.2, 0.8)
 scene.collection.objects.link(sun)
 world = bpy.data.worlds.new("world")
