@@ -20,7 +20,8 @@ struct FieldDump {
   long step = 0;
 };
 
-// Written to a temporary name and renamed. False + message on failure.
+// Written whole through writeFileAtomically (core/output_file.h): a failed
+// write throws OutputError naming the path. False + message when it cannot be encoded.
 bool writeFieldDump(const std::string& path, const FieldDump& dump, std::string* error);
 
 // Reads a dump written by writeFieldDump, or any image: then a 2D grid whose

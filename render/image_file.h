@@ -1,5 +1,5 @@
-// Internal to render/: image files through OpenImageIO. Writes go to a
-// temporary name, then a rename, so a crash never leaves a half-written file.
+// Internal to render/: image files through OpenImageIO. An image is encoded
+// in memory and written whole by writeFileAtomically (core/output_file.h).
 #pragma once
 
 #include <string>

@@ -16,8 +16,9 @@ struct GrayImage {
 bool readGrayImage(const std::string& path, GrayImage* image, std::string* error);
 
 // Writes 8-bit RGB (row-major, top row first): 8-bit files (PNG), or half-float
-// RGB in [0, 1] when the path ends in .exr. The file is written to a
-// temporary name and renamed, so a crash never leaves a half-written frame.
+// RGB in [0, 1] when the path ends in .exr. The image is encoded in memory and
+// written whole through writeFileAtomically (core/output_file.h): a failed
+// write throws OutputError naming the path, and leaves no file cut short.
 bool writeRgb8(const std::string& path, int width, int height, const std::vector<uint8_t>& rgb,
                std::string* error);
 
