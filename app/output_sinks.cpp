@@ -112,9 +112,12 @@ template <int D>
 void FieldDumpSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
   FieldDump d;
   d.names = sim.dumpFieldNames();
-  for (const std::string& n : d.names) d.channels.push_back(sim.field(n).front().values());
-  const Grid<float, D> first = sim.field(d.names.front()).front();
-  for (int a = 0; a < D; ++a) d.resolution.push_back(first.dim(a));
+  for (const std::string& n : d.names) {
+    const Grid<float, D> g = sim.field(n).front();
+    if (d.resolution.empty())
+      for (int a = 0; a < D; ++a) d.resolution.push_back(g.dim(a));
+    d.channels.push_back(g.values());
+  }
   d.time = sim.time();
   d.step = at.step;
   std::string err;

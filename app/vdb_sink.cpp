@@ -31,7 +31,8 @@ VolumeGrid volumeGrid(const std::string& name, VolumeGrid::Kind kind, std::vecto
 }  // namespace
 
 template <int D>
-VdbSink<D>::VdbSink(const std::filesystem::path& out, const Scene& scene) : dir_(out / "vdb"), scene_(scene) {
+VdbSink<D>::VdbSink(const std::filesystem::path& out, const Scene& scene)
+    : dir_(out / "vdb"), scene_(scene), hash_(sceneHash(scene)) {
   createOutputFolder(dir_);
 }
 
@@ -62,7 +63,7 @@ void VdbSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
   meta.dt = at.dt;
   meta.scene = scene_.name;
   meta.version = kVersion;
-  meta.settingsHash = sceneHash(scene_);
+  meta.settingsHash = hash_;
   meta.units = "lengths in the scene's domain units (world space fills [0, domain.size]); time in its time units; "
                "vel in domain units per time unit";
   const VolumeOptions options{float(o.vdbTolerance), o.vdbHalf};

@@ -7,6 +7,7 @@
 #pragma once
 
 #include <filesystem>
+#include <string>
 
 #include "app/output_sinks.h"
 #include "render/vdb_volume.h"
@@ -27,6 +28,7 @@ class VdbSink : public OutputSink<D> {
   std::vector<VolumeGrid> grids(const Simulation<D>& sim) const;
   std::filesystem::path dir_;
   const Scene& scene_;
+  const std::string hash_;  // the scene's settings hash, for the metadata
   int written_ = 0;
   uintmax_t bytes_ = 0, nanoBytes_ = 0;
 };
