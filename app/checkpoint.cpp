@@ -93,6 +93,8 @@ Checkpoint readCheckpoint(const fs::path& file) {
   return c;
 }
 
+bool hasCheckpoint(const fs::path& out) { return !checkpointsNewestFirst(checkpointDir(out)).empty(); }
+
 Checkpoint latestCheckpoint(const fs::path& out, const std::function<void(const std::string&)>& warn) {
   const std::vector<fs::path> files = checkpointsNewestFirst(checkpointDir(out));
   for (const fs::path& f : files) {

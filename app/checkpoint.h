@@ -31,6 +31,9 @@ std::filesystem::path writeCheckpoint(const std::filesystem::path& out, long ste
 // short, corrupted or not a checkpoint.
 Checkpoint readCheckpoint(const std::filesystem::path& file);
 
+// Whether `out` holds any checkpoint file (intact or not).
+bool hasCheckpoint(const std::filesystem::path& out);
+
 // The newest intact checkpoint under `out`; each damaged one on the way is
 // reported through `warn`. Throws UserError when there is none.
 Checkpoint latestCheckpoint(const std::filesystem::path& out, const std::function<void(const std::string&)>& warn);

@@ -73,12 +73,28 @@ int main(int argc, char** argv) {
   runCmd->add_flag("--force", run.force, "with --resume: continue even though the scene changed");
   runCmd->add_flag("--quiet", run.quiet, "no progress output");
 
-  BatchOptions batch;
-  CLI::App* batchCmd = app.add_subcommand("batch", "run several scenes, each into OUT/<scene name>");
+  BatchOptions batch, sweep;
+  auto batchOptions = [](CLI::App* cmd, BatchOptions* b) {
+    cmd->add_option("--jobs", b->jobs, "runs at once; the machine's threads are divided between them")
+        ->check(CLI::Range(1, 256));
+    cmd->add_option("--shard", b->shard, "I/N: only every N-th run, from the I-th (0-based)");
+    cmd->add_option("--set", b->sets, "override a scene key in every run: key.path=value (TOML value)");
+    cmd->add_flag("--resume", b->resume, "skip runs completed with the same settings; resume interrupted ones");
+    cmd->add_flag("--quiet", b->quiet, "no progress lines (the summary is still printed)");
+    cmd->add_option("--out", b->out, "output folder: one folder per run inside it")->required();
+  };
+  CLI::App* batchCmd = app.add_subcommand("batch", "run several scenes, each in its own process, into OUT/<scene name>");
   batchCmd->add_option("scenes", batch.scenes, "scene files")->required();
-  batchCmd->add_option("--jobs", batch.jobs, "scenes run at once")->check(CLI::Range(1, 256));
-  batchCmd->add_option("--shard", batch.shard, "I/N: run only every N-th scene starting at I (0-based)");
-  batchCmd->add_option("--out", batch.out, "output root")->capture_default_str();
+  batchCmd->add_flag("--keep-going", batch.keepGoing, "run the valid scenes when some are invalid");
+  batchOptions(batchCmd, &batch);
+  std::string sweepScene;
+  CLI::App* sweepCmd = app.add_subcommand("sweep", "run a scene over every combination of values, into OUT/<key=value,...>");
+  sweepCmd->add_option("scene", sweepScene, "scene file")->required();
+  sweepCmd->add_option("--vary", sweep.varies, "key=start:stop:count or key=[a,b,c] (TOML values)")->required();
+  batchOptions(sweepCmd, &sweep);
+  std::string gatherDir;
+  CLI::App* gatherCmd = app.add_subcommand("gather", "merge the shards' summaries of a batch or sweep folder");
+  gatherCmd->add_option("dir", gatherDir, "the folder the shards wrote into (--out)")->required();
 
   std::vector<std::string> validateScenes;
   CLI::App* validateCmd = app.add_subcommand("validate", "parse and check scenes; no simulation");
@@ -140,6 +156,11 @@ int main(int argc, char** argv) {
       return runScene(run);
     }
     if (*batchCmd) return runBatch(batch);
+    if (*sweepCmd) {
+      sweep.scenes = {sweepScene};
+      return runSweep(sweep);
+    }
+    if (*gatherCmd) return gatherBatch(gatherDir);
     if (*validateCmd) {
       for (const std::string& s : validateScenes) {
         Scene sc = loadScene(s);

@@ -27,8 +27,17 @@ bool readImageFloat(const std::string& path, OIIO::ImageSpec* spec, std::vector<
     return false;
   }
   *spec = in->spec();
-  if (spec->width <= 0 || spec->height <= 0 || spec->nchannels <= 0) {
-    *error = "empty image";
+  if (spec->width <= 0 || spec->height <= 0 || spec->nchannels <= 0 || spec->depth != 1) {
+    *error = "empty image (or a volume): " + path;
+    return false;
+  }
+  // The header's size is checked before anything is decoded: a small file
+  // may claim 100000 x 100000 pixels.
+  const double values = double(spec->width) * double(spec->height) * double(spec->nchannels);
+  if (spec->width > kMaxImageSide || spec->height > kMaxImageSide || values > double(kMaxImageValues)) {
+    *error = path + " claims " + std::to_string(spec->width) + " x " + std::to_string(spec->height) + " pixels, " +
+             std::to_string(spec->nchannels) + " channels: more than this program reads (" +
+             std::to_string(kMaxImageSide) + " pixels a side, " + std::to_string(kMaxImageValues >> 20) + " Mi values)";
     return false;
   }
   pixels->resize(size_t(spec->width) * size_t(spec->height) * size_t(spec->nchannels));
