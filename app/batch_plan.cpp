@@ -20,9 +20,11 @@ namespace {
 
 constexpr size_t kMaxRuns = 100000;
 
+// Which runs, into which folders (not their settings: a batch resumed with
+// another --set, or with an edited scene, reruns what changed).
 void identify(BatchPlan* p) {
   nlohmann::json j = {{"kind", p->kind}, {"keys", p->keys}, {"runs", nlohmann::json::array()}};
-  for (const BatchRun& r : p->runs) j["runs"].push_back({r.scene, r.folder, r.overrides});
+  for (const BatchRun& r : p->runs) j["runs"].push_back({r.scene, r.folder});
   const std::string text = j.dump();
   p->id = hashHex(text.data(), text.size());
 }

@@ -20,7 +20,7 @@ struct BatchPlan {
   std::string kind;               // "batch" or "sweep"
   std::vector<std::string> keys;  // sweep: the varied keys
   std::vector<BatchRun> runs;
-  std::string id;                 // hash of everything above: which batch a folder holds
+  std::string id;                 // hash of the kind, keys, scenes and folders: which batch a folder holds
 };
 
 // A scene listed twice is refused; scenes with the same file name get the

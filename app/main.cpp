@@ -1,6 +1,8 @@
 // The morphoflow command line (DESIGN.md: "The command-line contract").
 // Exit status: 0 success, 2 user error (file:line:col on stderr), 1 internal error.
+#include <climits>
 #include <filesystem>
+#include <optional>
 #include <iostream>
 
 #include <CLI/CLI.hpp>
@@ -13,6 +15,7 @@
 #include "app/version.h"
 #include "bench/bench_suites.h"
 #include "core/error.h"
+#include "core/number_text.h"
 #include "render/colormap.h"
 #include "rd/model_registry.h"
 #include "scenes/scene_loader.h"
@@ -22,18 +25,17 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Parses "A:B" (either side may be empty).
+// Parses "A:B" (either side may be empty; each a whole number).
 void parseFrames(const std::string& s, RunOptions* o) {
-  size_t colon = s.find(':');
+  const size_t colon = s.find(':');
   if (colon == std::string::npos)
     throw UserError({"--frames", 0, 0}, "", "expected A:B (first and last frame, inclusive), got '" + s + "'");
-  try {
-    std::string a = s.substr(0, colon), b = s.substr(colon + 1);
-    o->firstFrame = a.empty() ? 0 : std::stoi(a);
-    o->lastFrame = b.empty() ? -1 : std::stoi(b);
-  } catch (...) {
-    throw UserError({"--frames", 0, 0}, "", "expected whole numbers in A:B, got '" + s + "'");
-  }
+  const std::string a = s.substr(0, colon), b = s.substr(colon + 1);
+  const std::optional<long> first = a.empty() ? 0L : parseWhole(a), last = b.empty() ? -1L : parseWhole(b);
+  if (!first || !last || *first > INT_MAX || *last > INT_MAX)
+    throw UserError({"--frames", 0, 0}, "", "expected whole numbers in A:B, got '" + s + "'", "e.g. --frames 10:20");
+  o->firstFrame = int(*first);
+  o->lastFrame = int(*last);
   if (o->firstFrame < 0 || (o->lastFrame >= 0 && o->lastFrame < o->firstFrame))
     throw UserError({"--frames", 0, 0}, "", "expected 0 <= A <= B in A:B, got '" + s + "'");
 }

@@ -44,7 +44,7 @@ inline T neighbourSumUniform(const RowStencil<D, T>& s, const T* xr, size_t i, T
 // other colour and writing this colour in the rows beyond the last axis's
 // neighbours, so only the colour's cells are stored here and only the
 // other colour's cells are loaded there. Returns the next cell of the colour.
-inline vf4 evens(const float* p) { return __builtin_shuffle(load4(p), load4(p + 4), vi4{0, 2, 4, 6}); }
+inline vf4 evens(const float* p) { return MF_SHUFFLE(load4(p), load4(p + 4), 0, 2, 4, 6); }
 inline vf4 evensOnly(const float* p) { return vf4{p[0], p[2], p[4], p[6]}; }
 
 template <int D, bool Weighted>
@@ -55,8 +55,8 @@ size_t sweepUniform4(const RowStencil<D, float>& s, const float* br, float* xr, 
   vf4 before = {0.0f, 0.0f, 0.0f, i + 7 <= end ? xr[i - 1] : 0.0f};
   for (; i + 7 <= end; i += 8) {  // updates i .. i + 6 < end, reads x up to i + 7 <= end < nx
     const vf4 here = load4(xr + i), next = load4(xr + i + 4);
-    const vf4 right = __builtin_shuffle(here, next, vi4{1, 3, 5, 7});
-    const vf4 left = __builtin_shuffle(before, right, vi4{3, 4, 5, 6});
+    const vf4 right = MF_SHUFFLE(here, next, 1, 3, 5, 7);
+    const vf4 left = MF_SHUFFLE(before, right, 3, 4, 5, 6);
     before = right;
     vf4 sum = times<Weighted>(wu, right) + times<Weighted>(wu, left);
     for (int a = 1; a < D; ++a) {
@@ -69,8 +69,8 @@ size_t sweepUniform4(const RowStencil<D, float>& s, const float* br, float* xr, 
     if (shared) {
       for (int k = 0; k < 4; ++k) xr[i + 2 * size_t(k)] = r[k];
     } else {
-      store4(xr + i, __builtin_shuffle(r, here, vi4{0, 5, 1, 7}));
-      store4(xr + i + 4, __builtin_shuffle(r, next, vi4{2, 5, 3, 7}));
+      store4(xr + i, MF_SHUFFLE(r, here, 0, 5, 1, 7));
+      store4(xr + i + 4, MF_SHUFFLE(r, next, 2, 5, 3, 7));
     }
   }
   return i;

@@ -299,7 +299,7 @@ void Multigrid<D>::prolongAdd(int l) {
       const vf4 ve = 0.75f * c + 0.25f * load4(cy + X0 - 1), vo = 0.75f * c + 0.25f * load4(cy + X0 + 1);
       float* out = xr + 2 * X0;
       const float* d = fd + 2 * X0;
-      const vf4 a = __builtin_shuffle(ve, vo, vi4{0, 4, 1, 5}), b = __builtin_shuffle(ve, vo, vi4{2, 6, 3, 7});
+      const vf4 a = MF_SHUFFLE(ve, vo, 0, 4, 1, 5), b = MF_SHUFFLE(ve, vo, 2, 6, 3, 7);
       store4(out, load4(out) + (vf4)((vi4)a & (load4(d) > 0.0f)));
       store4(out + 4, load4(out + 4) + (vf4)((vi4)b & (load4(d + 4) > 0.0f)));
     }

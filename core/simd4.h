@@ -20,4 +20,11 @@ inline vf4 load4(const float* p) {  // unaligned
 inline void store4(float* p, vf4 v) { std::memcpy(p, &v, sizeof v); }
 inline vf4 splat(float v) { return vf4{} + v; }
 
+// Lanes of two vectors picked by index (0-3: a, 4-7: b), for GCC and clang alike.
+#if defined(__clang__)
+#define MF_SHUFFLE(a, b, i, j, k, l) __builtin_shufflevector(a, b, i, j, k, l)
+#else
+#define MF_SHUFFLE(a, b, i, j, k, l) __builtin_shuffle(a, b, vi4{i, j, k, l})
+#endif
+
 }  // namespace morphoflow

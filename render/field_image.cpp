@@ -60,7 +60,8 @@ template <int D>
 std::vector<uint8_t> fieldToRgb(const Grid<float, D>& f, const FieldImageOptions& o, int* width, int* height) {
   const int nx = f.dim(0), ny = f.dim(1);
   const size_t offset = sliceOffset(f, o.slice);
-  const auto [lo, hi] = valueRange(&f[offset], size_t(nx) * size_t(ny), o);
+  const std::array<double, 2> range = valueRange(&f[offset], size_t(nx) * size_t(ny), o);
+  const double lo = range[0], hi = range[1];
   *width = nx;
   *height = ny;
   return paint(nx, ny, offset, [&](size_t i) { return o.palette((f[i] - lo) / (hi - lo)); });
@@ -71,8 +72,8 @@ std::vector<uint8_t> twoFieldsToRgb(const Grid<float, D>& red, const Grid<float,
                                     const FieldImageOptions& o, int* width, int* height) {
   const int nx = red.dim(0), ny = red.dim(1);
   const size_t offset = sliceOffset(red, o.slice), n = size_t(nx) * size_t(ny);
-  const auto [rlo, rhi] = valueRange(&red[offset], n, o);
-  const auto [glo, ghi] = valueRange(&green[offset], n, o);
+  const std::array<double, 2> r = valueRange(&red[offset], n, o), g = valueRange(&green[offset], n, o);
+  const double rlo = r[0], rhi = r[1], glo = g[0], ghi = g[1];
   auto byte = [](double t) { return uint8_t(std::lround(255.0 * std::clamp(std::isfinite(t) ? t : 0.0, 0.0, 1.0))); };
   *width = nx;
   *height = ny;

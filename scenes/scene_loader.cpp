@@ -31,21 +31,37 @@ long Scene::totalSteps() const {
 }
 
 Scene loadScene(const std::string& path, const std::vector<std::string>& overrides) {
+  return parseScene(readSceneText(path), path, overrides);
+}
+
+std::string readSceneText(const std::string& path) {
+  // What the path is, before opening it: a FIFO would block and /dev/zero never ends.
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (ec || !std::filesystem::exists(status)) throw UserError({path, 0, 0}, "", "cannot open the scene file", "check the path");
+  if (!std::filesystem::is_regular_file(status))
+    throw UserError({path, 0, 0}, "", "the scene is not a regular file (a folder, device or pipe)", "give a .toml file");
+  const uintmax_t size = std::filesystem::file_size(path, ec);
+  if (ec || size > kMaxSceneBytes)
+    throw UserError({path, 0, 0}, "", "the scene file is larger than " + std::to_string(kMaxSceneBytes >> 20) + " MiB",
+                    "a scene is a short text file; give large data as images or expressions");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw UserError({path, 0, 0}, "", "cannot open the scene file", "check the path and its permissions");
+  std::string text(size_t(size), '\0');
+  in.read(text.data(), std::streamsize(size));
+  text.resize(size_t(in.gcount()));
+  return text;
+}
+
+Scene parseScene(const std::string& text, const std::string& path, const std::vector<std::string>& overrides) {
+  if (text.size() > kMaxSceneBytes)
+    throw UserError({path, 0, 0}, "", "the scene is larger than " + std::to_string(kMaxSceneBytes >> 20) + " MiB");
   toml::table root;
-  {
-    std::error_code ec;
-    if (std::filesystem::exists(path, ec) && !std::filesystem::is_regular_file(path, ec))
-      throw UserError({path, 0, 0}, "", "the scene is not a regular file (a folder, device or pipe)", "give a .toml file");
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw UserError({path, 0, 0}, "", "cannot open the scene file", "check the path");
-    std::stringstream buf;
-    buf << in.rdbuf();
-    try {
-      root = toml::parse(buf.str(), path);
-    } catch (const toml::parse_error& e) {
-      throw UserError({path, int(e.source().begin.line), int(e.source().begin.column)}, "",
-                      "not valid TOML: " + std::string(e.description()));
-    }
+  try {
+    root = toml::parse(text, path);
+  } catch (const toml::parse_error& e) {
+    throw UserError({path, int(e.source().begin.line), int(e.source().begin.column)}, "",
+                    "not valid TOML: " + std::string(e.description()));
   }
   std::map<std::string, SourceLocation> overrideLocs;
   for (const std::string& kv : overrides) applyOverride(root, kv, &overrideLocs);
