@@ -49,8 +49,9 @@ CouplingMode couplingMode(const std::string& mode) {
 }  // namespace
 
 template <int D>
-CoupledSimulation<D>::CoupledSimulation(const Scene& scene, CouplingBackend backend)
-    : scene_(scene), backend_(backend), fluid_(scene.fluid), rd_(scene.rd.settings, *findModel(scene.rd.settings.model)) {
+CoupledSimulation<D>::CoupledSimulation(const Scene& scene, CouplingBackend backend, Warn warn)
+    : scene_(scene), backend_(backend), warn_(std::move(warn)), fluid_(scene.fluid), rd_(scene.rd.settings, *findModel(scene.rd.settings.model)) {
+  checkFluidLeft<D>(scene, fluid_);
   initialState<D>(scene, &rd_);
   applyScene<D>(scene, &rd_);
   const CouplingScene& C = scene.coupling;
@@ -70,9 +71,13 @@ void CoupledSimulation<D>::step(double dt) {
   stepSeconds_ += stepper_->stepSeconds();
   pressureIterations_ += fluid_.lastStats().pressure.iterations;
   diffusionIterations_ += rd_.lastStats().diffusion.iterations;
-  unconverged_ += fluid_.lastStats().pressure.converged ? 0 : 1;
+  const SolverResult& pressure = fluid_.lastStats().pressure;
+  if (!pressure.converged && unconverged_++ == 0)
+    warn_(fmt::format("warning: step {}: pressure solve stopped at relative residual {:.2e} after {} iterations",
+                      fluid_.steps(), pressure.residual, pressure.iterations));
   if (!std::isfinite(fluid_.maxSpeed()))
-    throw std::runtime_error(fmt::format("the simulation diverged at step {} (non-finite velocity)", fluid_.steps()));
+    throw NonFiniteError(fmt::format("the simulation diverged at step {} in the fluid step: the velocity is not finite", fluid_.steps()),
+                         "use a smaller time.dt or set time.cfl, and check the forces and boundary speeds");
 }
 
 template <int D>
@@ -91,7 +96,8 @@ std::vector<Grid<float, D>> CoupledSimulation<D>::field(const std::string& name)
 
 template <int D>
 void CoupledSimulation<D>::checkFinite(const std::string& when) const {
-  morphoflow::checkFinite<D>(rd_, when);
+  checkFluidFinite<D>(fluid_, when);
+  morphoflow::checkFinite<D>(rd_, when, "the advection-reaction-diffusion step (" + rdStage(rd_.settings()) + ")");
 }
 
 template <int D>

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <memory>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -18,7 +19,8 @@ namespace morphoflow {
 template <int D>
 class CoupledSimulation : public Simulation<D> {
  public:
-  CoupledSimulation(const Scene& scene, CouplingBackend backend);
+  using Warn = std::function<void(const std::string&)>;
+  CoupledSimulation(const Scene& scene, CouplingBackend backend, Warn warn);
 
   void step(double dt) override;
   double cflTimeStep(double cfl, double dtMax) const override { return fluid_.cflTimeStep(cfl, dtMax); }
@@ -39,6 +41,7 @@ class CoupledSimulation : public Simulation<D> {
  private:
   const Scene& scene_;
   CouplingBackend backend_;
+  Warn warn_;
   FluidSolver<D> fluid_;
   RDSolver<D> rd_;
   std::unique_ptr<ARDSolver<D>> ard_;

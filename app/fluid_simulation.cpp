@@ -1,5 +1,7 @@
 #include "app/fluid_simulation.h"
 
+#include "core/error.h"
+
 #include <cmath>
 #include <stdexcept>
 
@@ -51,6 +53,7 @@ std::vector<Grid<float, D>> fluidField(const FluidSolver<D>& f, const std::strin
 template <int D>
 FluidSimulation<D>::FluidSimulation(const Scene& scene, Warn warn)
     : scene_(scene), warn_(std::move(warn)), fluid_(scene.fluid) {
+  checkFluidLeft<D>(scene, fluid_);
   initialiseDye<D>(scene, &fluid_);
   for (int a = 0; a < D; ++a)
     for (bool hi : {false, true})
@@ -71,7 +74,8 @@ void FluidSimulation<D>::step(double dt) {
     warn_(fmt::format("warning: step {}: pressure solve stopped at relative residual {:.2e} after {} iterations",
                       fluid_.steps(), st.pressure.residual, st.pressure.iterations));
   if (!std::isfinite(fluid_.maxSpeed()))
-    throw std::runtime_error(fmt::format("the simulation diverged at step {} (non-finite velocity)", fluid_.steps()));
+    throw NonFiniteError(fmt::format("the simulation diverged at step {} in the fluid step: the velocity is not finite", fluid_.steps()),
+                         "use a smaller time.dt or set time.cfl, and check the forces and boundary speeds");
   if (scene_.probes.forces) {
     const ProbeSettings& pr = scene_.probes;
     const double q = 0.5 * scene_.fluid.density * pr.referenceSpeed * pr.referenceSpeed * pr.referenceArea;
@@ -189,6 +193,35 @@ std::vector<std::pair<std::string, std::string>> FluidSimulation<D>::measurement
   return files;
 }
 
+template <int D>
+void checkFluidLeft(const Scene& scene, const FluidSolver<D>& fluid) {
+  for (uint8_t solid : fluid.solid().values())
+    if (!solid) return;
+  throw UserError({scene.path, 0, 0}, "obstacles", "the obstacles cover every cell: no fluid is left to simulate",
+                  "make the obstacles smaller than the domain");
+}
+
+template <int D>
+void checkFluidFinite(const FluidSolver<D>& fluid, const std::string& where) {
+  auto finite = [](const Grid<float, D>& g) {
+    for (float v : g.values())
+      if (!std::isfinite(v)) return false;
+    return true;
+  };
+  for (int a = 0; a < D; ++a)
+    if (!finite(fluid.velocity()[a]))
+      throw NonFiniteError(fmt::format("the simulation diverged {} in the fluid step: velocity component {} is not finite",
+                                       where, "xyz"[a]),
+                           "use a smaller time.dt or set time.cfl, and check the forces and boundary speeds");
+  if (!finite(fluid.dye()))
+    throw NonFiniteError(fmt::format("the simulation diverged {} in the fluid step: the dye is not finite", where),
+                         "use a smaller time.dt or set time.cfl");
+}
+
+template void checkFluidFinite<2>(const FluidSolver<2>&, const std::string&);
+template void checkFluidFinite<3>(const FluidSolver<3>&, const std::string&);
+template void checkFluidLeft<2>(const Scene&, const FluidSolver<2>&);
+template void checkFluidLeft<3>(const Scene&, const FluidSolver<3>&);
 template void initialiseDye<2>(const Scene&, FluidSolver<2>*);
 template void initialiseDye<3>(const Scene&, FluidSolver<3>*);
 template std::vector<Grid<float, 2>> fluidField<2>(const FluidSolver<2>&, const std::string&);

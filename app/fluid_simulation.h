@@ -18,6 +18,14 @@ namespace morphoflow {
 template <int D>
 void initialiseDye(const Scene& scene, FluidSolver<D>* fluid);
 
+// Refuses (UserError naming [[obstacles]]) a scene whose obstacles cover every cell.
+template <int D>
+void checkFluidLeft(const Scene& scene, const FluidSolver<D>& fluid);
+
+// Throws NonFiniteError when a velocity component or the dye is not finite.
+template <int D>
+void checkFluidFinite(const FluidSolver<D>& fluid, const std::string& where);
+
 // The fluid fields every fluid simulation offers.
 std::vector<std::string> fluidFieldNames();
 template <int D>
@@ -38,6 +46,7 @@ class FluidSimulation : public Simulation<D> {
   std::vector<Grid<float, D>> field(const std::string& name) const override { return fluidField<D>(fluid_, name); }
   bool symmetric(const std::string& name) const override { return name == "vorticity" && D == 2; }
   bool hasObstacles() const override { return !scene_.fluid.obstacles.empty(); }
+  void checkFinite(const std::string& when) const override { checkFluidFinite<D>(fluid_, when); }
   void save(StateWriter* out) const override;
   void load(const StateReader& in) override;
   nlohmann::json resolved() const override;

@@ -16,6 +16,7 @@
 #include "bench/bench_suites.h"
 #include "core/error.h"
 #include "core/number_text.h"
+#include "core/simulation.h"
 #include "render/colormap.h"
 #include "rd/model_registry.h"
 #include "scenes/scene_loader.h"
@@ -112,7 +113,7 @@ int main(int argc, char** argv) {
   BenchOptions bench;
   CLI::App* benchCmd = app.add_subcommand("bench", "run a benchmark suite");
   benchCmd->add_option("suite", suite, std::string("suite: ") + benchSuiteNames())->required();
-  benchCmd->add_option("--size", bench.size, "only grids of this many cells per axis");
+  benchCmd->add_option("--size", bench.size, "only grids of this many cells per axis")->check(CLI::Range(8, 16384));
   benchCmd->add_option("--json", bench.json, "also write results as JSON");
   benchCmd->add_option("--seconds", bench.minSeconds, "minimum timed seconds per case");
   benchCmd->add_option("--trace", bench.trace, "coupling: write a Chrome trace-event JSON of the stages per thread");
@@ -205,12 +206,20 @@ int main(int argc, char** argv) {
     if (*benchCmd) {
       if (!bench.trace.empty() && suite != "coupling")
         throw UserError({"--trace", 0, 0}, "", "only the coupling suite writes a trace", "drop --trace or run `bench coupling`");
+      // A --size case of n^2 cells (the suites' own sizes are known to fit) needs at most ~1 kB a cell.
+      if (const uintmax_t need = uintmax_t(bench.size) * uintmax_t(bench.size) * 1000; need > availableBytes())
+        throw UserError({"--size", 0, 0}, "", fmt::format("a {0} x {0} case needs about {1}; this machine has {2} free", bench.size,
+                                                          humanBytes(need), humanBytes(availableBytes())),
+                        "give a smaller --size");
       if (!runBenchSuite(suite, bench))
         throw UserError({"bench", 0, 0}, "", "unknown suite '" + suite + "'", std::string("suites: ") + benchSuiteNames());
       return 0;
     }
   } catch (const UserError& e) {
     std::cerr << e.what() << "\n";
+    return 2;
+  } catch (const NonFiniteError& e) {  // before the run loop (a coarse-to-fine start)
+    std::cerr << "error: " << e.what() << " (" << e.hint() << ")\n";
     return 2;
   } catch (const std::exception& e) {
     std::cerr << "internal error: " << e.what() << "\n";

@@ -1,7 +1,10 @@
 #include "app/rd_scene_setup.h"
 
+#include "core/simulation.h"
+
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 
 #include <fmt/format.h>
@@ -119,22 +122,36 @@ void applyScene(const Scene& scene, RDSolver<D>* rd) {
   }
 }
 
+std::string rdStage(const RDSettings& s) {
+  switch (s.integrator) {
+    case RDIntegrator::ExplicitEuler: return "the explicit reaction-diffusion step";
+    case RDIntegrator::SemiImplicit: return "the semi-implicit reaction-diffusion step";
+    default: return "the reaction (Kim & Lin's Newton) and implicit diffusion step";
+  }
+}
+
 template <int D>
-void checkFinite(const RDSolver<D>& rd, const std::string& where) {
+void checkFinite(const RDSolver<D>& rd, const std::string& where, const std::string& stage) {
   for (int s = 0; s < rd.species(); ++s)
     for (double v : rd.field(s).values())
-      if (!std::isfinite(v))
-        throw std::runtime_error(fmt::format("the simulation diverged {} (species {} is not finite); "
-                                             "use the kim-lin integrator or a smaller time.dt",
-                                             where, rd.model().info().species[size_t(s)]));
+      if (!(std::abs(v) <= double(std::numeric_limits<float>::max()))) {  // NaN, infinite, or not a float when stored
+        const bool isExplicit = rd.settings().integrator == RDIntegrator::ExplicitEuler;
+        throw NonFiniteError(
+            fmt::format("the simulation diverged {} in {}: species {} is {} (it must fit a float to be stored)", where,
+                        stage, rd.model().info().species[size_t(s)], std::isnan(v) ? "NaN" : fmt::format("{:g}", v)),
+            isExplicit ? fmt::format("the explicit integrator is stable up to time.dt = {:.4g} for this diffusion "
+                                     "(seed 001: use integrator = \"kim-lin\" for larger steps)",
+                                     rd.explicitDiffusionLimit())
+                       : std::string("use a smaller time.dt"));
+      }
 }
 
 template void initialState<2>(const Scene&, RDSolver<2>*);
 template void initialState<3>(const Scene&, RDSolver<3>*);
 template void applyScene<2>(const Scene&, RDSolver<2>*);
 template void applyScene<3>(const Scene&, RDSolver<3>*);
-template void checkFinite<2>(const RDSolver<2>&, const std::string&);
-template void checkFinite<3>(const RDSolver<3>&, const std::string&);
+template void checkFinite<2>(const RDSolver<2>&, const std::string&, const std::string&);
+template void checkFinite<3>(const RDSolver<3>&, const std::string&, const std::string&);
 
 namespace {
 
@@ -161,7 +178,7 @@ bool growCoarseToFine(const Scene& scene, RDSolver<D>* rd, const std::function<v
     const auto t0 = std::chrono::steady_clock::now();
     const double dt = scene.time.dt * (scene.rd.coarseScaleDt ? std::pow(4.0, level) : 1.0);
     for (long k = 0; k < scene.rd.coarseSteps; ++k) cur->step(dt);
-    checkFinite(*cur, fmt::format("on the coarse grid {}", fmt::join(st.resolution, "x")));
+    checkFinite(*cur, fmt::format("on the coarse grid {}", fmt::join(st.resolution, "x")), "the coarse-to-fine start");
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     log(fmt::format("coarse grid {}: {} steps, {:.2f} s", fmt::join(st.resolution, "x"), scene.rd.coarseSteps, wall));
     report->push_back({{"resolution", st.resolution}, {"steps", scene.rd.coarseSteps}, {"dt", dt}, {"time", cur->time()},

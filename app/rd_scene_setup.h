@@ -17,8 +17,12 @@ template <int D>
 void initialState(const Scene& scene, RDSolver<D>* rd);
 template <int D>
 void applyScene(const Scene& scene, RDSolver<D>* rd);
+// Throws NonFiniteError when a species is NaN, infinite or beyond float
+// range, naming `where` (the step), `stage`, and for the explicit integrator its stable dt.
 template <int D>
-void checkFinite(const RDSolver<D>& rd, const std::string& where);
+void checkFinite(const RDSolver<D>& rd, const std::string& where, const std::string& stage);
+// "the explicit reaction-diffusion step", ...: the integrator's step, for messages.
+std::string rdStage(const RDSettings& settings);
 // Coarse-to-fine acceleration (seed 002, seed 000 sec. 6): grows the pattern
 // on grids 2^L, ..., 2 times coarser over the same domain, each started from
 // the previous one, and prolongates the last onto `rd`; false (rd untouched)

@@ -52,7 +52,7 @@ void RDSimulation<D>::step(double dt) {
 
 template <int D>
 void RDSimulation<D>::checkFinite(const std::string& when) const {
-  morphoflow::checkFinite<D>(rd_, when);
+  morphoflow::checkFinite<D>(rd_, when, rdStage(rd_.settings()));
 }
 
 template <int D>

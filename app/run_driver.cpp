@@ -62,14 +62,12 @@ class Driver {
     if (checkpoint_) restoreSinks();
     try {
       return loop();
+    } catch (const NonFiniteError& e) {
+      // Every frame and checkpoint written so far stays: each was checked finite.
+      fail("diverged", e.what());
+      throw UserError({scene_.path, 0, 0}, "", e.what(), e.hint());
     } catch (const std::exception& e) {
-      log_.endProgress();
-      log_.keep(std::string("failed: ") + e.what());
-      record("failed", e.what());
-      try {
-        writeLog();
-      } catch (const std::exception&) {  // the first error is the one to report
-      }
+      fail("failed", e.what());
       throw;
     }
   }
@@ -87,7 +85,7 @@ class Driver {
       if (f > 0 && scene_.output.checkpointEvery > 0 && f % scene_.output.checkpointEvery == 0) saveCheckpoint();
       log_.progress(lastFrame_, sim_.steps(), stepsEstimate, sim_.time(), endTime);
     }
-    sim_.checkFinite(fmt::format("at step {}", sim_.steps()));
+    checkFinite();
     log_.endProgress();
     for (const auto& s : sinks_) s->finish();
     if (StopSignals::received()) return stop();
@@ -106,11 +104,28 @@ class Driver {
     return 0;
   }
 
+  void fail(const std::string& exitState, const std::string& error) {
+    log_.endProgress();
+    log_.keep(exitState + ": " + error);
+    record(exitState, error);
+    try {
+      writeLog();
+    } catch (const std::exception&) {  // the first error is the one to report
+    }
+  }
+
+  // The finiteness check at the current step, naming the last step found finite.
+  void checkFinite() {
+    sim_.checkFinite(checkedStep_ < 0 ? fmt::format("at step {}", sim_.steps())
+                                      : fmt::format("by step {} (finite at step {})", sim_.steps(), checkedStep_));
+    checkedStep_ = sim_.steps();
+  }
+
   // Writes the frame of the current step, if it has one; returns its number or -1.
   long frame() {
     const long f = schedule_.frameAt(sim_.steps());
     if (f < 0) return -1;
-    sim_.checkFinite(fmt::format("at step {}", sim_.steps()));
+    checkFinite();
     for (const auto& s : sinks_) s->write(FrameInfo{f, sim_.steps(), lastDt_ > 0 ? lastDt_ : scene_.time.dt}, sim_);
     lastFrame_ = f;
     return f;
@@ -225,6 +240,7 @@ class Driver {
   std::optional<Checkpoint> checkpoint_;
   std::string resumedFrom_;
   long lastFrame_ = -1;
+  long checkedStep_ = -1;
   double lastDt_ = 0.0;
   uintmax_t checkpointBytes_ = 0, measurementBytes_ = 0;
   const std::chrono::steady_clock::time_point wall0_ = std::chrono::steady_clock::now();

@@ -22,8 +22,8 @@ std::unique_ptr<Simulation<D>> makeSimulation(const Scene& scene, const RunOptio
   auto warn = [log](const std::string& line) { log->warn(line); };
   if (!scene.hasFluid) return std::make_unique<RDSimulation<D>>(scene, say);
   if (scene.rd.enabled)
-    return std::make_unique<CoupledSimulation<D>>(scene, opt.backend == "serial" ? CouplingBackend::Serial
-                                                                               : CouplingBackend::TBB);
+    return std::make_unique<CoupledSimulation<D>>(
+        scene, opt.backend == "serial" ? CouplingBackend::Serial : CouplingBackend::TBB, warn);
   return std::make_unique<FluidSimulation<D>>(scene, warn);
 }
 

@@ -51,9 +51,16 @@ int analyzeCommand(const AnalyzeOptions& o) {
   }
   const std::vector<float>& ch = d.channels[c];
   std::vector<double> t(ch.begin() + long(z) * nx * ny, ch.begin() + long(z + 1) * nx * ny);
+  if (nx < 4 || ny < 4)
+    throw UserError({o.file, 0, 0}, "", fmt::format("the image is {} x {}: a variogram needs at least 4 x 4 pixels", nx, ny),
+                    "analyse a larger image");
   if (o.maxLag >= std::max(nx, ny))
     throw UserError({"--max-lag", 0, 0}, "", fmt::format("the lag must be below the field's size ({} x {})", nx, ny));
   Variogram v = variogram(t, nx, ny, {.maxLag = o.maxLag, .periodic = o.periodic});
+  if (!(v.variance > 0))
+    throw UserError({o.file, 0, 0}, "", fmt::format("channel {} is constant (or not finite): it has no pattern to measure",
+                                                    d.names[c].empty() ? "0" : d.names[c]),
+                    "analyse a frame with a pattern, or pick another --channel");
   std::cout << fmt::format("{}: {} x {}{}, channel {}\n", o.file, nx, ny, nz > 1 ? fmt::format(" (z slice {} of {})", z, nz) : "",
                            d.names[c].empty() ? "0" : d.names[c]);
   printReg("variogram (seed 003 eq. 4-5, normalised by the variance)", v);

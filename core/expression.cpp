@@ -162,7 +162,19 @@ class Parser {
     return make(Kind::Binary, std::move(v), op);
   }
 
+  // Nesting (parentheses, unary signs, chained conditionals) is bounded, so
+  // thousands of '(' are an error, not a stack overflow.
+  struct Deeper {
+    explicit Deeper(Parser* p) : p_(p) {
+      if (++p_->depth_ > kMaxExpressionDepth)
+        p_->fail(p_->p_, "nested more than " + std::to_string(kMaxExpressionDepth) + " deep");
+    }
+    ~Deeper() { --p_->depth_; }
+    Parser* p_;
+  };
+
   NodePtr conditional() {
+    Deeper deeper(this);
     NodePtr c = logicalOr();
     if (!accept("?")) return c;
     NodePtr a = conditional();
@@ -215,6 +227,7 @@ class Parser {
     }
   }
   NodePtr unary() {
+    Deeper deeper(this);
     if (accept("-")) {
       std::vector<NodePtr> v;
       v.push_back(unary());
@@ -302,12 +315,15 @@ class Parser {
   const std::string& s_;
   const std::vector<std::string>& vars_;
   size_t p_ = 0;
+  int depth_ = 0;
 };
 
 }  // namespace
 
 Expression::Expression(const std::string& text, std::vector<std::string> variables)
     : text_(text), variables_(std::move(variables)) {
+  if (text_.size() > kMaxExpressionLength)
+    throw ExpressionError(kMaxExpressionLength, "longer than " + std::to_string(kMaxExpressionLength) + " characters");
   root_ = Parser(text_, variables_).parse();
 }
 Expression::Expression(const Expression& o) : text_(o.text_), variables_(o.variables_), root_(o.root_->clone()) {}

@@ -15,6 +15,10 @@
 
 namespace morphoflow {
 
+// The longest expression, and its deepest nesting, that compile.
+constexpr size_t kMaxExpressionLength = 10000;
+constexpr int kMaxExpressionDepth = 200;
+
 // A syntax error; `column` is the 0-based offset into the expression text.
 class ExpressionError : public std::runtime_error {
  public:

@@ -5,6 +5,7 @@
 // schedule, outputs, progress, checkpoints and run.json.
 #pragma once
 
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -15,6 +16,17 @@
 #include "core/state_archive.h"
 
 namespace morphoflow {
+
+// A field turned NaN, infinite or too large for a float: the run stops
+// (exit 2) with the step, the stage and what to change.
+class NonFiniteError : public std::runtime_error {
+ public:
+  NonFiniteError(const std::string& message, std::string hint) : std::runtime_error(message), hint_(std::move(hint)) {}
+  const std::string& hint() const { return hint_; }
+
+ private:
+  std::string hint_;
+};
 
 template <int D>
 class Simulation {

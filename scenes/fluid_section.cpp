@@ -1,4 +1,6 @@
 // [fluid] (viscosity or Reynolds number, advection, pressure solver, forces), [dye] and [probes].
+#include <fmt/format.h>
+
 #include "scenes/scene_reader.h"
 
 #include <cmath>
@@ -51,6 +53,12 @@ void parseFluid(SceneContext& c, Scene* sp) {
   if (useRe) {
     s.reynolds = r.number(fluid, "fluid.", "reynolds", 100.0, 0, 1e12, true);
     s.fluid.viscosity = pr.referenceSpeed * pr.referenceLength / s.reynolds;
+    // The viscosity the Reynolds number implies is bounded like a given one.
+    if (!(s.fluid.viscosity <= 1e9))
+      r.fail(reNode, "fluid.reynolds",
+             fmt::format("Re = {:g} gives a viscosity of {:g} (speed {:g} x length {:g} / Re), more than 1e9", s.reynolds,
+                         s.fluid.viscosity, pr.referenceSpeed, pr.referenceLength),
+             fmt::format("use a Reynolds number of at least {:g}", pr.referenceSpeed * pr.referenceLength / 1e9));
   } else {
     s.fluid.viscosity = r.number(fluid, "fluid.", "viscosity", 1e-3, 0, 1e9);
     s.reynolds = s.fluid.viscosity > 0 ? pr.referenceSpeed * pr.referenceLength / s.fluid.viscosity : 0.0;

@@ -7,6 +7,7 @@
 #include <map>
 #include <sstream>
 
+#include <fmt/format.h>
 #include <toml++/toml.h>
 
 #include "scenes/scene_reader.h"
@@ -29,6 +30,25 @@ long Scene::totalSteps() const {
   if (time.steps > 0) return time.steps;
   return long(std::ceil(time.duration / time.dt - 1e-9));
 }
+
+namespace {
+
+// A fixed step's semi-Lagrangian back-trace crosses speed x dt / h cells;
+// beyond a million, cell positions lose their precision (and overflow an
+// int further on). An adaptive step (time.cfl) bounds it itself.
+void checkBackTraces(SceneContext& c, const Scene& s) {
+  if (!s.hasFluid || s.time.cfl > 0) return;
+  const double cells = s.probes.referenceSpeed * s.time.dt / (c.size[0] / c.res[0]);
+  if (cells > 1e6) {
+    const toml::table* time = c.root["time"].as_table();
+    c.r.fail(time ? time->get("dt") : nullptr, "time.dt",
+             fmt::format("a back-trace at speed {:g} crosses {:.3g} cells per step (speed x dt / cell size), more than 1e6",
+                         s.probes.referenceSpeed, cells),
+             "use a smaller time.dt, or set time.cfl");
+  }
+}
+
+}  // namespace
 
 Scene loadScene(const std::string& path, const std::vector<std::string>& overrides) {
   return parseScene(readSceneText(path), path, overrides);
@@ -84,6 +104,7 @@ Scene parseScene(const std::string& text, const std::string& path, const std::ve
   parseRD(c, &s);
   parseCoupling(c, &s);
   parseOutput(c, &s);
+  checkBackTraces(c, s);
 
   r.checkUnknown(root, "");
 

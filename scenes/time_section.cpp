@@ -1,7 +1,11 @@
 // [time]: the step, and how many (steps) or how long (duration); the CFL limit.
+#include <fmt/format.h>
+
 #include "scenes/scene_reader.h"
 
 namespace morphoflow {
+
+constexpr long kMaxSteps = 100'000'000;
 
 void parseTime(SceneContext& c, Scene* sp) {
   Reader& r = c.r;
@@ -12,10 +16,16 @@ void parseTime(SceneContext& c, Scene* sp) {
   const toml::node* stepsNode = r.node(time, "time.", "steps");
   const toml::node* durNode = r.node(time, "time.", "duration");
   if (stepsNode && durNode) r.fail(durNode, "time.duration", "give either time.steps or time.duration, not both");
-  s.time.steps = r.integer(time, "time.", "steps", 0, 1, 100'000'000);
+  s.time.steps = r.integer(time, "time.", "steps", 0, 1, kMaxSteps);
   s.time.duration = r.number(time, "time.", "duration", 0.0, 0, 1e9, true);
   if (!stepsNode && !durNode) s.time.steps = 100;
   s.time.cfl = r.number(time, "time.", "cfl", 0.0, 0, 1000);
+  // The work a scene asks for is bounded before any of it is done.
+  if (durNode && !(s.time.duration / s.time.dt <= double(kMaxSteps)))
+    r.fail(durNode, "time.duration",
+           fmt::format("duration {:g} at dt = {:g} is {:.3g} steps, more than {}", s.time.duration, s.time.dt,
+                       s.time.duration / s.time.dt, kMaxSteps),
+           "use a larger time.dt or a shorter time.duration");
 }
 
 }  // namespace morphoflow

@@ -48,13 +48,15 @@ const nlohmann::json& runNamed(const nlohmann::json& summary, const std::string&
   throw std::runtime_error("no run " + folder);
 }
 
-// The batch's child running `scene` (by its command line), or -1.
-pid_t childRunning(pid_t batch, const std::string& scene) {
+// The batch's child running `scene` (`morphoflow run SCENE ...`, by its
+// command line: a child not yet started still shows the batch's), or -1.
+pid_t childRunning(pid_t batch, const fs::path& scene) {
   std::ifstream in("/proc/" + std::to_string(batch) + "/task/" + std::to_string(batch) + "/children");
   for (pid_t pid; in >> pid;) {
     std::ifstream cmd("/proc/" + std::to_string(pid) + "/cmdline");
-    const std::string line(std::istreambuf_iterator<char>(cmd), {});
-    if (line.find(scene) != std::string::npos) return pid;
+    std::vector<std::string> argv;
+    for (std::string a; std::getline(cmd, a, '\0');) argv.push_back(a);
+    if (argv.size() > 2 && argv[1] == "run" && argv[2] == scene.string()) return pid;
   }
   return -1;
 }
@@ -81,7 +83,7 @@ TEST(Batch, ACrashAndAKillNineInTwoScenesNeverStopTheOthers) {
   const fs::path segv = writeScene(dir, "segv", 1000000, 1000), oom = writeScene(dir, "oom", 1000000, 1000);
   const pid_t batch = startMorphoflow(batchArgs({segv, a, oom, b}, out, {"--jobs", "4"}), dir / "log.txt");
   pid_t p1 = -1, p2 = -1;
-  ASSERT_TRUE(waitUntil([&] { return (p1 = childRunning(batch, "segv.toml")) > 0 && (p2 = childRunning(batch, "oom.toml")) > 0; }, 30));
+  ASSERT_TRUE(waitUntil([&] { return (p1 = childRunning(batch, segv)) > 0 && (p2 = childRunning(batch, oom)) > 0; }, 30));
   kill(p1, SIGSEGV);
   kill(p2, SIGKILL);  // what the out-of-memory killer sends
   EXPECT_EQ(waitMorphoflow(batch), 1);

@@ -80,13 +80,13 @@ TEST(RunRecords, RunJsonSaysHowItEndedAndWhatItWrote) {
   EXPECT_EQ(j["bytes_written"]["fields"].get<uintmax_t>(), sum("fields"));
   EXPECT_EQ(j["bytes_written"]["vdb"].get<uintmax_t>(), sum("vdb"));
   EXPECT_GT(j["bytes_written"]["checkpoints"].get<uintmax_t>(), 0u);
-  // A run that fails records it, with the message.
+  // A run that diverges records it, with the message (exit 2: the scene's dt is the cause).
   CommandResult bad = runMorphoflow("run " + sceneFile("rd/turing_lawlor.toml") +
                                     " --set grid.resolution=[32,32] --set 'rd.integrator=\"explicit\"' --set time.dt=50"
                                     " --set time.steps=40 --set output.every=10 --quiet --out " + (dir / "bad").string());
-  EXPECT_NE(bad.status, 0);
+  EXPECT_EQ(bad.status, 2) << bad.output;
   const nlohmann::json f = runJson(dir / "bad");
-  EXPECT_EQ(f["exit_state"], "failed");
+  EXPECT_EQ(f["exit_state"], "diverged");
   EXPECT_NE(f["error"].get<std::string>().find("diverged"), std::string::npos) << f.dump();
   EXPECT_NE(text(dir / "bad" / "log.txt"), "");
   fs::remove_all(dir);
