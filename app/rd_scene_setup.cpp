@@ -139,8 +139,8 @@ void checkFinite(const RDSolver<D>& rd, const std::string& where, const std::str
         throw NonFiniteError(
             fmt::format("the simulation diverged {} in {}: species {} is {} (it must fit a float to be stored)", where,
                         stage, rd.model().info().species[size_t(s)], std::isnan(v) ? "NaN" : fmt::format("{:g}", v)),
-            isExplicit ? fmt::format("the explicit integrator is stable up to time.dt = {:.4g} for this diffusion "
-                                     "(seed 001: use integrator = \"kim-lin\" for larger steps)",
+            isExplicit ? fmt::format("the explicit integrator's limit for this diffusion is time.dt = {:.4g}, and a stiff "
+                                     "reaction needs less; integrator = \"kim-lin\" is stable at any step (seed 001)",
                                      rd.explicitDiffusionLimit())
                        : std::string("use a smaller time.dt"));
       }

@@ -1,0 +1,207 @@
+// Input a hostile or careless user can give: every case is a clear error
+// (exit 2, naming the file or key, at once), never a crash, a hang, a huge
+// allocation or a NaN field.
+#include <gtest/gtest.h>
+#include <sys/stat.h>
+
+#include <chrono>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+#include "test_support.h"
+
+using namespace morphoflow::testing;
+namespace fs = std::filesystem;
+
+namespace {
+
+const char* const kRdScene = R"(name = "hostile"
+[grid]
+resolution = [32, 32]
+[domain]
+size = [0.5, 0.5]
+[time]
+dt = 1.0
+steps = 20
+[rd]
+model = "gray-scott"
+diffusion = [2e-5, 1e-5]
+[rd.initial]
+values = [1.0, 0.0]
+square = 0.1
+square_values = [0.5, 0.25]
+[output]
+every = 10
+image_size = 32
+)";
+
+const char* const kFluidScene = R"(name = "cavity"
+[grid]
+resolution = [32, 32]
+[time]
+dt = 0.01
+steps = 5
+[fluid]
+reynolds = 100
+lid_velocity = 1.0
+)";
+
+fs::path write(const fs::path& p, const std::string& text) {
+  std::ofstream(p, std::ios::binary) << text;
+  return p;
+}
+
+// Exit 2 within `seconds`, the output naming `expect`.
+void expectUserError(const std::string& args, const std::string& expect, double seconds = 20) {
+  const auto t0 = std::chrono::steady_clock::now();
+  CommandResult r = runMorphoflow(args);
+  const double took = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_EQ(r.status, 2) << args << "\n" << r.output;
+  EXPECT_NE(r.output.find(expect), std::string::npos) << args << "\n" << r.output;
+  EXPECT_LT(took, seconds) << args;
+}
+
+// A PNG whose header claims width x height (8-bit grey) and holds no pixels.
+std::string pngHeader(uint32_t width, uint32_t height) {
+  auto crc = [](const std::string& bytes) {
+    uint32_t c = 0xffffffffu;
+    for (unsigned char b : bytes) {
+      c ^= b;
+      for (int k = 0; k < 8; ++k) c = (c >> 1) ^ (0xedb88320u & (0u - (c & 1u)));
+    }
+    return c ^ 0xffffffffu;
+  };
+  auto be = [](uint32_t v) { return std::string{char(v >> 24), char(v >> 16), char(v >> 8), char(v)}; };
+  auto chunk = [&](const std::string& type, const std::string& data) { return be(uint32_t(data.size())) + type + data + be(crc(type + data)); };
+  return std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", be(width) + be(height) + std::string("\x08\x00\x00\x00\x00", 5)) +
+         chunk("IDAT", std::string("\x78\x9c\x03\x00\x00\x00\x00\x01", 8)) + chunk("IEND", "");
+}
+
+}  // namespace
+
+TEST(HostileInput, ASceneThatIsAFolderADeviceOrAPipeIsRefusedAtOnce) {
+  const fs::path dir = tempDir("hostile_paths");
+  const fs::path fifo = dir / "scene.toml";
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0644), 0);
+  for (const std::string& path : {dir.string(), std::string("/dev/zero"), fifo.string()}) {
+    expectUserError("run " + path + " --out " + (dir / "o").string(), "not a regular file", 5);
+    expectUserError("validate " + path, "not a regular file", 5);
+    expectUserError("batch " + path + " --out " + (dir / "b").string(), "not a regular file", 5);
+  }
+  // A file far larger than any scene is not read whole.
+  {
+    std::ofstream big(dir / "big.toml");
+    big << "# " << std::string(5u << 20, 'x') << "\n";
+  }
+  expectUserError("validate " + (dir / "big.toml").string(), "larger than 4 MiB");
+  fs::remove_all(dir);
+}
+
+TEST(HostileInput, QuantitiesThatSizeWorkAreBoundedBeforeUse) {
+  const fs::path dir = tempDir("hostile_bounds");
+  const std::string rd = write(dir / "rd.toml", kRdScene).string(), fluid = write(dir / "fluid.toml", kFluidScene).string();
+  // duration / dt steps
+  const std::string o = " --quiet --out " + (dir / "o").string();
+  expectUserError("run " + rd + o + " --set time.steps=0", "time.steps");
+  CommandResult r = runMorphoflow("run " + rd + " --quiet --out " + (dir / "o").string() +
+                                  " --set 'time={dt=1e-300,duration=1e9}'");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("steps, more than 100000000"), std::string::npos) << r.output;
+  // a viscosity from a tiny Reynolds number
+  expectUserError("run " + fluid + " --quiet --set fluid.reynolds=1e-300 --out " + (dir / "o").string(), "fluid.reynolds");
+  // cells so small that back-traces lose all precision, and back-traces a million cells long
+  expectUserError("run " + fluid + " --quiet --set domain.size=[1e-12,1e-12] --out " + (dir / "o").string(), "domain.size");
+  expectUserError("run " + fluid + " --quiet --set fluid.lid_velocity=1e6 --set time.dt=1 --out " + (dir / "o").string(),
+                  "time.dt");
+  // bench sizes
+  for (const char* size : {"0", "1", "-3", "2x", "16384"}) expectUserError(std::string("bench rd --size ") + size, "size");
+  // expressions: thousands of nested parentheses, and a very long one
+  const std::string deep = std::string(2400, '(') + "x" + std::string(2400, ')');
+  expectUserError("run " + rd + o + " --set 'rd.maps.F=\"" + deep + "\"'", "nested more than 200 deep");
+  std::string longExpr = "x";
+  for (int i = 0; i < 6000; ++i) longExpr += "+x";
+  expectUserError("run " + rd + o + " --set 'rd.maps.F=\"" + longExpr + "\"'", "longer than 10000 characters");
+  fs::remove_all(dir);
+}
+
+TEST(HostileInput, AnImageIsCheckedByItsHeaderBeforeItIsDecoded) {
+  const fs::path dir = tempDir("hostile_images");
+  const fs::path huge = write(dir / "huge.png", pngHeader(100000, 100000));
+  expectUserError("analyze " + huge.string(), "claims 100000 x 100000", 5);
+  const std::string rd = write(dir / "rd.toml", kRdScene).string();
+  expectUserError("run " + rd + " --out " + (dir / "o").string() + " --set 'rd.maps.F={image=\"" + huge.string() + "\",range=[0.02,0.05]}'",
+                  "claims 100000 x 100000", 5);
+  // Degenerate images for analyze: 1 x 1, and constant.
+  const fs::path one = write(dir / "one.png", "");
+  CommandResult made = runMorphoflow("texton --size 1 --elements 1 --steps 0 --out " + one.string());
+  ASSERT_EQ(made.status, 0) << made.output;
+  expectUserError("analyze " + one.string(), "at least 4 x 4");
+  CommandResult flat = runMorphoflow("run " + rd + " --quiet --set 'rd.initial={values=[1.0,0.0]}' --set output.every=20 --out " +
+                                     (dir / "flat").string());
+  ASSERT_EQ(flat.status, 0) << flat.output;
+  expectUserError("analyze " + (dir / "flat" / "frames" / "000000.png").string(), "constant");
+  fs::remove_all(dir);
+}
+
+TEST(HostileInput, NoFluidLeftIsRefusedAndAnUnconvergedPressureIsAWarning) {
+  const fs::path dir = tempDir("hostile_fluid");
+  const std::string fluid = write(dir / "fluid.toml", std::string(kFluidScene) +
+                                  "[[obstacles]]\nshape = \"box\"\ncenter = [0.5, 0.5]\nsize = [2, 2]\n").string();
+  expectUserError("run " + fluid + " --quiet --out " + (dir / "o").string(), "no fluid is left");
+  const std::string cavity = write(dir / "cavity.toml", kFluidScene).string();
+  for (const std::string& args : {cavity, sceneFile("coupled/cavity_gray_scott.toml") +
+                                              " --set grid.resolution=[32,32] --set rd.resolution=[32,32] --set time.steps=3"}) {
+    CommandResult r = runMorphoflow("run " + args + " --quiet --set fluid.pressure_max_iterations=1 --out " + (dir / "u").string());
+    EXPECT_EQ(r.status, 0) << r.output;
+    EXPECT_NE(r.output.find("warning: step 1: pressure solve stopped"), std::string::npos) << r.output;
+    std::ifstream in(dir / "u" / "run.json");
+    const nlohmann::json j = nlohmann::json::parse(in, nullptr, false);
+    EXPECT_GT(j["solvers"]["pressure_unconverged_steps"].get<long>(), 0) << j.dump();
+  }
+  fs::remove_all(dir);
+}
+
+// An explicit step far beyond its stability limit: the run stops at the
+// first check that sees it, naming the step, the stage and the stable dt;
+// the frames and checkpoints written before stay.
+TEST(HostileInput, ADivergingRunStopsNamingTheStepAndStageAndKeepsItsFrames) {
+  const fs::path dir = tempDir("hostile_diverge");
+  const std::string rd = write(dir / "rd.toml", kRdScene).string();
+  for (const auto& [scene, sets, stage] :
+       {std::tuple{rd, std::string(" --set time.dt=50"), std::string("in the explicit reaction-diffusion step")},
+        std::tuple{sceneFile("coupled/cavity_gray_scott.toml"),
+                   std::string(" --set grid.resolution=[32,32] --set rd.resolution=[32,32] --set time.dt=0.2 --set time.steps=100"),
+                   std::string("in the advection-reaction-diffusion step")}}) {
+    const fs::path out = dir / "o";
+    fs::remove_all(out);
+    CommandResult r = runMorphoflow("run " + scene + sets + " --quiet --set 'rd.integrator=\"explicit\"' --set output.every=1"
+                                    " --set output.checkpoint_every=1 --out " + out.string());
+    ASSERT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("diverged"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(stage), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("limit for this diffusion is time.dt = "), std::string::npos) << r.output;
+    std::ifstream in(out / "run.json");
+    const nlohmann::json j = nlohmann::json::parse(in);
+    EXPECT_EQ(j["exit_state"], "diverged");
+    const long frames = j["frames_written"];
+    int onDisk = 0;
+    for (const auto& e : fs::directory_iterator(out / "frames")) onDisk += e.is_regular_file();
+    EXPECT_EQ(onDisk, frames);
+    EXPECT_GE(frames, 1);
+  }
+  fs::remove_all(dir);
+}
+
+TEST(HostileInput, CommandLineNumbersAreWholeTokens) {
+  const fs::path dir = tempDir("hostile_cli");
+  const std::string rd = write(dir / "rd.toml", kRdScene).string(), out = " --out " + (dir / "o").string();
+  for (const std::string& args : {"run " + rd + " --frames 1x:2y" + out, "run " + rd + " --frames 1:2y" + out,
+                                  "run " + rd + " --frames ' 1:2'" + out, "run " + rd + " --threads 2x" + out,
+                                  "batch " + rd + " --shard 1/2x" + out, "batch " + rd + " --shard ' 0/2'" + out,
+                                  "batch " + rd + " --jobs 2x" + out, "analyze " + rd + " --max-lag 3q"}) {
+    CommandResult r = runMorphoflow(args);
+    EXPECT_EQ(r.status, 2) << args << "\n" << r.output;
+  }
+  fs::remove_all(dir);
+}
