@@ -65,7 +65,8 @@ uintmax_t availableBytes() { return std::min(meminfoAvailable(), cgroupRoom()); 
 
 std::string humanBytes(uintmax_t b) {
   if (b >= (uintmax_t(1) << 30)) return fmt::format("{:.2f} GiB", double(b) / double(1 << 30));
-  return fmt::format("{:.0f} MiB", double(b) / double(1 << 20));
+  if (b >= (uintmax_t(1) << 20)) return fmt::format("{:.0f} MiB", double(b) / double(1 << 20));
+  return fmt::format("{:.0f} KiB", double(b) / 1024.0);
 }
 
 void checkRunFits(const Scene& scene) {
