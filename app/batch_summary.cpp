@@ -83,12 +83,14 @@ void readRunResult(const fs::path& batchDir, fs::file_time_type startedAt, RunRe
         if (bytes.is_number_unsigned()) r->bytesWritten += bytes.get<uintmax_t>();
     r->error = j.value("error", "");
   }
-  if (r->signal != 0) r->status = r->signal == SIGKILL ? "killed" : "crashed";
+  // A child stopped by SIGINT or SIGTERM before its run loop started dies of it: it too is interrupted.
+  if (r->signal == SIGINT || r->signal == SIGTERM) r->status = "interrupted";
+  else if (r->signal != 0) r->status = r->signal == SIGKILL ? "killed" : "crashed";
   else if (r->exitCode == 0) r->status = "completed";
   else if (r->exitCode == 2) r->status = "error";
   else if (r->exitCode == 128 + SIGINT || r->exitCode == 128 + SIGTERM) r->status = "interrupted";
   else r->status = "failed";
-  if (r->signal != 0)
+  if (r->signal != 0 && r->status != "interrupted")
     r->error = "killed by " + signalName(r->signal) + (r->signal == SIGKILL ? " (the out-of-memory killer, or kill -9)" : "");
   else if (r->exitCode != 0 && r->error.empty())
     r->error = lastLine(batchDir / r->run.folder / "console.txt");

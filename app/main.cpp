@@ -65,7 +65,11 @@ int main(int argc, char** argv) {
   std::string frames;
   CLI::App* runCmd = app.add_subcommand("run", "run a scene");
   runCmd->add_option("scene", run.scene, "scene file (.toml)")->required();
-  runCmd->add_option("--set", run.overrides, "override a scene key: key.path=value (TOML value)");
+  // Each --set takes one value, so scene files may follow it.
+  runCmd->add_option("--set", run.overrides, "override a scene key: key.path=value (TOML value)")
+      ->expected(1)
+      ->allow_extra_args(false)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   runCmd->add_option("--out", run.out, "output directory")->capture_default_str();
   runCmd->add_option("--backend", run.backend, "serial | tbb | gpu")
       ->check(CLI::IsMember({"serial", "tbb", "gpu"}))
@@ -81,7 +85,10 @@ int main(int argc, char** argv) {
     cmd->add_option("--jobs", b->jobs, "runs at once; the machine's threads are divided between them")
         ->check(CLI::Range(1, 256));
     cmd->add_option("--shard", b->shard, "I/N: only every N-th run, from the I-th (0-based)");
-    cmd->add_option("--set", b->sets, "override a scene key in every run: key.path=value (TOML value)");
+    cmd->add_option("--set", b->sets, "override a scene key in every run: key.path=value (TOML value)")
+        ->expected(1)
+        ->allow_extra_args(false)
+        ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
     cmd->add_flag("--resume", b->resume, "skip runs completed with the same settings; resume interrupted ones");
     cmd->add_flag("--quiet", b->quiet, "no progress lines (the summary is still printed)");
     cmd->add_option("--out", b->out, "output folder: one folder per run inside it")->required();
@@ -93,7 +100,11 @@ int main(int argc, char** argv) {
   std::string sweepScene;
   CLI::App* sweepCmd = app.add_subcommand("sweep", "run a scene over every combination of values, into OUT/<key=value,...>");
   sweepCmd->add_option("scene", sweepScene, "scene file")->required();
-  sweepCmd->add_option("--vary", sweep.varies, "key=start:stop:count or key=[a,b,c] (TOML values)")->required();
+  sweepCmd->add_option("--vary", sweep.varies, "key=start:stop:count or key=[a,b,c] (TOML values)")
+      ->required()
+      ->expected(1)
+      ->allow_extra_args(false)
+      ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
   batchOptions(sweepCmd, &sweep);
   std::string gatherDir;
   CLI::App* gatherCmd = app.add_subcommand("gather", "merge the shards' summaries of a batch or sweep folder");

@@ -136,8 +136,9 @@ TEST(Batch, SetAppliesToEveryRunAndJobsDivideTheThreads) {
   CommandResult one = runMorphoflow("run " + a.string() + " --quiet --set time.steps=1 --out " + (dir / "one").string());
   ASSERT_EQ(one.status, 0) << one.output;
   const int machine = readJson(dir / "one" / "run.json")["threads"];
-  CommandResult r = runMorphoflow("batch " + a.string() + " " + b.string() +
-                                  " --jobs 2 --quiet --set time.steps=7 --set output.every=7 --out " + (dir / "o").string());
+  // Scene files may follow a --set (each takes one value).
+  CommandResult r = runMorphoflow("batch --set time.steps=7 " + a.string() + " --set output.every=7 " + b.string() +
+                                  " --jobs 2 --quiet --out " + (dir / "o").string());
   ASSERT_EQ(r.status, 0) << r.output;
   for (const char* name : {"a", "b"}) {
     const nlohmann::json j = readJson(dir / "o" / name / "run.json");
