@@ -16,7 +16,7 @@ struct BatchOptions {
   bool keepGoing = false;           // run the valid scenes when some are invalid
   bool resume = false;              // skip completed runs, resume interrupted ones
   bool quiet = false;
-  std::string out;
+  std::string out = "out";
 };
 
 // Each returns the exit status: 0 when every run completed, 2 when any was a

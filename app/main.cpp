@@ -1,6 +1,7 @@
 // The morphoflow command line (DESIGN.md: "The command-line contract").
 // Exit status: 0 success, 2 user error (file:line:col on stderr), 1 internal error.
 #include <climits>
+#include <cstdlib>
 #include <filesystem>
 #include <optional>
 #include <iostream>
@@ -9,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "app/batch.h"
+#include "app/gpu_simulation.h"
 #include "app/memory_estimate.h"
 #include "app/run_options.h"
 #include "app/texture_commands.h"
@@ -16,6 +18,8 @@
 #include "bench/bench_suites.h"
 #include "core/error.h"
 #include "core/number_text.h"
+#include "core/parallel.h"
+#include "core/simd_dispatch.h"
 #include "core/simulation.h"
 #include "render/colormap.h"
 #include "rd/model_registry.h"
@@ -91,7 +95,7 @@ int main(int argc, char** argv) {
         ->multi_option_policy(CLI::MultiOptionPolicy::TakeAll);
     cmd->add_flag("--resume", b->resume, "skip runs completed with the same settings; resume interrupted ones");
     cmd->add_flag("--quiet", b->quiet, "no progress lines (the summary is still printed)");
-    cmd->add_option("--out", b->out, "output folder: one folder per run inside it")->required();
+    cmd->add_option("--out", b->out, "output folder: one folder per run inside it")->capture_default_str();
   };
   CLI::App* batchCmd = app.add_subcommand("batch", "run several scenes, each in its own process, into OUT/<scene name>");
   batchCmd->add_option("scenes", batch.scenes, "scene files")->required();
@@ -113,6 +117,8 @@ int main(int argc, char** argv) {
   std::vector<std::string> validateScenes;
   CLI::App* validateCmd = app.add_subcommand("validate", "parse and check scenes; no simulation");
   validateCmd->add_option("scenes", validateScenes, "scene files")->required();
+
+  CLI::App* infoCmd = app.add_subcommand("info", "the backends built, the GL renderer, the CPU's vector features and threads");
 
   std::string what;
   CLI::App* listCmd = app.add_subcommand("list", "list models, scenes or palettes");
@@ -186,6 +192,18 @@ int main(int argc, char** argv) {
           std::cout << fmt::format("{}: ok ({}D, {} steps, reaction-diffusion {}, {})\n", s, sc.dimension,
                                    sc.totalSteps(), sc.rd.settings.model, memory);
       }
+      return 0;
+    }
+    if (*infoCmd) {
+      const GpuInfo g = gpuInfo();
+      std::cout << fmt::format("morphoflow {}\nbackends: serial, tbb, gpu\n", kVersion);
+      if (g.available)
+        std::cout << fmt::format("gpu: {} ({}), OpenGL {}\n", g.renderer, g.platform, g.version);
+      else
+        std::cout << "gpu: unavailable: " << g.reason << "\n";
+      std::cout << fmt::format("cpu: {} threads; vector kernels {} (AVX2 {}){}\n", hardwareThreads(),
+                               useAvx2() ? "8-lane AVX2" : "4-lane SSE", cpuHasAvx2() ? "present" : "absent",
+                               std::getenv("MORPHOFLOW_SIMD") ? " (MORPHOFLOW_SIMD set)" : "");
       return 0;
     }
     if (*listCmd) {

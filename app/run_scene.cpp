@@ -3,6 +3,7 @@
 
 #include "app/coupled_simulation.h"
 #include "app/fluid_simulation.h"
+#include "app/gpu_simulation.h"
 #include "app/memory_estimate.h"
 #include "app/rd_simulation.h"
 #include "app/run_driver.h"
@@ -20,6 +21,7 @@ template <int D>
 std::unique_ptr<Simulation<D>> makeSimulation(const Scene& scene, const RunOptions& opt, RunLog* log) {
   auto say = [log](const std::string& line) { log->say(line); };
   auto warn = [log](const std::string& line) { log->warn(line); };
+  if (opt.backend == "gpu") return std::make_unique<GpuRDSimulation<D>>(scene);  // checkGpuRuns said it can
   if (!scene.hasFluid) return std::make_unique<RDSimulation<D>>(scene, say);
   if (scene.rd.enabled)
     return std::make_unique<CoupledSimulation<D>>(
@@ -38,8 +40,7 @@ int run(const Scene& scene, const RunOptions& opt) {
 
 int runScene(const RunOptions& opt) {
   Scene scene = loadScene(opt.scene, opt.overrides);
-  if (opt.backend == "gpu")
-    throw UserError({"--backend", 0, 0}, "", "the gpu backend is not part of this build yet", "use --backend tbb or serial");
+  if (opt.backend == "gpu") checkGpuRuns(scene);
   checkRunFits(scene);
   ThreadLimit limit(opt.backend == "serial" ? 1 : opt.threads);
   return scene.dimension == 2 ? run<2>(scene, opt) : run<3>(scene, opt);

@@ -203,7 +203,7 @@ TEST(Batch, BadOptionsAreUserErrors) {
   const std::string a = writeScene(dir, "a", 10, 10).string(), out = " --out " + (dir / "o").string();
   for (const std::string& args : {"batch " + a + " --shard 1/2x" + out, "batch " + a + " --shard 2/2" + out,
                                   "batch " + a + " --shard 1" + out, "batch " + a + " --jobs 0" + out, "batch" + out,
-                                  "batch " + a, "sweep " + a + " --vary rd.parameters.F=0.01:0.02" + out,
+                                  "sweep " + a + " --vary rd.parameters.F=0.01:0.02" + out,
                                   "sweep " + a + " --vary rd.parameters.F=0.01:0.02:3x" + out,
                                   "sweep " + a + " --vary 'rd.parameters.F=[0.01,' " + out,
                                   "sweep " + a + " --vary rd.parameters.F=[] " + out,

@@ -1,0 +1,151 @@
+#include "app/gpu_simulation.h"
+
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "app/rd_scene_setup.h"
+#include "core/error.h"
+#include "gpu/gl_context.h"
+#include "gpu/gpu_explicit_rd.h"
+#include "rd/model_registry.h"
+#include "rd/rd_solver.h"
+
+namespace morphoflow {
+
+namespace {
+
+// The first stage of the scene with no GPU program, or "".
+std::string missingStage(const Scene& s) {
+  const RDScene& rd = s.rd;
+  if (s.hasFluid) return "the fluid (forces, advection, viscosity, pressure projection)";
+  if (rd.settings.integrator != RDIntegrator::ExplicitEuler)
+    return "the implicit reaction-diffusion integrators (kim-lin, semi-implicit, crank-nicolson); integrator = \"explicit\" runs";
+  if (gpuReaction(rd.settings.model).empty())
+    return "the reaction of model " + rd.settings.model + " (the GPU has gray-scott)";
+  if (rd.settings.boundary == RDBoundary::Dirichlet) return "Dirichlet walls (rd.boundary = \"dirichlet\")";
+  if (!rd.parameterMaps.empty() || !rd.perturb.empty()) return "parameter maps ([rd.maps], rd.perturb)";
+  if (!rd.fixed.empty() || !rd.settings.frozen.empty()) return "fixed regions and frozen species ([[rd.fixed]], rd.frozen)";
+  if (rd.anisotropy.enabled) return "anisotropic diffusion ([rd.anisotropy])";
+  if (rd.lobes.enabled) return "cosine-lobe diffusion ([rd.cosine_lobes])";
+  if (rd.coarseLevels > 0) return "the coarse-to-fine start (rd.coarse_to_fine)";
+  if (rd.settings.lookupTable) return "the reaction lookup table (rd.lookup_table)";
+  return "";
+}
+
+}  // namespace
+
+GpuInfo gpuInfo() {
+  GpuInfo g;
+  try {
+    const GlContext& c = GlContext::instance();
+    g = {true, c.renderer(), c.version(), c.platform(), ""};
+  } catch (const std::exception& e) {
+    g.reason = e.what();
+  }
+  return g;
+}
+
+void checkGpuRuns(const Scene& scene) {
+  const std::string stage = missingStage(scene);
+  if (!stage.empty())
+    throw UserError({scene.path, 0, 0}, "--backend", "the gpu backend has no program yet for " + stage,
+                    "run this scene with --backend tbb; docs/gpu.md lists what the gpu backend runs");
+  const GpuInfo g = gpuInfo();
+  if (!g.available) throw UserError({"--backend", 0, 0}, "", "no usable GPU context: " + g.reason, "use --backend tbb");
+}
+
+template <int D>
+GpuRDSimulation<D>::GpuRDSimulation(const Scene& scene) : scene_(scene) {
+  // The initial state as the CPU builds it, then only the GPU steps.
+  RDSolver<D> init(scene.rd.settings, *findModel(scene.rd.settings.model));
+  initialState<D>(scene, &init);
+  applyScene<D>(scene, &init);
+  species_ = init.model().info().species;
+  cells_ = init.field(0).dims();
+  explicitLimit_ = init.explicitDiffusionLimit();
+  std::vector<double> params;
+  for (size_t k = 0; k < init.model().info().parameters.size(); ++k) params.push_back(init.parameter(int(k)));
+  auto values = [&](int s) {
+    const Grid<float, D> f = toFloat<D>(init.field(s));
+    return f.values();
+  };
+  gpu_ = std::make_unique<GpuExplicitRD>(scene.rd.settings, init.diffusion(), params, values(0), values(1));
+}
+
+template <int D>
+GpuRDSimulation<D>::~GpuRDSimulation() = default;
+
+template <int D>
+void GpuRDSimulation<D>::step(double dt) {
+  gpu_->step(dt);
+  time_ += dt;
+  ++steps_;
+}
+
+template <int D>
+std::vector<Grid<float, D>> GpuRDSimulation<D>::field(const std::string& name) const {
+  for (size_t s = 0; s < species_.size(); ++s)
+    if (species_[s] == name) {
+      Grid<float, D> g(cells_, 0.0f);
+      g.values() = gpu_->download(int(s));
+      return {g};
+    }
+  throw std::invalid_argument("no species '" + name + "'");
+}
+
+template <int D>
+void GpuRDSimulation<D>::checkFinite(const std::string& when) const {
+  for (size_t s = 0; s < species_.size(); ++s)
+    for (float v : gpu_->download(int(s)))
+      if (!std::isfinite(v))
+        throw NonFiniteError(fmt::format("the simulation diverged {} in the explicit reaction-diffusion step (gpu): species {} "
+                                         "is not finite",
+                                         when, species_[s]),
+                             fmt::format("the explicit integrator's limit for this diffusion is time.dt = {:.4g}, and a "
+                                         "stiff reaction needs less",
+                                         explicitLimit_));
+}
+
+template <int D>
+void GpuRDSimulation<D>::save(StateWriter* out) const {
+  out->put("gpu.rd.time", time_);
+  out->put("gpu.rd.steps", steps_);
+  for (size_t s = 0; s < species_.size(); ++s) out->putVector("gpu.rd.species." + species_[s], gpu_->download(int(s)));
+}
+
+template <int D>
+void GpuRDSimulation<D>::load(const StateReader& in) {
+  in.get("gpu.rd.time", &time_);
+  in.get("gpu.rd.steps", &steps_);
+  for (size_t s = 0; s < species_.size(); ++s) {
+    std::vector<float> v(gpu_->cells());
+    in.getVector("gpu.rd.species." + species_[s], &v);
+    gpu_->upload(int(s), v);
+  }
+}
+
+template <int D>
+nlohmann::json GpuRDSimulation<D>::resolved() const {
+  return {{"dimension", D},
+          {"model", scene_.rd.settings.model},
+          {"species", species_},
+          {"resolution", scene_.rd.settings.resolution},
+          {"size", scene_.rd.settings.size},
+          {"dt", scene_.time.dt},
+          {"explicit_diffusion_limit", explicitLimit_}};
+}
+
+template <int D>
+void GpuRDSimulation<D>::report(nlohmann::json* run) const {
+  const GlContext& c = GlContext::instance();
+  (*run)["gl_renderer"] = c.renderer();
+  (*run)["gl_version"] = c.version();
+  (*run)["gl_platform"] = c.platform();
+}
+
+template class GpuRDSimulation<2>;
+template class GpuRDSimulation<3>;
+
+}  // namespace morphoflow

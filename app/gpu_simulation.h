@@ -1,0 +1,58 @@
+// --backend gpu: the scenes whose every stage has a GPU program
+// (gpu/gpu_explicit_rd.h), as a Simulation. Any other scene is refused,
+// naming the first stage the GPU cannot run yet; nothing falls back to the CPU.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/simulation.h"
+#include "scenes/scene.h"
+
+namespace morphoflow {
+
+class GpuExplicitRD;
+
+// Throws UserError naming the stage when the scene needs one the GPU backend
+// lacks, and when no OpenGL 4.3 context can be created (the reason).
+void checkGpuRuns(const Scene& scene);
+
+// The GL renderer and version ("llvmpipe (LLVM 15.0.6, 256 bits)", "4.5 (Core Profile) Mesa 22.3.6"),
+// or the reason there is no context.
+struct GpuInfo {
+  bool available = false;
+  std::string renderer, version, platform, reason;
+};
+GpuInfo gpuInfo();
+
+template <int D>
+class GpuRDSimulation : public Simulation<D> {
+ public:
+  explicit GpuRDSimulation(const Scene& scene);
+  ~GpuRDSimulation() override;
+
+  void step(double dt) override;
+  double time() const override { return time_; }
+  long steps() const override { return steps_; }
+  std::vector<std::string> fieldNames() const override { return species_; }
+  std::vector<std::string> species() const override { return species_; }
+  std::vector<std::string> dumpFieldNames() const override { return species_; }
+  std::vector<Grid<float, D>> field(const std::string& name) const override;
+  void checkFinite(const std::string& when) const override;
+  void save(StateWriter* out) const override;
+  void load(const StateReader& in) override;
+  nlohmann::json resolved() const override;
+  void report(nlohmann::json* run) const override;
+
+ private:
+  const Scene& scene_;
+  std::vector<std::string> species_;
+  IVec<D> cells_;
+  double explicitLimit_ = 0.0;
+  std::unique_ptr<GpuExplicitRD> gpu_;
+  double time_ = 0.0;
+  long steps_ = 0;
+};
+
+}  // namespace morphoflow

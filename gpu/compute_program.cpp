@@ -1,0 +1,50 @@
+#include "gpu/compute_program.h"
+
+#include <epoxy/gl.h>
+
+#include "gpu/gl_context.h"
+#include "gpu/shader_source.h"
+
+namespace morphoflow {
+
+ComputeProgram::ComputeProgram(const std::string& shader, const std::string& prologue) {
+  const std::string text = "#version 430 core\n" + prologue + "\n#line 1\n" + shaderSource(shader);
+  const char* src = text.c_str();
+  const GLuint s = glCreateShader(GL_COMPUTE_SHADER);
+  glShaderSource(s, 1, &src, nullptr);
+  glCompileShader(s);
+  GLint ok = 0;
+  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+  auto logOf = [](GLuint object, bool isProgram) {
+    GLint n = 0;
+    isProgram ? glGetProgramiv(object, GL_INFO_LOG_LENGTH, &n) : glGetShaderiv(object, GL_INFO_LOG_LENGTH, &n);
+    std::string log(size_t(std::max(n, 1)), '\0');
+    isProgram ? glGetProgramInfoLog(object, n, nullptr, log.data()) : glGetShaderInfoLog(object, n, nullptr, log.data());
+    return log;
+  };
+  if (!ok) {
+    const std::string log = logOf(s, false);
+    glDeleteShader(s);
+    throw GpuError("shader " + shader + " does not compile:\n" + log);
+  }
+  id_ = glCreateProgram();
+  glAttachShader(id_, s);
+  glLinkProgram(id_);
+  glDeleteShader(s);
+  glGetProgramiv(id_, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    const std::string log = logOf(id_, true);
+    glDeleteProgram(id_);
+    throw GpuError("shader " + shader + " does not link:\n" + log);
+  }
+}
+
+ComputeProgram::~ComputeProgram() {
+  if (id_) glDeleteProgram(id_);
+}
+
+void ComputeProgram::use() const { glUseProgram(id_); }
+
+int ComputeProgram::uniform(const char* name) const { return glGetUniformLocation(id_, name); }
+
+}  // namespace morphoflow

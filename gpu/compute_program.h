@@ -1,0 +1,24 @@
+// A linked GLSL compute program: an embedded shader with a prologue of
+// #version and #defines; a compile or link error is a GpuError with the log.
+#pragma once
+
+#include <string>
+
+namespace morphoflow {
+
+class ComputeProgram {
+ public:
+  ComputeProgram(const std::string& shader, const std::string& prologue);
+  ComputeProgram(const ComputeProgram&) = delete;
+  ComputeProgram& operator=(const ComputeProgram&) = delete;
+  ~ComputeProgram();
+
+  void use() const;
+  int uniform(const char* name) const;  // its location (-1 when the compiler removed it)
+  unsigned id() const { return id_; }
+
+ private:
+  unsigned id_ = 0;
+};
+
+}  // namespace morphoflow

@@ -1,0 +1,11 @@
+# Writes OUT: every shader of SHADERS (a ;-list of paths) as a C++ raw string,
+# looked up by file name through gpu/shader_source.h.
+set(body "// Generated from gpu/shaders/*.comp by gpu/embed_shaders.cmake.\n#include \"gpu/shader_source.h\"\n#include <map>\n#include <stdexcept>\nnamespace morphoflow {\nconst std::string& shaderSource(const std::string& name) {\n  static const std::map<std::string, std::string> sources = {\n")
+foreach(path ${SHADERS})
+  get_filename_component(name ${path} NAME)
+  file(READ ${path} text)
+  string(APPEND body "    {\"${name}\", R\"glsl(${text})glsl\"},\n")
+endforeach()
+string(APPEND body "  };\n  const auto it = sources.find(name);\n  if (it == sources.end()) throw std::logic_error(\"no shader \" + name);\n  return it->second;\n}\n}  // namespace morphoflow\n")
+file(WRITE ${OUT}.tmp "${body}")
+file(COPY_FILE ${OUT}.tmp ${OUT} ONLY_IF_DIFFERENT)

@@ -1,0 +1,133 @@
+#include "gpu/gl_context.h"
+
+#include <cstdio>
+#include <vector>
+
+#include <epoxy/egl.h>
+#include <epoxy/gl.h>
+#include <fmt/format.h>
+
+namespace morphoflow {
+
+struct GlContext::Egl {
+  EGLDisplay display = EGL_NO_DISPLAY;
+  EGLContext context = EGL_NO_CONTEXT;
+};
+
+namespace {
+
+bool hasExtension(EGLDisplay d, const char* name) { return epoxy_has_egl_extension(d, name); }
+
+// The EGL devices, the one with a CUDA id (an NVIDIA GPU) first, then any
+// other hardware device; software devices last.
+std::vector<EGLDeviceEXT> devicesBestFirst() {
+  std::vector<EGLDeviceEXT> out;
+  if (!epoxy_has_egl_extension(EGL_NO_DISPLAY, "EGL_EXT_device_enumeration")) return out;
+  EGLint n = 0;
+  if (!eglQueryDevicesEXT(0, nullptr, &n) || n <= 0) return out;
+  std::vector<EGLDeviceEXT> all(static_cast<size_t>(n));
+  eglQueryDevicesEXT(n, all.data(), &n);
+  std::vector<EGLDeviceEXT> cuda, hardware, software;
+  for (EGLDeviceEXT d : all) {
+    const char* ext = eglQueryDeviceStringEXT(d, EGL_EXTENSIONS);
+    const std::string e = ext ? ext : "";
+    EGLAttrib id = 0;
+    if (e.find("EGL_NV_device_cuda") != std::string::npos && eglQueryDeviceAttribEXT(d, EGL_CUDA_DEVICE_NV, &id))
+      cuda.push_back(d);
+    else if (e.find("EGL_MESA_device_software") != std::string::npos)
+      software.push_back(d);
+    else
+      hardware.push_back(d);
+  }
+  for (auto* v : {&cuda, &hardware, &software}) out.insert(out.end(), v->begin(), v->end());
+  return out;
+}
+
+// Initialises `d` and creates a 4.3 core context current with no surface; false if it cannot.
+bool makeContext(EGLDisplay d, GlContext::Egl* egl) {
+  EGLint major = 0, minor = 0;
+  if (d == EGL_NO_DISPLAY || !eglInitialize(d, &major, &minor)) return false;
+  if (!hasExtension(d, "EGL_KHR_surfaceless_context") || !eglBindAPI(EGL_OPENGL_API)) {
+    eglTerminate(d);
+    return false;
+  }
+  const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 3,
+                            EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+#ifndef NDEBUG
+                            EGL_CONTEXT_OPENGL_DEBUG, EGL_TRUE,
+#endif
+                            EGL_NONE};
+  EGLConfig config = nullptr;
+  if (!hasExtension(d, "EGL_KHR_no_config_context")) {
+    const EGLint want[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_BIT, EGL_NONE};
+    EGLint count = 0;
+    if (!eglChooseConfig(d, want, &config, 1, &count) || count < 1) {
+      eglTerminate(d);
+      return false;
+    }
+  }
+  EGLContext c = eglCreateContext(d, config, EGL_NO_CONTEXT, attribs);
+  if (c == EGL_NO_CONTEXT || !eglMakeCurrent(d, EGL_NO_SURFACE, EGL_NO_SURFACE, c)) {
+    if (c != EGL_NO_CONTEXT) eglDestroyContext(d, c);
+    eglTerminate(d);
+    return false;
+  }
+  egl->display = d;
+  egl->context = c;
+  return true;
+}
+
+#ifndef NDEBUG
+void GLAPIENTRY debugMessage(GLenum, GLenum type, GLuint, GLenum severity, GLsizei, const GLchar* message, const void*) {
+  if (severity != GL_DEBUG_SEVERITY_NOTIFICATION)
+    std::fprintf(stderr, "GL %s: %s\n", type == GL_DEBUG_TYPE_ERROR ? "error" : "debug", message);
+}
+#endif
+
+}  // namespace
+
+GlContext& GlContext::instance() {
+  static GlContext context;
+  return context;
+}
+
+GlContext::GlContext() : egl_(std::make_unique<Egl>()) {
+  if (!epoxy_has_egl()) throw GpuUnavailable("no EGL library (libEGL.so.1) could be loaded");
+  for (EGLDeviceEXT dev : devicesBestFirst())
+    if (makeContext(eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, dev, nullptr), egl_.get())) {
+      platform_ = "EGL device";
+      break;
+    }
+  if (egl_->context == EGL_NO_CONTEXT &&
+      makeContext(eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr), egl_.get()))
+    platform_ = "Mesa surfaceless";
+  if (egl_->context == EGL_NO_CONTEXT)
+    throw GpuUnavailable("no OpenGL 4.3 core context: neither an EGL device nor Mesa's surfaceless platform offers one "
+                         "(install libegl-mesa0 and libgl1-mesa-dri for llvmpipe)");
+  if (epoxy_gl_version() < 43) throw GpuUnavailable(fmt::format("OpenGL {:.1f} only; compute shaders need 4.3", epoxy_gl_version() / 10.0));
+  renderer_ = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+  version_ = reinterpret_cast<const char*>(glGetString(GL_VERSION));
+#ifndef NDEBUG
+  glEnable(GL_DEBUG_OUTPUT_SYNCHRONOUS);
+  glDebugMessageCallback(debugMessage, nullptr);
+#endif
+}
+
+GlContext::~GlContext() {
+  if (egl_->context != EGL_NO_CONTEXT) {
+    eglMakeCurrent(egl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    eglDestroyContext(egl_->display, egl_->context);
+    eglTerminate(egl_->display);
+  }
+}
+
+void GlContext::check(const char* what) {
+  const GLenum e = glGetError();
+  if (e == GL_NO_ERROR) return;
+  throw GpuError(fmt::format("OpenGL error 0x{:04x} ({}) in {}", e,
+                             e == GL_OUT_OF_MEMORY ? "out of GPU memory" : e == GL_INVALID_OPERATION ? "invalid operation"
+                                                                                                    : "invalid value or enum",
+                             what));
+}
+
+}  // namespace morphoflow

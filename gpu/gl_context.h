@@ -1,0 +1,51 @@
+// A headless OpenGL 4.3+ core context through EGL, with no window and no X
+// server: the EGL device platform first (a hardware GPU; on NVIDIA the
+// device that reports EGL_CUDA_DEVICE_NV), then Mesa's surfaceless platform
+// (llvmpipe when there is no GPU). One context per process, made current on
+// the thread that created it.
+#pragma once
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+
+namespace morphoflow {
+
+// No usable context (no EGL, no GL 4.3): the reason, for exit 2 or a skipped test.
+class GpuUnavailable : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// A GL call that failed (a shader that does not compile, out of memory).
+class GpuError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class GlContext {
+ public:
+  // The process's context, created on first use; throws GpuUnavailable.
+  static GlContext& instance();
+  GlContext(const GlContext&) = delete;
+  GlContext& operator=(const GlContext&) = delete;
+  ~GlContext();
+
+  const std::string& renderer() const { return renderer_; }
+  const std::string& version() const { return version_; }
+  const std::string& platform() const { return platform_; }  // "EGL device" or "Mesa surfaceless"
+  // The glGetError state after `what`, as a GpuError.
+  static void check(const char* what);
+
+ private:
+  GlContext();
+
+ public:
+  struct Egl;  // the display and context (gl_context.cpp)
+
+ private:
+  std::unique_ptr<Egl> egl_;
+  std::string renderer_, version_, platform_;
+};
+
+}  // namespace morphoflow

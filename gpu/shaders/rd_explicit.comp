@@ -1,0 +1,42 @@
+// One explicit Euler step of a two-species reaction-diffusion model
+// (rd_settings.h: x += dt (R(x) + d lap x)), the 5- or 7-point Laplacian with
+// periodic or zero-flux walls. The host prepends #version, DIM, the model's
+// REACTION(u, v, p) and the work-group size.
+layout(std430, binding = 0) readonly buffer InU { float inU[]; };
+layout(std430, binding = 1) readonly buffer InV { float inV[]; };
+layout(std430, binding = 2) writeonly buffer OutU { float outU[]; };
+layout(std430, binding = 3) writeonly buffer OutV { float outV[]; };
+
+uniform ivec3 cells;      // nx, ny, nz (nz = 1 in 2D)
+uniform bool periodic;    // else zero-flux (Neumann) walls
+uniform float dt;
+uniform vec2 dOverH2;     // d_u / h^2, d_v / h^2
+uniform vec4 params;      // the model's parameters
+
+int at(ivec3 c) { return c.x + cells.x * (c.y + cells.y * c.z); }
+
+// The neighbour's index, wrapped (periodic) or mirrored onto the cell itself (no flux).
+int neighbour(ivec3 c, int axis, int step) {
+  ivec3 q = c;
+  q[axis] += step;
+  if (q[axis] < 0 || q[axis] >= cells[axis]) q[axis] = periodic ? (q[axis] + cells[axis]) % cells[axis] : c[axis];
+  return at(q);
+}
+
+void main() {
+  const ivec3 c = ivec3(gl_GlobalInvocationID);
+  if (any(greaterThanEqual(c, cells))) return;
+  const int i = at(c);
+  const float u = inU[i], v = inV[i];
+  float lapU = 0.0, lapV = 0.0;
+  for (int axis = 0; axis < DIM; ++axis)
+    for (int s = -1; s <= 1; s += 2) {
+      const int j = neighbour(c, axis, s);
+      lapU += inU[j] - u;
+      lapV += inV[j] - v;
+    }
+  vec2 r;
+  REACTION(u, v, params, r);
+  outU[i] = u + dt * (r.x + dOverH2.x * lapU);
+  outV[i] = v + dt * (r.y + dOverH2.y * lapV);
+}
