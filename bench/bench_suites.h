@@ -10,9 +10,12 @@ struct BenchOptions {
   std::string json;        // write results here when not empty
   double minSeconds = 1.0; // time each case for at least this long (after warm-up)
   std::string trace;       // coupling: write a Chrome trace of the stages here
+  std::string backend = "cpu";  // cpu | gpu
 };
 
-// Runs the named suite; returns false when the suite does not exist.
+// Runs the named suite; returns false when the suite does not exist. With
+// backend "gpu" only the rd suite runs (its explicit kernel); the others
+// throw UserError naming the stage the GPU lacks.
 bool runBenchSuite(const std::string& suite, const BenchOptions& options);
 const char* benchSuiteNames();
 

@@ -12,6 +12,7 @@
 #include "bench/bench_setups.h"
 #include "bench/bench_suites.h"
 #include "bench/bench_timing.h"
+#include "core/error.h"
 #include "core/parallel.h"
 #include "fluid/fluid_solver.h"
 
@@ -76,8 +77,16 @@ bool runFluidBench(const BenchOptions& o) {
 
 bool runRDBench(const BenchOptions& o);        // rd_bench.cpp
 bool runCouplingBench(const BenchOptions& o);  // coupling_bench.cpp
+bool runGpuRDBench(const BenchOptions& o);     // gpu_rd_bench.cpp
 
 bool runBenchSuite(const std::string& suite, const BenchOptions& o) {
+  if (o.backend == "gpu") {
+    if (suite == "rd") return runGpuRDBench(o);
+    if (suite == "fluid" || suite == "coupling")
+      throw UserError({"--backend", 0, 0}, "", "the gpu backend has no program yet for the fluid, so no " + suite + " suite",
+                      "bench rd --backend gpu runs the explicit reaction-diffusion kernel");
+    return false;
+  }
   if (suite == "fluid") return runFluidBench(o);
   if (suite == "rd") return runRDBench(o);
   if (suite == "coupling") return runCouplingBench(o);

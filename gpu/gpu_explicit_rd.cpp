@@ -63,6 +63,8 @@ void GpuExplicitRD::step(double dt) {
   GlContext::check("the explicit reaction-diffusion step");
 }
 
+void GpuExplicitRD::finish() const { glFinish(); }
+
 std::vector<float> GpuExplicitRD::download(int species) const {
   std::vector<float> out(n_);
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);

@@ -28,6 +28,7 @@ class GpuExplicitRD {
   GpuExplicitRD& operator=(const GpuExplicitRD&) = delete;
 
   void step(double dt);                        // queued; returns before the GPU is done
+  void finish() const;                         // waits for every queued step (benchmarks)
   std::vector<float> download(int species) const;  // waits for the queued steps
   void upload(int species, const std::vector<float>& values);
   size_t cells() const { return n_; }
