@@ -23,7 +23,7 @@ std::string missingStage(const Scene& s) {
   if (rd.settings.integrator != RDIntegrator::ExplicitEuler)
     return "the implicit reaction-diffusion integrators (kim-lin, semi-implicit, crank-nicolson); integrator = \"explicit\" runs";
   if (gpuReaction(rd.settings.model).empty())
-    return "the reaction of model " + rd.settings.model + " (the GPU has gray-scott)";
+    return "the reaction of model " + rd.settings.model + " (the GPU has the two-species models)";
   if (rd.settings.boundary == RDBoundary::Dirichlet) return "Dirichlet walls (rd.boundary = \"dirichlet\")";
   if (!rd.parameterMaps.empty() || !rd.perturb.empty()) return "parameter maps ([rd.maps], rd.perturb)";
   if (!rd.fixed.empty() || !rd.settings.frozen.empty()) return "fixed regions and frozen species ([[rd.fixed]], rd.frozen)";

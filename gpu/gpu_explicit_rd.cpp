@@ -1,5 +1,7 @@
 #include "gpu/gpu_explicit_rd.h"
 
+#include <map>
+
 #include <epoxy/gl.h>
 #include <fmt/format.h>
 
@@ -13,9 +15,23 @@ constexpr int kGroup = 8;  // 8 x 8 (x 4 in 3D) invocations a work group
 }
 
 std::string gpuReaction(const std::string& model) {
-  // Pearson 1993, seed 001 eq. 7-8 (rd/models.h GrayScott).
-  if (model == "gray-scott") return "{ float uvv = u * v * v; r = vec2(-uvv + p.x * (1.0 - u), uvv - (p.x + p.y) * v); }";
-  return "";
+  // The two-species models of rd/models.h, term for term (p[k]: the model's k-th parameter).
+  static const std::map<std::string, std::string> reactions = {
+      {"turing", "r = p[0] * vec2(p[1] - u * v, u * v - v - p[2]);"},
+      {"turing-sanderson", "r = p[0] * vec2(u * v - u - p[1], p[2] - u * v);"},
+      {"gray-scott", "{ float uvv = u * v * v; r = vec2(-uvv + p[0] * (1.0 - u), uvv - (p[0] + p[1]) * v); }"},
+      {"gray-scott-sanderson", "{ float aab = u * u * v; r = p[0] * vec2(aab - (p[1] + p[2]) * u, -aab + p[1] * (1.0 - v)); }"},
+      {"fitzhugh-nagumo", "r = vec2(u - u * u * u - v, p[0] * (u - p[2] * v - p[1]));"},
+      {"barkley", "r = vec2(u * (1.0 - u) * (u - (v + p[1]) / p[0]) / p[2], u - v);"},
+      {"barkley-turbulent", "r = vec2(u * (1.0 - u) * (u - (v + p[1]) / p[0]) / p[2], u * u * u - v);"},
+      {"meinhardt", "{ float B = v < 1e-9 ? 1e-9 : v, aa = 0.01 * p[1] * u * u; "
+                    "r = p[0] * vec2(p[2] * u + aa / B + p[4], p[3] * v + aa); }"},
+      {"brusselator", "{ float aab = u * u * v; r = p[0] * vec2(p[1] - (1.0 + p[2]) * u + aab, p[2] * u - aab); }"},
+      {"gierer-meinhardt", "{ float b = v < 1e-9 ? 1e-9 : v; r = p[0] * vec2(p[3] + u * u / b - p[1] * u, u * u - p[2] * v); }"},
+      {"oregonator", "{ float a = u < 0.0 ? 0.0 : u; r = vec2((u - u * u - p[1] * v * (a - p[2]) / (a + p[2])) / p[0], u - v); }"},
+  };
+  const auto it = reactions.find(model);
+  return it == reactions.end() ? "" : it->second;
 }
 
 GpuExplicitRD::GpuExplicitRD(const RDSettings& s, const std::vector<double>& diffusion, const std::vector<double>& params,
@@ -26,11 +42,11 @@ GpuExplicitRD::GpuExplicitRD(const RDSettings& s, const std::vector<double>& dif
   n_ = size_t(cells_[0]) * size_t(cells_[1]) * size_t(cells_[2]);
   h_ = s.size[0] / s.resolution[0];
   for (int k = 0; k < 2; ++k) dOverH2_[size_t(k)] = float(diffusion[size_t(k)] / (h_ * h_));
-  for (size_t k = 0; k < params.size() && k < 4; ++k) params_[k] = float(params[k]);
+  for (size_t k = 0; k < params.size() && k < params_.size(); ++k) params_[k] = float(params[k]);
   periodic_ = s.boundary == RDBoundary::Periodic;
   const std::string reaction = gpuReaction(s.model);
   program_ = std::make_unique<ComputeProgram>(
-      "rd_explicit.comp", fmt::format("#define DIM {}\n#define REACTION(u, v, p, r) {}\nlayout(local_size_x = {}, local_size_y = {}, "
+      "rd_explicit.comp", fmt::format("#define DIM {}\n#define REACTION(u, v, r) {}\nlayout(local_size_x = {}, local_size_y = {}, "
                                       "local_size_z = {}) in;",
                                       D, reaction, kGroup, kGroup, D == 3 ? 4 : 1));
   glCreateBuffers(4, buffers_.data());
@@ -48,7 +64,7 @@ void GpuExplicitRD::step(double dt) {
   glUniform1i(program_->uniform("periodic"), periodic_ ? 1 : 0);
   glUniform1f(program_->uniform("dt"), float(dt));
   glUniform2f(program_->uniform("dOverH2"), dOverH2_[0], dOverH2_[1]);
-  glUniform4f(program_->uniform("params"), params_[0], params_[1], params_[2], params_[3]);
+  glUniform1fv(program_->uniform("p"), GLsizei(params_.size()), params_.data());
   const int in = current_ * 2, out = 2 - current_ * 2;
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, buffers_[size_t(in)]);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, buffers_[size_t(in + 1)]);

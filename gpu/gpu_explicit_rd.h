@@ -14,8 +14,8 @@ namespace morphoflow {
 
 class ComputeProgram;
 
-// The GLSL body of REACTION(u, v, p, r) for a model (p = its parameters in
-// order), or "" when the model has no GPU program yet.
+// The GLSL body of REACTION(u, v, r) for a two-species model (its
+// parameters in the uniform p[8], in order), or "" when it has no GPU program yet.
 std::string gpuReaction(const std::string& model);
 
 class GpuExplicitRD {
@@ -38,7 +38,7 @@ class GpuExplicitRD {
   size_t n_ = 1;
   double h_ = 1.0;
   std::array<float, 2> dOverH2_{};
-  std::array<float, 4> params_{};
+  std::array<float, 8> params_{};
   bool periodic_ = true;
   std::unique_ptr<ComputeProgram> program_;
   std::array<unsigned, 4> buffers_{};  // u, v, u', v'

@@ -97,9 +97,6 @@ TEST(Gpu, AStageWithNoGpuProgramIsRefusedNamingIt) {
        {std::pair{sceneFile("coupled/cavity_gray_scott.toml"), std::string("the fluid")},
         std::pair{sceneFile("lid_driven_cavity.toml"), std::string("the fluid")},
         std::pair{scene.string() + " --set 'rd.integrator=\"kim-lin\"'", std::string("the implicit reaction-diffusion integrators")},
-        std::pair{scene.string() + " --set 'rd.model=\"turing\"' --set 'rd.parameters={}' --set 'rd.diffusion=[0.125,0.03125]'" +
-                      " --set 'output.field=\"a\"' --set 'rd.initial={values=[4.0,4.0]}'",
-                  std::string("the reaction of model turing")},
         std::pair{scene.string() + " --set 'rd.maps.F=\"0.02 + 0.03 * x\"'", std::string("parameter maps")}}) {
     CommandResult r = runMorphoflow("run " + args + " --backend gpu --quiet" + out);
     EXPECT_EQ(r.status, 2) << args << "\n" << r.output;

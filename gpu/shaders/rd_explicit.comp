@@ -11,7 +11,7 @@ uniform ivec3 cells;      // nx, ny, nz (nz = 1 in 2D)
 uniform bool periodic;    // else zero-flux (Neumann) walls
 uniform float dt;
 uniform vec2 dOverH2;     // d_u / h^2, d_v / h^2
-uniform vec4 params;      // the model's parameters
+uniform float p[8];       // the model's parameters, in order
 
 int at(ivec3 c) { return c.x + cells.x * (c.y + cells.y * c.z); }
 
@@ -36,7 +36,7 @@ void main() {
       lapV += inV[j] - v;
     }
   vec2 r;
-  REACTION(u, v, params, r);
+  REACTION(u, v, r);
   outU[i] = u + dt * (r.x + dOverH2.x * lapU);
   outV[i] = v + dt * (r.y + dOverH2.y * lapV);
 }
