@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <csignal>
 #include <fstream>
 
 #include <nlohmann/json.hpp>
@@ -103,5 +104,45 @@ TEST(Gpu, AStageWithNoGpuProgramIsRefusedNamingIt) {
     EXPECT_NE(r.output.find("the gpu backend has no program yet for " + stage), std::string::npos) << args << "\n" << r.output;
     EXPECT_FALSE(fs::exists(dir / "o" / "frames")) << args;  // refused before anything ran
   }
+  fs::remove_all(dir);
+}
+
+// A GPU run killed midway (SIGKILL) and resumed from its checkpoint writes the
+// same fields, bit for bit, as one that was never stopped.
+TEST(Gpu, AKilledRunResumesBitForBit) {
+  if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
+  const fs::path dir = tempDir("gpu_resume");
+  const fs::path scene = dir / "gs.toml";
+  std::string text = explicitScene("[64, 64]", "[0.5, 0.5]", "periodic");
+  text.replace(text.find("steps = 200"), 11, "steps = 6000");
+  text.replace(text.find("every = 100"), 11, "every = 500");
+  std::ofstream(scene) << text + "checkpoint_every = 1\n";
+  const std::vector<std::string> args = {"run", scene.string(), "--backend", "gpu", "--quiet", "--out"};
+  auto with = [&](const fs::path& out, std::vector<std::string> more = {}) {
+    std::vector<std::string> a = args;
+    a.push_back(out.string());
+    a.insert(a.end(), more.begin(), more.end());
+    return a;
+  };
+  ASSERT_EQ(waitMorphoflow(startMorphoflow(with(dir / "whole"), dir / "whole.log")), 0);
+  const pid_t pid = startMorphoflow(with(dir / "cut"), dir / "cut.log");
+  ASSERT_TRUE(waitUntil([&] {
+    std::error_code ec;
+    return fs::exists(dir / "cut" / "checkpoints", ec) && !fs::is_empty(dir / "cut" / "checkpoints", ec);
+  }, 60));
+  kill(pid, SIGKILL);
+  waitMorphoflow(pid);
+  ASSERT_EQ(waitMorphoflow(startMorphoflow(with(dir / "cut", {"--resume"}), dir / "resume.log")), 0);
+  int compared = 0;
+  for (const auto& e : fs::directory_iterator(dir / "whole" / "fields")) {
+    std::ifstream a(e.path(), std::ios::binary), b(dir / "cut" / "fields" / e.path().filename(), std::ios::binary);
+    const std::string x(std::istreambuf_iterator<char>(a), {}), y(std::istreambuf_iterator<char>(b), {});
+    EXPECT_EQ(x, y) << e.path().filename();
+    ++compared;
+  }
+  EXPECT_EQ(compared, 13);
+  std::ifstream in(dir / "cut" / "run.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  EXPECT_TRUE(j.contains("resumed_from")) << j.dump();
   fs::remove_all(dir);
 }
