@@ -54,6 +54,15 @@ void checkGpuRuns(const Scene& scene) {
                     "run this scene with --backend tbb; docs/gpu.md lists what the gpu backend runs");
   const GpuInfo g = gpuInfo();
   if (!g.available) throw UserError({"--backend", 0, 0}, "", "no usable GPU context: " + g.reason, "use --backend tbb");
+  // Two buffers per species, float: checked before anything is allocated.
+  size_t cells = 1;
+  for (int n : scene.rd.settings.resolution) cells *= size_t(n);
+  const size_t need = 4 * cells * sizeof(float), have = GlContext::instance().availableBytes();
+  if (have > 0 && need > have)
+    throw UserError({scene.path, 0, 0}, "rd.resolution",
+                    fmt::format("the GPU has {:.0f} MiB free and this scene needs {:.0f} MiB", double(have) / (1 << 20),
+                                double(need) / (1 << 20)),
+                    "use a smaller grid, or --backend tbb");
 }
 
 template <int D>

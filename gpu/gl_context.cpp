@@ -1,5 +1,6 @@
 #include "gpu/gl_context.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <vector>
 
@@ -119,6 +120,14 @@ GlContext::~GlContext() {
     eglDestroyContext(egl_->display, egl_->context);
     eglTerminate(egl_->display);
   }
+}
+
+size_t GlContext::availableBytes() const {
+  if (!epoxy_has_gl_extension("GL_NVX_gpu_memory_info")) return 0;
+  GLint kib = 0;
+  glGetIntegerv(0x9049, &kib);  // GPU_MEMORY_INFO_CURRENT_AVAILABLE_VIDMEM_NVX, in KiB
+  glGetError();
+  return size_t(std::max(kib, 0)) * 1024;
 }
 
 void GlContext::check(const char* what) {

@@ -5,6 +5,7 @@
 // the thread that created it.
 #pragma once
 
+#include <cstddef>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -34,6 +35,9 @@ class GlContext {
   const std::string& renderer() const { return renderer_; }
   const std::string& version() const { return version_; }
   const std::string& platform() const { return platform_; }  // "EGL device" or "Mesa surfaceless"
+  // Free device memory in bytes where the driver says (NVIDIA's
+  // GL_NVX_gpu_memory_info), else 0 (unknown: llvmpipe uses the CPU's memory).
+  size_t availableBytes() const;
   // The glGetError state after `what`, as a GpuError.
   static void check(const char* what);
 
