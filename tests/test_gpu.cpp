@@ -126,9 +126,11 @@ TEST(Gpu, AKilledRunResumesBitForBit) {
   };
   ASSERT_EQ(waitMorphoflow(startMorphoflow(with(dir / "whole"), dir / "whole.log")), 0);
   const pid_t pid = startMorphoflow(with(dir / "cut"), dir / "cut.log");
-  ASSERT_TRUE(waitUntil([&] {
+  ASSERT_TRUE(waitUntil([&] {  // a complete checkpoint (renamed from its temporary name)
     std::error_code ec;
-    return fs::exists(dir / "cut" / "checkpoints", ec) && !fs::is_empty(dir / "cut" / "checkpoints", ec);
+    for (const auto& e : fs::directory_iterator(dir / "cut" / "checkpoints", ec))
+      if (e.path().extension() == ".ckpt") return true;
+    return false;
   }, 60));
   kill(pid, SIGKILL);
   waitMorphoflow(pid);
