@@ -131,7 +131,8 @@ class BatchRunner {
     const fs::path folder = dir_ / r.run.folder;
     createOutputFolder(folder);
     const fs::path console = folder / "console.txt";
-    if (!prepared_[i].resume) fs::remove(console);
+    std::error_code ec;
+    if (!prepared_[i].resume) fs::remove(console, ec);  // a new run starts a new console log
     std::vector<std::string> args{"run", r.run.scene, "--out", folder.string(), "--threads", std::to_string(threads),
                                   "--quiet"};
     for (const std::string& s : r.run.overrides) args.insert(args.end(), {"--set", s});

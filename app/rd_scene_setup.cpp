@@ -1,7 +1,5 @@
 #include "app/rd_scene_setup.h"
 
-#include "core/simulation.h"
-
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -11,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/parallel.h"
+#include "core/simulation.h"
 #include "core/spatial_field.h"
 #include "core/random.h"
 #include "rd/coarse_to_fine.h"
