@@ -116,7 +116,7 @@ class BatchRunner {
     const nlohmann::json prev = readJsonFile(folder / "run.json");
     if (prev.is_object() && prev.value("exit_state", "") == "completed" &&
         prev.value("settings_hash", "") == prepared_[i].hash) {
-      readRunResult(dir_, fs::file_time_type::min(), &r);
+      readRunFolder(dir_, fs::file_time_type::min(), &r);
       r.status = "skipped";
       r.exitCode = 0;
       r.wallSeconds = prev.value("wall_seconds", 0.0);
@@ -148,7 +148,8 @@ class BatchRunner {
     r.exitCode = e.code;
     r.signal = e.signal;
     r.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - run.started).count();
-    readRunResult(dir_, run.startedFile, &r);
+    readRunFolder(dir_, run.startedFile, &r);
+    recordExit(dir_, &r);
     ++finished_;
     say(fmt::format("[{}/{}] {}: {} ({:.1f} s){}", finished_, records_.size(), r.run.folder, r.status, r.wallSeconds,
                     r.error.empty() || succeeded(r) ? "" : ": " + r.error));
@@ -208,13 +209,15 @@ class BatchRunner {
 
 }  // namespace
 
-int gatherBatch(const std::string& dirText) {
-  const fs::path dir(dirText);
+namespace {
+
+// DIR/batch.shard-I-of-N.json by I, all of one batch and all N present.
+std::map<int, nlohmann::json> readShardSummaries(const std::string& dirText) {
   static const std::regex shardFile(R"(batch\.shard-(\d+)-of-(\d+)\.json)");
   std::map<int, nlohmann::json> shards;
   int count = 0;
   std::error_code ec;
-  for (const auto& e : fs::directory_iterator(dir, ec)) {
+  for (const auto& e : fs::directory_iterator(fs::path(dirText), ec)) {
     std::smatch m;
     const std::string name = e.path().filename().string();
     if (!std::regex_match(name, m, shardFile)) continue;
@@ -222,6 +225,7 @@ int gatherBatch(const std::string& dirText) {
     if (!j.is_object() || !j.contains("runs"))
       throw UserError({e.path().string(), 0, 0}, "", "not a batch summary", "remove it, or run that shard again");
     const int i = std::stoi(m[1]), n = std::stoi(m[2]);
+    if (i >= n) throw UserError({e.path().string(), 0, 0}, "", "not a shard's summary (I must be below N)", "remove it");
     if (count && (n != count || j.value("batch_id", "") != shards.begin()->second.value("batch_id", "")))
       throw UserError({e.path().string(), 0, 0}, "", "the shard summaries are from different batches",
                       "gather each batch's folder on its own");
@@ -229,32 +233,47 @@ int gatherBatch(const std::string& dirText) {
     shards[i] = j;
   }
   if (ec || shards.empty())
-    throw UserError({dirText, 0, 0}, "", "no shard summaries (batch.shard-I-of-N.json) here", "run the shards with --shard I/N --out " + dirText);
+    throw UserError({dirText, 0, 0}, "", "no shard summaries (batch.shard-I-of-N.json) here",
+                    "run the shards with --shard I/N --out " + dirText);
   std::vector<std::string> missing;
   for (int i = 0; i < count; ++i)
     if (!shards.count(i)) missing.push_back(std::to_string(i));
   if (!missing.empty())
     throw UserError({dirText, 0, 0}, "", fmt::format("shards {} of {} have written no summary", fmt::join(missing, ", "), count),
                     "wait for them or run them again");
-  // Shard I holds runs I, I + N, I + 2N, ...: interleave them back into plan order.
-  const nlohmann::json& first = shards.begin()->second;
+  return shards;
+}
+
+// Shard I holds runs I, I + N, I + 2N, ...: interleaved back into plan order.
+std::vector<RunRecord> interleaveShards(const std::map<int, nlohmann::json>& shards, const std::string& dirText) {
+  const size_t count = shards.size();
   std::vector<std::vector<RunRecord>> parts;
   size_t total = 0;
-  for (auto& [i, j] : shards) total += (parts.emplace_back(recordsFromJson(j))).size();
+  for (const auto& [i, j] : shards) total += parts.emplace_back(recordsFromJson(j)).size();
   std::vector<RunRecord> records;
   for (size_t k = 0; k < total; ++k) {
-    const auto& part = parts[k % size_t(count)];
-    if (k / size_t(count) >= part.size())
+    const auto& part = parts[k % count];
+    if (k / count >= part.size())
       throw UserError({dirText, 0, 0}, "", "the shard summaries do not add up to one batch", "run the shards again");
-    records.push_back(part[k / size_t(count)]);
+    records.push_back(part[k / count]);
   }
+  return records;
+}
+
+}  // namespace
+
+int gatherBatch(const std::string& dirText) {
+  const fs::path dir(dirText);
+  const std::map<int, nlohmann::json> shards = readShardSummaries(dirText);
+  const std::vector<RunRecord> records = interleaveShards(shards, dirText);
+  const nlohmann::json& first = shards.begin()->second;
   BatchPlan plan;
   plan.kind = first.value("kind", "batch");
   plan.keys = first.value("keys", std::vector<std::string>{});
   plan.id = first.value("batch_id", "");
   for (const RunRecord& r : records) plan.runs.push_back(r.run);
   nlohmann::json merged = summaryJson(plan, records, "");
-  merged["shards"] = count;
+  merged["shards"] = shards.size();
   writeFileAtomically(dir / "batch.json", merged.dump(2) + "\n");
   printSummary(std::cout, records, dir);
   if (plan.kind == "sweep") writeSweepOutputs(dir, plan.keys, records);

@@ -69,7 +69,7 @@ int batchExitStatus(const std::vector<RunRecord>& records) {
   return worst;
 }
 
-void readRunResult(const fs::path& batchDir, fs::file_time_type startedAt, RunRecord* r) {
+void readRunFolder(const fs::path& batchDir, fs::file_time_type startedAt, RunRecord* r) {
   const fs::path runJson = batchDir / r->run.folder / "run.json";
   std::error_code ec;
   const bool fresh = fs::last_write_time(runJson, ec) >= startedAt && !ec;
@@ -83,6 +83,10 @@ void readRunResult(const fs::path& batchDir, fs::file_time_type startedAt, RunRe
         if (bytes.is_number_unsigned()) r->bytesWritten += bytes.get<uintmax_t>();
     r->error = j.value("error", "");
   }
+  r->lastFrame = lastFrame(batchDir, r->run.folder);
+}
+
+void recordExit(const fs::path& batchDir, RunRecord* r) {
   // A child stopped by SIGINT or SIGTERM before its run loop started dies of it: it too is interrupted.
   if (r->signal == SIGINT || r->signal == SIGTERM) r->status = "interrupted";
   else if (r->signal != 0) r->status = r->signal == SIGKILL ? "killed" : "crashed";
@@ -94,7 +98,6 @@ void readRunResult(const fs::path& batchDir, fs::file_time_type startedAt, RunRe
     r->error = "killed by " + signalName(r->signal) + (r->signal == SIGKILL ? " (the out-of-memory killer, or kill -9)" : "");
   else if (r->exitCode != 0 && r->error.empty())
     r->error = lastLine(batchDir / r->run.folder / "console.txt");
-  r->lastFrame = lastFrame(batchDir, r->run.folder);
 }
 
 nlohmann::json summaryJson(const BatchPlan& plan, const std::vector<RunRecord>& records, const std::string& shard) {

@@ -35,9 +35,11 @@ bool succeeded(const RunRecord& r);
 // 0, 2 (any user error), 1 (anything else not completed).
 int batchExitStatus(const std::vector<RunRecord>& records);
 
-// Fills a finished run's record from its exit and its folder's run.json
-// (only when written after `startedAt`, so a crash never reports an older run).
-void readRunResult(const std::filesystem::path& batchDir, std::filesystem::file_time_type startedAt, RunRecord* r);
+// Fills a run's steps, frames, bytes, error and last frame from its folder
+// (run.json only when written after `startedAt`, so a crash never reports an older run).
+void readRunFolder(const std::filesystem::path& batchDir, std::filesystem::file_time_type startedAt, RunRecord* r);
+// A finished child's status (and error, when run.json gave none) from its exit code and signal.
+void recordExit(const std::filesystem::path& batchDir, RunRecord* r);
 
 nlohmann::json summaryJson(const BatchPlan& plan, const std::vector<RunRecord>& records, const std::string& shard);
 std::vector<RunRecord> recordsFromJson(const nlohmann::json& summary);
