@@ -7,9 +7,8 @@
 
 namespace morphoflow {
 
-namespace {
 template <int D>
-LaplaceSystem<D> buildPressureSystem(const VelocityConstraints<D>& vc) {
+LaplaceSystem<D> pressureSystem(const VelocityConstraints<D>& vc) {
   const IVec<D>& n = vc.cells;
   LaplaceSystem<D> A(n, vc.periodic(), 1.0 / (vc.h * vc.h));
   forEachCell<D>(n, [&](const IVec<D>& k, size_t i) {
@@ -26,12 +25,13 @@ LaplaceSystem<D> buildPressureSystem(const VelocityConstraints<D>& vc) {
   A.finalize();
   return A;
 }
-}  // namespace
+template LaplaceSystem<2> pressureSystem<2>(const VelocityConstraints<2>&);
+template LaplaceSystem<3> pressureSystem<3>(const VelocityConstraints<3>&);
 
 template <int D>
 PressureProjection<D>::PressureProjection(const VelocityConstraints<D>& vc, PressureSolver solver,
                                           const SolverOptions& options)
-    : vc_(vc), solver_(solver), options_(options), A_(buildPressureSystem(vc)) {
+    : vc_(vc), solver_(solver), options_(options), A_(pressureSystem(vc)) {
   if (solver_ == PressureSolver::ICPCG)
     mic_ = std::make_unique<MIC0Preconditioner<D>>(A_);
   else

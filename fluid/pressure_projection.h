@@ -17,6 +17,11 @@
 
 namespace morphoflow {
 
+// -lap on the fluid cells (scale 1 / h^2): Neumann at walls, inflow and
+// solids, p = 0 at outflow through a mirrored ghost.
+template <int D>
+LaplaceSystem<D> pressureSystem(const VelocityConstraints<D>& constraints);
+
 template <int D>
 class PressureProjection {
  public:

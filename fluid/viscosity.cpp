@@ -8,56 +8,72 @@
 namespace morphoflow {
 
 template <int D>
-ViscositySolver<D>::ViscositySolver(const VelocityConstraints<D>& vc, const SolverOptions& options)
-    : vc_(vc), options_(options) {
-  const IVec<D>& n = vc_.cells;
-  const std::array<bool, D> periodic = vc_.periodic();
-  for (int a = 0; a < D; ++a) {
-    Component& C = comp_[size_t(a)];
-    const Grid<uint8_t, D>& fixed = vc_.fixed[a];
-    const Grid<float, D>& value = vc_.value[a];
-    // Unknowns: the face grid, less the duplicate face n_a on a periodic axis.
-    C.dims = n + unitVector<D>(a);
-    if (periodic[size_t(a)]) C.dims[a] = n[a];
-    C.A = LaplaceSystem<D>(C.dims, periodic, 1.0);
-    C.cBoundary = Grid<float, D>(C.dims, 0.0f);
-    C.boundaryRhs.assign(C.A.size(), 0.0);
-    C.b.assign(C.A.size(), 0.0);
-    C.x.assign(C.A.size(), 0.0);
-    forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) {
-      size_t gi = fixed.index(k);
-      if (fixed[gi]) return;
-      double c = 0.0, extra = 0.0;
-      for (int bx = 0; bx < D; ++bx) {
-        for (int dir = -1; dir <= 1; dir += 2) {
-          IVec<D> nb = k;
-          nb[bx] += dir;
-          if (nb[bx] < 0 || nb[bx] >= C.dims[bx]) {
-            if (periodic[size_t(bx)]) {
-              nb[bx] = (nb[bx] + C.dims[bx]) % C.dims[bx];
-            } else {
-              if (bx == a) continue;  // an outflow face: zero gradient
-              const DomainSide& side = vc_.boundaries.side(bx, dir > 0);
-              if (side.kind == BoundaryKind::Outflow) continue;
-              // Ghost mirrored about the wall: u_g = 2 u_wall - u.
-              double uw = side.kind == BoundaryKind::Wall ? side.wallVelocity[size_t(a)] : 0.0;
-              c += 2.0;
-              extra += 2.0 * uw;
-              continue;
-            }
-          }
-          size_t ni = fixed.index(nb);
-          if (fixed[ni]) {
-            c += 1.0;
-            extra += double(value[ni]);
-          } else if (dir > 0) {
-            C.A.w[bx][i] = 1.0f;
+ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
+  ViscousSystem<D> C;
+  const IVec<D>& n = vc.cells;
+  const std::array<bool, D> periodic = vc.periodic();
+  const Grid<uint8_t, D>& fixed = vc.fixed[a];
+  const Grid<float, D>& value = vc.value[a];
+  // Unknowns: the face grid, less the duplicate face n_a on a periodic axis.
+  C.dims = n + unitVector<D>(a);
+  if (periodic[size_t(a)]) C.dims[a] = n[a];
+  C.A = LaplaceSystem<D>(C.dims, periodic, 1.0);
+  C.cBoundary = Grid<float, D>(C.dims, 0.0f);
+  C.boundaryRhs.assign(C.A.size(), 0.0);
+  C.unknownFixed = Grid<uint8_t, D>(C.dims, 0);
+  forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) {
+    size_t gi = fixed.index(k);
+    C.unknownFixed[i] = fixed[gi];
+    if (fixed[gi]) return;
+    double c = 0.0, extra = 0.0;
+    for (int bx = 0; bx < D; ++bx) {
+      for (int dir = -1; dir <= 1; dir += 2) {
+        IVec<D> nb = k;
+        nb[bx] += dir;
+        if (nb[bx] < 0 || nb[bx] >= C.dims[bx]) {
+          if (periodic[size_t(bx)]) {
+            nb[bx] = (nb[bx] + C.dims[bx]) % C.dims[bx];
+          } else {
+            if (bx == a) continue;  // an outflow face: zero gradient
+            const DomainSide& side = vc.boundaries.side(bx, dir > 0);
+            if (side.kind == BoundaryKind::Outflow) continue;
+            // Ghost mirrored about the wall: u_g = 2 u_wall - u.
+            double uw = side.kind == BoundaryKind::Wall ? side.wallVelocity[size_t(a)] : 0.0;
+            c += 2.0;
+            extra += 2.0 * uw;
+            continue;
           }
         }
+        size_t ni = fixed.index(nb);
+        if (fixed[ni]) {
+          c += 1.0;
+          extra += double(value[ni]);
+        } else if (dir > 0) {
+          C.A.w[bx][i] = 1.0f;
+        }
       }
-      C.cBoundary[i] = float(c);
-      C.boundaryRhs[i] = extra;
-    });
+    }
+    C.cBoundary[i] = float(c);
+    C.boundaryRhs[i] = extra;
+  });
+  return C;
+}
+
+template <int D>
+void ViscousSystem<D>::setRate(double s) {
+  A.scale = s;
+  parallelFor(A.size(), [&](size_t i) { A.c[i] = unknownFixed[i] ? 0.0f : float(1.0 / s + cBoundary[i]); }, 4096);
+  A.finalize();
+}
+
+template <int D>
+ViscositySolver<D>::ViscositySolver(const VelocityConstraints<D>& vc, const SolverOptions& options)
+    : vc_(vc), options_(options) {
+  for (int a = 0; a < D; ++a) {
+    Component& C = comp_[size_t(a)];
+    static_cast<ViscousSystem<D>&>(C) = viscousSystem<D>(vc_, a);
+    C.b.assign(C.A.size(), 0.0);
+    C.x.assign(C.A.size(), 0.0);
   }
 }
 
@@ -95,9 +111,7 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
     const Grid<float, D>& g = (*u)[a];
     const Grid<uint8_t, D>& fixed = vc_.fixed[a];
     if (s != s_) {  // A = s (c + sum w (x_i - x_j)), c = 1/s + boundary terms
-      C.A.scale = s;
-      eachUnknown(a, [&](size_t i, size_t gi) { C.A.c[i] = fixed[gi] ? 0.0f : float(1.0 / s + C.cBoundary[i]); });
-      C.A.finalize();
+      C.setRate(s);
       if (C.chebyshev)
         C.chebyshev->refresh();
       else
@@ -197,6 +211,10 @@ void ViscositySolver<D>::load(const StateReader& in) {
   }
 }
 
+template struct ViscousSystem<2>;
+template struct ViscousSystem<3>;
+template ViscousSystem<2> viscousSystem<2>(const VelocityConstraints<2>&, int);
+template ViscousSystem<3> viscousSystem<3>(const VelocityConstraints<3>&, int);
 template class ViscositySolver<2>;
 template class ViscositySolver<3>;
 

@@ -27,6 +27,23 @@
 
 namespace morphoflow {
 
+// Velocity component a's implicit system, A = s (c + sum w (x_i - x_j)): its
+// unknowns (the face grid, less the duplicate layer of a periodic axis),
+// couplings, and per unknown the diagonal terms and right-hand side that
+// walls and prescribed neighbours add; c and s follow the step (setRate).
+template <int D>
+struct ViscousSystem {
+  IVec<D> dims;
+  LaplaceSystem<D> A;
+  Grid<float, D> cBoundary;     // diagonal terms from walls and prescribed neighbours
+  Vector boundaryRhs;           // their prescribed values, times the coupling
+  Grid<uint8_t, D> unknownFixed;  // 1 where the face is prescribed (inactive)
+  // A for s = nu dt / h^2: c = 1/s + boundary terms, 0 on prescribed faces.
+  void setRate(double s);
+};
+template <int D>
+ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& constraints, int axis);
+
 template <int D>
 class ViscositySolver {
  public:
@@ -38,11 +55,7 @@ class ViscositySolver {
   void load(const StateReader& in);
 
  private:
-  struct Component {
-    IVec<D> dims;               // the face grid less a periodic duplicate layer
-    LaplaceSystem<D> A;
-    Grid<float, D> cBoundary;   // diagonal terms from walls and prescribed neighbours
-    Vector boundaryRhs;         // their prescribed values, times the coupling
+  struct Component : ViscousSystem<D> {
     Vector b, x;
     // The last two solves' (x - u*) / s, newest first: the next warm start
     // (a guess only, so single precision: half the memory traffic).

@@ -1,0 +1,348 @@
+#include "gpu/gpu_fluid.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/multigrid.h"
+#include "fluid/pressure_projection.h"
+#include "gpu/compute_program.h"
+#include "gpu/gpu_kernels.h"
+#include "gpu/gpu_laplace.h"
+#include "gpu/gpu_multigrid.h"
+#include "gpu/gpu_pcg.h"
+
+namespace morphoflow {
+
+// Component a's implicit viscous system: the host copy (its diagonal
+// follows nu dt / h^2), the GPU copy, its solver and vectors.
+template <int D>
+struct GpuFluid<D>::Viscous {
+  ViscousSystem<D> host;
+  std::unique_ptr<GpuLaplace> A;
+  std::unique_ptr<GpuPcg> pcg;
+  GpuBuffer b, x, boundaryRhs;
+};
+
+namespace {
+std::string dimDefine(int D, const char* mode) { return fmt::format("#define DIM {}\n#define {}", D, mode); }
+}  // namespace
+
+template <int D>
+size_t GpuFluid<D>::faces(int a) const {
+  size_t n = 1;
+  for (int b = 0; b < D; ++b) n *= size_t(cells_[size_t(b)] + (a == b ? 1 : 0));
+  return n;
+}
+
+template <int D>
+GpuFluid<D>::GpuFluid(const FluidSettings& s, const VelocityConstraints<D>& vc) : settings_(s), vc_(vc), h_(vc.h) {
+  cellCount_ = 1;
+  for (int a = 0; a < D; ++a) {
+    cells_[size_t(a)] = vc.cells[a];
+    periodic_[size_t(a)] = vc.boundaries.periodic(a) ? 1 : 0;
+    cellCount_ *= size_t(vc.cells[a]);
+  }
+  std::vector<uint32_t> fixed;
+  std::vector<float> value;
+  for (int a = 0; a < D; ++a) {
+    off_[size_t(a)] = faceCount_;
+    faceCount_ += faces(a);
+    maxGrid_ = std::max(maxGrid_, faces(a));
+    fixed.insert(fixed.end(), vc.fixed[a].values().begin(), vc.fixed[a].values().end());
+    value.insert(value.end(), vc.value[a].values().begin(), vc.value[a].values().end());
+  }
+  vel_ = GpuBuffer(faceCount_ * sizeof(float));
+  velScratch_ = GpuBuffer(faceCount_ * sizeof(float));
+  vel_.zero();
+  velScratch_.zero();
+  fixed_ = GpuBuffer::of(fixed);
+  value_ = GpuBuffer::of(value);
+  dye_ = GpuBuffer(cellCount_ * sizeof(float));
+  dyeScratch_ = GpuBuffer(cellCount_ * sizeof(float));
+  dye_.zero();
+  solid_ = GpuBuffer::of(std::vector<uint32_t>(vc.solid.values().begin(), vc.solid.values().end()));
+  for (GpuBuffer* b : {&lo_, &hi_, &back_, &fwd_}) *b = GpuBuffer(maxGrid_ * sizeof(float));
+  // The pressure: the CPU's system and multigrid levels, uploaded once.
+  const LaplaceSystem<D> P = pressureSystem<D>(vc);
+  pressure_ = std::make_unique<GpuLaplace>(P);
+  multigrid_ = std::make_unique<GpuMultigrid>(Multigrid<D>(P), *pressure_, MultigridOptions{});
+  pressurePcg_ = std::make_unique<GpuPcg>(*pressure_);
+  for (GpuBuffer* b : {&phi_, &rhs_, &ratePrev_}) *b = GpuBuffer(cellCount_ * sizeof(double));
+  phi_.zero();
+  for (int a = 0; a < D; ++a) {
+    auto v = std::make_unique<Viscous>();
+    v->host = viscousSystem<D>(vc, a);
+    v->host.setRate(1.0);
+    v->A = std::make_unique<GpuLaplace>(v->host.A);
+    v->pcg = std::make_unique<GpuPcg>(*v->A);
+    v->b = GpuBuffer(v->host.A.size() * sizeof(double));
+    v->x = GpuBuffer(v->host.A.size() * sizeof(double));
+    v->boundaryRhs = GpuBuffer::of(v->host.boundaryRhs);
+    viscous_[size_t(a)] = std::move(v);
+  }
+  dyeActive_ = s.inflowDyeStripes > 0;
+}
+
+template <int D>
+GpuFluid<D>::~GpuFluid() = default;
+
+template <int D>
+void GpuFluid<D>::applyConstraints(const GpuBuffer& vel) {
+  for (const char* mode : {"MODE_FIXED", "MODE_PERIODIC"})
+    for (int a = 0; a < D; ++a) {
+      if (std::string(mode) == "MODE_PERIODIC" && !periodic_[size_t(a)]) continue;
+      const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, mode));
+      setUniform(p, "cells", cells_);
+      setUniform(p, "axis", a);
+      setUniform(p, "n", int(faces(a)));
+      setUniform(p, "velOff", std::array<int, 3>{int(off_[0]), int(off_[1]), int(off_[2])});
+      vel.bind(0);
+      fixed_.bind(1);
+      value_.bind(2);
+      dispatchFlat(faces(a));
+      storageBarrier();
+    }
+}
+
+template <int D>
+void GpuFluid<D>::forces(double dt) {
+  for (int a = 0; a < D; ++a) {
+    const float f = float(dt * settings_.force[size_t(a)]);
+    const float b = dyeActive_ ? float(dt * settings_.buoyancy * settings_.buoyancyDirection[size_t(a)]) : 0.0f;
+    if (f == 0.0f && b == 0.0f) continue;
+    const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, "MODE_FORCES"));
+    setUniform(p, "cells", cells_);
+    setUniform(p, "axis", a);
+    setUniform(p, "n", int(faces(a)));
+    setUniform(p, "velOff", std::array<int, 3>{int(off_[0]), int(off_[1]), int(off_[2])});
+    setUniform(p, "fa", f);
+    setUniform(p, "fb", b);
+    vel_.bind(0);
+    dye_.bind(3);
+    dispatchFlat(faces(a));
+    storageBarrier();
+  }
+}
+
+// One grid through the scheme: src (at srcOff) -> dst (at dstOff), as advectField in fluid/advection.cpp.
+template <int D>
+void GpuFluid<D>::advectField(const GpuBuffer& src, size_t srcOff, const std::array<int, 3>& dims,
+                              const std::array<float, 3>& offset, double dt, GpuBuffer* dst, size_t dstOff) {
+  const size_t n = size_t(dims[0]) * size_t(dims[1]) * size_t(dims[2]);
+  auto pass = [&](const GpuBuffer& in, size_t inOff, double step, GpuBuffer* out, size_t outOff, bool limits) {
+    const ComputeProgram& p = useKernel("advect.comp", fmt::format("#define DIM {}{}", D, limits ? "\n#define LIMITS" : ""));
+    setUniform(p, "cells", cells_);
+    setUniform(p, "periodic", periodic_);
+    setUniform(p, "velOff", std::array<int, 3>{int(off_[0]), int(off_[1]), int(off_[2])});
+    setUniform(p, "c", float(step / h_));
+    setUniform(p, "sdims", dims);
+    setUniform(p, "soff", offset);
+    setUniform(p, "srcOff", int(inOff));
+    setUniform(p, "dstOff", int(outOff));
+    vel_.bind(0);
+    in.bind(1);
+    out->bind(2);
+    lo_.bind(3);
+    hi_.bind(4);
+    dispatchFlat(n);
+    storageBarrier();
+  };
+  auto combine = [&](const char* mode, const GpuBuffer& f0, size_t f0Off, const GpuBuffer& f1, size_t f1Off,
+                     const GpuBuffer& f2, const GpuBuffer& f3, const GpuBuffer& f4) {
+    const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, mode));
+    setUniform(p, "n", int(n));
+    setUniform(p, "dstOff", int(f0Off));
+    setUniform(p, "f1Off", int(f1Off));
+    f0.bind(3);
+    f1.bind(4);
+    f2.bind(5);
+    f3.bind(6);
+    f4.bind(11);
+    dispatchFlat(n);
+    storageBarrier();
+  };
+  switch (settings_.advection) {
+    case AdvectionScheme::SemiLagrangian:
+      pass(src, srcOff, dt, dst, dstOff, false);
+      break;
+    case AdvectionScheme::MacCormack:
+      // phi^ = A(phi); phi~ = A^-1(phi^); phi = phi^ + (phi - phi~) / 2, limited
+      pass(src, srcOff, dt, dst, dstOff, true);
+      pass(*dst, dstOff, -dt, &back_, 0, false);
+      combine("MODE_MACCORMACK", *dst, dstOff, src, srcOff, back_, lo_, hi_);
+      break;
+    case AdvectionScheme::Bfecc:
+      // phi_bar = phi + (phi - A^-1 A phi) / 2, then A(phi_bar), limited
+      pass(src, srcOff, dt, &fwd_, 0, false);
+      pass(fwd_, 0, -dt, &back_, 0, false);
+      combine("MODE_BFECC_CORRECT", fwd_, 0, src, srcOff, back_, back_, back_);
+      pass(fwd_, 0, dt, dst, dstOff, false);
+      pass(src, srcOff, dt, &back_, 0, true);  // the first-order fallback
+      combine("MODE_BFECC_LIMIT", *dst, dstOff, back_, 0, lo_, hi_, hi_);
+      break;
+  }
+}
+
+template <int D>
+void GpuFluid<D>::advect(double dt) {
+  for (int a = 0; a < D; ++a) {
+    std::array<int, 3> dims = cells_;
+    dims[size_t(a)] += 1;
+    std::array<float, 3> offset{0.5f, 0.5f, 0.5f};
+    offset[size_t(a)] = 0.0f;
+    if (D == 2) offset[2] = 0.0f;
+    advectField(vel_, off_[size_t(a)], dims, offset, dt, &velScratch_, off_[size_t(a)]);
+  }
+  // The dye through the same field (a dye that is all zero advects to zero).
+  if (dyeActive_) {
+    advectField(dye_, 0, cells_, {0.5f, 0.5f, D == 3 ? 0.5f : 0.0f}, dt, &dyeScratch_, 0);
+    std::swap(dye_, dyeScratch_);
+  }
+  std::swap(vel_, velScratch_);
+  applyConstraints(vel_);
+  for (int a = 0; a < D; ++a)
+    for (bool high : {false, true}) {
+      if (settings_.inflowDyeStripes <= 0 || settings_.boundaries.side(a, high).kind != BoundaryKind::Inflow) continue;
+      const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, "MODE_INFLOW_DYE"));
+      setUniform(p, "cells", cells_);
+      setUniform(p, "n", int(cellCount_));
+      setUniform(p, "inflow", std::array<int, 4>{a, high ? 1 : 0, a == 0 ? 1 : 0, settings_.inflowDyeStripes});
+      dye_.bind(3);
+      solid_.bind(10);
+      dispatchFlat(cellCount_);
+      storageBarrier();
+    }
+}
+
+template <int D>
+void GpuFluid<D>::diffuse(double dt) {
+  stats_.viscosity = SolverResult{};
+  stats_.viscosity.converged = true;
+  const double nu = settings_.viscosity;
+  if (nu <= 0 || dt <= 0) return;
+  const double s = nu * dt / (h_ * h_);
+  double bAll = 0.0, rAll = 0.0;
+  for (int a = 0; a < D; ++a) {
+    Viscous& V = *viscous_[size_t(a)];
+    if (s != s_) {
+      V.host.setRate(s);
+      V.A->update(V.host.A);
+    }
+    std::array<int, 3> udims{1, 1, 1};
+    for (int b = 0; b < D; ++b) udims[size_t(b)] = V.host.dims[b];
+    auto run = [&](const char* mode) {
+      const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, mode));
+      setUniform(p, "cells", cells_);
+      setUniform(p, "axis", a);
+      setUniform(p, "n", int(V.host.A.size()));
+      setUniform(p, "udims", udims);
+      setUniform(p, "velOff", std::array<int, 3>{int(off_[0]), int(off_[1]), int(off_[2])});
+      setUniform(p, "s", s);
+      vel_.bind(0);
+      fixed_.bind(1);
+      V.b.bind(7);
+      V.x.bind(8);
+      V.boundaryRhs.bind(9);
+      dispatchFlat(V.host.A.size());
+      storageBarrier();
+    };
+    run("MODE_VISCOUS_SETUP");
+    const SolverResult r = V.pcg->solve(&V.b, &V.x, nullptr, {settings_.viscosityTolerance, 500});
+    run("MODE_VISCOUS_STORE");
+    // The tolerance is that of each block; the whole system's relative residual is reported.
+    const double bb = V.pcg->reduction().read()[0];
+    bAll += bb;
+    rAll += r.residual * r.residual * bb;
+    stats_.viscosity.iterations = std::max(stats_.viscosity.iterations, r.iterations);
+    stats_.viscosity.converged = stats_.viscosity.converged && r.converged;
+  }
+  stats_.viscosity.residual = bAll > 0 ? std::sqrt(rAll / bAll) : 0.0;
+  s_ = s;
+  applyConstraints(vel_);
+}
+
+template <int D>
+void GpuFluid<D>::project(double dt) {
+  auto run = [&](const char* mode, int axis, size_t n) {
+    const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, mode));
+    setUniform(p, "cells", cells_);
+    setUniform(p, "periodic", periodic_);
+    setUniform(p, "axis", axis);
+    setUniform(p, "n", int(n));
+    setUniform(p, "velOff", std::array<int, 3>{int(off_[0]), int(off_[1]), int(off_[2])});
+    setUniform(p, "invH", 1.0 / h_);
+    setUniform(p, "dt", dt);
+    setUniform(p, "lastDt", lastDt_);
+    setUniform(p, "extrapolate", solves_ >= 2 ? 1 : 0);
+    vel_.bind(0);
+    fixed_.bind(1);
+    (std::string(mode) == "MODE_DIVERGENCE" ? rhs_ : phi_).bind(7);
+    ratePrev_.bind(8);
+    solid_.bind(10);
+    dispatchFlat(n);
+    storageBarrier();
+  };
+  run("MODE_DIVERGENCE", 0, cellCount_);
+  // Warm start: phi / dt extrapolated from the last two projections.
+  if (solves_ >= 1 && lastDt_ > 0) run("MODE_WARM_START", 0, cellCount_);
+  stats_.pressure = pressurePcg_->solve(&rhs_, &phi_, multigrid_.get(),
+                                        {settings_.pressureTolerance, settings_.pressureMaxIterations});
+  lastDt_ = dt;
+  solves_ = dt > 0 ? std::min(solves_ + 1, 2) : 0;
+  for (int a = 0; a < D; ++a) run("MODE_GRADIENT", a, faces(a));
+  applyConstraints(vel_);
+}
+
+template <int D>
+void GpuFluid<D>::step(double dt) {
+  forces(dt);
+  applyConstraints(vel_);
+  advect(dt);
+  diffuse(dt);
+  project(dt);
+}
+
+template <int D>
+void GpuFluid<D>::upload(const MacVelocity<D>& u, const Grid<float, D>& dye) {
+  for (int a = 0; a < D; ++a) vel_.upload(u[a].values(), off_[size_t(a)] * sizeof(float));
+  dye_.upload(dye.values());
+  dyeActive_ = settings_.inflowDyeStripes > 0 ||
+               std::any_of(dye.values().begin(), dye.values().end(), [](float v) { return v != 0.0f; });
+}
+
+template <int D>
+void GpuFluid<D>::download(MacVelocity<D>* u, Grid<float, D>* dye) const {
+  for (int a = 0; a < D; ++a) vel_.download((*u)[a].data(), faces(a) * sizeof(float), off_[size_t(a)] * sizeof(float));
+  if (dye) dye_.download(dye->data(), cellCount_ * sizeof(float));
+}
+
+template <int D>
+std::vector<double> GpuFluid<D>::phi() const {
+  return phi_.read<double>(cellCount_);
+}
+
+template <int D>
+void GpuFluid<D>::save(StateWriter* out) const {
+  out->putVector("gpu.fluid.phi", phi_.read<double>(cellCount_));
+  out->putVector("gpu.fluid.rate_prev", ratePrev_.read<double>(cellCount_));
+  out->put("gpu.fluid.last_dt", lastDt_);
+  out->put("gpu.fluid.solves", solves_);
+}
+
+template <int D>
+void GpuFluid<D>::load(const StateReader& in) {
+  std::vector<double> v(cellCount_);
+  in.getVector("gpu.fluid.phi", &v);
+  phi_.upload(v);
+  in.getVector("gpu.fluid.rate_prev", &v);
+  ratePrev_.upload(v);
+  in.get("gpu.fluid.last_dt", &lastDt_);
+  in.get("gpu.fluid.solves", &solves_);
+}
+
+template class GpuFluid<2>;
+template class GpuFluid<3>;
+
+}  // namespace morphoflow

@@ -1,0 +1,89 @@
+// The stable fluid (fluid/fluid_solver.h) on the GPU: the same stages in the
+// same order (forces, advect, diffuse, project) on the same MAC grid, with
+// the CPU's boundary handling (walls, moving lids, inflow, outflow, periodic
+// axes, obstacles) taken from the same VelocityConstraints. Advection is
+// semi-Lagrangian, MacCormack or BFECC; viscosity is implicit (diagonally
+// preconditioned CG: the identity term keeps it well conditioned); the
+// pressure is solved by MGPCG to the scene's relative tolerance. The fields
+// stay on the GPU and leave it only when asked for.
+#pragma once
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "core/mac_velocity.h"
+#include "core/solver_result.h"
+#include "core/state_archive.h"
+#include "fluid/fluid_settings.h"
+#include "fluid/velocity_constraints.h"
+#include "fluid/viscosity.h"
+#include "gpu/gpu_buffer.h"
+
+namespace morphoflow {
+
+class GpuLaplace;
+class GpuMultigrid;
+class GpuPcg;
+
+struct GpuFluidStats {
+  SolverResult pressure, viscosity;
+};
+
+template <int D>
+class GpuFluid {
+ public:
+  // `constraints` must outlive this.
+  GpuFluid(const FluidSettings& settings, const VelocityConstraints<D>& constraints);
+  ~GpuFluid();
+  GpuFluid(const GpuFluid&) = delete;
+  GpuFluid& operator=(const GpuFluid&) = delete;
+
+  void step(double dt);
+  const GpuFluidStats& lastStats() const { return stats_; }
+
+  void upload(const MacVelocity<D>& u, const Grid<float, D>& dye);
+  void download(MacVelocity<D>* u, Grid<float, D>* dye) const;
+  // phi of the last projection (p = rho phi / dt), and that dt.
+  std::vector<double> phi() const;
+  double lastDt() const { return lastDt_; }
+  // The velocity buffer (component a at offset(a) floats) for the chemicals' advection.
+  const GpuBuffer& velocity() const { return vel_; }
+  size_t offset(int a) const { return off_[size_t(a)]; }
+  // Everything step() reads besides the settings and the fields (checkpoints).
+  void save(StateWriter* out) const;
+  void load(const StateReader& in);
+
+ private:
+  struct Viscous;
+  void applyConstraints(const GpuBuffer& vel);
+  void forces(double dt);
+  void advect(double dt);
+  void advectField(const GpuBuffer& src, size_t srcOff, const std::array<int, 3>& dims, const std::array<float, 3>& offset,
+                   double dt, GpuBuffer* dst, size_t dstOff);
+  void diffuse(double dt);
+  void project(double dt);
+  size_t faces(int a) const;
+
+  FluidSettings settings_;
+  const VelocityConstraints<D>& vc_;
+  std::array<int, 3> cells_{1, 1, 1}, periodic_{};
+  std::array<size_t, 3> off_{};
+  size_t cellCount_ = 0, faceCount_ = 0, maxGrid_ = 0;
+  double h_ = 1.0;
+  bool dyeActive_ = false;
+  GpuBuffer vel_, velScratch_, fixed_, value_, dye_, dyeScratch_, solid_;
+  GpuBuffer lo_, hi_, back_, fwd_;  // the second-order schemes' scratch
+  // pressure
+  std::unique_ptr<GpuLaplace> pressure_;
+  std::unique_ptr<GpuMultigrid> multigrid_;
+  std::unique_ptr<GpuPcg> pressurePcg_;
+  GpuBuffer phi_, rhs_, ratePrev_;
+  double lastDt_ = 0.0;
+  int solves_ = 0;
+  std::array<std::unique_ptr<Viscous>, D> viscous_;
+  double s_ = -1.0;
+  GpuFluidStats stats_;
+};
+
+}  // namespace morphoflow

@@ -1,0 +1,50 @@
+#include "gpu/gpu_kernels.h"
+
+#include <map>
+#include <memory>
+
+#include <epoxy/gl.h>
+
+#include "gpu/compute_program.h"
+#include "gpu/gl_context.h"
+#include "gpu/shader_source.h"
+
+namespace morphoflow {
+
+const ComputeProgram& useKernel(const std::string& shader, const std::string& defines) {
+  static std::map<std::string, std::unique_ptr<ComputeProgram>> programs;
+  const std::string key = shader + "\n" + defines;
+  auto it = programs.find(key);
+  if (it == programs.end())
+    it = programs.emplace(key, std::make_unique<ComputeProgram>(shader, defines + "\n" + shaderSource("common.glsl"))).first;
+  it->second->use();
+  return *it->second;
+}
+
+void dispatchFlat(size_t samples) {
+  constexpr size_t kGroup = 256, kMaxX = 65535;
+  const size_t groups = (samples + kGroup - 1) / kGroup;
+  if (groups == 0) return;
+  const size_t gx = groups < kMaxX ? groups : kMaxX, gy = (groups + gx - 1) / gx;
+  glDispatchCompute(GLuint(gx), GLuint(gy), 1);
+}
+
+void storageBarrier() { glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT); }
+
+void setUniform(const ComputeProgram& p, const char* name, int v) { glUniform1i(p.uniform(name), v); }
+void setUniform(const ComputeProgram& p, const char* name, float v) { glUniform1f(p.uniform(name), v); }
+void setUniform(const ComputeProgram& p, const char* name, double v) { glUniform1d(p.uniform(name), v); }
+void setUniform(const ComputeProgram& p, const char* name, const std::array<int, 3>& v) {
+  glUniform3i(p.uniform(name), v[0], v[1], v[2]);
+}
+void setUniformBools(const ComputeProgram& p, const char* name, const std::array<bool, 3>& v) {
+  glUniform3i(p.uniform(name), v[0], v[1], v[2]);
+}
+void setUniform(const ComputeProgram& p, const char* name, const std::array<int, 4>& v) {
+  glUniform4i(p.uniform(name), v[0], v[1], v[2], v[3]);
+}
+void setUniform(const ComputeProgram& p, const char* name, const std::array<float, 3>& v) {
+  glUniform3f(p.uniform(name), v[0], v[1], v[2]);
+}
+
+}  // namespace morphoflow

@@ -1,0 +1,31 @@
+// The flat compute kernels (shaders/common.glsl prepended): each compiled
+// once per process for its #defines, and dispatched one invocation a sample.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <string>
+
+namespace morphoflow {
+
+class ComputeProgram;
+
+// The program of shaders/SHADER with `defines` (lines of #define), made
+// current (glUseProgram).
+const ComputeProgram& useKernel(const std::string& shader, const std::string& defines);
+// Dispatches the current kernel over `samples` invocations.
+void dispatchFlat(size_t samples);
+// The barrier between a kernel and the next one that reads what it wrote
+// through storage buffers.
+void storageBarrier();
+
+// Uniform setters on the current program (a name the compiler removed is ignored).
+void setUniform(const ComputeProgram& p, const char* name, int v);
+void setUniform(const ComputeProgram& p, const char* name, float v);
+void setUniform(const ComputeProgram& p, const char* name, double v);
+void setUniform(const ComputeProgram& p, const char* name, const std::array<int, 3>& v);
+void setUniformBools(const ComputeProgram& p, const char* name, const std::array<bool, 3>& v);
+void setUniform(const ComputeProgram& p, const char* name, const std::array<int, 4>& v);
+void setUniform(const ComputeProgram& p, const char* name, const std::array<float, 3>& v);
+
+}  // namespace morphoflow

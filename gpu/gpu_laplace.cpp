@@ -1,0 +1,72 @@
+#include "gpu/gpu_laplace.h"
+
+#include <fmt/format.h>
+
+#include "gpu/compute_program.h"
+#include "gpu/gpu_kernels.h"
+
+namespace morphoflow {
+
+template <int D>
+GpuLaplace::GpuLaplace(const LaplaceSystem<D>& A) : dim_(D), n_(A.size()) {
+  for (int a = 0; a < D; ++a) {
+    dims_[size_t(a)] = A.dims[a];
+    periodic_[size_t(a)] = A.periodic[size_t(a)];
+  }
+  for (int a = 0; a < D; ++a) w_[size_t(a)] = GpuBuffer(n_ * sizeof(float));
+  if (D == 2) w_[2] = GpuBuffer(sizeof(float));
+  diag_ = GpuBuffer(n_ * sizeof(float));
+  update(A);
+}
+
+template <int D>
+void GpuLaplace::update(const LaplaceSystem<D>& A) {
+  for (int a = 0; a < D; ++a) w_[size_t(a)].upload(A.w[a].values());
+  diag_.upload(A.diag.values());
+  scale_ = A.scale;
+  singular_ = A.singular();
+}
+
+bool GpuLaplace::mixesColours() const {
+  for (int a = 0; a < dim_; ++a)
+    if (periodic_[size_t(a)] && dims_[size_t(a)] % 2 == 1) return true;
+  return false;
+}
+
+void GpuLaplace::run(const char* mode, bool single, const GpuBuffer& x, const GpuBuffer* y, const GpuBuffer* b,
+                     int colour, float omega) const {
+  const ComputeProgram& p =
+      useKernel("laplace.comp", fmt::format("#define DIM {}\n#define REAL {}\n#define {}", dim_, single ? "float" : "double", mode));
+  setUniform(p, "dims", dims_);
+  setUniform(p, "scale", scale_);
+  setUniform(p, "colour", colour);
+  setUniform(p, "omega", omega);
+  x.bind(0);
+  (y ? *y : x).bind(1);
+  (b ? *b : x).bind(2);
+  for (int a = 0; a < 3; ++a) w_[size_t(a < dim_ ? a : 0)].bind(3 + a);
+  diag_.bind(6);
+  dispatchFlat(n_);
+  storageBarrier();
+}
+
+void GpuLaplace::apply(const GpuBuffer& x, GpuBuffer* y) const { run("MODE_APPLY", false, x, y, nullptr, 0, 0.0f); }
+
+void GpuLaplace::residual(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* r, bool single) const {
+  run("MODE_RESIDUAL", single, x, r, &b, 0, 0.0f);
+}
+
+void GpuLaplace::smooth(const GpuBuffer& b, GpuBuffer* x, int colour) const {
+  run("MODE_SMOOTH", true, *x, nullptr, &b, colour, 0.0f);
+}
+
+void GpuLaplace::jacobi(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* y, float omega) const {
+  run("MODE_JACOBI", true, x, y, &b, 0, omega);
+}
+
+template GpuLaplace::GpuLaplace(const LaplaceSystem<2>&);
+template GpuLaplace::GpuLaplace(const LaplaceSystem<3>&);
+template void GpuLaplace::update(const LaplaceSystem<2>&);
+template void GpuLaplace::update(const LaplaceSystem<3>&);
+
+}  // namespace morphoflow

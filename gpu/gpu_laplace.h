@@ -1,0 +1,53 @@
+// A LaplaceSystem (core/laplace_system.h) on the GPU: its face weights and
+// diagonal in storage buffers, and the kernels of shaders/laplace.comp on
+// double vectors (the PCG's) or float ones (the multigrid levels').
+#pragma once
+
+#include <array>
+
+#include "core/laplace_system.h"
+#include "gpu/gpu_buffer.h"
+
+namespace morphoflow {
+
+class GpuLaplace {
+ public:
+  GpuLaplace() = default;
+  template <int D>
+  explicit GpuLaplace(const LaplaceSystem<D>& A);
+  // The system's coefficients changed, not its shape.
+  template <int D>
+  void update(const LaplaceSystem<D>& A);
+
+  size_t size() const { return n_; }
+  bool singular() const { return singular_; }
+  int dimension() const { return dim_; }
+  const std::array<int, 3>& dims() const { return dims_; }
+  const std::array<bool, 3>& periodic() const { return periodic_; }
+  const GpuBuffer& diag() const { return diag_; }
+  // True when an odd periodic axis couples cells of one colour (the
+  // red-black sweep would then race): such levels smooth by Jacobi.
+  bool mixesColours() const;
+
+  void apply(const GpuBuffer& x, GpuBuffer* y) const;  // y = A x (double)
+  // r = b - A x, in double or (`single`) float.
+  void residual(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* r, bool single) const;
+  // One colour of a red-black Gauss-Seidel sweep on float vectors.
+  void smooth(const GpuBuffer& b, GpuBuffer* x, int colour) const;
+  // y = x + omega (D^-1 (b / scale + N x) - x) on float vectors.
+  void jacobi(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* y, float omega) const;
+
+ private:
+  void run(const char* mode, bool single, const GpuBuffer& x, const GpuBuffer* y, const GpuBuffer* b, int colour,
+           float omega) const;
+  std::array<int, 3> dims_{1, 1, 1};
+  std::array<bool, 3> periodic_{};
+  int dim_ = 2;
+  size_t n_ = 0;
+  double scale_ = 1.0;
+  bool singular_ = false;
+  std::array<GpuBuffer, 3> w_;
+  GpuBuffer diag_;
+};
+
+}  // namespace morphoflow

@@ -1,0 +1,223 @@
+#include "gpu/gpu_multigrid.h"
+
+#include <cmath>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "core/parallel.h"
+#include "gpu/compute_program.h"
+#include "gpu/gl_context.h"
+#include "gpu/gpu_kernels.h"
+
+namespace morphoflow {
+
+namespace {
+
+// The coarsest level's matrix, dense, in double; a singular (pure Neumann)
+// level gets alpha 1 1^T on its active cells, which keeps its inverse
+// symmetric and maps a mean-free b to the mean-free solution.
+template <int D>
+std::vector<double> denseMatrix(const LaplaceSystem<D>& A) {
+  const size_t n = A.size();
+  std::vector<double> M(n * n, 0.0);
+  double maxDiag = 0.0;
+  forEachCell<D>(A.dims, [&](const IVec<D>& k, size_t i) {
+    if (A.diag[i] <= 0) return;
+    M[i * n + i] += A.scale * A.diag[i];
+    maxDiag = std::max(maxDiag, A.scale * A.diag[i]);
+    for (int a = 0; a < D; ++a) {
+      IVec<D> up = k;
+      up[a] = (up[a] + 1) % A.dims[a];
+      const size_t j = A.diag.index(up);
+      const double w = A.scale * A.w[a][i];
+      if (w == 0.0) continue;
+      M[i * n + j] -= w;
+      M[j * n + i] -= w;
+    }
+  });
+  if (A.singular()) {
+    size_t active = 0;
+    for (size_t i = 0; i < n; ++i) active += A.diag[i] > 0;
+    const double alpha = maxDiag / double(active);
+    for (size_t i = 0; i < n; ++i)
+      for (size_t j = 0; j < n; ++j)
+        if (A.diag[i] > 0 && A.diag[j] > 0) M[i * n + j] += alpha;
+  }
+  for (size_t i = 0; i < n; ++i)
+    if (A.diag[i] <= 0) M[i * n + i] = 1.0;  // inactive: pinned, zeroed in the inverse below
+  return M;
+}
+
+// Gauss-Jordan inversion with partial pivoting; a pivot below `tiny` (a
+// further null direction, say a region walled off by obstacles) is left
+// out (its row and column of the inverse are 0).
+std::vector<double> invert(std::vector<double> M, size_t n) {
+  std::vector<double> I(n * n, 0.0);
+  for (size_t i = 0; i < n; ++i) I[i * n + i] = 1.0;
+  double big = 0.0;
+  for (size_t i = 0; i < n; ++i) big = std::max(big, std::abs(M[i * n + i]));
+  const double tiny = 1e-12 * big;
+  std::vector<bool> dropped(n, false);
+  for (size_t c = 0; c < n; ++c) {
+    size_t piv = c;
+    for (size_t r = c + 1; r < n; ++r)
+      if (std::abs(M[r * n + c]) > std::abs(M[piv * n + c])) piv = r;
+    if (std::abs(M[piv * n + c]) <= tiny) {
+      dropped[c] = true;
+      continue;
+    }
+    if (piv != c)
+      for (size_t k = 0; k < n; ++k) {
+        std::swap(M[c * n + k], M[piv * n + k]);
+        std::swap(I[c * n + k], I[piv * n + k]);
+      }
+    const double inv = 1.0 / M[c * n + c];
+    for (size_t k = 0; k < n; ++k) {
+      M[c * n + k] *= inv;
+      I[c * n + k] *= inv;
+    }
+    for (size_t r = 0; r < n; ++r) {
+      if (r == c || M[r * n + c] == 0.0) continue;
+      const double f = M[r * n + c];
+      for (size_t k = 0; k < n; ++k) {
+        M[r * n + k] -= f * M[c * n + k];
+        I[r * n + k] -= f * I[c * n + k];
+      }
+    }
+  }
+  for (size_t c = 0; c < n; ++c)
+    if (dropped[c])
+      for (size_t k = 0; k < n; ++k) I[c * n + k] = I[k * n + c] = 0.0;
+  return I;
+}
+
+// Coarsest levels larger than this are smoothed many times instead (odd
+// periodic grids, which stop coarsening early).
+constexpr size_t kDenseMax = 1024;
+constexpr int kCoarseSweeps = 40;
+
+}  // namespace
+
+template <int D>
+GpuMultigrid::GpuMultigrid(const Multigrid<D>& levels, const GpuLaplace& fine, const MultigridOptions& options)
+    : options_(options) {
+  for (int l = 0; l < levels.levels(); ++l) {
+    Level L;
+    if (l == 0) {
+      L.A = &fine;
+    } else {
+      L.own = std::make_unique<GpuLaplace>(levels.level(l));
+      L.A = L.own.get();
+    }
+    const size_t n = levels.level(l).size() * sizeof(float);
+    L.x = GpuBuffer(n);
+    L.b = GpuBuffer(n);
+    L.r = GpuBuffer(n);
+    levels_.push_back(std::move(L));
+  }
+  invertCoarsest(levels.level(levels.levels() - 1));
+}
+
+template <int D>
+void GpuMultigrid::update(const Multigrid<D>& levels) {
+  for (int l = 1; l < levels.levels(); ++l) levels_[size_t(l)].own->update(levels.level(l));
+  invertCoarsest(levels.level(levels.levels() - 1));
+}
+
+template <int D>
+void GpuMultigrid::invertCoarsest(const LaplaceSystem<D>& A) {
+  if (A.size() > kDenseMax) {
+    dense_ = GpuBuffer();
+    return;
+  }
+  const std::vector<double> inv = invert(denseMatrix<D>(A), A.size());
+  dense_ = GpuBuffer::of(std::vector<float>(inv.begin(), inv.end()));
+}
+
+void GpuMultigrid::smooth(Level& L, bool reverse, int sweeps) {
+  for (int s = 0; s < sweeps; ++s) {
+    if (L.A->mixesColours()) {  // damped Jacobi, r as the other buffer
+      L.A->jacobi(L.b, L.x, &L.r, L.A->dimension() == 3 ? 6.0f / 7.0f : 0.8f);
+      std::swap(L.x, L.r);
+      continue;
+    }
+    L.A->smooth(L.b, &L.x, reverse ? 1 : 0);
+    L.A->smooth(L.b, &L.x, reverse ? 0 : 1);
+  }
+}
+
+void GpuMultigrid::cycle(size_t l) {
+  Level& L = levels_[l];
+  const int dim = L.A->dimension();
+  if (l + 1 == levels_.size()) {
+    if (dense_.id()) {
+      const ComputeProgram& p = useKernel("multigrid.comp", fmt::format("#define DIM {}\n#define MODE_DENSE", dim));
+      setUniform(p, "n", int(L.A->size()));
+      L.b.bind(0);
+      L.x.bind(1);
+      L.x.bind(2);
+      L.A->diag().bind(3);
+      dense_.bind(4);
+      dispatchFlat(L.A->size());
+      storageBarrier();
+    } else {
+      L.x.zero();
+      smooth(L, false, kCoarseSweeps);
+      smooth(L, true, kCoarseSweeps);
+    }
+    return;
+  }
+  Level& C = levels_[l + 1];
+  L.x.zero();
+  smooth(L, false, options_.preSmooth);
+  L.A->residual(L.b, L.x, &L.r, true);
+  auto transfer = [&](const char* mode, const GpuBuffer& fine, const GpuBuffer& coarse, const GpuBuffer& fineX,
+                      const GpuBuffer& diag, size_t samples) {
+    const ComputeProgram& p = useKernel("multigrid.comp", fmt::format("#define DIM {}\n#define {}", dim, mode));
+    setUniform(p, "fd", L.A->dims());
+    setUniform(p, "cd", C.A->dims());
+    setUniformBools(p, "periodic", L.A->periodic());
+    fine.bind(0);
+    coarse.bind(1);
+    fineX.bind(2);
+    diag.bind(3);
+    fine.bind(4);
+    dispatchFlat(samples);
+    storageBarrier();
+  };
+  transfer("MODE_RESTRICT", L.r, C.b, L.x, C.A->diag(), C.A->size());
+  cycle(l + 1);
+  transfer("MODE_PROLONG", L.r, C.x, L.x, L.A->diag(), L.A->size());
+  smooth(L, true, options_.postSmooth);
+}
+
+void GpuMultigrid::apply(const GpuBuffer& r, GpuBuffer* z, const GpuBuffer& scalars, int slot) {
+  Level& L = levels_[0];
+  const size_t n = L.A->size();
+  auto convert = [&](const char* op, const GpuBuffer& in, const GpuBuffer& out) {
+    const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + op);
+    setUniform(p, "n", int(n));
+    setUniform(p, "slots", std::array<int, 4>{slot, 0, 0, 0});
+    in.bind(0);
+    out.bind(1);
+    in.bind(2);
+    in.bind(3);
+    L.b.bind(4);
+    if (std::string(op) == "OP_FROM_FLOAT") L.x.bind(4);
+    L.A->diag().bind(5);
+    scalars.bind(6);
+    dispatchFlat(n);
+    storageBarrier();
+  };
+  convert("OP_TO_FLOAT", r, r);
+  cycle(0);
+  convert("OP_FROM_FLOAT", *z, *z);
+}
+
+template GpuMultigrid::GpuMultigrid(const Multigrid<2>&, const GpuLaplace&, const MultigridOptions&);
+template GpuMultigrid::GpuMultigrid(const Multigrid<3>&, const GpuLaplace&, const MultigridOptions&);
+template void GpuMultigrid::update(const Multigrid<2>&);
+template void GpuMultigrid::update(const Multigrid<3>&);
+
+}  // namespace morphoflow

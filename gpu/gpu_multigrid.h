@@ -1,0 +1,46 @@
+// The multigrid V-cycle of core/multigrid.h as a PCG preconditioner on the
+// GPU (MGPCG, McAdams et al. 2010): the same levels (taken from the CPU's
+// hierarchy, whose coarse operators re-discretise the fine one), the same
+// transfers and red-black Gauss-Seidel smoothing, single precision. The
+// coarsest level is solved exactly by its dense (pseudo-)inverse, computed
+// once on the host, so the cycle is a fixed symmetric linear operator.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "core/multigrid.h"
+#include "gpu/gpu_laplace.h"
+
+namespace morphoflow {
+
+class GpuMultigrid {
+ public:
+  // `fine` is the GPU copy of levels.level(0) (the PCG's system); it must outlive this.
+  template <int D>
+  GpuMultigrid(const Multigrid<D>& levels, const GpuLaplace& fine, const MultigridOptions& options);
+  // The CPU hierarchy was refreshed (new coefficients, same shapes).
+  template <int D>
+  void update(const Multigrid<D>& levels);
+
+  // z = M r for double vectors: one cycle on r / s, times s, where s^2 is
+  // scalars[slot] (r . r), so single precision neither under- nor overflows.
+  void apply(const GpuBuffer& r, GpuBuffer* z, const GpuBuffer& scalars, int slot);
+
+ private:
+  struct Level {
+    const GpuLaplace* A = nullptr;
+    std::unique_ptr<GpuLaplace> own;  // levels >= 1
+    GpuBuffer x, b, r;
+  };
+  void cycle(size_t l);
+  void smooth(Level& L, bool reverse, int sweeps);
+  template <int D>
+  void invertCoarsest(const LaplaceSystem<D>& A);
+
+  MultigridOptions options_;
+  std::vector<Level> levels_;
+  GpuBuffer dense_;  // the coarsest level's inverse, row-major, float
+};
+
+}  // namespace morphoflow

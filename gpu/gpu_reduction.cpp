@@ -1,0 +1,55 @@
+#include "gpu/gpu_reduction.h"
+
+#include <algorithm>
+
+#include <epoxy/gl.h>
+#include <fmt/format.h>
+
+#include "gpu/compute_program.h"
+#include "gpu/gpu_kernels.h"
+
+namespace morphoflow {
+
+namespace {
+constexpr size_t kGroups = 256;  // partial sums: a fixed count, so the sum's order is fixed
+}
+
+GpuReduction::GpuReduction() : partial_(kGroups * sizeof(double)), scalars_(kSlots * sizeof(double)) {
+  partial_.zero();
+  scalars_.zero();
+}
+
+void GpuReduction::run(const char* term, const GpuBuffer& x, const GpuBuffer& y, const GpuBuffer& diag, size_t n,
+                       int slot) {
+  const size_t groups = std::clamp<size_t>((n + 255) / 256, 1, kGroups);
+  const ComputeProgram& p = useKernel("reduce.comp", fmt::format("#define MODE_PARTIAL\n#define {}", term));
+  setUniform(p, "n", int(n));
+  x.bind(0);
+  y.bind(1);
+  diag.bind(2);
+  partial_.bind(3);
+  scalars_.bind(4);
+  glDispatchCompute(GLuint(groups), 1, 1);
+  storageBarrier();
+  const ComputeProgram& f = useKernel("reduce.comp", "#define MODE_FINAL");
+  setUniform(f, "n", int(groups));
+  setUniform(f, "slot", slot);
+  partial_.bind(3);
+  scalars_.bind(4);
+  glDispatchCompute(1, 1, 1);
+  storageBarrier();
+}
+
+void GpuReduction::dot(const GpuBuffer& x, const GpuBuffer& y, size_t n, int slot) { run("TERM_DOT", x, y, x, n, slot); }
+
+void GpuReduction::activeSum(const GpuBuffer& x, const GpuBuffer& diag, size_t n, int slot) {
+  run("TERM_ACTIVE_SUM", x, x, diag, n, slot);
+}
+
+void GpuReduction::activeCount(const GpuBuffer& diag, size_t n, int slot) {
+  run("TERM_ACTIVE_COUNT", diag, diag, diag, n, slot);
+}
+
+std::vector<double> GpuReduction::read() const { return scalars_.read<double>(kSlots); }
+
+}  // namespace morphoflow
