@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "app/gpu_simulation.h"
 #include "core/parallel.h"
 #include "fluid/probes.h"
 
@@ -51,10 +52,14 @@ std::vector<Grid<float, D>> fluidField(const FluidSolver<D>& f, const std::strin
 }
 
 template <int D>
-FluidSimulation<D>::FluidSimulation(const Scene& scene, Warn warn)
+FluidSimulation<D>::FluidSimulation(const Scene& scene, Warn warn, bool gpu)
     : scene_(scene), warn_(std::move(warn)), fluid_(scene.fluid) {
   checkFluidLeft<D>(scene, fluid_);
   initialiseDye<D>(scene, &fluid_);
+  if (gpu) {
+    gpu_ = std::make_unique<GpuFluid<D>>(scene.fluid, fluid_.constraints());
+    gpu_->upload(fluid_.velocity(), fluid_.dye());
+  }
   for (int a = 0; a < D; ++a)
     for (bool hi : {false, true})
       if (scene.fluid.boundaries.side(a, hi).kind == BoundaryKind::Inflow) flowAxis_ = a;
@@ -62,9 +67,31 @@ FluidSimulation<D>::FluidSimulation(const Scene& scene, Warn warn)
 }
 
 template <int D>
+void FluidSimulation<D>::syncHost() const {
+  if (!gpu_ || !hostStale_) return;
+  gpu_->download(&fluid_.velocity(), &fluid_.dye());
+  fluid_.adopt(time_, steps_, gpu_->phi(), gpu_->lastDt());
+  hostStale_ = false;
+}
+
+template <int D>
+double FluidSimulation<D>::cflTimeStep(double cfl, double dtMax) const {
+  if (!gpu_) return fluid_.cflTimeStep(cfl, dtMax);
+  const double umax = gpu_->maxSpeed();
+  return umax > 0 ? std::min(dtMax, cfl * fluid_.h() / umax) : dtMax;
+}
+
+template <int D>
 void FluidSimulation<D>::step(double dt) {
-  fluid_.step(dt);
-  const FluidStepStats& st = fluid_.lastStats();
+  if (gpu_) {
+    gpu_->step(dt);
+    time_ += dt;
+    ++steps_;
+    hostStale_ = true;
+  } else {
+    fluid_.step(dt);
+  }
+  const FluidStepStats& st = gpu_ ? gpu_->lastStats() : fluid_.lastStats();
   for (int k = 0; k < FluidStepStats::kStages; ++k) stageTotals_[size_t(k)] += st.seconds[size_t(k)];
   pressureIterations_ += st.pressure.iterations;
   viscosityIterations_ += st.viscosity.iterations;
@@ -72,15 +99,17 @@ void FluidSimulation<D>::step(double dt) {
   maxPressureResidual_ = std::max(maxPressureResidual_, st.pressure.residual);
   if (!st.pressure.converged && unconverged_++ == 0)
     warn_(fmt::format("warning: step {}: pressure solve stopped at relative residual {:.2e} after {} iterations",
-                      fluid_.steps(), st.pressure.residual, st.pressure.iterations));
-  if (!std::isfinite(fluid_.maxSpeed()))
-    throw NonFiniteError(fmt::format("the simulation diverged at step {} in the fluid step: the velocity is not finite", fluid_.steps()),
+                      steps(), st.pressure.residual, st.pressure.iterations));
+  // (gpu: a velocity that is not finite makes the divergence, hence the pressure residual, NaN)
+  if (gpu_ ? !std::isfinite(st.pressure.residual) : !std::isfinite(fluid_.maxSpeed()))
+    throw NonFiniteError(fmt::format("the simulation diverged at step {} in the fluid step: the velocity is not finite", steps()),
                          "use a smaller time.dt or set time.cfl, and check the forces and boundary speeds");
   if (scene_.probes.forces) {
     const ProbeSettings& pr = scene_.probes;
     const double q = 0.5 * scene_.fluid.density * pr.referenceSpeed * pr.referenceSpeed * pr.referenceArea;
+    syncHost();
     const auto F = obstacleForce<D>(fluid_);
-    forceTime_.push_back(fluid_.time());
+    forceTime_.push_back(time());
     drag_.push_back(F[size_t(flowAxis_)] / q);
     lift_.push_back(F[size_t(liftAxis_)] / q);
   }
@@ -88,7 +117,9 @@ void FluidSimulation<D>::step(double dt) {
 
 template <int D>
 void FluidSimulation<D>::save(StateWriter* out) const {
+  syncHost();
   fluid_.save(out);
+  if (gpu_) gpu_->save(out);
   out->put("fluid.stats.stage_totals", stageTotals_);
   out->put("fluid.stats.pressure_iterations", pressureIterations_);
   out->put("fluid.stats.viscosity_iterations", viscosityIterations_);
@@ -103,13 +134,19 @@ void FluidSimulation<D>::save(StateWriter* out) const {
 template <int D>
 void FluidSimulation<D>::load(const StateReader& in) {
   fluid_.load(in);
+  if (gpu_) {
+    gpu_->upload(fluid_.velocity(), fluid_.dye());
+    gpu_->load(in);
+    time_ = fluid_.time();
+    steps_ = fluid_.steps();
+  }
   in.get("fluid.stats.stage_totals", &stageTotals_);
   in.get("fluid.stats.pressure_iterations", &pressureIterations_);
   in.get("fluid.stats.viscosity_iterations", &viscosityIterations_);
   in.get("fluid.stats.pressure_iterations_max", &maxPressureIterations_);
   in.get("fluid.stats.unconverged", &unconverged_);
   in.get("fluid.stats.pressure_residual_max", &maxPressureResidual_);
-  const size_t n = scene_.probes.forces ? size_t(fluid_.steps()) : 0;
+  const size_t n = scene_.probes.forces ? size_t(steps()) : 0;
   forceTime_.resize(n);
   drag_.resize(n);
   lift_.resize(n);
@@ -135,7 +172,11 @@ nlohmann::json FluidSimulation<D>::resolved() const {
 
 template <int D>
 void FluidSimulation<D>::report(nlohmann::json* j) const {
-  const double steps = double(fluid_.steps());
+  const double steps = double(this->steps());
+  if (gpu_) {
+    recordGlContext(j);
+    (*j)["pressure_solver"] = "mgpcg";
+  }
   nlohmann::json stages;
   for (int k = 0; k < FluidStepStats::kStages; ++k)
     stages[FluidStepStats::kStageNames[k]] = {{"total_seconds", stageTotals_[size_t(k)]},
@@ -148,7 +189,7 @@ void FluidSimulation<D>::report(nlohmann::json* j) const {
                      {"viscosity_iterations_mean", steps ? double(viscosityIterations_) / steps : 0.0}};
   const ProbeSettings& pr = scene_.probes;
   if (!pr.forces) return;
-  const double start = pr.strouhalStart >= 0 ? pr.strouhalStart : 0.5 * fluid_.time();
+  const double start = pr.strouhalStart >= 0 ? pr.strouhalStart : 0.5 * time();
   const StrouhalEstimate st = estimateStrouhal(forceTime_, lift_, start, pr.referenceLength, pr.referenceSpeed);
   double cdMean = 0;
   int n = 0;
@@ -177,6 +218,7 @@ std::string profileCsv(const Profile& p) {
 
 template <int D>
 std::vector<std::pair<std::string, std::string>> FluidSimulation<D>::measurementFiles() const {
+  syncHost();
   std::vector<std::pair<std::string, std::string>> files;
   const ProbeSettings& pr = scene_.probes;
   if (pr.centerlines) {

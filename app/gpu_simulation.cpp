@@ -9,6 +9,7 @@
 #include "core/error.h"
 #include "gpu/gl_context.h"
 #include "gpu/gpu_explicit_rd.h"
+#include "gpu/gpu_fluid.h"
 #include "rd/model_registry.h"
 #include "rd/rd_solver.h"
 
@@ -19,7 +20,10 @@ namespace {
 // The first stage of the scene with no GPU program, or "".
 std::string missingStage(const Scene& s) {
   const RDScene& rd = s.rd;
-  if (s.hasFluid) return "the fluid (forces, advection, viscosity, pressure projection)";
+  if (s.hasFluid)
+    return rd.enabled ? "the advection-reaction-diffusion coupling ([coupling]: the fluid runs on the gpu, the chemicals "
+                        "carried by it do not yet)"
+                      : "";
   if (rd.settings.integrator != RDIntegrator::ExplicitEuler)
     return "the implicit reaction-diffusion integrators (kim-lin, semi-implicit, crank-nicolson); integrator = \"explicit\" runs";
   if (gpuReaction(rd.settings.model).empty())
@@ -47,6 +51,13 @@ GpuInfo gpuInfo() {
   return g;
 }
 
+void recordGlContext(nlohmann::json* run) {
+  const GlContext& c = GlContext::instance();
+  (*run)["gl_renderer"] = c.renderer();
+  (*run)["gl_version"] = c.version();
+  (*run)["gl_platform"] = c.platform();
+}
+
 void checkGpuRuns(const Scene& scene) {
   const std::string stage = missingStage(scene);
   if (!stage.empty())
@@ -54,12 +65,17 @@ void checkGpuRuns(const Scene& scene) {
                     "run this scene with --backend tbb; docs/gpu.md lists what the gpu backend runs");
   const GpuInfo g = gpuInfo();
   if (!g.available) throw UserError({"--backend", 0, 0}, "", "no usable GPU context: " + g.reason, "use --backend tbb");
-  // Two buffers per species, float: checked before anything is allocated.
+  // Checked before anything is allocated: the fluid's buffers, or two per species (float).
   size_t cells = 1;
   for (int n : scene.rd.settings.resolution) cells *= size_t(n);
-  const size_t need = 4 * cells * sizeof(float), have = GlContext::instance().availableBytes();
+  size_t need = 4 * cells * sizeof(float);
+  if (scene.hasFluid) {
+    const std::vector<int>& r = scene.fluid.resolution;
+    need = scene.dimension == 2 ? GpuFluid<2>::deviceBytes({r[0], r[1]}) : GpuFluid<3>::deviceBytes({r[0], r[1], r[2]});
+  }
+  const size_t have = GlContext::instance().availableBytes();
   if (have > 0 && need > have)
-    throw UserError({scene.path, 0, 0}, "rd.resolution",
+    throw UserError({scene.path, 0, 0}, scene.hasFluid ? "grid.resolution" : "rd.resolution",
                     fmt::format("the GPU has {:.0f} MiB free and this scene needs {:.0f} MiB", double(have) / (1 << 20),
                                 double(need) / (1 << 20)),
                     "use a smaller grid, or --backend tbb");
@@ -148,10 +164,7 @@ nlohmann::json GpuRDSimulation<D>::resolved() const {
 
 template <int D>
 void GpuRDSimulation<D>::report(nlohmann::json* run) const {
-  const GlContext& c = GlContext::instance();
-  (*run)["gl_renderer"] = c.renderer();
-  (*run)["gl_version"] = c.version();
-  (*run)["gl_platform"] = c.platform();
+  recordGlContext(run);
 }
 
 template class GpuRDSimulation<2>;

@@ -25,6 +25,8 @@ struct GpuInfo {
   std::string renderer, version, platform, reason;
 };
 GpuInfo gpuInfo();
+// run.json: gl_renderer, gl_version, gl_platform of the context in use.
+void recordGlContext(nlohmann::json* run);
 
 template <int D>
 class GpuRDSimulation : public Simulation<D> {

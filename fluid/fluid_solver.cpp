@@ -144,6 +144,13 @@ void FluidSolver<D>::load(const StateReader& in) {
   viscosity_->load(in);
 }
 
+template <int D>
+void FluidSolver<D>::adopt(double time, long steps, const std::vector<double>& phi, double dt) {
+  time_ = time;
+  steps_ = steps;
+  projection_->adopt(phi, dt, settings_.density);
+}
+
 template class FluidSolver<2>;
 template class FluidSolver<3>;
 

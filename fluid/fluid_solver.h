@@ -54,6 +54,10 @@ class FluidSolver {
   // the solvers' warm starts), so that load(save()) continues bit for bit.
   void save(StateWriter* out) const;
   void load(const StateReader& in);
+  // The clock and last pressure of steps taken elsewhere (the GPU backend,
+  // which sets velocity() and dye() itself), so that fields, probes and
+  // save() describe them.
+  void adopt(double time, long steps, const std::vector<double>& phi, double dt);
   Layout<D> cellLayout() const { return Layout<D>::cellCentred(h_, cells_, constraints_.periodic()); }
 
  private:

@@ -175,6 +175,13 @@ SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double
 }
 
 template <int D>
+void PressureProjection<D>::adopt(const Vector& phi, double dt, double density) {
+  phi_ = phi;
+  lastDt_ = dt;
+  lastDensity_ = density;
+}
+
+template <int D>
 Grid<float, D> PressureProjection<D>::pressure() const {
   Grid<float, D> p(vc_.cells, 0.0f);
   if (lastDt_ <= 0) return p;

@@ -31,6 +31,9 @@ class PressureProjection {
   SolverResult project(MacVelocity<D>* u, double dt, double density);
   // Cell divergence of u (0 on solid cells).
   void divergence(const MacVelocity<D>& u, Vector* div) const;
+  // Takes phi of a projection computed elsewhere (the GPU backend) as the
+  // last one's, for pressure() and the force probes.
+  void adopt(const Vector& phi, double dt, double density);
   // Pressure of the last projection, p = rho phi / dt.
   Grid<float, D> pressure() const;
   const LaplaceSystem<D>& system() const { return A_; }

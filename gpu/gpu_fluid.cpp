@@ -1,8 +1,10 @@
 #include "gpu/gpu_fluid.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
+#include <epoxy/gl.h>
 #include <fmt/format.h>
 
 #include "core/multigrid.h"
@@ -12,6 +14,7 @@
 #include "gpu/gpu_laplace.h"
 #include "gpu/gpu_multigrid.h"
 #include "gpu/gpu_pcg.h"
+#include "gpu/gpu_reduction.h"
 
 namespace morphoflow {
 
@@ -83,6 +86,31 @@ GpuFluid<D>::GpuFluid(const FluidSettings& s, const VelocityConstraints<D>& vc) 
     viscous_[size_t(a)] = std::move(v);
   }
   dyeActive_ = s.inflowDyeStripes > 0;
+  speed_ = std::make_unique<GpuReduction>();
+}
+
+template <int D>
+size_t GpuFluid<D>::deviceBytes(const IVec<D>& cells) {
+  size_t c = 1, f = 0, g = 0;
+  for (int a = 0; a < D; ++a) c *= size_t(cells[a]);
+  for (int a = 0; a < D; ++a) {
+    const size_t fa = c / size_t(cells[a]) * size_t(cells[a] + 1);
+    f += fa;
+    g = std::max(g, fa);
+  }
+  const double system = (D + 1) * 4.0;       // face weights and diagonal, float
+  const double coarse = 1.0 / ((1 << D) - 1);  // the multigrid levels below the fine one, relative to it
+  const double bytes = 4.0 * 4 * double(f)     // u, its scratch, fixed flags, prescribed values
+                       + 3.0 * 4 * double(c) + 4.0 * 4 * double(g)  // dye, its scratch, solid; the schemes' scratch
+                       + double(c) * (system + 3 * 8 + 4 * 8 + 3 * 4 + coarse * (system + 3 * 4))  // pressure
+                       + double(f) * (system + 3 * 8 + 4 * 8);  // viscosity: system, b, x, rhs, PCG vectors
+  return size_t(bytes);
+}
+
+template <int D>
+double GpuFluid<D>::maxSpeed() const {
+  speed_->maxAbs(vel_, faceCount_, 0);
+  return std::sqrt(double(D)) * speed_->read()[0];
 }
 
 template <int D>
@@ -297,11 +325,23 @@ void GpuFluid<D>::project(double dt) {
 
 template <int D>
 void GpuFluid<D>::step(double dt) {
+  using Clock = std::chrono::steady_clock;
+  auto t0 = Clock::now();
+  auto lap = [&](int stage) {
+    glFinish();
+    const auto t1 = Clock::now();
+    stats_.seconds[size_t(stage)] = std::chrono::duration<double>(t1 - t0).count();
+    t0 = t1;
+  };
   forces(dt);
   applyConstraints(vel_);
+  lap(0);
   advect(dt);
+  lap(1);
   diffuse(dt);
+  lap(2);
   project(dt);
+  lap(3);
 }
 
 template <int D>

@@ -16,6 +16,7 @@
 #include "core/solver_result.h"
 #include "core/state_archive.h"
 #include "fluid/fluid_settings.h"
+#include "fluid/fluid_solver.h"
 #include "fluid/velocity_constraints.h"
 #include "fluid/viscosity.h"
 #include "gpu/gpu_buffer.h"
@@ -25,10 +26,6 @@ namespace morphoflow {
 class GpuLaplace;
 class GpuMultigrid;
 class GpuPcg;
-
-struct GpuFluidStats {
-  SolverResult pressure, viscosity;
-};
 
 template <int D>
 class GpuFluid {
@@ -40,7 +37,13 @@ class GpuFluid {
   GpuFluid& operator=(const GpuFluid&) = delete;
 
   void step(double dt);
-  const GpuFluidStats& lastStats() const { return stats_; }
+  // The solvers' results and each stage's wall time (the queue drained at
+  // each stage's end, so a stage's time is its own).
+  const FluidStepStats& lastStats() const { return stats_; }
+  // sqrt(D) max_a max |u_a|, as FluidSolver::maxSpeed (a bound of the speed).
+  double maxSpeed() const;
+  // Bytes of device memory a fluid of these cells allocates.
+  static size_t deviceBytes(const IVec<D>& cells);
 
   void upload(const MacVelocity<D>& u, const Grid<float, D>& dye);
   void download(MacVelocity<D>* u, Grid<float, D>* dye) const;
@@ -83,7 +86,8 @@ class GpuFluid {
   int solves_ = 0;
   std::array<std::unique_ptr<Viscous>, D> viscous_;
   double s_ = -1.0;
-  GpuFluidStats stats_;
+  FluidStepStats stats_;
+  std::unique_ptr<class GpuReduction> speed_;
 };
 
 }  // namespace morphoflow

@@ -29,9 +29,10 @@ void GpuReduction::run(const char* term, const GpuBuffer& x, const GpuBuffer& y,
   diag.bind(2);
   partial_.bind(3);
   scalars_.bind(4);
+  x.bind(5);
   glDispatchCompute(GLuint(groups), 1, 1);
   storageBarrier();
-  const ComputeProgram& f = useKernel("reduce.comp", "#define MODE_FINAL");
+  const ComputeProgram& f = useKernel("reduce.comp", std::string("#define MODE_FINAL\n#define ") + term);
   setUniform(f, "n", int(groups));
   setUniform(f, "slot", slot);
   partial_.bind(3);
@@ -49,6 +50,8 @@ void GpuReduction::activeSum(const GpuBuffer& x, const GpuBuffer& diag, size_t n
 void GpuReduction::activeCount(const GpuBuffer& diag, size_t n, int slot) {
   run("TERM_ACTIVE_COUNT", diag, diag, diag, n, slot);
 }
+
+void GpuReduction::maxAbs(const GpuBuffer& f, size_t n, int slot) { run("TERM_MAX_ABS", f, f, f, n, slot); }
 
 std::vector<double> GpuReduction::read() const { return scalars_.read<double>(kSlots); }
 

@@ -19,6 +19,7 @@ class GpuReduction {
   void dot(const GpuBuffer& x, const GpuBuffer& y, size_t n, int slot);       // x . y (double vectors)
   void activeSum(const GpuBuffer& x, const GpuBuffer& diag, size_t n, int slot);  // sum of x where diag > 0
   void activeCount(const GpuBuffer& diag, size_t n, int slot);
+  void maxAbs(const GpuBuffer& f, size_t n, int slot);  // max |f_i| of a float vector
   std::vector<double> read() const;  // every slot (waits for the queued work)
   const GpuBuffer& scalars() const { return scalars_; }
 
