@@ -7,8 +7,10 @@
 
 namespace morphoflow {
 
-ComputeProgram::ComputeProgram(const std::string& shader, const std::string& prologue) {
-  const std::string text = "#version 430 core\n" + prologue + "\n#line 1\n" + shaderSource(shader);
+ComputeProgram::ComputeProgram(const std::string& shader, const std::string& prologue,
+                               const std::function<std::string(const std::string&)>& expand) {
+  const std::string& source = shaderSource(shader);
+  const std::string text = "#version 430 core\n" + prologue + "\n#line 1\n" + (expand ? expand(source) : source);
   const char* src = text.c_str();
   const GLuint s = glCreateShader(GL_COMPUTE_SHADER);
   glShaderSource(s, 1, &src, nullptr);

@@ -2,13 +2,16 @@
 // #version and #defines; a compile or link error is a GpuError with the log.
 #pragma once
 
+#include <functional>
 #include <string>
 
 namespace morphoflow {
 
 class ComputeProgram {
  public:
-  ComputeProgram(const std::string& shader, const std::string& prologue);
+  // `expand` (if given) rewrites the shader's text before it compiles (includes).
+  ComputeProgram(const std::string& shader, const std::string& prologue,
+                 const std::function<std::string(const std::string&)>& expand = {});
   ComputeProgram(const ComputeProgram&) = delete;
   ComputeProgram& operator=(const ComputeProgram&) = delete;
   ~ComputeProgram();

@@ -1,37 +1,17 @@
 #include "gpu/gpu_explicit_rd.h"
 
-#include <map>
 
 #include <epoxy/gl.h>
 #include <fmt/format.h>
 
 #include "gpu/compute_program.h"
 #include "gpu/gl_context.h"
+#include "gpu/gpu_models.h"
 
 namespace morphoflow {
 
 namespace {
 constexpr int kGroup = 8;  // 8 x 8 (x 4 in 3D) invocations a work group
-}
-
-std::string gpuReaction(const std::string& model) {
-  // The two-species models of rd/models.h, term for term (p[k]: the model's k-th parameter).
-  static const std::map<std::string, std::string> reactions = {
-      {"turing", "r = p[0] * vec2(p[1] - u * v, u * v - v - p[2]);"},
-      {"turing-sanderson", "r = p[0] * vec2(u * v - u - p[1], p[2] - u * v);"},
-      {"gray-scott", "{ float uvv = u * v * v; r = vec2(-uvv + p[0] * (1.0 - u), uvv - (p[0] + p[1]) * v); }"},
-      {"gray-scott-sanderson", "{ float aab = u * u * v; r = p[0] * vec2(aab - (p[1] + p[2]) * u, -aab + p[1] * (1.0 - v)); }"},
-      {"fitzhugh-nagumo", "r = vec2(u - u * u * u - v, p[0] * (u - p[2] * v - p[1]));"},
-      {"barkley", "r = vec2(u * (1.0 - u) * (u - (v + p[1]) / p[0]) / p[2], u - v);"},
-      {"barkley-turbulent", "r = vec2(u * (1.0 - u) * (u - (v + p[1]) / p[0]) / p[2], u * u * u - v);"},
-      {"meinhardt", "{ float B = v < 1e-9 ? 1e-9 : v, aa = 0.01 * p[1] * u * u; "
-                    "r = p[0] * vec2(p[2] * u + aa / B + p[4], p[3] * v + aa); }"},
-      {"brusselator", "{ float aab = u * u * v; r = p[0] * vec2(p[1] - (1.0 + p[2]) * u + aab, p[2] * u - aab); }"},
-      {"gierer-meinhardt", "{ float b = v < 1e-9 ? 1e-9 : v; r = p[0] * vec2(p[3] + u * u / b - p[1] * u, u * u - p[2] * v); }"},
-      {"oregonator", "{ float a = u < 0.0 ? 0.0 : u; r = vec2((u - u * u - p[1] * v * (a - p[2]) / (a + p[2])) / p[0], u - v); }"},
-  };
-  const auto it = reactions.find(model);
-  return it == reactions.end() ? "" : it->second;
 }
 
 GpuExplicitRD::GpuExplicitRD(const RDSettings& s, const std::vector<double>& diffusion, const std::vector<double>& params,
@@ -46,7 +26,7 @@ GpuExplicitRD::GpuExplicitRD(const RDSettings& s, const std::vector<double>& dif
   periodic_ = s.boundary == RDBoundary::Periodic;
   const std::string reaction = gpuReaction(s.model);
   program_ = std::make_unique<ComputeProgram>(
-      "rd_explicit.comp", fmt::format("#define DIM {}\n#define REACTION(u, v, r) {}\nlayout(local_size_x = {}, local_size_y = {}, "
+      "rd_explicit.comp", fmt::format("#define DIM {}\n{}\nlayout(local_size_x = {}, local_size_y = {}, "
                                       "local_size_z = {}) in;",
                                       D, reaction, kGroup, kGroup, D == 3 ? 4 : 1));
   glCreateBuffers(4, buffers_.data());

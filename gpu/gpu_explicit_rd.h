@@ -8,15 +8,12 @@
 #include <string>
 #include <vector>
 
+#include "gpu/gpu_models.h"
 #include "rd/rd_settings.h"
 
 namespace morphoflow {
 
 class ComputeProgram;
-
-// The GLSL body of REACTION(u, v, r) for a two-species model (its
-// parameters in the uniform p[8], in order), or "" when it has no GPU program yet.
-std::string gpuReaction(const std::string& model);
 
 class GpuExplicitRD {
  public:

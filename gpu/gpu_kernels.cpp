@@ -11,12 +11,33 @@
 
 namespace morphoflow {
 
+namespace {
+// The shader's text with each line `#include "NAME"` replaced by shaders/NAME
+// (GLSL has no includes of its own without an extension).
+std::string expandIncludes(const std::string& text) {
+  std::string out;
+  size_t at = 0;
+  while (at < text.size()) {
+    size_t end = text.find('\n', at);
+    if (end == std::string::npos) end = text.size();
+    const std::string line = text.substr(at, end - at);
+    const size_t q = line.find('"');
+    if (line.rfind("#include \"", 0) == 0 && q != std::string::npos)
+      out += shaderSource(line.substr(q + 1, line.find('"', q + 1) - q - 1)) + "\n";
+    else
+      out += line + "\n";
+    at = end + 1;
+  }
+  return out;
+}
+}  // namespace
+
 const ComputeProgram& useKernel(const std::string& shader, const std::string& defines) {
   static std::map<std::string, std::unique_ptr<ComputeProgram>> programs;
   const std::string key = shader + "\n" + defines;
   auto it = programs.find(key);
   if (it == programs.end())
-    it = programs.emplace(key, std::make_unique<ComputeProgram>(shader, defines + "\n" + shaderSource("common.glsl"))).first;
+    it = programs.emplace(key, std::make_unique<ComputeProgram>(shader, defines + "\n" + shaderSource("common.glsl"), expandIncludes)).first;
   it->second->use();
   return *it->second;
 }

@@ -1,7 +1,7 @@
 // One explicit Euler step of a two-species reaction-diffusion model
 // (rd_settings.h: x += dt (R(x) + d lap x)), the 5- or 7-point Laplacian with
 // periodic or zero-flux walls. The host prepends #version, DIM, the model's
-// REACTION(u, v, p) and the work-group size.
+// RATES(x, r) (gpu/gpu_models.h) and the work-group size.
 layout(std430, binding = 0) readonly buffer InU { float inU[]; };
 layout(std430, binding = 1) readonly buffer InV { float inV[]; };
 layout(std430, binding = 2) writeonly buffer OutU { float outU[]; };
@@ -35,8 +35,9 @@ void main() {
       lapU += inU[j] - u;
       lapV += inV[j] - v;
     }
-  vec2 r;
-  REACTION(u, v, r);
-  outU[i] = u + dt * (r.x + dOverH2.x * lapU);
-  outV[i] = v + dt * (r.y + dOverH2.y * lapV);
+  const float x[2] = float[2](u, v);
+  float r[2];
+  RATES(x, r)
+  outU[i] = u + dt * (r[0] + dOverH2.x * lapU);
+  outV[i] = v + dt * (r[1] + dOverH2.y * lapV);
 }

@@ -7,6 +7,7 @@
 // OP_TO_FLOAT   f = float(x / sqrt(S[rr]))       (into a multigrid level)
 // OP_FROM_FLOAT z = double(f) sqrt(S[rr])
 // OP_SCALE_ADD  y = a x + b y (a, b uniforms)
+// OP_CLAMP_ZERO y = max(y, 0)
 layout(std430, binding = 0) buffer X { double x[]; };
 layout(std430, binding = 1) buffer Y { double y[]; };
 layout(std430, binding = 2) buffer Z { double z[]; };
@@ -39,5 +40,7 @@ void main() {
   y[i] = double(f[i]) * sqrt(S[slots.x]);
 #elif defined(OP_SCALE_ADD)
   y[i] = ca * x[i] + cb * y[i];
+#elif defined(OP_CLAMP_ZERO)
+  y[i] = max(y[i], 0.0lf);
 #endif
 }

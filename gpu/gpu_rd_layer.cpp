@@ -1,0 +1,194 @@
+#include "gpu/gpu_rd_layer.h"
+
+#include <epoxy/gl.h>
+#include <fmt/format.h>
+
+#include "core/multigrid.h"
+#include "gpu/compute_program.h"
+#include "gpu/gpu_kernels.h"
+#include "gpu/gpu_laplace.h"
+#include "gpu/gpu_models.h"
+#include "gpu/gpu_multigrid.h"
+#include "gpu/gpu_pcg.h"
+
+namespace morphoflow {
+
+namespace {
+// As rd/rd_solver.cpp: three smoothing sweeps each way.
+const MultigridOptions kDiffusionCycle{3, 3, 4};
+}  // namespace
+
+// One species' implicit system for the current theta dt, its solver, and the
+// last step's diffusive change (the warm start).
+template <int D>
+struct GpuRDLayer<D>::Diffusion {
+  double thetaDt = -1.0;
+  AnisotropicSystem<D> host;  // the shifted system, I + theta dt d (-lap)
+  std::unique_ptr<GpuLaplace> A;
+  std::unique_ptr<GpuMultigrid> M;
+  std::unique_ptr<GpuPcg> pcg;
+  GpuBuffer increment;
+  double incrementThetaDt = 0.0;
+  bool hasIncrement = false;
+};
+
+template <int D>
+GpuRDLayer<D>::GpuRDLayer(const RDSolver<D>& rd) : rd_(rd), n_(rd.field(0).size()) {
+  for (size_t k = 0; k < rd.model().info().parameters.size() && k < params_.size(); ++k) params_[k] = rd.parameter(int(k));
+  for (int s : rd.model().info().clamped) clamped_ |= 1u << s;
+  for (int s = 0; s < 2; ++s) {
+    x_[size_t(s)] = GpuBuffer::of(rd.field(s).values());
+    rates_[size_t(s)] = GpuBuffer(n_ * sizeof(double));
+    work_[size_t(s)] = GpuBuffer(n_ * sizeof(double));
+    diffusion_[size_t(s)] = std::make_unique<Diffusion>();
+    diffusion_[size_t(s)]->increment = GpuBuffer(n_ * sizeof(double));
+  }
+  stats_buffer_ = GpuBuffer(2 * sizeof(uint32_t));
+  laplacian_ = std::make_unique<GpuLaplace>(rd.diffusionOperator(0).axis);
+}
+
+template <int D>
+GpuRDLayer<D>::~GpuRDLayer() = default;
+
+template <int D>
+size_t GpuRDLayer<D>::deviceBytes(size_t n) {
+  // species, rates, work; per species a system (D weights, diagonal), PCG
+  // vectors and the increment; the explicit Laplacian; a multigrid's levels.
+  return n * (6 * 8 + 2 * ((D + 1) * 4 + 4 * 8 + 8 + 3 * 4 * 2) + (D + 1) * 4);
+}
+
+template <int D>
+void GpuRDLayer<D>::vectorOp(const char* op, const GpuBuffer& x, GpuBuffer* y, double a, double b) const {
+  const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + op);
+  setUniform(p, "n", int(n_));
+  setUniform(p, "ca", a);
+  setUniform(p, "cb", b);
+  x.bind(0);
+  y->bind(1);
+  for (int k = 2; k <= 6; ++k) x.bind(k);
+  dispatchFlat(n_);
+  storageBarrier();
+}
+
+template <int D>
+void GpuRDLayer<D>::react(double dt, bool implicit) {
+  const ComputeProgram& p = useKernel(
+      "rd_react.comp", gpuReaction(rd_.settings().model, true) + (implicit ? "#define MODE_IMPLICIT" : "#define MODE_RATES"));
+  setUniform(p, "n", int(n_));
+  setUniform(p, "dt", dt);
+  glUniform1dv(p.uniform("p"), GLsizei(params_.size()), params_.data());
+  glUniform1ui(p.uniform("clamped"), clamped_);
+  x_[0].bind(0);
+  x_[1].bind(1);
+  rates_[0].bind(2);
+  rates_[1].bind(3);
+  stats_buffer_.bind(4);
+  dispatchFlat(n_);
+  storageBarrier();
+}
+
+// Solves (I - theta dt d lap) x' = x in place for species s.
+template <int D>
+SolverResult GpuRDLayer<D>::diffuse(int s, double thetaDt) {
+  const double d = rd_.diffusion()[size_t(s)];
+  if (d == 0.0 || thetaDt == 0.0) return SolverResult{true, 0, 0.0};
+  Diffusion& df = *diffusion_[size_t(s)];
+  if (df.thetaDt != thetaDt) {
+    df.host = rd_.diffusionOperator(s).shifted(thetaDt * d);
+    if (df.A)
+      df.A->update(df.host.axis);
+    else
+      df.A = std::make_unique<GpuLaplace>(df.host.axis);
+    df.pcg = std::make_unique<GpuPcg>(*df.A);
+    // multigrid once diffusion dominates the identity, the diagonal below
+    const double scale = thetaDt * d / (rd_.h() * rd_.h());
+    df.M = scale > 1.0 ? std::make_unique<GpuMultigrid>(Multigrid<D>(df.host.axis, kDiffusionCycle), *df.A, kDiffusionCycle)
+                       : nullptr;
+    df.thetaDt = thetaDt;
+  }
+  GpuBuffer& b = x_[size_t(s)];
+  GpuBuffer& x = work_[size_t(s)];
+  // warm start: b plus the last change, rescaled to this theta dt
+  x.copyFrom(b, n_ * sizeof(double));
+  if (df.hasIncrement) vectorOp("OP_SCALE_ADD", df.increment, &x, thetaDt / df.incrementThetaDt, 1.0);
+  const SolverResult r = df.pcg->solve(&b, &x, df.M.get(), {rd_.settings().tolerance, 2000});
+  df.increment.copyFrom(x, n_ * sizeof(double));
+  vectorOp("OP_SCALE_ADD", b, &df.increment, -1.0, 1.0);
+  df.incrementThetaDt = thetaDt;
+  df.hasIncrement = true;
+  std::swap(x_[size_t(s)], work_[size_t(s)]);
+  return r;
+}
+
+template <int D>
+void GpuRDLayer<D>::step(double dt) {
+  stats_ = RDStepStats{};
+  stats_.diffusion.converged = true;
+  const RDIntegrator integ = rd_.settings().integrator;
+  const bool implicitReaction = integ == RDIntegrator::KimLin;
+  const double theta = integ == RDIntegrator::ExplicitEuler ? 0.0 : integ == RDIntegrator::CrankNicolson ? 0.5 : 1.0;
+  stats_buffer_.zero();
+  react(dt, implicitReaction);
+  for (int s = 0; s < 2; ++s) {
+    // the theta scheme's explicit part: x += dt R + (1 - theta) dt d lap x
+    const double explicitD = (1.0 - theta) * dt * rd_.diffusion()[size_t(s)];
+    if (explicitD > 0) laplacian_->apply(x_[size_t(s)], &work_[size_t(s)]);  // -lap x
+    if (!implicitReaction) vectorOp("OP_SCALE_ADD", rates_[size_t(s)], &x_[size_t(s)], dt, 1.0);
+    if (explicitD > 0) vectorOp("OP_SCALE_ADD", work_[size_t(s)], &x_[size_t(s)], -explicitD, 1.0);
+    const SolverResult r = diffuse(s, theta * dt);
+    stats_.diffusion.converged = stats_.diffusion.converged && r.converged;
+    stats_.diffusion.iterations = std::max(stats_.diffusion.iterations, r.iterations);
+    stats_.diffusion.residual = std::max(stats_.diffusion.residual, r.residual);
+  }
+  for (int s = 0; s < 2; ++s)
+    if ((clamped_ >> s) & 1u) vectorOp("OP_CLAMP_ZERO", x_[size_t(s)], &x_[size_t(s)], 0.0, 0.0);
+  if (implicitReaction) {
+    const std::vector<uint32_t> st = stats_buffer_.read<uint32_t>(2);
+    stats_.newton.cells = long(n_);
+    stats_.newton.failures = long(st[0]);
+    stats_.newton.maxIterations = int(st[1]);
+  }
+}
+
+template <int D>
+void GpuRDLayer<D>::upload(int s, const std::vector<double>& values) {
+  x_[size_t(s)].upload(values);
+}
+
+template <int D>
+std::vector<double> GpuRDLayer<D>::download(int s) const {
+  return x_[size_t(s)].read<double>(n_);
+}
+
+template <int D>
+void GpuRDLayer<D>::save(StateWriter* out) const {
+  for (int s = 0; s < 2; ++s) {
+    const Diffusion& df = *diffusion_[size_t(s)];
+    const std::string p = "gpu.rd." + std::to_string(s) + ".";
+    out->put(p + "has_increment", df.hasIncrement ? 1 : 0);
+    out->put(p + "increment_theta_dt", df.incrementThetaDt);
+    if (df.hasIncrement) out->putVector(p + "increment", df.increment.template read<double>(n_));
+  }
+}
+
+template <int D>
+void GpuRDLayer<D>::load(const StateReader& in) {
+  for (int s = 0; s < 2; ++s) {
+    Diffusion& df = *diffusion_[size_t(s)];
+    const std::string p = "gpu.rd." + std::to_string(s) + ".";
+    int has = 0;
+    in.get(p + "has_increment", &has);
+    in.get(p + "increment_theta_dt", &df.incrementThetaDt);
+    df.hasIncrement = has != 0;
+    if (df.hasIncrement) {
+      std::vector<double> v(n_);
+      in.getVector(p + "increment", &v);
+      df.increment.upload(v);
+    }
+  }
+}
+
+template class GpuRDLayer<2>;
+template class GpuRDLayer<3>;
+
+}  // namespace morphoflow

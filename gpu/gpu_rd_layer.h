@@ -1,0 +1,67 @@
+// A reaction-diffusion layer (rd/rd_solver.h) on the GPU, double precision:
+// the species in storage buffers, the reaction of a two-species model
+// (Kim & Lin's per-cell Newton, or the rates for the explicit and
+// semi-implicit integrators; shaders/rd_react.comp), then every integrator's
+// theta scheme on the isotropic diffusion, (I - theta dt d lap) x' = x + ...,
+// solved by CG (diagonal preconditioner while the identity dominates, one
+// multigrid V-cycle beyond, as on the CPU) to rd.tolerance, warm-started from
+// the last step's diffusive change. Uniform parameters, periodic or
+// zero-flux walls: the host refuses the rest (app/gpu_simulation.cpp).
+#pragma once
+
+#include <array>
+#include <memory>
+#include <vector>
+
+#include "core/state_archive.h"
+#include "gpu/gpu_buffer.h"
+#include "rd/rd_solver.h"
+
+namespace morphoflow {
+
+class GpuLaplace;
+class GpuMultigrid;
+class GpuPcg;
+
+template <int D>
+class GpuRDLayer {
+ public:
+  // The settings, model, parameters, diffusion operator and initial species
+  // of `rd` (which must outlive this).
+  explicit GpuRDLayer(const RDSolver<D>& rd);
+  ~GpuRDLayer();
+  GpuRDLayer(const GpuRDLayer&) = delete;
+  GpuRDLayer& operator=(const GpuRDLayer&) = delete;
+
+  void step(double dt);
+  // Newton failures and iterations, the worst diffusion solve.
+  const RDStepStats& lastStats() const { return stats_; }
+  int species() const { return 2; }
+  size_t cells() const { return n_; }
+  GpuBuffer& field(int s) { return x_[size_t(s)]; }
+  void upload(int s, const std::vector<double>& values);
+  std::vector<double> download(int s) const;
+  // The warm starts of the diffusion solves (checkpoints).
+  void save(StateWriter* out) const;
+  void load(const StateReader& in);
+  // Device bytes a layer of n cells allocates (its solvers included).
+  static size_t deviceBytes(size_t n);
+
+ private:
+  struct Diffusion;
+  void react(double dt, bool implicit);
+  SolverResult diffuse(int s, double thetaDt);
+  void vectorOp(const char* op, const GpuBuffer& x, GpuBuffer* y, double a, double b) const;
+
+  const RDSolver<D>& rd_;
+  size_t n_ = 0;
+  std::array<double, 12> params_{};
+  unsigned clamped_ = 0;
+  std::array<GpuBuffer, 2> x_, rates_, work_;
+  GpuBuffer stats_buffer_;
+  std::unique_ptr<GpuLaplace> laplacian_;  // -lap (scale 1/h^2): the explicit part
+  std::array<std::unique_ptr<Diffusion>, 2> diffusion_;
+  RDStepStats stats_;
+};
+
+}  // namespace morphoflow
