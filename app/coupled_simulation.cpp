@@ -7,6 +7,9 @@
 #include <fmt/format.h>
 
 #include "app/fluid_simulation.h"
+#include "app/gpu_simulation.h"
+#include "coupling/gpu_ard_solver.h"
+#include "core/stage_trace.h"
 #include "app/rd_scene_setup.h"
 #include "core/parallel.h"
 #include "rd/model_registry.h"
@@ -49,34 +52,88 @@ CouplingMode couplingMode(const std::string& mode) {
 }  // namespace
 
 template <int D>
-CoupledSimulation<D>::CoupledSimulation(const Scene& scene, CouplingBackend backend, Warn warn)
+struct CoupledSimulation<D>::Gpu {
+  GpuFluid<D> fluid;
+  GpuRDLayer<D> layer;
+  GpuARDSolver<D> ard;
+  Gpu(const Scene& scene, const FluidSolver<D>& f, const RDSolver<D>& rd, const ChemicalDomain<D>& domain)
+      : fluid(scene.fluid, f.constraints()),
+        layer(rd),
+        ard(&layer, domain, scene.coupling.interpolation == "cubic" ? ChemicalInterpolation::Cubic : ChemicalInterpolation::Linear,
+            couplingMode(scene.coupling.mode), scene.coupling.rdTimeScale, f.cells(), f.h()) {
+    fluid.upload(f.velocity(), f.dye());
+  }
+};
+
+template <int D>
+CoupledSimulation<D>::CoupledSimulation(const Scene& scene, CouplingBackend backend, Warn warn, bool gpu)
     : scene_(scene), backend_(backend), warn_(std::move(warn)), fluid_(scene.fluid), rd_(scene.rd.settings, *findModel(scene.rd.settings.model)) {
   checkFluidLeft<D>(scene, fluid_);
   initialState<D>(scene, &rd_);
   applyScene<D>(scene, &rd_);
   const CouplingScene& C = scene.coupling;
+  const ChemicalDomain<D> domain = chemicalDomain<D>(scene, fluid_, rd_);
   ard_ = std::make_unique<ARDSolver<D>>(
-      &rd_,
-      ChemicalAdvector<D>(chemicalDomain<D>(scene, fluid_, rd_),
-                          C.interpolation == "cubic" ? ChemicalInterpolation::Cubic : ChemicalInterpolation::Linear),
+      &rd_, ChemicalAdvector<D>(domain, C.interpolation == "cubic" ? ChemicalInterpolation::Cubic : ChemicalInterpolation::Linear),
       couplingMode(C.mode), C.rdTimeScale);
   stepper_ = std::make_unique<CoupledStepper<D>>(&fluid_, ard_.get(), backend);
+  if (gpu) gpu_ = std::make_unique<Gpu>(scene, fluid_, rd_, domain);  // from the state the CPU set up
+}
+
+template <int D>
+CoupledSimulation<D>::~CoupledSimulation() = default;
+
+template <int D>
+double CoupledSimulation<D>::cflTimeStep(double cfl, double dtMax) const {
+  return gpu_ ? gpu_->fluid.cflTimeStep(cfl, dtMax) : fluid_.cflTimeStep(cfl, dtMax);
+}
+
+// The ARD step reads velocity n, then the fluid writes n + 1: the CPU's
+// serial order (coupled_stepper.h), with no copy of the velocity needed.
+template <int D>
+void CoupledSimulation<D>::stepGpu(double dt) {
+  const double t0 = traceClock();
+  gpu_->ard.step(dt, gpu_->fluid);
+  const double t1 = traceClock();
+  gpu_->fluid.step(dt);
+  const double t2 = traceClock();
+  ardSeconds_ += t1 - t0;
+  fluidSeconds_ += t2 - t1;
+  stepSeconds_ += t2 - t0;
+  time_ += dt;
+  ++steps_;
+  hostStale_ = true;
+}
+
+template <int D>
+void CoupledSimulation<D>::syncHost() const {
+  if (!gpu_ || !hostStale_) return;
+  gpu_->fluid.download(&fluid_.velocity(), &fluid_.dye());
+  fluid_.adopt(time_, steps_, gpu_->fluid.phi(), gpu_->fluid.lastDt());
+  for (int s = 0; s < 2; ++s) rd_.field(s).values() = gpu_->layer.download(s);
+  hostStale_ = false;
 }
 
 template <int D>
 void CoupledSimulation<D>::step(double dt) {
-  stepper_->step(dt);
-  fluidSeconds_ += stepper_->fluidSeconds();
-  ardSeconds_ += stepper_->ardSeconds();
-  stepSeconds_ += stepper_->stepSeconds();
-  pressureIterations_ += fluid_.lastStats().pressure.iterations;
-  diffusionIterations_ += rd_.lastStats().diffusion.iterations;
-  const SolverResult& pressure = fluid_.lastStats().pressure;
+  if (gpu_) {
+    stepGpu(dt);
+  } else {
+    stepper_->step(dt);
+    fluidSeconds_ += stepper_->fluidSeconds();
+    ardSeconds_ += stepper_->ardSeconds();
+    stepSeconds_ += stepper_->stepSeconds();
+  }
+  const FluidStepStats& fs = gpu_ ? gpu_->fluid.lastStats() : fluid_.lastStats();
+  pressureIterations_ += fs.pressure.iterations;
+  diffusionIterations_ += (gpu_ ? gpu_->layer.lastStats() : rd_.lastStats()).diffusion.iterations;
+  const SolverResult& pressure = fs.pressure;
   if (!pressure.converged && unconverged_++ == 0)
     warn_(fmt::format("warning: step {}: pressure solve stopped at relative residual {:.2e} after {} iterations",
-                      fluid_.steps(), pressure.residual, pressure.iterations));
-  if (!std::isfinite(fluid_.maxSpeed()))
-    throw NonFiniteError(fmt::format("the simulation diverged at step {} in the fluid step: the velocity is not finite", fluid_.steps()),
+                      steps(), pressure.residual, pressure.iterations));
+  // (gpu: a velocity that is not finite makes the pressure residual NaN)
+  if (gpu_ ? !std::isfinite(pressure.residual) : !std::isfinite(fluid_.maxSpeed()))
+    throw NonFiniteError(fmt::format("the simulation diverged at step {} in the fluid step: the velocity is not finite", steps()),
                          "use a smaller time.dt or set time.cfl, and check the forces and boundary speeds");
 }
 
@@ -89,6 +146,7 @@ std::vector<std::string> CoupledSimulation<D>::fieldNames() const {
 
 template <int D>
 std::vector<Grid<float, D>> CoupledSimulation<D>::field(const std::string& name) const {
+  syncHost();
   const std::vector<std::string> sp = species();
   if (std::find(sp.begin(), sp.end(), name) != sp.end()) return speciesField<D>(rd_, name);
   return fluidField<D>(fluid_, name);
@@ -96,14 +154,20 @@ std::vector<Grid<float, D>> CoupledSimulation<D>::field(const std::string& name)
 
 template <int D>
 void CoupledSimulation<D>::checkFinite(const std::string& when) const {
+  syncHost();
   checkFluidFinite<D>(fluid_, when);
   morphoflow::checkFinite<D>(rd_, when, "the advection-reaction-diffusion step (" + rdStage(rd_.settings()) + ")");
 }
 
 template <int D>
 void CoupledSimulation<D>::save(StateWriter* out) const {
+  syncHost();
   fluid_.save(out);
   rd_.save(out);
+  if (gpu_) {
+    gpu_->fluid.save(out);
+    gpu_->layer.save(out);
+  }
   out->put("coupled.stats.seconds", std::array<double, 3>{fluidSeconds_, ardSeconds_, stepSeconds_});
   out->put("coupled.stats.iterations", std::array<long, 2>{pressureIterations_, diffusionIterations_});
   out->put("coupled.stats.unconverged", unconverged_);
@@ -113,6 +177,14 @@ template <int D>
 void CoupledSimulation<D>::load(const StateReader& in) {
   fluid_.load(in);
   rd_.load(in);
+  if (gpu_) {
+    gpu_->fluid.upload(fluid_.velocity(), fluid_.dye());
+    gpu_->fluid.load(in);
+    for (int s = 0; s < 2; ++s) gpu_->layer.upload(s, rd_.field(s).values());
+    gpu_->layer.load(in);
+    time_ = fluid_.time();
+    steps_ = fluid_.steps();
+  }
   std::array<double, 3> s{};
   std::array<long, 2> it{};
   in.get("coupled.stats.seconds", &s);
@@ -143,11 +215,12 @@ nlohmann::json CoupledSimulation<D>::resolved() const {
 
 template <int D>
 void CoupledSimulation<D>::report(nlohmann::json* j) const {
-  const double steps = double(fluid_.steps());
+  const double steps = double(this->steps());
+  if (gpu_) recordGlContext(j);
   (*j)["coupling"] = {{"fluid_seconds", fluidSeconds_},
                       {"ard_seconds", ardSeconds_},
                       {"step_seconds", stepSeconds_},
-                      {"overlapped", backend_ != CouplingBackend::Serial}};
+                      {"overlapped", !gpu_ && backend_ != CouplingBackend::Serial}};
   (*j)["solvers"] = {{"pressure_iterations_mean", steps ? double(pressureIterations_) / steps : 0.0},
                      {"pressure_unconverged_steps", unconverged_},
                      {"diffusion_iterations_mean", steps ? double(diffusionIterations_) / steps : 0.0}};

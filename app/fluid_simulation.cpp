@@ -76,9 +76,7 @@ void FluidSimulation<D>::syncHost() const {
 
 template <int D>
 double FluidSimulation<D>::cflTimeStep(double cfl, double dtMax) const {
-  if (!gpu_) return fluid_.cflTimeStep(cfl, dtMax);
-  const double umax = gpu_->maxSpeed();
-  return umax > 0 ? std::min(dtMax, cfl * fluid_.h() / umax) : dtMax;
+  return gpu_ ? gpu_->cflTimeStep(cfl, dtMax) : fluid_.cflTimeStep(cfl, dtMax);
 }
 
 template <int D>

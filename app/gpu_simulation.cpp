@@ -10,6 +10,7 @@
 #include "gpu/gl_context.h"
 #include "gpu/gpu_explicit_rd.h"
 #include "gpu/gpu_fluid.h"
+#include "gpu/gpu_rd_layer.h"
 #include "rd/model_registry.h"
 #include "rd/rd_solver.h"
 
@@ -20,12 +21,7 @@ namespace {
 // The first stage of the scene with no GPU program, or "".
 std::string missingStage(const Scene& s) {
   const RDScene& rd = s.rd;
-  if (s.hasFluid)
-    return rd.enabled ? "the advection-reaction-diffusion coupling ([coupling]: the fluid runs on the gpu, the chemicals "
-                        "carried by it do not yet)"
-                      : "";
-  if (rd.settings.integrator != RDIntegrator::ExplicitEuler)
-    return "the implicit reaction-diffusion integrators (kim-lin, semi-implicit, crank-nicolson); integrator = \"explicit\" runs";
+  if (s.hasFluid && !rd.enabled) return "";
   if (gpuReaction(rd.settings.model).empty())
     return "the reaction of model " + rd.settings.model + " (the GPU has the two-species models)";
   if (rd.settings.boundary == RDBoundary::Dirichlet) return "Dirichlet walls (rd.boundary = \"dirichlet\")";
@@ -65,13 +61,18 @@ void checkGpuRuns(const Scene& scene) {
                     "run this scene with --backend tbb; docs/gpu.md lists what the gpu backend runs");
   const GpuInfo g = gpuInfo();
   if (!g.available) throw UserError({"--backend", 0, 0}, "", "no usable GPU context: " + g.reason, "use --backend tbb");
-  // Checked before anything is allocated: the fluid's buffers, or two per species (float).
+  // Checked before anything is allocated: the fluid's buffers, and the
+  // layer's (two float buffers per species for the explicit step).
   size_t cells = 1;
   for (int n : scene.rd.settings.resolution) cells *= size_t(n);
-  size_t need = 4 * cells * sizeof(float);
+  size_t need = 0;
+  if (scene.rd.enabled)
+    need = scene.rd.settings.integrator == RDIntegrator::ExplicitEuler && !scene.hasFluid ? 4 * cells * sizeof(float)
+           : scene.dimension == 2 ? GpuRDLayer<2>::deviceBytes(cells)
+                                  : GpuRDLayer<3>::deviceBytes(cells);
   if (scene.hasFluid) {
     const std::vector<int>& r = scene.fluid.resolution;
-    need = scene.dimension == 2 ? GpuFluid<2>::deviceBytes({r[0], r[1]}) : GpuFluid<3>::deviceBytes({r[0], r[1], r[2]});
+    need += scene.dimension == 2 ? GpuFluid<2>::deviceBytes({r[0], r[1]}) : GpuFluid<3>::deviceBytes({r[0], r[1], r[2]});
   }
   const size_t have = GlContext::instance().availableBytes();
   if (have > 0 && need > have)
@@ -84,19 +85,28 @@ void checkGpuRuns(const Scene& scene) {
 template <int D>
 GpuRDSimulation<D>::GpuRDSimulation(const Scene& scene) : scene_(scene) {
   // The initial state as the CPU builds it, then only the GPU steps.
-  RDSolver<D> init(scene.rd.settings, *findModel(scene.rd.settings.model));
-  initialState<D>(scene, &init);
-  applyScene<D>(scene, &init);
-  species_ = init.model().info().species;
-  cells_ = init.field(0).dims();
-  explicitLimit_ = init.explicitDiffusionLimit();
+  auto init = std::make_unique<RDSolver<D>>(scene.rd.settings, *findModel(scene.rd.settings.model));
+  initialState<D>(scene, init.get());
+  applyScene<D>(scene, init.get());
+  species_ = init->model().info().species;
+  cells_ = init->field(0).dims();
+  explicitLimit_ = init->explicitDiffusionLimit();
+  if (scene.rd.settings.integrator != RDIntegrator::ExplicitEuler) {  // double precision, every integrator
+    host_ = std::move(init);
+    layer_ = std::make_unique<GpuRDLayer<D>>(*host_);
+    return;
+  }
   std::vector<double> params;
-  for (size_t k = 0; k < init.model().info().parameters.size(); ++k) params.push_back(init.parameter(int(k)));
-  auto values = [&](int s) {
-    const Grid<float, D> f = toFloat<D>(init.field(s));
-    return f.values();
-  };
-  gpu_ = std::make_unique<GpuExplicitRD>(scene.rd.settings, init.diffusion(), params, values(0), values(1));
+  for (size_t k = 0; k < init->model().info().parameters.size(); ++k) params.push_back(init->parameter(int(k)));
+  auto values = [&](int s) { return toFloat<D>(init->field(s)).values(); };
+  gpu_ = std::make_unique<GpuExplicitRD>(scene.rd.settings, init->diffusion(), params, values(0), values(1));
+}
+
+template <int D>
+std::vector<float> GpuRDSimulation<D>::download(int s) const {
+  if (gpu_) return gpu_->download(s);
+  const std::vector<double> v = layer_->download(s);
+  return std::vector<float>(v.begin(), v.end());
 }
 
 template <int D>
@@ -104,7 +114,10 @@ GpuRDSimulation<D>::~GpuRDSimulation() = default;
 
 template <int D>
 void GpuRDSimulation<D>::step(double dt) {
-  gpu_->step(dt);
+  if (gpu_)
+    gpu_->step(dt);
+  else
+    layer_->step(dt);
   time_ += dt;
   ++steps_;
 }
@@ -114,7 +127,7 @@ std::vector<Grid<float, D>> GpuRDSimulation<D>::field(const std::string& name) c
   for (size_t s = 0; s < species_.size(); ++s)
     if (species_[s] == name) {
       Grid<float, D> g(cells_, 0.0f);
-      g.values() = gpu_->download(int(s));
+      g.values() = download(int(s));
       return {g};
     }
   throw std::invalid_argument("no species '" + name + "'");
@@ -123,21 +136,28 @@ std::vector<Grid<float, D>> GpuRDSimulation<D>::field(const std::string& name) c
 template <int D>
 void GpuRDSimulation<D>::checkFinite(const std::string& when) const {
   for (size_t s = 0; s < species_.size(); ++s)
-    for (float v : gpu_->download(int(s)))
+    for (float v : download(int(s)))
       if (!std::isfinite(v))
-        throw NonFiniteError(fmt::format("the simulation diverged {} in the explicit reaction-diffusion step (gpu): species {} "
+        throw NonFiniteError(fmt::format("the simulation diverged {} in the reaction-diffusion step (gpu, {}): species {} "
                                          "is not finite",
-                                         when, species_[s]),
-                             fmt::format("the explicit integrator's limit for this diffusion is time.dt = {:.4g}, and a "
-                                         "stiff reaction needs less",
-                                         explicitLimit_));
+                                         when, rdStage(scene_.rd.settings), species_[s]),
+                             gpu_ ? fmt::format("the explicit integrator's limit for this diffusion is time.dt = {:.4g}, and a "
+                                                "stiff reaction needs less",
+                                                explicitLimit_)
+                                  : std::string("use a smaller time.dt"));
 }
 
 template <int D>
 void GpuRDSimulation<D>::save(StateWriter* out) const {
   out->put("gpu.rd.time", time_);
   out->put("gpu.rd.steps", steps_);
-  for (size_t s = 0; s < species_.size(); ++s) out->putVector("gpu.rd.species." + species_[s], gpu_->download(int(s)));
+  for (size_t s = 0; s < species_.size(); ++s) {
+    if (gpu_)
+      out->putVector("gpu.rd.species." + species_[s], gpu_->download(int(s)));
+    else
+      out->putVector("gpu.rd.layer." + species_[s], layer_->download(int(s)));
+  }
+  if (layer_) layer_->save(out);
 }
 
 template <int D>
@@ -145,10 +165,17 @@ void GpuRDSimulation<D>::load(const StateReader& in) {
   in.get("gpu.rd.time", &time_);
   in.get("gpu.rd.steps", &steps_);
   for (size_t s = 0; s < species_.size(); ++s) {
-    std::vector<float> v(gpu_->cells());
-    in.getVector("gpu.rd.species." + species_[s], &v);
-    gpu_->upload(int(s), v);
+    if (gpu_) {
+      std::vector<float> v(gpu_->cells());
+      in.getVector("gpu.rd.species." + species_[s], &v);
+      gpu_->upload(int(s), v);
+    } else {
+      std::vector<double> v(layer_->cells());
+      in.getVector("gpu.rd.layer." + species_[s], &v);
+      layer_->upload(int(s), v);
+    }
   }
+  if (layer_) layer_->load(in);
 }
 
 template <int D>

@@ -1,6 +1,9 @@
-// --backend gpu: the scenes whose every stage has a GPU program
-// (gpu/gpu_explicit_rd.h), as a Simulation. Any other scene is refused,
-// naming the first stage the GPU cannot run yet; nothing falls back to the CPU.
+// --backend gpu: which scenes the GPU runs (every stage has a GPU program;
+// any other scene is refused naming the first stage it lacks, and nothing
+// falls back to the CPU), and the reaction-diffusion-only scenes as a
+// Simulation: the explicit step in single precision (gpu/gpu_explicit_rd.h),
+// every other integrator in double (gpu/gpu_rd_layer.h). Fluid and coupled
+// scenes are FluidSimulation and CoupledSimulation on their gpu path.
 #pragma once
 
 #include <memory>
@@ -13,6 +16,10 @@
 namespace morphoflow {
 
 class GpuExplicitRD;
+template <int D>
+class GpuRDLayer;
+template <int D>
+class RDSolver;
 
 // Throws UserError naming the stage when the scene needs one the GPU backend
 // lacks, and when no OpenGL 4.3 context can be created (the reason).
@@ -52,7 +59,11 @@ class GpuRDSimulation : public Simulation<D> {
   std::vector<std::string> species_;
   IVec<D> cells_;
   double explicitLimit_ = 0.0;
-  std::unique_ptr<GpuExplicitRD> gpu_;
+  std::vector<float> download(int s) const;
+
+  std::unique_ptr<GpuExplicitRD> gpu_;           // the explicit step, single precision
+  std::unique_ptr<RDSolver<D>> host_;            // other integrators: the settings and operators
+  std::unique_ptr<GpuRDLayer<D>> layer_;         // ... stepped in double precision
   double time_ = 0.0;
   long steps_ = 0;
 };

@@ -108,6 +108,12 @@ size_t GpuFluid<D>::deviceBytes(const IVec<D>& cells) {
 }
 
 template <int D>
+double GpuFluid<D>::cflTimeStep(double cfl, double dtMax) const {
+  const double umax = maxSpeed();
+  return umax > 0 ? std::min(dtMax, cfl * h_ / umax) : dtMax;
+}
+
+template <int D>
 double GpuFluid<D>::maxSpeed() const {
   speed_->maxAbs(vel_, faceCount_, 0);
   return std::sqrt(double(D)) * speed_->read()[0];

@@ -42,6 +42,8 @@ class GpuFluid {
   const FluidStepStats& lastStats() const { return stats_; }
   // sqrt(D) max_a max |u_a|, as FluidSolver::maxSpeed (a bound of the speed).
   double maxSpeed() const;
+  // Largest dt with maxSpeed() dt <= cfl h (dtMax when the fluid is at rest), as FluidSolver's.
+  double cflTimeStep(double cfl, double dtMax) const;
   // Bytes of device memory a fluid of these cells allocates.
   static size_t deviceBytes(const IVec<D>& cells);
 

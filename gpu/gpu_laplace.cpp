@@ -16,6 +16,7 @@ GpuLaplace::GpuLaplace(const LaplaceSystem<D>& A) : dim_(D), n_(A.size()) {
   for (int a = 0; a < D; ++a) w_[size_t(a)] = GpuBuffer(n_ * sizeof(float));
   if (D == 2) w_[2] = GpuBuffer(sizeof(float));
   diag_ = GpuBuffer(n_ * sizeof(float));
+  c_ = GpuBuffer(n_ * sizeof(float));
   update(A);
 }
 
@@ -23,6 +24,7 @@ template <int D>
 void GpuLaplace::update(const LaplaceSystem<D>& A) {
   for (int a = 0; a < D; ++a) w_[size_t(a)].upload(A.w[a].values());
   diag_.upload(A.diag.values());
+  c_.upload(A.c.values());
   scale_ = A.scale;
   singular_ = A.singular();
 }
@@ -46,6 +48,7 @@ void GpuLaplace::run(const char* mode, bool single, const GpuBuffer& x, const Gp
   (b ? *b : x).bind(2);
   for (int a = 0; a < 3; ++a) w_[size_t(a < dim_ ? a : 0)].bind(3 + a);
   diag_.bind(6);
+  c_.bind(7);
   dispatchFlat(n_);
   storageBarrier();
 }

@@ -47,7 +47,7 @@ class GpuLaplace {
   double scale_ = 1.0;
   bool singular_ = false;
   std::array<GpuBuffer, 3> w_;
-  GpuBuffer diag_;
+  GpuBuffer diag_, c_;
 };
 
 }  // namespace morphoflow

@@ -1,0 +1,51 @@
+// GpuARDSolver<D>: the advection-reaction-diffusion layer of ard_solver.h on
+// the GPU, with the same modes: react and diffuse (gpu/gpu_rd_layer.h) over
+// rdTimeScale dt, then carry the species with the GPU fluid's velocity
+// (shaders/chem_advect.comp: the same feet, stencils, inflow blending and
+// solids as chemical_advection.h). The species never leave the GPU.
+#pragma once
+
+#include <array>
+#include <memory>
+
+#include "coupling/ard_solver.h"
+#include "coupling/chemical_advection.h"
+#include "gpu/gpu_buffer.h"
+#include "gpu/gpu_fluid.h"
+#include "gpu/gpu_rd_layer.h"
+
+namespace morphoflow {
+
+template <int D>
+class GpuARDSolver {
+ public:
+  // `layer` holds the species; `fluidCells`, `fluidH` and the domain's
+  // periodic axes place the fluid's velocity.
+  GpuARDSolver(GpuRDLayer<D>* layer, const ChemicalDomain<D>& domain, ChemicalInterpolation interpolation,
+               CouplingMode mode, double rdTimeScale, const IVec<D>& fluidCells, double fluidH);
+
+  // One step over dt of fluid time reading the fluid's current velocity
+  // (seed 001 eq. 6, 19, 20): react and diffuse over rdTimeScale dt, then advect over dt.
+  void step(double dt, const GpuFluid<D>& fluid);
+  // Sets the solid cells of both species to the solid values.
+  void emptySolids();
+  // Wall seconds of the last step's two stages (the queue drained at each end).
+  const std::array<double, ARDSolver<D>::kStages>& stageSeconds() const { return stageSeconds_; }
+
+ private:
+  void advect(double dt, const GpuFluid<D>& fluid);
+
+  GpuRDLayer<D>* layer_;
+  ChemicalDomain<D> domain_;
+  bool cubic_;
+  CouplingMode mode_;
+  double rdTimeScale_;
+  std::array<int, 3> fluidCells_{1, 1, 1}, rdCells_{1, 1, 1}, periodic_{};
+  double fluidH_;
+  bool hasSolids_ = false;
+  GpuBuffer solid_;
+  std::array<GpuBuffer, 2> scratch_;
+  std::array<double, ARDSolver<D>::kStages> stageSeconds_{};
+};
+
+}  // namespace morphoflow
