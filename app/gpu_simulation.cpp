@@ -24,9 +24,6 @@ std::string missingStage(const Scene& s) {
   if (s.hasFluid && !rd.enabled) return "";
   if (gpuReaction(rd.settings.model).empty())
     return "the reaction of model " + rd.settings.model + " (the GPU has the two-species models)";
-  if (rd.settings.boundary == RDBoundary::Dirichlet) return "Dirichlet walls (rd.boundary = \"dirichlet\")";
-  if (!rd.parameterMaps.empty() || !rd.perturb.empty()) return "parameter maps ([rd.maps], rd.perturb)";
-  if (!rd.fixed.empty() || !rd.settings.frozen.empty()) return "fixed regions and frozen species ([[rd.fixed]], rd.frozen)";
   if (rd.anisotropy.enabled) return "anisotropic diffusion ([rd.anisotropy])";
   if (rd.lobes.enabled) return "cosine-lobe diffusion ([rd.cosine_lobes])";
   if (rd.coarseLevels > 0) return "the coarse-to-fine start (rd.coarse_to_fine)";
@@ -66,10 +63,8 @@ void checkGpuRuns(const Scene& scene) {
   size_t cells = 1;
   for (int n : scene.rd.settings.resolution) cells *= size_t(n);
   size_t need = 0;
-  if (scene.rd.enabled)
-    need = scene.rd.settings.integrator == RDIntegrator::ExplicitEuler && !scene.hasFluid ? 4 * cells * sizeof(float)
-           : scene.dimension == 2 ? GpuRDLayer<2>::deviceBytes(cells)
-                                  : GpuRDLayer<3>::deviceBytes(cells);
+  if (scene.rd.enabled)  // (the double-precision layer's, an upper bound of the explicit step's)
+    need = scene.dimension == 2 ? GpuRDLayer<2>::deviceBytes(cells) : GpuRDLayer<3>::deviceBytes(cells);
   if (scene.hasFluid) {
     const std::vector<int>& r = scene.fluid.resolution;
     need += scene.dimension == 2 ? GpuFluid<2>::deviceBytes({r[0], r[1]}) : GpuFluid<3>::deviceBytes({r[0], r[1], r[2]});
@@ -91,7 +86,13 @@ GpuRDSimulation<D>::GpuRDSimulation(const Scene& scene) : scene_(scene) {
   species_ = init->model().info().species;
   cells_ = init->field(0).dims();
   explicitLimit_ = init->explicitDiffusionLimit();
-  if (scene.rd.settings.integrator != RDIntegrator::ExplicitEuler) {  // double precision, every integrator
+  // The plain explicit step in single precision; everything else (every
+  // integrator, maps, fixed regions, frozen species, Dirichlet walls) in double.
+  const RDScene& rd = scene.rd;
+  const bool plainExplicit = rd.settings.integrator == RDIntegrator::ExplicitEuler &&
+                             rd.settings.boundary != RDBoundary::Dirichlet && rd.parameterMaps.empty() &&
+                             rd.perturb.empty() && rd.fixed.empty() && rd.settings.frozen.empty();
+  if (!plainExplicit) {
     host_ = std::move(init);
     layer_ = std::make_unique<GpuRDLayer<D>>(*host_);
     return;

@@ -45,6 +45,27 @@ GpuRDLayer<D>::GpuRDLayer(const RDSolver<D>& rd) : rd_(rd), n_(rd.field(0).size(
   }
   stats_buffer_ = GpuBuffer(2 * sizeof(uint32_t));
   laplacian_ = std::make_unique<GpuLaplace>(rd.diffusionOperator(0).axis);
+  // parameter maps (and perturbations), concatenated
+  std::vector<double> maps;
+  mapAt_.fill(-1);
+  for (size_t k = 0; k < rd.model().info().parameters.size() && k < mapAt_.size(); ++k) {
+    const std::vector<double>& f = rd.parameterField(int(k));
+    if (f.empty()) continue;
+    mapAt_[k] = int(maps.size());
+    maps.insert(maps.end(), f.begin(), f.end());
+  }
+  maps_ = GpuBuffer::of(maps.empty() ? std::vector<double>{0.0} : maps);
+  for (int s = 0; s < 2; ++s) {
+    const size_t si = size_t(s);
+    if (si < rd.fixedMasks().size() && !rd.fixedMasks()[si].empty()) {
+      isFixed_[si] = true;
+      fixedMask_[si] = GpuBuffer::of(std::vector<uint32_t>(rd.fixedMasks()[si].begin(), rd.fixedMasks()[si].end()));
+      fixedValue_[si] = GpuBuffer::of(rd.fixedValues()[si]);
+    }
+    if (rd.settings().boundary == RDBoundary::Dirichlet) faces_[si] = GpuBuffer::of(rd.dirichletFaces(s));
+  }
+  for (int s : rd.settings().frozen) isFrozen_[size_t(s)] = true;
+  allHeld_ = GpuBuffer::of(std::vector<uint32_t>(isFrozen_[0] || isFrozen_[1] ? n_ : 1, 1u));
 }
 
 template <int D>
@@ -58,7 +79,8 @@ size_t GpuRDLayer<D>::deviceBytes(size_t n) {
 }
 
 template <int D>
-void GpuRDLayer<D>::vectorOp(const char* op, const GpuBuffer& x, GpuBuffer* y, double a, double b) const {
+void GpuRDLayer<D>::vectorOp(const char* op, const GpuBuffer& x, GpuBuffer* y, double a, double b,
+                             const GpuBuffer* held) const {
   const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + op);
   setUniform(p, "n", int(n_));
   setUniform(p, "ca", a);
@@ -66,17 +88,24 @@ void GpuRDLayer<D>::vectorOp(const char* op, const GpuBuffer& x, GpuBuffer* y, d
   x.bind(0);
   y->bind(1);
   for (int k = 2; k <= 6; ++k) x.bind(k);
+  (held ? *held : x).bind(7);
   dispatchFlat(n_);
   storageBarrier();
 }
 
 template <int D>
 void GpuRDLayer<D>::react(double dt, bool implicit) {
-  const ComputeProgram& p = useKernel(
-      "rd_react.comp", gpuReaction(rd_.settings().model, true) + (implicit ? "#define MODE_IMPLICIT" : "#define MODE_RATES"));
+  // Each parameter by a constant index, so the compiler keeps p[] in registers.
+  std::string gather = "#define GATHER_PARAMETERS";
+  for (size_t k = 0; k < rd_.model().info().parameters.size(); ++k)
+    gather += fmt::format(" p[{0}] = mapAt[{0}] < 0 ? uniformP[{0}] : maps[mapAt[{0}] + i];", k);
+  const ComputeProgram& p = useKernel("rd_react.comp", gpuReaction(rd_.settings().model, true) + gather + "\n" +
+                                                           (implicit ? "#define MODE_IMPLICIT" : "#define MODE_RATES"));
   setUniform(p, "n", int(n_));
   setUniform(p, "dt", dt);
-  glUniform1dv(p.uniform("p"), GLsizei(params_.size()), params_.data());
+  glUniform1dv(p.uniform("uniformP"), GLsizei(params_.size()), params_.data());
+  glUniform1iv(p.uniform("mapAt"), GLsizei(mapAt_.size()), mapAt_.data());
+  maps_.bind(5);
   glUniform1ui(p.uniform("clamped"), clamped_);
   x_[0].bind(0);
   x_[1].bind(1);
@@ -108,6 +137,10 @@ SolverResult GpuRDLayer<D>::diffuse(int s, double thetaDt) {
   }
   GpuBuffer& b = x_[size_t(s)];
   GpuBuffer& x = work_[size_t(s)];
+  // the Dirichlet ghost adds theta dt d 2 g / h^2 per boundary face
+  if (faces_[size_t(s)].id())
+    vectorOp("OP_ADD_FACES", faces_[size_t(s)], &b,
+             thetaDt * d / (rd_.h() * rd_.h()) * 2.0 * rd_.settings().dirichletValues[size_t(s)], 1.0);
   // warm start: b plus the last change, rescaled to this theta dt
   x.copyFrom(b, n_ * sizeof(double));
   if (df.hasIncrement) vectorOp("OP_SCALE_ADD", df.increment, &x, thetaDt / df.incrementThetaDt, 1.0);
@@ -128,11 +161,22 @@ void GpuRDLayer<D>::step(double dt) {
   const bool implicitReaction = integ == RDIntegrator::KimLin;
   const double theta = integ == RDIntegrator::ExplicitEuler ? 0.0 : integ == RDIntegrator::CrankNicolson ? 0.5 : 1.0;
   stats_buffer_.zero();
+  if (!frozenTaken_) {  // frozen species keep the values they start the run with
+    for (int s = 0; s < 2; ++s)
+      if (isFrozen_[size_t(s)]) {
+        frozen_[size_t(s)] = GpuBuffer(n_ * sizeof(double));
+        frozen_[size_t(s)].copyFrom(x_[size_t(s)], n_ * sizeof(double));
+      }
+    frozenTaken_ = true;
+  }
   react(dt, implicitReaction);
   for (int s = 0; s < 2; ++s) {
     // the theta scheme's explicit part: x += dt R + (1 - theta) dt d lap x
     const double explicitD = (1.0 - theta) * dt * rd_.diffusion()[size_t(s)];
-    if (explicitD > 0) laplacian_->apply(x_[size_t(s)], &work_[size_t(s)]);  // -lap x
+    if (explicitD > 0) laplacian_->apply(x_[size_t(s)], &work_[size_t(s)]);  // -lap x (less the Dirichlet ghosts)
+    if (explicitD > 0 && faces_[size_t(s)].id())
+      vectorOp("OP_ADD_FACES", faces_[size_t(s)], &work_[size_t(s)],
+               -2.0 * rd_.settings().dirichletValues[size_t(s)] / (rd_.h() * rd_.h()), 1.0);
     if (!implicitReaction) vectorOp("OP_SCALE_ADD", rates_[size_t(s)], &x_[size_t(s)], dt, 1.0);
     if (explicitD > 0) vectorOp("OP_SCALE_ADD", work_[size_t(s)], &x_[size_t(s)], -explicitD, 1.0);
     const SolverResult r = diffuse(s, theta * dt);
@@ -142,11 +186,21 @@ void GpuRDLayer<D>::step(double dt) {
   }
   for (int s = 0; s < 2; ++s)
     if ((clamped_ >> s) & 1u) vectorOp("OP_CLAMP_ZERO", x_[size_t(s)], &x_[size_t(s)], 0.0, 0.0);
+  holdFixed();
   if (implicitReaction) {
     const std::vector<uint32_t> st = stats_buffer_.read<uint32_t>(2);
     stats_.newton.cells = long(n_);
     stats_.newton.failures = long(st[0]);
     stats_.newton.maxIterations = int(st[1]);
+  }
+}
+
+template <int D>
+void GpuRDLayer<D>::holdFixed() {
+  for (int s = 0; s < 2; ++s) {
+    const size_t si = size_t(s);
+    if (isFrozen_[si]) vectorOp("OP_HOLD", frozen_[si], &x_[si], 0.0, 0.0, &allHeld_);
+    if (isFixed_[si]) vectorOp("OP_HOLD", fixedValue_[si], &x_[si], 0.0, 0.0, &fixedMask_[si]);
   }
 }
 
@@ -168,7 +222,9 @@ void GpuRDLayer<D>::save(StateWriter* out) const {
     out->put(p + "has_increment", df.hasIncrement ? 1 : 0);
     out->put(p + "increment_theta_dt", df.incrementThetaDt);
     if (df.hasIncrement) out->putVector(p + "increment", df.increment.template read<double>(n_));
+    if (isFrozen_[size_t(s)] && frozenTaken_) out->putVector(p + "frozen", frozen_[size_t(s)].template read<double>(n_));
   }
+  out->put("gpu.rd.frozen_taken", frozenTaken_ ? 1 : 0);
 }
 
 template <int D>
@@ -186,6 +242,15 @@ void GpuRDLayer<D>::load(const StateReader& in) {
       df.increment.upload(v);
     }
   }
+  int taken = 0;
+  in.get("gpu.rd.frozen_taken", &taken);
+  frozenTaken_ = taken != 0;
+  for (int s = 0; s < 2 && frozenTaken_; ++s)
+    if (isFrozen_[size_t(s)]) {
+      std::vector<double> v(n_);
+      in.getVector("gpu.rd." + std::to_string(s) + ".frozen", &v);
+      frozen_[size_t(s)] = GpuBuffer::of(v);
+    }
 }
 
 template class GpuRDLayer<2>;

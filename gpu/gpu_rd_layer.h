@@ -5,8 +5,9 @@
 // theta scheme on the isotropic diffusion, (I - theta dt d lap) x' = x + ...,
 // solved by CG (diagonal preconditioner while the identity dominates, one
 // multigrid V-cycle beyond, as on the CPU) to rd.tolerance, warm-started from
-// the last step's diffusive change. Uniform parameters, periodic or
-// zero-flux walls: the host refuses the rest (app/gpu_simulation.cpp).
+// the last step's diffusive change. Parameter maps, fixed regions, frozen
+// species, periodic, zero-flux and Dirichlet walls; the host refuses the
+// rest (app/gpu_simulation.cpp).
 #pragma once
 
 #include <array>
@@ -51,7 +52,9 @@ class GpuRDLayer {
   struct Diffusion;
   void react(double dt, bool implicit);
   SolverResult diffuse(int s, double thetaDt);
-  void vectorOp(const char* op, const GpuBuffer& x, GpuBuffer* y, double a, double b) const;
+  void vectorOp(const char* op, const GpuBuffer& x, GpuBuffer* y, double a, double b,
+                const GpuBuffer* held = nullptr) const;
+  void holdFixed();
 
   const RDSolver<D>& rd_;
   size_t n_ = 0;
@@ -59,6 +62,14 @@ class GpuRDLayer {
   unsigned clamped_ = 0;
   std::array<GpuBuffer, 2> x_, rates_, work_;
   GpuBuffer stats_buffer_;
+  GpuBuffer maps_;                    // the parameter maps, one after another
+  std::array<int, 12> mapAt_{};       // where parameter k's map starts (-1: uniform)
+  std::array<GpuBuffer, 2> fixedMask_, fixedValue_;  // per species (empty: free)
+  std::array<GpuBuffer, 2> faces_;    // Dirichlet faces per cell (empty: none)
+  std::array<GpuBuffer, 2> frozen_;   // frozen species' values, taken at the first step
+  std::array<bool, 2> isFrozen_{}, isFixed_{};
+  bool frozenTaken_ = false;
+  GpuBuffer allHeld_;                 // a mask of ones (frozen species)
   std::unique_ptr<GpuLaplace> laplacian_;  // -lap (scale 1/h^2): the explicit part
   std::array<std::unique_ptr<Diffusion>, 2> diffusion_;
   RDStepStats stats_;

@@ -51,6 +51,8 @@ class RDSolver {
   // after every step, cell i of species s is reset to values[s][i] wherever
   // masks[s][i]; an empty masks[s] leaves species s free.
   void setFixedCells(std::vector<std::vector<uint8_t>> masks, std::vector<std::vector<double>> values);
+  const std::vector<std::vector<uint8_t>>& fixedMasks() const { return fixedMasks_; }
+  const std::vector<std::vector<double>>& fixedValues() const { return fixedValues_; }
   // Inhomogeneous anisotropic diffusion (seed 004 eq. 11-19): the spec's
   // species diffuse by div(d sigma grad); a shaped (dynamic) spec rebuilds
   // sigma from the current state at every step.
@@ -65,6 +67,10 @@ class RDSolver {
   const AnisotropicSystem<D>& diffusionOperator(int s) const {
     return lobed(s) ? lobeSystem_[size_t(s)] : anisotropic(s) ? tensor_ : laplacian_;
   }
+
+  // Per cell, the weight of its Dirichlet faces in species s's operator (the
+  // ghost value 2 g enters the right-hand side through it; 0 without Dirichlet walls).
+  const Vector& dirichletFaces(int s) const { return boundaryWeights(s); }
 
   void step(double dt);
   const RDStepStats& lastStats() const { return stats_; }

@@ -95,10 +95,11 @@ TEST(Gpu, AStageWithNoGpuProgramIsRefusedNamingIt) {
   std::ofstream(scene) << explicitScene("[32, 32]", "[0.25, 0.25]", "periodic");
   const std::string out = " --out " + (dir / "o").string();
   for (const auto& [args, stage] :
-       {std::pair{sceneFile("coupled/cavity_gray_scott.toml") + " --set 'rd.maps.F=\"0.02 + 0.03 * x\"'", std::string("parameter maps")},
+       {std::pair{sceneFile("coupled/cavity_gray_scott.toml") + " --set 'rd.lookup_table=true'", std::string("the reaction lookup table")},
         std::pair{sceneFile("rd/seeds/sanderson_fig10.toml"), std::string("the reaction of model brusselator-coupled")},
 
-        std::pair{scene.string() + " --set 'rd.maps.F=\"0.02 + 0.03 * x\"'", std::string("parameter maps")}}) {
+        std::pair{sceneFile("rd/seeds/kim_lin_lobes3.toml"), std::string("cosine-lobe diffusion")},
+        std::pair{sceneFile("rd/turing_coarse_to_fine.toml"), std::string("the coarse-to-fine start")}}) {
     CommandResult r = runMorphoflow("run " + args + " --backend gpu --quiet" + out);
     EXPECT_EQ(r.status, 2) << args << "\n" << r.output;
     EXPECT_NE(r.output.find("the gpu backend has no program yet for " + stage), std::string::npos) << args << "\n" << r.output;

@@ -5,17 +5,21 @@
 // solution for species that must stay >= 0: rd/newton.h, step for step.
 // MODE_RATES: r = R(x) (the explicit and semi-implicit integrators).
 // The host prepends RATES(x, r) and JACOBIAN(x, J) (rd/models.h in GLSL, the
-// model's parameters in p[]).
+// model's parameters in p[]: uniform, or a parameter map's value at the cell).
 layout(std430, binding = 0) buffer X0 { double xu[]; };
 layout(std430, binding = 1) buffer X1 { double xv[]; };
 layout(std430, binding = 2) writeonly buffer R0 { double ru[]; };
 layout(std430, binding = 3) writeonly buffer R1 { double rv[]; };
 layout(std430, binding = 4) buffer Stats { uint failures; uint maxIterations; };
+layout(std430, binding = 5) readonly buffer Maps { double maps[]; };  // parameter maps, one after another
 
 uniform int n;
 uniform double dt;
-uniform double p[12];
-uniform uint clamped;  // bit s: species s stays >= 0
+uniform double uniformP[12];  // the parameters' uniform values
+uniform int mapAt[12];        // where parameter k's map starts in maps[], -1: uniform
+uniform uint clamped;         // bit s: species s stays >= 0
+
+double p[12];  // this cell's parameters (RATES and JACOBIAN read p)
 
 // `precise` throughout: no fused multiply-adds, so every operation rounds as
 // the CPU's does and Newton takes the CPU's path near folds and multiple roots.
@@ -191,6 +195,7 @@ Result implicitReaction(dvec2 x0, double h, out dvec2 x) {
 void main() {
   const int i = flatIndex();
   if (i >= n) return;
+  GATHER_PARAMETERS  // p[k] = uniformP[k] or maps[mapAt[k] + i], for each of the model's k (constant indices)
   const dvec2 x0 = dvec2(xu[i], xv[i]);
 #if defined(MODE_IMPLICIT)
   dvec2 x;

@@ -8,6 +8,8 @@
 // OP_FROM_FLOAT z = double(f) sqrt(S[rr])
 // OP_SCALE_ADD  y = a x + b y (a, b uniforms)
 // OP_CLAMP_ZERO y = max(y, 0)
+// OP_HOLD       y = x where held[i] != 0 (fixed regions; frozen species hold everywhere)
+// OP_ADD_FACES  y += ca faces (x: the Dirichlet faces per cell)
 layout(std430, binding = 0) buffer X { double x[]; };
 layout(std430, binding = 1) buffer Y { double y[]; };
 layout(std430, binding = 2) buffer Z { double z[]; };
@@ -15,6 +17,7 @@ layout(std430, binding = 3) buffer Q { double q[]; };
 layout(std430, binding = 4) buffer F { float f[]; };
 layout(std430, binding = 5) readonly buffer Diag { float diag[]; };
 layout(std430, binding = 6) readonly buffer Scalars { double S[]; };
+layout(std430, binding = 7) readonly buffer Held { uint held[]; };
 
 uniform int n;
 uniform ivec4 slots;   // the scalar slots each op reads
@@ -42,5 +45,9 @@ void main() {
   y[i] = ca * x[i] + cb * y[i];
 #elif defined(OP_CLAMP_ZERO)
   y[i] = max(y[i], 0.0lf);
+#elif defined(OP_HOLD)
+  if (held[i] != 0u) y[i] = x[i];
+#elif defined(OP_ADD_FACES)
+  y[i] += ca * x[i];
 #endif
 }
