@@ -133,7 +133,7 @@ int main(int argc, char** argv) {
   benchCmd->add_option("--size", bench.size, "only grids of this many cells per axis")->check(CLI::Range(8, 16384));
   benchCmd->add_option("--json", bench.json, "also write results as JSON");
   benchCmd->add_option("--seconds", bench.minSeconds, "minimum timed seconds per case");
-  benchCmd->add_option("--backend", bench.backend, "cpu | gpu (rd: the explicit kernel)")
+  benchCmd->add_option("--backend", bench.backend, "cpu | gpu")
       ->check(CLI::IsMember({"cpu", "gpu"}))
       ->capture_default_str();
   benchCmd->add_option("--trace", bench.trace, "coupling: write a Chrome trace-event JSON of the stages per thread");

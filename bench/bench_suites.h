@@ -13,9 +13,8 @@ struct BenchOptions {
   std::string backend = "cpu";  // cpu | gpu
 };
 
-// Runs the named suite; returns false when the suite does not exist. With
-// backend "gpu" only the rd suite runs (its explicit kernel); the others
-// throw UserError naming the stage the GPU lacks.
+// Runs the named suite (on the CPU, or with backend "gpu" the same problems
+// on the GPU); returns false when the suite does not exist.
 bool runBenchSuite(const std::string& suite, const BenchOptions& options);
 const char* benchSuiteNames();
 

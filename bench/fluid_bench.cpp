@@ -78,13 +78,14 @@ bool runFluidBench(const BenchOptions& o) {
 bool runRDBench(const BenchOptions& o);        // rd_bench.cpp
 bool runCouplingBench(const BenchOptions& o);  // coupling_bench.cpp
 bool runGpuRDBench(const BenchOptions& o);     // gpu_rd_bench.cpp
+bool runGpuFluidBench(const BenchOptions& o);  // gpu_fluid_bench.cpp
+bool runGpuCouplingBench(const BenchOptions& o);
 
 bool runBenchSuite(const std::string& suite, const BenchOptions& o) {
   if (o.backend == "gpu") {
     if (suite == "rd") return runGpuRDBench(o);
-    if (suite == "fluid" || suite == "coupling")
-      throw UserError({"--backend", 0, 0}, "", "the gpu backend has no program yet for the fluid, so no " + suite + " suite",
-                      "bench rd --backend gpu runs the explicit reaction-diffusion kernel");
+    if (suite == "fluid") return runGpuFluidBench(o);
+    if (suite == "coupling") return runGpuCouplingBench(o);
     return false;
   }
   if (suite == "fluid") return runFluidBench(o);

@@ -39,7 +39,7 @@ void GpuARDSolver<D>::emptySolids() {
   layer_->field(0).bind(3);
   layer_->field(1).bind(4);
   solid_.bind(5);
-  dispatchFlat(layer_->cells());
+  dispatchFlat(layer_->cells(), 4.0 + 16.0);  // the mask, both species written
   storageBarrier();
 }
 
@@ -70,7 +70,8 @@ void GpuARDSolver<D>::advect(double dt, const GpuFluid<D>& fluid) {
   scratch_[0].bind(3);
   scratch_[1].bind(4);
   solid_.bind(5);
-  dispatchFlat(layer_->cells());
+  // both species read and written, the velocity once (the fluid's grid, here per chemical cell at most)
+  dispatchFlat(layer_->cells(), 32.0 + 4.0 * D);
   storageBarrier();
   for (int s = 0; s < 2; ++s) std::swap(layer_->field(s), scratch_[size_t(s)]);
   emptySolids();

@@ -6,6 +6,7 @@
 
 #include "gpu/compute_program.h"
 #include "gpu/gl_context.h"
+#include "gpu/gpu_kernels.h"
 #include "gpu/gpu_models.h"
 
 namespace morphoflow {
@@ -53,6 +54,7 @@ void GpuExplicitRD::step(double dt) {
   const int gz = cells_[2] > 1 ? 4 : 1;
   glDispatchCompute(GLuint((cells_[0] + kGroup - 1) / kGroup), GLuint((cells_[1] + kGroup - 1) / kGroup),
                     GLuint((cells_[2] + gz - 1) / gz));
+  countGpuTraffic(16.0 * double(n_));  // two species read and written
   // The next step reads what this one wrote, through storage buffers.
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
   current_ = 1 - current_;

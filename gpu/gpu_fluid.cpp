@@ -135,7 +135,7 @@ void GpuFluid<D>::applyConstraints(const GpuBuffer& vel) {
       vel.bind(0);
       fixed_.bind(1);
       value_.bind(2);
-      dispatchFlat(faces(a));
+      dispatchFlat(faces(a), std::string(mode) == "MODE_FIXED" ? 12.0 : 0.0);  // flag, value, u; (the periodic layer: none)
       storageBarrier();
     }
 }
@@ -155,7 +155,7 @@ void GpuFluid<D>::forces(double dt) {
     setUniform(p, "fb", b);
     vel_.bind(0);
     dye_.bind(3);
-    dispatchFlat(faces(a));
+    dispatchFlat(faces(a), b != 0.0f ? 16.0 : 8.0);
     storageBarrier();
   }
 }
@@ -180,7 +180,7 @@ void GpuFluid<D>::advectField(const GpuBuffer& src, size_t srcOff, const std::ar
     out->bind(2);
     lo_.bind(3);
     hi_.bind(4);
-    dispatchFlat(n);
+    dispatchFlat(n, 8.0 + 4.0 * D + (limits ? 8.0 : 0.0));  // src, dst, the velocity once (, lo, hi)
     storageBarrier();
   };
   auto combine = [&](const char* mode, const GpuBuffer& f0, size_t f0Off, const GpuBuffer& f1, size_t f1Off,
@@ -194,7 +194,7 @@ void GpuFluid<D>::advectField(const GpuBuffer& src, size_t srcOff, const std::ar
     f2.bind(5);
     f3.bind(6);
     f4.bind(11);
-    dispatchFlat(n);
+    dispatchFlat(n, std::string(mode) == "MODE_MACCORMACK" ? 24.0 : std::string(mode) == "MODE_BFECC_CORRECT" ? 12.0 : 16.0);
     storageBarrier();
   };
   switch (settings_.advection) {
@@ -245,7 +245,7 @@ void GpuFluid<D>::advect(double dt) {
       setUniform(p, "inflow", std::array<int, 4>{a, high ? 1 : 0, a == 0 ? 1 : 0, settings_.inflowDyeStripes});
       dye_.bind(3);
       solid_.bind(10);
-      dispatchFlat(cellCount_);
+      dispatchFlat(cellCount_, 0.0);  // one layer of cells
       storageBarrier();
     }
 }
@@ -279,7 +279,7 @@ void GpuFluid<D>::diffuse(double dt) {
       V.b.bind(7);
       V.x.bind(8);
       V.boundaryRhs.bind(9);
-      dispatchFlat(V.host.A.size());
+      dispatchFlat(V.host.A.size(), std::string(mode) == "MODE_VISCOUS_SETUP" ? 32.0 : 16.0);
       storageBarrier();
     };
     run("MODE_VISCOUS_SETUP");
@@ -315,7 +315,8 @@ void GpuFluid<D>::project(double dt) {
     (std::string(mode) == "MODE_DIVERGENCE" ? rhs_ : phi_).bind(7);
     ratePrev_.bind(8);
     solid_.bind(10);
-    dispatchFlat(n);
+    const std::string m = mode;
+    dispatchFlat(n, m == "MODE_DIVERGENCE" ? 8.0 * D + 12.0 : m == "MODE_WARM_START" ? 32.0 : 32.0);
     storageBarrier();
   };
   run("MODE_DIVERGENCE", 0, cellCount_);

@@ -42,7 +42,15 @@ const ComputeProgram& useKernel(const std::string& shader, const std::string& de
   return *it->second;
 }
 
-void dispatchFlat(size_t samples) {
+namespace {
+double traffic = 0.0;
+}
+
+void countGpuTraffic(double bytes) { traffic += bytes; }
+double gpuTrafficBytes() { return traffic; }
+
+void dispatchFlat(size_t samples, double bytes) {
+  countGpuTraffic(double(samples) * bytes);
   constexpr size_t kGroup = 256, kMaxX = 65535;
   const size_t groups = (samples + kGroup - 1) / kGroup;
   if (groups == 0) return;

@@ -13,8 +13,14 @@ class ComputeProgram;
 // The program of shaders/SHADER with `defines` (lines of #define), made
 // current (glUseProgram).
 const ComputeProgram& useKernel(const std::string& shader, const std::string& defines);
-// Dispatches the current kernel over `samples` invocations.
-void dispatchFlat(size_t samples);
+// Dispatches the current kernel over `samples` invocations, each of which
+// must read or write `bytes` of the buffers at least once (the traffic model
+// the benchmarks divide by time: a lower bound of the memory traffic).
+void dispatchFlat(size_t samples, double bytes);
+// Counts dispatched traffic (dispatchFlat's, and kernels that call it directly).
+void countGpuTraffic(double bytes);
+// The traffic counted since the process started.
+double gpuTrafficBytes();
 // The barrier between a kernel and the next one that reads what it wrote
 // through storage buffers.
 void storageBarrier();

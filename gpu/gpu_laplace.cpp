@@ -49,7 +49,11 @@ void GpuLaplace::run(const char* mode, bool single, const GpuBuffer& x, const Gp
   for (int a = 0; a < 3; ++a) w_[size_t(a < dim_ ? a : 0)].bind(3 + a);
   diag_.bind(6);
   c_.bind(7);
-  dispatchFlat(n_);
+  // x and y (and b), the face weights, c and the diagonal; a smoothing pass touches half the cells
+  const double real = single ? 4.0 : 8.0, coefficients = 4.0 * (dim_ + 2);
+  const std::string m = mode;
+  const double bytes = m == "MODE_SMOOTH" ? 0.5 * (3 * real + coefficients) : (y ? 2 : 1) * real + (b ? real : 0) + coefficients;
+  dispatchFlat(n_, bytes);
   storageBarrier();
 }
 

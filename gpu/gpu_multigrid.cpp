@@ -159,7 +159,7 @@ void GpuMultigrid::cycle(size_t l) {
       L.x.bind(2);
       L.A->diag().bind(3);
       dense_.bind(4);
-      dispatchFlat(L.A->size());
+      dispatchFlat(L.A->size(), 4.0 * double(L.A->size()) + 8.0);  // a row of the inverse, x
       storageBarrier();
     } else {
       L.x.zero();
@@ -183,7 +183,9 @@ void GpuMultigrid::cycle(size_t l) {
     fineX.bind(2);
     diag.bind(3);
     fine.bind(4);
-    dispatchFlat(samples);
+    // restrict: the fine residual once (2^D fine cells a coarse one), b, diag; prolong: x read and written, diag
+    const bool restriction = std::string(mode) == "MODE_RESTRICT";
+    dispatchFlat(samples, restriction ? 4.0 * (1 << dim) + 8.0 : 12.0);
     storageBarrier();
   };
   transfer("MODE_RESTRICT", L.r, C.b, L.x, C.A->diag(), C.A->size());
@@ -207,7 +209,7 @@ void GpuMultigrid::apply(const GpuBuffer& r, GpuBuffer* z, const GpuBuffer& scal
     if (std::string(op) == "OP_FROM_FLOAT") L.x.bind(4);
     L.A->diag().bind(5);
     scalars.bind(6);
-    dispatchFlat(n);
+    dispatchFlat(n, 12.0);
     storageBarrier();
   };
   convert("OP_TO_FLOAT", r, r);

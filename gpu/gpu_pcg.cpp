@@ -32,7 +32,8 @@ void GpuPcg::op(const char* name, const GpuBuffer& x, const GpuBuffer& y, const 
   A_.diag().bind(4);  // (no float vector in these ops)
   A_.diag().bind(5);
   sums_.scalars().bind(6);
-  dispatchFlat(A_.size());
+  const std::string o = name;
+  dispatchFlat(A_.size(), o == "OP_UPDATE_XR" ? 48.0 : o == "OP_UPDATE_P" ? 24.0 : 20.0);
   storageBarrier();
 }
 

@@ -89,7 +89,7 @@ void GpuRDLayer<D>::vectorOp(const char* op, const GpuBuffer& x, GpuBuffer* y, d
   y->bind(1);
   for (int k = 2; k <= 6; ++k) x.bind(k);
   (held ? *held : x).bind(7);
-  dispatchFlat(n_);
+  dispatchFlat(n_, held ? 20.0 : 24.0);
   storageBarrier();
 }
 
@@ -112,7 +112,7 @@ void GpuRDLayer<D>::react(double dt, bool implicit) {
   rates_[0].bind(2);
   rates_[1].bind(3);
   stats_buffer_.bind(4);
-  dispatchFlat(n_);
+  dispatchFlat(n_, 32.0);  // two species read and written (or rates written)
   storageBarrier();
 }
 

@@ -31,6 +31,8 @@ void GpuReduction::run(const char* term, const GpuBuffer& x, const GpuBuffer& y,
   scalars_.bind(4);
   x.bind(5);
   glDispatchCompute(GLuint(groups), 1, 1);
+  const std::string t = term;
+  countGpuTraffic(double(n) * (t == "TERM_DOT" ? 16.0 : t == "TERM_ACTIVE_SUM" ? 12.0 : 4.0));
   storageBarrier();
   const ComputeProgram& f = useKernel("reduce.comp", std::string("#define MODE_FINAL\n#define ") + term);
   setUniform(f, "n", int(groups));

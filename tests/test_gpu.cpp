@@ -363,3 +363,29 @@ TEST(Gpu, ShippedImplicitRDScenesMatchTheCpu) {
     fs::remove_all(dir);
   }
 }
+
+// The GPU suites print the CPU suites' tables for the same problems (here at
+// 32^2, on llvmpipe) and their JSON: every case converged, a positive rate,
+// the modelled traffic over the time as GB/s; carrying the chemicals costs
+// the fluid something (overhead above 1).
+TEST(Gpu, BenchSuitesTimeTheFluidTheLayerAndTheCoupling) {
+  if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
+  const fs::path dir = tempDir("gpu_bench");
+  for (const char* suite : {"rd", "fluid", "coupling"}) {
+    const fs::path json = dir / (std::string(suite) + ".json");
+    CommandResult r = runMorphoflow(std::string("bench ") + suite + " --backend gpu --size 32 --seconds 0 --json " + json.string());
+    ASSERT_EQ(r.status, 0) << suite << "\n" << r.output;
+    EXPECT_NE(r.output.find("gpu: "), std::string::npos) << r.output;
+    std::ifstream in(json);
+    const nlohmann::json j = nlohmann::json::parse(in);
+    ASSERT_FALSE(j.empty()) << suite;
+    for (const nlohmann::json& c : j) {
+      EXPECT_GT(c.contains("ms") ? c["ms"].get<double>() : c["ms_per_step_median"].get<double>(), 0.0) << c;
+      EXPECT_GT(c["gb_per_second"].get<double>(), 0.0) << c;
+      if (c.contains("pressure_converged")) EXPECT_TRUE(c["pressure_converged"].get<bool>()) << c;
+      if (c.contains("overhead")) EXPECT_GT(c["overhead"].get<double>(), 1.0) << c;
+    }
+    if (std::string(suite) == "rd") EXPECT_EQ(j.size(), 2u) << "the explicit and the Kim & Lin rows";
+  }
+  fs::remove_all(dir);
+}

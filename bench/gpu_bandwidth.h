@@ -1,0 +1,44 @@
+// The GPU suites' shared pieces: the device's peak memory bandwidth (for the
+// "of peak" column) and the table header naming the device.
+#pragma once
+
+#include <cstdlib>
+#include <iostream>
+#include <string>
+
+#include <fmt/format.h>
+
+#include "core/error.h"
+#include "gpu/gl_context.h"
+
+namespace morphoflow {
+
+// Peak memory bandwidth in GB/s of the renderer, 0 when unknown
+// (MORPHOFLOW_GPU_PEAK_GBS gives it for any device).
+inline double peakBandwidth(const std::string& renderer) {
+  if (const char* env = std::getenv("MORPHOFLOW_GPU_PEAK_GBS")) return std::atof(env);
+  if (renderer.find("H200") != std::string::npos) return 4800;
+  if (renderer.find("H100") != std::string::npos) return renderer.find("PCIe") != std::string::npos ? 2000 : 3350;
+  if (renderer.find("A100") != std::string::npos) return 2039;
+  return 0;
+}
+
+// The context (exit 2 without one), after printing the device and its peak; returns the peak (0: unknown).
+inline double announceGpu() {
+  const GlContext* context = nullptr;
+  try {
+    context = &GlContext::instance();
+  } catch (const GpuUnavailable& e) {
+    throw UserError({"--backend", 0, 0}, "", std::string("no usable GPU context: ") + e.what(), "bench on the CPU");
+  }
+  const double peak = peakBandwidth(context->renderer());
+  std::cout << fmt::format("gpu: {}, OpenGL {}; peak bandwidth {}\n", context->renderer(), context->version(),
+                           peak > 0 ? fmt::format("{:.0f} GB/s", peak) : std::string("unknown (set MORPHOFLOW_GPU_PEAK_GBS)"));
+  return peak;
+}
+
+inline std::string ofPeak(double gbs, double peak) {
+  return peak > 0 ? fmt::format("{:.0f}%", 100 * gbs / peak) : std::string("-");
+}
+
+}  // namespace morphoflow
