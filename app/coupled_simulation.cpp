@@ -110,7 +110,7 @@ void CoupledSimulation<D>::syncHost() const {
   if (!gpu_ || !hostStale_) return;
   gpu_->fluid.download(&fluid_.velocity(), &fluid_.dye());
   fluid_.adopt(time_, steps_, gpu_->fluid.phi(), gpu_->fluid.lastDt());
-  for (int s = 0; s < 2; ++s) rd_.field(s).values() = gpu_->layer.download(s);
+  for (int s = 0; s < gpu_->layer.species(); ++s) rd_.field(s).values() = gpu_->layer.download(s);
   hostStale_ = false;
 }
 
@@ -180,7 +180,7 @@ void CoupledSimulation<D>::load(const StateReader& in) {
   if (gpu_) {
     gpu_->fluid.upload(fluid_.velocity(), fluid_.dye());
     gpu_->fluid.load(in);
-    for (int s = 0; s < 2; ++s) gpu_->layer.upload(s, rd_.field(s).values());
+    for (int s = 0; s < gpu_->layer.species(); ++s) gpu_->layer.upload(s, rd_.field(s).values());
     gpu_->layer.load(in);
     time_ = fluid_.time();
     steps_ = fluid_.steps();

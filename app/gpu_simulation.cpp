@@ -22,8 +22,10 @@ namespace {
 std::string missingStage(const Scene& s) {
   const RDScene& rd = s.rd;
   if (s.hasFluid && !rd.enabled) return "";
-  if (gpuReaction(rd.settings.model).empty())
-    return "the reaction of model " + rd.settings.model + " (the GPU has the two-species models)";
+  if (gpuSpecies(rd.settings.model) == 0) return "the reaction of model " + rd.settings.model;
+  if (s.hasFluid && gpuSpecies(rd.settings.model) != 2)
+    return "the chemicals' advection for a model of " + std::to_string(gpuSpecies(rd.settings.model)) +
+           " species (the coupled gpu step carries two)";
   if (rd.anisotropy.enabled) return "anisotropic diffusion ([rd.anisotropy])";
   if (rd.lobes.enabled) return "cosine-lobe diffusion ([rd.cosine_lobes])";
   if (rd.coarseLevels > 0) return "the coarse-to-fine start (rd.coarse_to_fine)";
@@ -64,7 +66,8 @@ void checkGpuRuns(const Scene& scene) {
   for (int n : scene.rd.settings.resolution) cells *= size_t(n);
   size_t need = 0;
   if (scene.rd.enabled)  // (the double-precision layer's, an upper bound of the explicit step's)
-    need = scene.dimension == 2 ? GpuRDLayer<2>::deviceBytes(cells) : GpuRDLayer<3>::deviceBytes(cells);
+    need = scene.dimension == 2 ? GpuRDLayer<2>::deviceBytes(cells, gpuSpecies(scene.rd.settings.model))
+                                : GpuRDLayer<3>::deviceBytes(cells, gpuSpecies(scene.rd.settings.model));
   if (scene.hasFluid) {
     const std::vector<int>& r = scene.fluid.resolution;
     need += scene.dimension == 2 ? GpuFluid<2>::deviceBytes({r[0], r[1]}) : GpuFluid<3>::deviceBytes({r[0], r[1], r[2]});
@@ -89,7 +92,7 @@ GpuRDSimulation<D>::GpuRDSimulation(const Scene& scene) : scene_(scene) {
   // The plain explicit step in single precision; everything else (every
   // integrator, maps, fixed regions, frozen species, Dirichlet walls) in double.
   const RDScene& rd = scene.rd;
-  const bool plainExplicit = rd.settings.integrator == RDIntegrator::ExplicitEuler &&
+  const bool plainExplicit = rd.settings.integrator == RDIntegrator::ExplicitEuler && species_.size() == 2 &&
                              rd.settings.boundary != RDBoundary::Dirichlet && rd.parameterMaps.empty() &&
                              rd.perturb.empty() && rd.fixed.empty() && rd.settings.frozen.empty();
   if (!plainExplicit) {

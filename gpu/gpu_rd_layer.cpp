@@ -33,10 +33,10 @@ struct GpuRDLayer<D>::Diffusion {
 };
 
 template <int D>
-GpuRDLayer<D>::GpuRDLayer(const RDSolver<D>& rd) : rd_(rd), n_(rd.field(0).size()) {
+GpuRDLayer<D>::GpuRDLayer(const RDSolver<D>& rd) : rd_(rd), species_(rd.species()), n_(rd.field(0).size()) {
   for (size_t k = 0; k < rd.model().info().parameters.size() && k < params_.size(); ++k) params_[k] = rd.parameter(int(k));
   for (int s : rd.model().info().clamped) clamped_ |= 1u << s;
-  for (int s = 0; s < 2; ++s) {
+  for (int s = 0; s < species_; ++s) {
     x_[size_t(s)] = GpuBuffer::of(rd.field(s).values());
     rates_[size_t(s)] = GpuBuffer(n_ * sizeof(double));
     work_[size_t(s)] = GpuBuffer(n_ * sizeof(double));
@@ -55,7 +55,7 @@ GpuRDLayer<D>::GpuRDLayer(const RDSolver<D>& rd) : rd_(rd), n_(rd.field(0).size(
     maps.insert(maps.end(), f.begin(), f.end());
   }
   maps_ = GpuBuffer::of(maps.empty() ? std::vector<double>{0.0} : maps);
-  for (int s = 0; s < 2; ++s) {
+  for (int s = 0; s < species_; ++s) {
     const size_t si = size_t(s);
     if (si < rd.fixedMasks().size() && !rd.fixedMasks()[si].empty()) {
       isFixed_[si] = true;
@@ -65,17 +65,17 @@ GpuRDLayer<D>::GpuRDLayer(const RDSolver<D>& rd) : rd_(rd), n_(rd.field(0).size(
     if (rd.settings().boundary == RDBoundary::Dirichlet) faces_[si] = GpuBuffer::of(rd.dirichletFaces(s));
   }
   for (int s : rd.settings().frozen) isFrozen_[size_t(s)] = true;
-  allHeld_ = GpuBuffer::of(std::vector<uint32_t>(isFrozen_[0] || isFrozen_[1] ? n_ : 1, 1u));
+  allHeld_ = GpuBuffer::of(std::vector<uint32_t>(rd.settings().frozen.empty() ? 1 : n_, 1u));
 }
 
 template <int D>
 GpuRDLayer<D>::~GpuRDLayer() = default;
 
 template <int D>
-size_t GpuRDLayer<D>::deviceBytes(size_t n) {
-  // species, rates, work; per species a system (D weights, diagonal), PCG
-  // vectors and the increment; the explicit Laplacian; a multigrid's levels.
-  return n * (6 * 8 + 2 * ((D + 1) * 4 + 4 * 8 + 8 + 3 * 4 * 2) + (D + 1) * 4);
+size_t GpuRDLayer<D>::deviceBytes(size_t n, int species) {
+  // per species: the species, rates, work, a system (D weights, c, diagonal),
+  // PCG vectors, the increment and a multigrid's levels; the explicit Laplacian
+  return n * (size_t(species) * (3 * 8 + (D + 2) * 4 + 4 * 8 + 8 + 3 * 4 * 2) + (D + 2) * 4);
 }
 
 template <int D>
@@ -105,14 +105,14 @@ void GpuRDLayer<D>::react(double dt, bool implicit) {
   setUniform(p, "dt", dt);
   glUniform1dv(p.uniform("uniformP"), GLsizei(params_.size()), params_.data());
   glUniform1iv(p.uniform("mapAt"), GLsizei(mapAt_.size()), mapAt_.data());
-  maps_.bind(5);
   glUniform1ui(p.uniform("clamped"), clamped_);
-  x_[0].bind(0);
-  x_[1].bind(1);
-  rates_[0].bind(2);
-  rates_[1].bind(3);
-  stats_buffer_.bind(4);
-  dispatchFlat(n_, 32.0);  // two species read and written (or rates written)
+  for (int s = 0; s < kMax; ++s) {  // (the unused bindings of a block array need a buffer too)
+    x_[size_t(s < species_ ? s : 0)].bind(s);
+    rates_[size_t(s < species_ ? s : 0)].bind(6 + s);
+  }
+  stats_buffer_.bind(12);
+  maps_.bind(13);
+  dispatchFlat(n_, 16.0 * species_);  // the species read and written (or rates written)
   storageBarrier();
 }
 
@@ -162,7 +162,7 @@ void GpuRDLayer<D>::step(double dt) {
   const double theta = integ == RDIntegrator::ExplicitEuler ? 0.0 : integ == RDIntegrator::CrankNicolson ? 0.5 : 1.0;
   stats_buffer_.zero();
   if (!frozenTaken_) {  // frozen species keep the values they start the run with
-    for (int s = 0; s < 2; ++s)
+    for (int s = 0; s < species_; ++s)
       if (isFrozen_[size_t(s)]) {
         frozen_[size_t(s)] = GpuBuffer(n_ * sizeof(double));
         frozen_[size_t(s)].copyFrom(x_[size_t(s)], n_ * sizeof(double));
@@ -170,7 +170,7 @@ void GpuRDLayer<D>::step(double dt) {
     frozenTaken_ = true;
   }
   react(dt, implicitReaction);
-  for (int s = 0; s < 2; ++s) {
+  for (int s = 0; s < species_; ++s) {
     // the theta scheme's explicit part: x += dt R + (1 - theta) dt d lap x
     const double explicitD = (1.0 - theta) * dt * rd_.diffusion()[size_t(s)];
     if (explicitD > 0) laplacian_->apply(x_[size_t(s)], &work_[size_t(s)]);  // -lap x (less the Dirichlet ghosts)
@@ -184,7 +184,7 @@ void GpuRDLayer<D>::step(double dt) {
     stats_.diffusion.iterations = std::max(stats_.diffusion.iterations, r.iterations);
     stats_.diffusion.residual = std::max(stats_.diffusion.residual, r.residual);
   }
-  for (int s = 0; s < 2; ++s)
+  for (int s = 0; s < species_; ++s)
     if ((clamped_ >> s) & 1u) vectorOp("OP_CLAMP_ZERO", x_[size_t(s)], &x_[size_t(s)], 0.0, 0.0);
   holdFixed();
   if (implicitReaction) {
@@ -197,7 +197,7 @@ void GpuRDLayer<D>::step(double dt) {
 
 template <int D>
 void GpuRDLayer<D>::holdFixed() {
-  for (int s = 0; s < 2; ++s) {
+  for (int s = 0; s < species_; ++s) {
     const size_t si = size_t(s);
     if (isFrozen_[si]) vectorOp("OP_HOLD", frozen_[si], &x_[si], 0.0, 0.0, &allHeld_);
     if (isFixed_[si]) vectorOp("OP_HOLD", fixedValue_[si], &x_[si], 0.0, 0.0, &fixedMask_[si]);
@@ -216,7 +216,7 @@ std::vector<double> GpuRDLayer<D>::download(int s) const {
 
 template <int D>
 void GpuRDLayer<D>::save(StateWriter* out) const {
-  for (int s = 0; s < 2; ++s) {
+  for (int s = 0; s < species_; ++s) {
     const Diffusion& df = *diffusion_[size_t(s)];
     const std::string p = "gpu.rd." + std::to_string(s) + ".";
     out->put(p + "has_increment", df.hasIncrement ? 1 : 0);
@@ -229,7 +229,7 @@ void GpuRDLayer<D>::save(StateWriter* out) const {
 
 template <int D>
 void GpuRDLayer<D>::load(const StateReader& in) {
-  for (int s = 0; s < 2; ++s) {
+  for (int s = 0; s < species_; ++s) {
     Diffusion& df = *diffusion_[size_t(s)];
     const std::string p = "gpu.rd." + std::to_string(s) + ".";
     int has = 0;
@@ -245,7 +245,7 @@ void GpuRDLayer<D>::load(const StateReader& in) {
   int taken = 0;
   in.get("gpu.rd.frozen_taken", &taken);
   frozenTaken_ = taken != 0;
-  for (int s = 0; s < 2 && frozenTaken_; ++s)
+  for (int s = 0; s < species_ && frozenTaken_; ++s)
     if (isFrozen_[size_t(s)]) {
       std::vector<double> v(n_);
       in.getVector("gpu.rd." + std::to_string(s) + ".frozen", &v);

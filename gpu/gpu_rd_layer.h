@@ -1,5 +1,5 @@
 // A reaction-diffusion layer (rd/rd_solver.h) on the GPU, double precision:
-// the species in storage buffers, the reaction of a two-species model
+// the species in storage buffers, the reaction of any model
 // (Kim & Lin's per-cell Newton, or the rates for the explicit and
 // semi-implicit integrators; shaders/rd_react.comp), then every integrator's
 // theta scheme on the isotropic diffusion, (I - theta dt d lap) x' = x + ...,
@@ -37,7 +37,7 @@ class GpuRDLayer {
   void step(double dt);
   // Newton failures and iterations, the worst diffusion solve.
   const RDStepStats& lastStats() const { return stats_; }
-  int species() const { return 2; }
+  int species() const { return species_; }
   size_t cells() const { return n_; }
   GpuBuffer& field(int s) { return x_[size_t(s)]; }
   void upload(int s, const std::vector<double>& values);
@@ -45,8 +45,8 @@ class GpuRDLayer {
   // The warm starts of the diffusion solves (checkpoints).
   void save(StateWriter* out) const;
   void load(const StateReader& in);
-  // Device bytes a layer of n cells allocates (its solvers included).
-  static size_t deviceBytes(size_t n);
+  // Device bytes a layer of n cells and that many species allocates (its solvers included).
+  static size_t deviceBytes(size_t n, int species);
 
  private:
   struct Diffusion;
@@ -56,22 +56,24 @@ class GpuRDLayer {
                 const GpuBuffer* held = nullptr) const;
   void holdFixed();
 
+  static constexpr int kMax = ReactionModel::kMaxSpecies;
   const RDSolver<D>& rd_;
+  int species_ = 2;
   size_t n_ = 0;
   std::array<double, 12> params_{};
   unsigned clamped_ = 0;
-  std::array<GpuBuffer, 2> x_, rates_, work_;
+  std::array<GpuBuffer, kMax> x_, rates_, work_;
   GpuBuffer stats_buffer_;
   GpuBuffer maps_;                    // the parameter maps, one after another
   std::array<int, 12> mapAt_{};       // where parameter k's map starts (-1: uniform)
-  std::array<GpuBuffer, 2> fixedMask_, fixedValue_;  // per species (empty: free)
-  std::array<GpuBuffer, 2> faces_;    // Dirichlet faces per cell (empty: none)
-  std::array<GpuBuffer, 2> frozen_;   // frozen species' values, taken at the first step
-  std::array<bool, 2> isFrozen_{}, isFixed_{};
+  std::array<GpuBuffer, kMax> fixedMask_, fixedValue_;  // per species (empty: free)
+  std::array<GpuBuffer, kMax> faces_;    // Dirichlet faces per cell (empty: none)
+  std::array<GpuBuffer, kMax> frozen_;   // frozen species' values, taken at the first step
+  std::array<bool, kMax> isFrozen_{}, isFixed_{};
   bool frozenTaken_ = false;
   GpuBuffer allHeld_;                 // a mask of ones (frozen species)
   std::unique_ptr<GpuLaplace> laplacian_;  // -lap (scale 1/h^2): the explicit part
-  std::array<std::unique_ptr<Diffusion>, 2> diffusion_;
+  std::array<std::unique_ptr<Diffusion>, kMax> diffusion_;
   RDStepStats stats_;
 };
 

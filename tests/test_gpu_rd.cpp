@@ -34,11 +34,12 @@ template <int D>
 double relativeDifference(RDSettings s, const ReactionModel& m, double dt, int steps) {
   RDSolver<D> cpu(s, m);
   const ModelInfo& info = m.info();
-  std::vector<double> start[2];
-  for (int k = 0; k < 2; ++k) {
+  const int ns = int(info.species.size());
+  std::vector<std::vector<double>> start(static_cast<size_t>(ns));
+  for (int k = 0; k < ns; ++k) {
     for (size_t i = 0; i < cpu.field(k).size(); ++i)
       cpu.field(k)[i] = info.initial[size_t(k)] + 0.1 * (1.0 + std::abs(info.initial[size_t(k)])) * (uniform01(3, uint64_t(k), i) - 0.5);
-    start[k] = cpu.field(k).values();
+    start[size_t(k)] = cpu.field(k).values();
   }
   GpuRDLayer<D> gpu(cpu);
   for (int n = 0; n < steps; ++n) {
@@ -48,11 +49,11 @@ double relativeDifference(RDSettings s, const ReactionModel& m, double dt, int s
     EXPECT_EQ(gpu.lastStats().newton.failures, cpu.lastStats().newton.failures) << info.name;
   }
   double worst = 0, moved = 0;
-  for (int k = 0; k < 2; ++k) {
+  for (int k = 0; k < ns; ++k) {
     const std::vector<double> g = gpu.download(k);
     for (size_t i = 0; i < g.size(); ++i) {
       worst = std::max(worst, std::abs(g[i] - cpu.field(k)[i]));
-      moved = std::max(moved, std::abs(cpu.field(k)[i] - start[k][i]));
+      moved = std::max(moved, std::abs(cpu.field(k)[i] - start[size_t(k)][i]));
     }
   }
   EXPECT_GT(moved, 1e-4) << info.name << ": the steps must change the state";
@@ -65,29 +66,35 @@ double relativeDifference(RDSettings s, const ReactionModel& m, double dt, int s
 // times the reaction's fastest local rate, where Newton needs its line
 // search, continuation and restarts and some cells fail: the GPU's Newton
 // (double, no fused multiply-adds) gives bitwise the CPU's roots, and fails
-// in the same cells, for every two-species model.
-TEST(GpuRD, KimLinNewtonIsBitwiseTheCpusForEveryTwoSpeciesModel) {
+// in the same cells, for every model (two to five species).
+TEST(GpuRD, KimLinNewtonIsBitwiseTheCpusForEveryModel) {
   std::string why;
   if (noGpu(&why)) GTEST_SKIP() << why;
   int checked = 0;
   for (const ReactionModel* m : allModels()) {
-    if (gpuReaction(m->info().name, true).empty()) continue;
+    ASSERT_FALSE(gpuReaction(m->info().name, true).empty()) << m->info().name;
     RDSettings s;
     s.model = m->info().name;
     s.resolution = {24, 20};
     s.size = {24.0, 20.0};
-    s.diffusion = {0.0, 0.0};
+    s.diffusion.assign(m->info().species.size(), 0.0);
     s.boundary = RDBoundary::Neumann;
     RDSolver<2> probe(s, *m);
     std::vector<double> p;
     for (size_t k = 0; k < m->info().parameters.size(); ++k) p.push_back(probe.parameter(int(k)));
-    double J[4];
-    m->jacobian(m->info().initial.data(), p.data(), J);
-    const double rate = std::max({1e-12, std::abs(J[0]) + std::abs(J[1]), std::abs(J[2]) + std::abs(J[3])});
+    const size_t ns = m->info().species.size();
+    std::vector<double> J(ns * ns);
+    m->jacobian(m->info().initial.data(), p.data(), J.data());
+    double rate = 1e-12;  // the largest row sum
+    for (size_t r = 0; r < ns; ++r) {
+      double row = 0;
+      for (size_t c = 0; c < ns; ++c) row += std::abs(J[r * ns + c]);
+      rate = std::max(rate, row);
+    }
     for (double factor : {10.0, 100.0}) EXPECT_EQ(relativeDifference<2>(s, *m, factor / rate, 10), 0.0) << m->info().name << " x" << factor;
     ++checked;
   }
-  EXPECT_GE(checked, 11);
+  EXPECT_GE(checked, 14);
 }
 
 // With diffusion both sides solve to rd.tolerance (1e-8): the layers agree
