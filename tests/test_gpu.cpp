@@ -366,8 +366,8 @@ TEST(Gpu, ShippedImplicitRDScenesMatchTheCpu) {
 
 // The GPU suites print the CPU suites' tables for the same problems (here at
 // 32^2, on llvmpipe) and their JSON: every case converged, a positive rate,
-// the modelled traffic over the time as GB/s; carrying the chemicals costs
-// the fluid something (overhead above 1).
+// the modelled traffic over the time as GB/s, the ARD part of a coupled step
+// timed (no figure is asserted: timings on a shared machine are not tests).
 TEST(Gpu, BenchSuitesTimeTheFluidTheLayerAndTheCoupling) {
   if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
   const fs::path dir = tempDir("gpu_bench");
@@ -383,7 +383,7 @@ TEST(Gpu, BenchSuitesTimeTheFluidTheLayerAndTheCoupling) {
       EXPECT_GT(c.contains("ms") ? c["ms"].get<double>() : c["ms_per_step_median"].get<double>(), 0.0) << c;
       EXPECT_GT(c["gb_per_second"].get<double>(), 0.0) << c;
       if (c.contains("pressure_converged")) EXPECT_TRUE(c["pressure_converged"].get<bool>()) << c;
-      if (c.contains("overhead")) EXPECT_GT(c["overhead"].get<double>(), 1.0) << c;
+      if (c.contains("ard_part_ms")) EXPECT_GT(c["ard_part_ms"].get<double>(), 0.0) << c;
     }
     if (std::string(suite) == "rd") EXPECT_EQ(j.size(), 2u) << "the explicit and the Kim & Lin rows";
   }
