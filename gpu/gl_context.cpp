@@ -52,6 +52,17 @@ bool makeContext(EGLDisplay d, GlContext::Egl* egl) {
     eglTerminate(d);
     return false;
   }
+  // Robust access with lose-on-reset first (EGL 1.5), so a lost device
+  // becomes GL_CONTEXT_LOST at the next check rather than undefined
+  // behaviour; without it, the plain context.
+  const EGLint robust[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 3,
+                           EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
+                           EGL_CONTEXT_OPENGL_ROBUST_ACCESS, EGL_TRUE,
+                           EGL_CONTEXT_OPENGL_RESET_NOTIFICATION_STRATEGY, EGL_LOSE_CONTEXT_ON_RESET,
+#ifndef NDEBUG
+                           EGL_CONTEXT_OPENGL_DEBUG, EGL_TRUE,
+#endif
+                           EGL_NONE};
   const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 3,
                             EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
 #ifndef NDEBUG
@@ -67,7 +78,8 @@ bool makeContext(EGLDisplay d, GlContext::Egl* egl) {
       return false;
     }
   }
-  EGLContext c = eglCreateContext(d, config, EGL_NO_CONTEXT, attribs);
+  EGLContext c = major > 1 || minor >= 5 ? eglCreateContext(d, config, EGL_NO_CONTEXT, robust) : EGL_NO_CONTEXT;
+  if (c == EGL_NO_CONTEXT) c = eglCreateContext(d, config, EGL_NO_CONTEXT, attribs);
   if (c == EGL_NO_CONTEXT || !eglMakeCurrent(d, EGL_NO_SURFACE, EGL_NO_SURFACE, c)) {
     if (c != EGL_NO_CONTEXT) eglDestroyContext(d, c);
     eglTerminate(d);
@@ -133,6 +145,10 @@ size_t GlContext::availableBytes() const {
 void GlContext::check(const char* what) {
   const GLenum e = glGetError();
   if (e == GL_NO_ERROR) return;
+  if (e == GL_CONTEXT_LOST)
+    throw GpuError(fmt::format("the GPU device was lost (a reset: a driver or GPU fault, or the device removed) in {}; "
+                               "the last checkpoint is intact: continue with --resume",
+                               what));
   throw GpuError(fmt::format("OpenGL error 0x{:04x} ({}) in {}", e,
                              e == GL_OUT_OF_MEMORY ? "out of GPU memory" : e == GL_INVALID_OPERATION ? "invalid operation"
                                                                                                     : "invalid value or enum",
