@@ -21,6 +21,26 @@ GpuLaplace::GpuLaplace(const LaplaceSystem<D>& A) : dim_(D), n_(A.size()) {
 }
 
 template <int D>
+GpuLaplace::GpuLaplace(const AnisotropicSystem<D>& A) : GpuLaplace(A.axis) {
+  update(A);
+}
+
+template <int D>
+void GpuLaplace::update(const AnisotropicSystem<D>& A) {
+  update(A.axis);
+  hasCross_ = A.hasCross;
+  if (!hasCross_) return;
+  for (int p = 0; p < AnisotropicSystem<D>::kPlanes; ++p) {
+    for (int k = 0; k < 2; ++k) {
+      const std::vector<float>& v = (k == 0 ? A.up : A.down)[size_t(p)].values();
+      GpuBuffer& b = cross_[size_t(2 * p + k)];
+      if (b.bytes() != v.size() * sizeof(float)) b = GpuBuffer(v.size() * sizeof(float));
+      b.upload(v);
+    }
+  }
+}
+
+template <int D>
 void GpuLaplace::update(const LaplaceSystem<D>& A) {
   for (int a = 0; a < D; ++a) w_[size_t(a)].upload(A.w[a].values());
   diag_.upload(A.diag.values());
@@ -37,8 +57,11 @@ bool GpuLaplace::mixesColours() const {
 
 void GpuLaplace::run(const char* mode, bool single, const GpuBuffer& x, const GpuBuffer* y, const GpuBuffer* b,
                      int colour, float omega) const {
-  const ComputeProgram& p =
-      useKernel("laplace.comp", fmt::format("#define DIM {}\n#define REAL {}\n#define {}", dim_, single ? "float" : "double", mode));
+  const std::string m = mode;
+  const bool cross = hasCross_ && !single && (m == "MODE_APPLY" || m == "MODE_RESIDUAL");
+  const ComputeProgram& p = useKernel("laplace.comp", fmt::format("#define DIM {}\n#define REAL {}\n#define {}{}", dim_,
+                                                                  single ? "float" : "double", mode,
+                                                                  cross ? "\n#define CROSS" : ""));
   setUniform(p, "dims", dims_);
   setUniform(p, "scale", scale_);
   setUniform(p, "colour", colour);
@@ -49,9 +72,11 @@ void GpuLaplace::run(const char* mode, bool single, const GpuBuffer& x, const Gp
   for (int a = 0; a < 3; ++a) w_[size_t(a < dim_ ? a : 0)].bind(3 + a);
   diag_.bind(6);
   c_.bind(7);
-  // x and y (and b), the face weights, c and the diagonal; a smoothing pass touches half the cells
-  const double real = single ? 4.0 : 8.0, coefficients = 4.0 * (dim_ + 2);
-  const std::string m = mode;
+  const int crossBuffers = cross ? (dim_ == 3 ? 6 : 2) : 0;
+  for (int k = 0; k < crossBuffers; ++k) cross_[size_t(k)].bind(8 + k);
+  // x and y (and b), the face weights, c and the diagonal (and the mixed
+  // terms); a smoothing pass touches half the cells
+  const double real = single ? 4.0 : 8.0, coefficients = 4.0 * (dim_ + 2 + crossBuffers);
   const double bytes = m == "MODE_SMOOTH" ? 0.5 * (3 * real + coefficients) : (y ? 2 : 1) * real + (b ? real : 0) + coefficients;
   dispatchFlat(n_, bytes);
   storageBarrier();
@@ -75,5 +100,9 @@ template GpuLaplace::GpuLaplace(const LaplaceSystem<2>&);
 template GpuLaplace::GpuLaplace(const LaplaceSystem<3>&);
 template void GpuLaplace::update(const LaplaceSystem<2>&);
 template void GpuLaplace::update(const LaplaceSystem<3>&);
+template GpuLaplace::GpuLaplace(const AnisotropicSystem<2>&);
+template GpuLaplace::GpuLaplace(const AnisotropicSystem<3>&);
+template void GpuLaplace::update(const AnisotropicSystem<2>&);
+template void GpuLaplace::update(const AnisotropicSystem<3>&);
 
 }  // namespace morphoflow

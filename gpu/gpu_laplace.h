@@ -5,6 +5,7 @@
 
 #include <array>
 
+#include "core/anisotropic_system.h"
 #include "core/laplace_system.h"
 #include "gpu/gpu_buffer.h"
 
@@ -15,9 +16,16 @@ class GpuLaplace {
   GpuLaplace() = default;
   template <int D>
   explicit GpuLaplace(const LaplaceSystem<D>& A);
+  // A tensor operator: the axis part, and the mixed terms in apply() and
+  // residual() on double vectors (the float kernels, the multigrid's, take
+  // the axis part: the preconditioner is the axis part's, as on the CPU).
+  template <int D>
+  explicit GpuLaplace(const AnisotropicSystem<D>& A);
   // The system's coefficients changed, not its shape.
   template <int D>
   void update(const LaplaceSystem<D>& A);
+  template <int D>
+  void update(const AnisotropicSystem<D>& A);
 
   size_t size() const { return n_; }
   bool singular() const { return singular_; }
@@ -48,6 +56,8 @@ class GpuLaplace {
   bool singular_ = false;
   std::array<GpuBuffer, 3> w_;
   GpuBuffer diag_, c_;
+  std::array<GpuBuffer, 6> cross_;  // up, down per plane (a tensor's mixed terms)
+  bool hasCross_ = false;
 };
 
 }  // namespace morphoflow

@@ -44,7 +44,8 @@ GpuRDLayer<D>::GpuRDLayer(const RDSolver<D>& rd) : rd_(rd), species_(rd.species(
     diffusion_[size_t(s)]->increment = GpuBuffer(n_ * sizeof(double));
   }
   stats_buffer_ = GpuBuffer(2 * sizeof(uint32_t));
-  laplacian_ = std::make_unique<GpuLaplace>(rd.diffusionOperator(0).axis);
+  // each species' operator (a tensor's for the anisotropic ones), for the explicit part
+  for (int s = 0; s < species_; ++s) operator_[size_t(s)] = std::make_unique<GpuLaplace>(rd.diffusionOperator(s));
   // parameter maps (and perturbations), concatenated
   std::vector<double> maps;
   mapAt_.fill(-1);
@@ -125,9 +126,9 @@ SolverResult GpuRDLayer<D>::diffuse(int s, double thetaDt) {
   if (df.thetaDt != thetaDt) {
     df.host = rd_.diffusionOperator(s).shifted(thetaDt * d);
     if (df.A)
-      df.A->update(df.host.axis);
+      df.A->update(df.host);
     else
-      df.A = std::make_unique<GpuLaplace>(df.host.axis);
+      df.A = std::make_unique<GpuLaplace>(df.host);
     df.pcg = std::make_unique<GpuPcg>(*df.A);
     // multigrid once diffusion dominates the identity, the diagonal below
     const double scale = thetaDt * d / (rd_.h() * rd_.h());
@@ -173,7 +174,7 @@ void GpuRDLayer<D>::step(double dt) {
   for (int s = 0; s < species_; ++s) {
     // the theta scheme's explicit part: x += dt R + (1 - theta) dt d lap x
     const double explicitD = (1.0 - theta) * dt * rd_.diffusion()[size_t(s)];
-    if (explicitD > 0) laplacian_->apply(x_[size_t(s)], &work_[size_t(s)]);  // -lap x (less the Dirichlet ghosts)
+    if (explicitD > 0) operator_[size_t(s)]->apply(x_[size_t(s)], &work_[size_t(s)]);  // -lap x (less the Dirichlet ghosts)
     if (explicitD > 0 && faces_[size_t(s)].id())
       vectorOp("OP_ADD_FACES", faces_[size_t(s)], &work_[size_t(s)],
                -2.0 * rd_.settings().dirichletValues[size_t(s)] / (rd_.h() * rd_.h()), 1.0);

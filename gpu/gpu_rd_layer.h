@@ -6,8 +6,8 @@
 // solved by CG (diagonal preconditioner while the identity dominates, one
 // multigrid V-cycle beyond, as on the CPU) to rd.tolerance, warm-started from
 // the last step's diffusive change. Parameter maps, fixed regions, frozen
-// species, periodic, zero-flux and Dirichlet walls; the host refuses the
-// rest (app/gpu_simulation.cpp).
+// species, periodic, zero-flux and Dirichlet walls, a fixed diffusion tensor
+// (seed 004 eq. 11-17); the host refuses the rest (app/gpu_simulation.cpp).
 #pragma once
 
 #include <array>
@@ -72,7 +72,7 @@ class GpuRDLayer {
   std::array<bool, kMax> isFrozen_{}, isFixed_{};
   bool frozenTaken_ = false;
   GpuBuffer allHeld_;                 // a mask of ones (frozen species)
-  std::unique_ptr<GpuLaplace> laplacian_;  // -lap (scale 1/h^2): the explicit part
+  std::array<std::unique_ptr<GpuLaplace>, kMax> operator_;  // -lap or -div(sigma grad) (scale 1/h^2): the explicit part
   std::array<std::unique_ptr<Diffusion>, kMax> diffusion_;
   RDStepStats stats_;
 };

@@ -7,6 +7,9 @@
 // x_i = (b_i / scale + sum_f w_f x_j) / diag_i; MODE_JACOBI: y = x + omega
 // (that update - x) (levels whose odd periodic axis mixes the colours).
 // REAL is double for the PCG vectors, float for the multigrid levels.
+// CROSS (apply and residual): the mixed terms of a tensor diffusion operator
+// (core/anisotropic_system.h), pair couplings K (x_i - x_q) with the four
+// diagonal neighbours in each plane; the preconditioners take the axis part.
 layout(std430, binding = 0) buffer X { REAL x[]; };
 layout(std430, binding = 1) buffer Y { REAL y[]; };
 layout(std430, binding = 2) readonly buffer B { REAL b[]; };
@@ -20,6 +23,34 @@ uniform ivec3 dims;
 uniform double scale;
 uniform int colour;    // MODE_SMOOTH: the cells with (x + y + z) % 2 == colour
 uniform float omega;   // MODE_JACOBI
+
+#if defined(CROSS)
+// K(p, p + e_a + e_b) and K(p, p + e_a - e_b) of plane 0 (xy), 1 (xz), 2 (yz)
+layout(std430, binding = 8) readonly buffer Mixed { float k[]; } mixed[2 * (DIM == 3 ? 3 : 1)];
+
+// The mixed terms' sum at cell c (index i): the couplings of +up and +down
+// live at i, those of -up and -down at the neighbour (0 across a wall).
+REAL crossSum(ivec3 c, int i) {
+  REAL s = REAL(0);
+  const REAL xi = x[i];
+  for (int p = 0; p < (DIM == 3 ? 3 : 1); ++p) {
+    const int a = p == 2 ? 1 : 0, b = p == 0 ? 1 : 2;
+    const ivec3 up = stepWrapped(stepWrapped(c, a, 1, dims), b, 1, dims);
+    const ivec3 down = stepWrapped(stepWrapped(c, a, 1, dims), b, -1, dims);
+    const ivec3 upNeg = stepWrapped(stepWrapped(c, a, -1, dims), b, -1, dims);
+    const ivec3 downNeg = stepWrapped(stepWrapped(c, a, -1, dims), b, 1, dims);
+    const int q0 = indexOf(up, dims);
+    const int q1 = indexOf(down, dims);
+    const int q2 = indexOf(upNeg, dims);
+    const int q3 = indexOf(downNeg, dims);
+    s += REAL(mixed[2 * p].k[i]) * (xi - x[q0]);
+    s += REAL(mixed[2 * p + 1].k[i]) * (xi - x[q1]);
+    s += REAL(mixed[2 * p].k[q2]) * (xi - x[q2]);
+    s += REAL(mixed[2 * p + 1].k[q3]) * (xi - x[q3]);
+  }
+  return s;
+}
+#endif
 
 float weight(int a, int i) { return a == 0 ? w0[i] : a == 1 ? w1[i] : w2[i]; }
 
@@ -61,10 +92,16 @@ void main() {
 #endif
     return;
   }
+#if defined(MODE_APPLY) || defined(MODE_RESIDUAL)
+  REAL ax = REAL(scale) * (REAL(cTerm[i]) * x[i] + faceSum(c, i));
+#if defined(CROSS)
+  ax += REAL(scale) * crossSum(c, i);
+#endif
 #if defined(MODE_APPLY)
-  y[i] = REAL(scale) * (REAL(cTerm[i]) * x[i] + faceSum(c, i));
-#elif defined(MODE_RESIDUAL)
-  y[i] = b[i] - REAL(scale) * (REAL(cTerm[i]) * x[i] + faceSum(c, i));
+  y[i] = ax;
+#else
+  y[i] = b[i] - ax;
+#endif
 #else
   const REAL s = neighbourSum(c, i);
 #endif
