@@ -28,7 +28,6 @@ std::string missingStage(const Scene& s) {
            " species (the coupled gpu step carries two)";
   if (rd.anisotropy.enabled && rd.anisotropy.shape != 0.0)
     return "the shape term of anisotropic diffusion (rd.anisotropy.shape: a tensor rebuilt from the state every step)";
-  if (rd.lobes.enabled) return "cosine-lobe diffusion ([rd.cosine_lobes])";
   if (rd.coarseLevels > 0) return "the coarse-to-fine start (rd.coarse_to_fine)";
   if (rd.settings.lookupTable) return "the reaction lookup table (rd.lookup_table)";
   return "";
@@ -95,7 +94,7 @@ GpuRDSimulation<D>::GpuRDSimulation(const Scene& scene) : scene_(scene) {
   const RDScene& rd = scene.rd;
   const bool plainExplicit = rd.settings.integrator == RDIntegrator::ExplicitEuler && species_.size() == 2 &&
                              rd.settings.boundary != RDBoundary::Dirichlet && rd.parameterMaps.empty() &&
-                             rd.perturb.empty() && rd.fixed.empty() && rd.settings.frozen.empty() && !rd.anisotropy.enabled;
+                             rd.perturb.empty() && rd.fixed.empty() && rd.settings.frozen.empty() && !rd.anisotropy.enabled && !rd.lobes.enabled;
   if (!plainExplicit) {
     host_ = std::move(init);
     layer_ = std::make_unique<GpuRDLayer<D>>(*host_);

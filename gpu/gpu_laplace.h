@@ -33,6 +33,10 @@ class GpuLaplace {
   const std::array<int, 3>& dims() const { return dims_; }
   const std::array<bool, 3>& periodic() const { return periodic_; }
   const GpuBuffer& diag() const { return diag_; }
+  // The coefficients, for kernels that build an operator on the GPU (cosine lobes).
+  GpuBuffer& weights(int a) { return w_[size_t(a)]; }
+  GpuBuffer& cBuffer() { return c_; }
+  GpuBuffer& diagBuffer() { return diag_; }
   // True when an odd periodic axis couples cells of one colour (the
   // red-black sweep would then race): such levels smooth by Jacobi.
   bool mixesColours() const;

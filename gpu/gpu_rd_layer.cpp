@@ -3,7 +3,10 @@
 #include <epoxy/gl.h>
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include "core/multigrid.h"
+#include "rd/cosine_lobe.h"
 #include "gpu/compute_program.h"
 #include "gpu/gpu_kernels.h"
 #include "gpu/gpu_laplace.h"
@@ -66,6 +69,17 @@ GpuRDLayer<D>::GpuRDLayer(const RDSolver<D>& rd) : rd_(rd), species_(rd.species(
     if (rd.settings().boundary == RDBoundary::Dirichlet) faces_[si] = GpuBuffer::of(rd.dirichletFaces(s));
   }
   for (int s : rd.settings().frozen) isFrozen_[size_t(s)] = true;
+  if (const CosineLobeSpec* lobes = rd.cosineLobes()) {
+    lobeA_ = GpuBuffer(n_ * sizeof(double));
+    std::vector<double> rot(lobes->theta0.empty() ? 2 : 2 * n_);
+    for (size_t i = 0; i < lobes->theta0.size(); ++i) {
+      rot[2 * i] = std::cos(lobes->theta0[i]);
+      rot[2 * i + 1] = std::sin(lobes->theta0[i]);
+    }
+    rot_ = GpuBuffer::of(rot);
+    for (int s = 0; s < species_; ++s)
+      if (rd.lobed(s) && !faces_[size_t(s)].id()) faces_[size_t(s)] = GpuBuffer(n_ * sizeof(double));
+  }
   allHeld_ = GpuBuffer::of(std::vector<uint32_t>(rd.settings().frozen.empty() ? 1 : n_, 1u));
 }
 
@@ -123,7 +137,16 @@ SolverResult GpuRDLayer<D>::diffuse(int s, double thetaDt) {
   const double d = rd_.diffusion()[size_t(s)];
   if (d == 0.0 || thetaDt == 0.0) return SolverResult{true, 0, 0.0};
   Diffusion& df = *diffusion_[size_t(s)];
-  if (df.thetaDt != thetaDt) {
+  if (rd_.lobed(s)) {  // rebuilt every step from this step's lobes: I + theta dt d (-div a grad)
+    if (!df.A) {
+      df.A = std::make_unique<GpuLaplace>(rd_.diffusionOperator(s).shifted(thetaDt * d));
+      df.pcg = std::make_unique<GpuPcg>(*df.A);
+    }
+    const double k = thetaDt * d / (rd_.h() * rd_.h());
+    lobeKernel("MODE_SHIFT", df.A.get(), nullptr, operator_[size_t(s)].get(), k, nullptr);
+    lobeKernel("MODE_DIAG", df.A.get(), nullptr, nullptr, 0.0, nullptr);
+    df.thetaDt = thetaDt;
+  } else if (df.thetaDt != thetaDt) {
     df.host = rd_.diffusionOperator(s).shifted(thetaDt * d);
     if (df.A)
       df.A->update(df.host);
@@ -139,7 +162,7 @@ SolverResult GpuRDLayer<D>::diffuse(int s, double thetaDt) {
   GpuBuffer& b = x_[size_t(s)];
   GpuBuffer& x = work_[size_t(s)];
   // the Dirichlet ghost adds theta dt d 2 g / h^2 per boundary face
-  if (faces_[size_t(s)].id())
+  if (rd_.settings().boundary == RDBoundary::Dirichlet)
     vectorOp("OP_ADD_FACES", faces_[size_t(s)], &b,
              thetaDt * d / (rd_.h() * rd_.h()) * 2.0 * rd_.settings().dirichletValues[size_t(s)], 1.0);
   // warm start: b plus the last change, rescaled to this theta dt
@@ -170,12 +193,13 @@ void GpuRDLayer<D>::step(double dt) {
       }
     frozenTaken_ = true;
   }
+  if (rd_.cosineLobes()) buildLobes();  // eq. 17: a(theta) from the state at the step's start
   react(dt, implicitReaction);
   for (int s = 0; s < species_; ++s) {
     // the theta scheme's explicit part: x += dt R + (1 - theta) dt d lap x
     const double explicitD = (1.0 - theta) * dt * rd_.diffusion()[size_t(s)];
     if (explicitD > 0) operator_[size_t(s)]->apply(x_[size_t(s)], &work_[size_t(s)]);  // -lap x (less the Dirichlet ghosts)
-    if (explicitD > 0 && faces_[size_t(s)].id())
+    if (explicitD > 0 && rd_.settings().boundary == RDBoundary::Dirichlet)
       vectorOp("OP_ADD_FACES", faces_[size_t(s)], &work_[size_t(s)],
                -2.0 * rd_.settings().dirichletValues[size_t(s)] / (rd_.h() * rd_.h()), 1.0);
     if (!implicitReaction) vectorOp("OP_SCALE_ADD", rates_[size_t(s)], &x_[size_t(s)], dt, 1.0);
@@ -193,6 +217,56 @@ void GpuRDLayer<D>::step(double dt) {
     stats_.newton.cells = long(n_);
     stats_.newton.failures = long(st[0]);
     stats_.newton.maxIterations = int(st[1]);
+  }
+}
+
+template <int D>
+void GpuRDLayer<D>::lobeKernel(const char* mode, GpuLaplace* target, const GpuBuffer* x, GpuLaplace* source, double k,
+                               GpuBuffer* faces) {
+  const CosineLobeSpec& spec = *rd_.cosineLobes();
+  const ComputeProgram& p = useKernel("rd_lobes.comp", fmt::format("#define DIM {}\n#define {}", D, mode));
+  std::array<int, 3> dims{1, 1, 1};
+  for (int a = 0; a < D; ++a) dims[size_t(a)] = rd_.cells()[a];
+  setUniform(p, "dims", dims);
+  setUniform(p, "periodic", rd_.settings().boundary == RDBoundary::Periodic ? 1 : 0);
+  setUniform(p, "dirichlet", rd_.settings().boundary == RDBoundary::Dirichlet ? 1 : 0);
+  setUniform(p, "witkinKass", spec.witkinKass ? 1 : 0);
+  setUniform(p, "rotated", spec.theta0.empty() ? 0 : 1);
+  const int lobes = int(spec.speeds.size());
+  setUniform(p, "lobes", lobes);
+  std::array<double, 8> speeds{};
+  std::array<double, 16> centres{};
+  for (int m = 0; m < lobes && m < 8; ++m) {
+    speeds[size_t(m)] = spec.speeds[size_t(m)];
+    centres[size_t(2 * m)] = std::cos(2.0 * M_PI * m / lobes);
+    centres[size_t(2 * m + 1)] = std::sin(2.0 * M_PI * m / lobes);
+  }
+  glUniform1dv(p.uniform("speeds"), 8, speeds.data());
+  glUniform1dv(p.uniform("centres"), 16, centres.data());
+  setUniform(p, "meanA", meanLobeDiffusivity(spec));
+  setUniform(p, "k", k);
+  (x ? *x : lobeA_).bind(0);
+  lobeA_.bind(1);
+  for (int a = 0; a < 3; ++a) target->weights(a < D ? a : 0).bind(2 + a);
+  target->cBuffer().bind(5);
+  target->diagBuffer().bind(6);
+  (faces ? *faces : lobeA_).bind(7);
+  rot_.bind(8);
+  GpuLaplace* src = source ? source : target;
+  for (int a = 0; a < 3; ++a) src->weights(a < D ? a : 0).bind(9 + a);
+  src->cBuffer().bind(12);
+  dispatchFlat(n_, 8.0 + 4.0 * (D + 2));
+  storageBarrier();
+}
+
+template <int D>
+void GpuRDLayer<D>::buildLobes() {
+  for (int s = 0; s < species_; ++s) {
+    if (!rd_.lobed(s)) continue;
+    GpuLaplace* op = operator_[size_t(s)].get();
+    lobeKernel("MODE_A", op, &x_[size_t(s)], nullptr, 0.0, nullptr);
+    lobeKernel("MODE_FACES", op, nullptr, nullptr, 0.0, &faces_[size_t(s)]);
+    lobeKernel("MODE_DIAG", op, nullptr, nullptr, 0.0, nullptr);
   }
 }
 

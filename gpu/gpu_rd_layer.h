@@ -7,7 +7,9 @@
 // multigrid V-cycle beyond, as on the CPU) to rd.tolerance, warm-started from
 // the last step's diffusive change. Parameter maps, fixed regions, frozen
 // species, periodic, zero-flux and Dirichlet walls, a fixed diffusion tensor
-// (seed 004 eq. 11-17); the host refuses the rest (app/gpu_simulation.cpp).
+// (seed 004 eq. 11-17), Kim & Lin's cosine lobes rebuilt from the state
+// every step (shaders/rd_lobes.comp; their systems preconditioned by the
+// diagonal); the host refuses the rest (app/gpu_simulation.cpp).
 #pragma once
 
 #include <array>
@@ -55,6 +57,10 @@ class GpuRDLayer {
   void vectorOp(const char* op, const GpuBuffer& x, GpuBuffer* y, double a, double b,
                 const GpuBuffer* held = nullptr) const;
   void holdFixed();
+  // Each lobed species' operator from its state at the step's start (eq. 14-17).
+  void buildLobes();
+  void lobeKernel(const char* mode, GpuLaplace* target, const GpuBuffer* x, GpuLaplace* source, double k,
+                  GpuBuffer* faces);
 
   static constexpr int kMax = ReactionModel::kMaxSpecies;
   const RDSolver<D>& rd_;
@@ -72,6 +78,7 @@ class GpuRDLayer {
   std::array<bool, kMax> isFrozen_{}, isFixed_{};
   bool frozenTaken_ = false;
   GpuBuffer allHeld_;                 // a mask of ones (frozen species)
+  GpuBuffer lobeA_, rot_;             // a(theta) per cell; cos, sin of theta0 per cell
   std::array<std::unique_ptr<GpuLaplace>, kMax> operator_;  // -lap or -div(sigma grad) (scale 1/h^2): the explicit part
   std::array<std::unique_ptr<Diffusion>, kMax> diffusion_;
   RDStepStats stats_;

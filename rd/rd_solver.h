@@ -62,6 +62,7 @@ class RDSolver {
   // species diffuse by div(d a(theta) grad), a(theta) rebuilt from each
   // species' own gradient at every step. Not combined with a tensor.
   void setCosineLobes(CosineLobeSpec spec);
+  const CosineLobeSpec* cosineLobes() const { return lobeSpec_.get(); }
   bool lobed(int s) const { return !lobeSpecies_.empty() && lobeSpecies_[size_t(s)]; }
   // The operator -h^2 div(sigma grad) (or -h^2 lap) that species s diffuses by.
   const AnisotropicSystem<D>& diffusionOperator(int s) const {

@@ -98,7 +98,6 @@ TEST(Gpu, AStageWithNoGpuProgramIsRefusedNamingIt) {
        {std::pair{sceneFile("coupled/cavity_gray_scott.toml") + " --set 'rd.lookup_table=true'", std::string("the reaction lookup table")},
         std::pair{sceneFile("rd/seeds/sanderson_fig06.toml") + " --set rd.anisotropy.shape=0.5", std::string("the shape term of anisotropic diffusion")},
 
-        std::pair{sceneFile("rd/seeds/kim_lin_lobes3.toml"), std::string("cosine-lobe diffusion")},
         std::pair{sceneFile("rd/turing_coarse_to_fine.toml"), std::string("the coarse-to-fine start")}}) {
     CommandResult r = runMorphoflow("run " + args + " --backend gpu --quiet" + out);
     EXPECT_EQ(r.status, 2) << args << "\n" << r.output;
@@ -391,8 +390,9 @@ TEST(Gpu, BenchSuitesTimeTheFluidTheLayerAndTheCoupling) {
 }
 
 // Shipped scenes with parameter maps (an image, a Pearson F x k map), a fixed
-// region, the four-species coupled Brusselator and fixed diffusion tensors
-// (a saddle, circles, a four-species layer), at 64^2 for 40 steps with
+// region, the four-species coupled Brusselator, fixed diffusion tensors (a
+// saddle, circles, a four-species layer) and Kim & Lin's cosine lobes (three
+// lobes, Witkin-Kass), at 64^2 for 40 steps with
 // the solves at 1e-12: every species within 1e-6 of its largest value
 // (measured: float rounding of the dumps, or exactly equal).
 TEST(Gpu, ShippedMapFixedAndMultiSpeciesScenesMatchTheCpu) {
@@ -400,7 +400,8 @@ TEST(Gpu, ShippedMapFixedAndMultiSpeciesScenesMatchTheCpu) {
   const fs::path dir = tempDir("gpu_map_scenes");
   for (const char* scene : {"rd/seeds/lawlor_image_growth.toml", "rd/seeds/pearson_map.toml", "rd/seeds/sanderson_fig20.toml",
                             "rd/seeds/sanderson_fig10.toml", "rd/seeds/sanderson_fig21.toml", "rd/seeds/sanderson_fig06.toml",
-                            "rd/seeds/sanderson_fig07.toml", "rd/seeds/sanderson_fig18.toml"}) {
+                            "rd/seeds/sanderson_fig07.toml", "rd/seeds/sanderson_fig18.toml", "rd/seeds/kim_lin_lobes3.toml",
+                            "rd/seeds/kim_lin_witkin_kass.toml"}) {
     for (const char* backend : {"gpu", "tbb"}) {
       CommandResult r = runMorphoflow("run " + sceneFile(scene) + " --set grid.resolution=[64,64] --set rd.tolerance=1e-12"
                                       " --set time.steps=40 --set output.every=20 --set output.fields=true --quiet --backend " +
