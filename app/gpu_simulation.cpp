@@ -28,7 +28,6 @@ std::string missingStage(const Scene& s) {
            " species (the coupled gpu step carries two)";
   if (rd.anisotropy.enabled && rd.anisotropy.shape != 0.0)
     return "the shape term of anisotropic diffusion (rd.anisotropy.shape: a tensor rebuilt from the state every step)";
-  if (rd.coarseLevels > 0) return "the coarse-to-fine start (rd.coarse_to_fine)";
   if (rd.settings.lookupTable) return "the reaction lookup table (rd.lookup_table)";
   return "";
 }
@@ -81,10 +80,17 @@ void checkGpuRuns(const Scene& scene) {
 }
 
 template <int D>
-GpuRDSimulation<D>::GpuRDSimulation(const Scene& scene) : scene_(scene) {
-  // The initial state as the CPU builds it, then only the GPU steps.
+GpuRDSimulation<D>::GpuRDSimulation(const Scene& scene, const std::function<void(const std::string&)>& log)
+    : scene_(scene) {
+  // The initial state as the CPU builds it (a coarse-to-fine start's levels
+  // stepped on the GPU), then only the GPU steps.
   auto init = std::make_unique<RDSolver<D>>(scene.rd.settings, *findModel(scene.rd.settings.model));
-  initialState<D>(scene, init.get());
+  const CoarseAdvance<D> onGpu = [](RDSolver<D>* level, long steps, double dt) {
+    GpuRDLayer<D> layer(*level);
+    for (long k = 0; k < steps; ++k) layer.step(dt);
+    for (int s = 0; s < level->species(); ++s) level->field(s).values() = layer.download(s);
+  };
+  if (!growCoarseToFine<D>(scene, init.get(), log, &coarseReport_, onGpu)) initialState<D>(scene, init.get());
   applyScene<D>(scene, init.get());
   species_ = init->model().info().species;
   cells_ = init->field(0).dims();
@@ -103,7 +109,8 @@ GpuRDSimulation<D>::GpuRDSimulation(const Scene& scene) : scene_(scene) {
   std::vector<double> params;
   for (size_t k = 0; k < init->model().info().parameters.size(); ++k) params.push_back(init->parameter(int(k)));
   auto values = [&](int s) { return toFloat<D>(init->field(s)).values(); };
-  gpu_ = std::make_unique<GpuExplicitRD>(scene.rd.settings, init->diffusion(), params, values(0), values(1));
+  gpu_ = std::make_unique<GpuExplicitRD>(scene.rd.settings, init->diffusion(), params, init->model().info().clamped, values(0),
+                                         values(1));
 }
 
 template <int D>
@@ -196,6 +203,7 @@ nlohmann::json GpuRDSimulation<D>::resolved() const {
 template <int D>
 void GpuRDSimulation<D>::report(nlohmann::json* run) const {
   recordGlContext(run);
+  if (!coarseReport_.empty()) (*run)["coarse_to_fine"] = coarseReport_;
 }
 
 template class GpuRDSimulation<2>;

@@ -6,6 +6,7 @@
 // scenes are FluidSimulation and CoupledSimulation on their gpu path.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -38,7 +39,7 @@ void recordGlContext(nlohmann::json* run);
 template <int D>
 class GpuRDSimulation : public Simulation<D> {
  public:
-  explicit GpuRDSimulation(const Scene& scene);
+  GpuRDSimulation(const Scene& scene, const std::function<void(const std::string&)>& log);
   ~GpuRDSimulation() override;
 
   void step(double dt) override;
@@ -64,6 +65,7 @@ class GpuRDSimulation : public Simulation<D> {
   std::unique_ptr<GpuExplicitRD> gpu_;           // the explicit step, single precision
   std::unique_ptr<RDSolver<D>> host_;            // other integrators: the settings and operators
   std::unique_ptr<GpuRDLayer<D>> layer_;         // ... stepped in double precision
+  nlohmann::json coarseReport_ = nlohmann::json::array();
   double time_ = 0.0;
   long steps_ = 0;
 };

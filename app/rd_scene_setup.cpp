@@ -165,7 +165,7 @@ void prolongateState(const RDSolver<D>& coarse, RDSolver<D>* fine) {
 
 template <int D>
 bool growCoarseToFine(const Scene& scene, RDSolver<D>* rd, const std::function<void(const std::string&)>& log,
-                      nlohmann::json* report) {
+                      nlohmann::json* report, const CoarseAdvance<D>& advance) {
   std::unique_ptr<RDSolver<D>> prev;
   for (int level = scene.rd.coarseLevels; level >= 1; --level) {
     RDSettings st = scene.rd.settings;
@@ -176,11 +176,15 @@ bool growCoarseToFine(const Scene& scene, RDSolver<D>* rd, const std::function<v
     applyScene<D>(scene, cur.get());
     const auto t0 = std::chrono::steady_clock::now();
     const double dt = scene.time.dt * (scene.rd.coarseScaleDt ? std::pow(4.0, level) : 1.0);
-    for (long k = 0; k < scene.rd.coarseSteps; ++k) cur->step(dt);
+    if (advance)
+      advance(cur.get(), scene.rd.coarseSteps, dt);
+    else
+      for (long k = 0; k < scene.rd.coarseSteps; ++k) cur->step(dt);
     checkFinite(*cur, fmt::format("on the coarse grid {}", fmt::join(st.resolution, "x")), "the coarse-to-fine start");
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     log(fmt::format("coarse grid {}: {} steps, {:.2f} s", fmt::join(st.resolution, "x"), scene.rd.coarseSteps, wall));
-    report->push_back({{"resolution", st.resolution}, {"steps", scene.rd.coarseSteps}, {"dt", dt}, {"time", cur->time()},
+    report->push_back({{"resolution", st.resolution}, {"steps", scene.rd.coarseSteps}, {"dt", dt},
+                       {"time", double(scene.rd.coarseSteps) * dt},
                        {"wall_seconds", wall}});
     prev = std::move(cur);
   }
@@ -190,8 +194,8 @@ bool growCoarseToFine(const Scene& scene, RDSolver<D>* rd, const std::function<v
 }
 
 template bool growCoarseToFine<2>(const Scene&, RDSolver<2>*, const std::function<void(const std::string&)>&,
-                                  nlohmann::json*);
+                                  nlohmann::json*, const CoarseAdvance<2>&);
 template bool growCoarseToFine<3>(const Scene&, RDSolver<3>*, const std::function<void(const std::string&)>&,
-                                  nlohmann::json*);
+                                  nlohmann::json*, const CoarseAdvance<3>&);
 
 }  // namespace morphoflow

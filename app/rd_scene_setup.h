@@ -27,9 +27,13 @@ std::string rdStage(const RDSettings& settings);
 // on grids 2^L, ..., 2 times coarser over the same domain, each started from
 // the previous one, and prolongates the last onto `rd`; false (rd untouched)
 // when the scene asks for none. Each level's line goes to `log` and `report`.
+// `advance` (when given) takes a coarse level's steps instead of its own
+// step(): the GPU backend's (the level's state in, its state after out).
+template <int D>
+using CoarseAdvance = std::function<void(RDSolver<D>* level, long steps, double dt)>;
 template <int D>
 bool growCoarseToFine(const Scene& scene, RDSolver<D>* rd, const std::function<void(const std::string&)>& log,
-                      nlohmann::json* report);
+                      nlohmann::json* report, const CoarseAdvance<D>& advance = {});
 // A species as floats, for frames and dumps.
 template <int D>
 Grid<float, D> toFloat(const Grid<double, D>& src) {

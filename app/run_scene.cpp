@@ -21,7 +21,7 @@ template <int D>
 std::unique_ptr<Simulation<D>> makeSimulation(const Scene& scene, const RunOptions& opt, RunLog* log) {
   auto say = [log](const std::string& line) { log->say(line); };
   auto warn = [log](const std::string& line) { log->warn(line); };
-  if (opt.backend == "gpu" && !scene.hasFluid) return std::make_unique<GpuRDSimulation<D>>(scene);  // checkGpuRuns said it can
+  if (opt.backend == "gpu" && !scene.hasFluid) return std::make_unique<GpuRDSimulation<D>>(scene, say);  // checkGpuRuns said it can
   if (opt.backend == "gpu" && scene.rd.enabled) return std::make_unique<CoupledSimulation<D>>(scene, CouplingBackend::Serial, warn, true);
   if (opt.backend == "gpu") return std::make_unique<FluidSimulation<D>>(scene, warn, true);
   if (!scene.hasFluid) return std::make_unique<RDSimulation<D>>(scene, say);

@@ -42,7 +42,7 @@ nlohmann::json benchGpuRD(int n, double minSeconds) {
   const double dt = 0.9 * rd.explicitDiffusionLimit();
   std::vector<float> u(rd.field(0).values().begin(), rd.field(0).values().end());
   std::vector<float> v(rd.field(1).values().begin(), rd.field(1).values().end());
-  GpuExplicitRD gpu(s, rd.diffusion(), {rd.parameter(0), rd.parameter(1)}, u, v);
+  GpuExplicitRD gpu(s, rd.diffusion(), {rd.parameter(0), rd.parameter(1)}, {}, u, v);
   gpu.step(dt);  // warm-up: the driver's first dispatch
   gpu.finish();
   // Ten steps a sample, so a sample is the GPU's time, not the queue's.

@@ -16,7 +16,7 @@ constexpr int kGroup = 8;  // 8 x 8 (x 4 in 3D) invocations a work group
 }
 
 GpuExplicitRD::GpuExplicitRD(const RDSettings& s, const std::vector<double>& diffusion, const std::vector<double>& params,
-                             const std::vector<float>& u, const std::vector<float>& v) {
+                             const std::vector<int>& clamped, const std::vector<float>& u, const std::vector<float>& v) {
   GlContext::instance();
   const int D = int(s.resolution.size());
   for (int a = 0; a < D; ++a) cells_[size_t(a)] = s.resolution[size_t(a)];
@@ -25,6 +25,7 @@ GpuExplicitRD::GpuExplicitRD(const RDSettings& s, const std::vector<double>& dif
   for (int k = 0; k < 2; ++k) dOverH2_[size_t(k)] = float(diffusion[size_t(k)] / (h_ * h_));
   for (size_t k = 0; k < params.size() && k < params_.size(); ++k) params_[k] = float(params[k]);
   periodic_ = s.boundary == RDBoundary::Periodic;
+  for (int k : clamped) clamped_ |= 1u << k;
   const std::string reaction = gpuReaction(s.model);
   program_ = std::make_unique<ComputeProgram>(
       "rd_explicit.comp", fmt::format("#define DIM {}\n{}\nlayout(local_size_x = {}, local_size_y = {}, "
@@ -46,6 +47,7 @@ void GpuExplicitRD::step(double dt) {
   glUniform1f(program_->uniform("dt"), float(dt));
   glUniform2f(program_->uniform("dOverH2"), dOverH2_[0], dOverH2_[1]);
   glUniform1fv(program_->uniform("p"), GLsizei(params_.size()), params_.data());
+  glUniform1ui(program_->uniform("clamped"), clamped_);
   const int in = current_ * 2, out = 2 - current_ * 2;
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, buffers_[size_t(in)]);
   glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, buffers_[size_t(in + 1)]);

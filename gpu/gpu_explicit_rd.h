@@ -17,9 +17,10 @@ class ComputeProgram;
 
 class GpuExplicitRD {
  public:
-  // `params` are the model's uniform parameters; `u`, `v` the initial species.
+  // `params` are the model's uniform parameters; `clamped` the species held
+  // >= 0 after each step (the model's projection); `u`, `v` the initial species.
   GpuExplicitRD(const RDSettings& settings, const std::vector<double>& diffusion, const std::vector<double>& params,
-                const std::vector<float>& u, const std::vector<float>& v);
+                const std::vector<int>& clamped, const std::vector<float>& u, const std::vector<float>& v);
   ~GpuExplicitRD();
   GpuExplicitRD(const GpuExplicitRD&) = delete;
   GpuExplicitRD& operator=(const GpuExplicitRD&) = delete;
@@ -37,6 +38,7 @@ class GpuExplicitRD {
   std::array<float, 2> dOverH2_{};
   std::array<float, 8> params_{};
   bool periodic_ = true;
+  unsigned clamped_ = 0;
   std::unique_ptr<ComputeProgram> program_;
   std::array<unsigned, 4> buffers_{};  // u, v, u', v'
   int current_ = 0;                     // 0: (u, v) hold the state, 1: (u', v')

@@ -109,6 +109,23 @@ void GpuRDLayer<D>::vectorOp(const char* op, const GpuBuffer& x, GpuBuffer* y, d
 }
 
 template <int D>
+void GpuRDLayer<D>::thetaStep(const GpuBuffer& rates, GpuBuffer* x, const GpuBuffer& ax, const GpuBuffer& faces, double dt,
+                              double explicitD, double ghost) const {
+  const ComputeProgram& p = useKernel("vector_ops.comp", "#define OP_THETA_STEP");
+  setUniform(p, "n", int(n_));
+  setUniform(p, "ca", dt);
+  setUniform(p, "cb", explicitD);
+  setUniform(p, "cc", ghost);
+  rates.bind(0);
+  x->bind(1);
+  ax.bind(2);
+  faces.bind(3);
+  for (int k = 4; k <= 7; ++k) rates.bind(k);
+  dispatchFlat(n_, 40.0);
+  storageBarrier();
+}
+
+template <int D>
 void GpuRDLayer<D>::react(double dt, bool implicit) {
   // Each parameter by a constant index, so the compiler keeps p[] in registers.
   std::string gather = "#define GATHER_PARAMETERS";
@@ -198,12 +215,13 @@ void GpuRDLayer<D>::step(double dt) {
   for (int s = 0; s < species_; ++s) {
     // the theta scheme's explicit part: x += dt R + (1 - theta) dt d lap x
     const double explicitD = (1.0 - theta) * dt * rd_.diffusion()[size_t(s)];
-    if (explicitD > 0) operator_[size_t(s)]->apply(x_[size_t(s)], &work_[size_t(s)]);  // -lap x (less the Dirichlet ghosts)
-    if (explicitD > 0 && rd_.settings().boundary == RDBoundary::Dirichlet)
-      vectorOp("OP_ADD_FACES", faces_[size_t(s)], &work_[size_t(s)],
-               -2.0 * rd_.settings().dirichletValues[size_t(s)] / (rd_.h() * rd_.h()), 1.0);
-    if (!implicitReaction) vectorOp("OP_SCALE_ADD", rates_[size_t(s)], &x_[size_t(s)], dt, 1.0);
-    if (explicitD > 0) vectorOp("OP_SCALE_ADD", work_[size_t(s)], &x_[size_t(s)], -explicitD, 1.0);
+    if (explicitD > 0) operator_[size_t(s)]->apply(x_[size_t(s)], &work_[size_t(s)]);  // A x = -lap x (less the ghosts)
+    if (!implicitReaction) {
+      const bool dirichlet = rd_.settings().boundary == RDBoundary::Dirichlet;
+      const double ghost = dirichlet ? 2.0 * rd_.settings().dirichletValues[size_t(s)] / (rd_.h() * rd_.h()) : 0.0;
+      thetaStep(rates_[size_t(s)], &x_[size_t(s)], work_[size_t(s)], dirichlet ? faces_[size_t(s)] : work_[size_t(s)],
+                dt, explicitD, ghost);
+    }
     const SolverResult r = diffuse(s, theta * dt);
     stats_.diffusion.converged = stats_.diffusion.converged && r.converged;
     stats_.diffusion.iterations = std::max(stats_.diffusion.iterations, r.iterations);

@@ -57,6 +57,9 @@ class GpuRDLayer {
   void vectorOp(const char* op, const GpuBuffer& x, GpuBuffer* y, double a, double b,
                 const GpuBuffer* held = nullptr) const;
   void holdFixed();
+  // x += dt R + explicitD (-A x + ghost faces) (rd_solver.cpp's explicit part, its order)
+  void thetaStep(const GpuBuffer& rates, GpuBuffer* x, const GpuBuffer& ax, const GpuBuffer& faces, double dt,
+                 double explicitD, double ghost) const;
   // Each lobed species' operator from its state at the step's start (eq. 14-17).
   void buildLobes();
   void lobeKernel(const char* mode, GpuLaplace* target, const GpuBuffer* x, GpuLaplace* source, double k,

@@ -53,7 +53,7 @@ TEST(GpuModels, EveryTwoSpeciesReactionStepsAsOnTheCpu) {
       rate = std::max({rate, std::abs(J[0]) + std::abs(J[1]), std::abs(J[2]) + std::abs(J[3])});
     }
     const double dt = 0.1 * std::min(cpu.explicitDiffusionLimit(), 1.0 / rate);
-    GpuExplicitRD gpu(s, cpu.diffusion(), params, start[0], start[1]);
+    GpuExplicitRD gpu(s, cpu.diffusion(), params, info.clamped, start[0], start[1]);
     for (int n = 0; n < 50; ++n) {
       cpu.step(dt);
       gpu.step(dt);

@@ -57,7 +57,7 @@ float weight(int a, int i) { return a == 0 ? w0[i] : a == 1 ? w1[i] : w2[i]; }
 // sum_f w_f (x_i - x_j(f)) over the 2 DIM faces of cell c (index i), the CPU's face sum.
 REAL faceSum(ivec3 c, int i) {
   const REAL xi = x[i];
-  REAL s = REAL(0);
+  precise REAL s = REAL(0);
   for (int a = 0; a < DIM; ++a) {
     const int iu = indexOf(stepWrapped(c, a, 1, dims), dims), il = indexOf(stepWrapped(c, a, -1, dims), dims);
     s += REAL(weight(a, i)) * (xi - x[iu]) + REAL(weight(a, il)) * (xi - x[il]);
@@ -93,7 +93,8 @@ void main() {
     return;
   }
 #if defined(MODE_APPLY) || defined(MODE_RESIDUAL)
-  REAL ax = REAL(scale) * (REAL(cTerm[i]) * x[i] + faceSum(c, i));
+  // precise: rounded as the CPU's (the explicit step depends on it bit for bit)
+  precise REAL ax = REAL(scale) * (REAL(cTerm[i]) * x[i] + faceSum(c, i));
 #if defined(CROSS)
   ax += REAL(scale) * crossSum(c, i);
 #endif

@@ -12,6 +12,7 @@ uniform bool periodic;    // else zero-flux (Neumann) walls
 uniform float dt;
 uniform vec2 dOverH2;     // d_u / h^2, d_v / h^2
 uniform float p[8];       // the model's parameters, in order
+uniform uint clamped;     // bit s: species s stays >= 0 (the model's projection)
 
 int at(ivec3 c) { return c.x + cells.x * (c.y + cells.y * c.z); }
 
@@ -38,6 +39,7 @@ void main() {
   const float x[2] = float[2](u, v);
   float r[2];
   RATES(x, r)
-  outU[i] = u + dt * (r[0] + dOverH2.x * lapU);
-  outV[i] = v + dt * (r[1] + dOverH2.y * lapV);
+  const float nu = u + dt * (r[0] + dOverH2.x * lapU), nv = v + dt * (r[1] + dOverH2.y * lapV);
+  outU[i] = (clamped & 1u) != 0u ? max(nu, 0.0) : nu;
+  outV[i] = (clamped & 2u) != 0u ? max(nv, 0.0) : nv;
 }

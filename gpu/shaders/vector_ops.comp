@@ -8,6 +8,9 @@
 // OP_FROM_FLOAT z = double(f) sqrt(S[rr])
 // OP_SCALE_ADD  y = a x + b y (a, b uniforms)
 // OP_CLAMP_ZERO y = max(y, 0)
+// OP_THETA_STEP y += ca x + cb (-z + cc q): the theta scheme's explicit part
+//               (x = R, y = the species, z = A y, q = the Dirichlet faces), in
+//               rd_solver.cpp's order, no fused multiply-adds
 // OP_HOLD       y = x where held[i] != 0 (fixed regions; frozen species hold everywhere)
 // OP_ADD_FACES  y += ca faces (x: the Dirichlet faces per cell)
 layout(std430, binding = 0) buffer X { double x[]; };
@@ -22,7 +25,7 @@ layout(std430, binding = 7) readonly buffer Held { uint held[]; };
 uniform int n;
 uniform ivec4 slots;   // the scalar slots each op reads
 uniform bool first;
-uniform double ca, cb;
+uniform double ca, cb, cc;
 
 void main() {
   const int i = flatIndex();
@@ -43,6 +46,10 @@ void main() {
   y[i] = double(f[i]) * sqrt(S[slots.x]);
 #elif defined(OP_SCALE_ADD)
   y[i] = ca * x[i] + cb * y[i];
+#elif defined(OP_THETA_STEP)
+  precise double L = -z[i] + cc * q[i];
+  precise double v = y[i] + (cb != 0.0lf ? ca * x[i] + cb * L : ca * x[i]);
+  y[i] = v;
 #elif defined(OP_CLAMP_ZERO)
   y[i] = max(y[i], 0.0lf);
 #elif defined(OP_HOLD)
