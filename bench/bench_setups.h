@@ -23,6 +23,19 @@ FluidSettings benchCavity(int n) {
   return s;
 }
 
+// Pearson's Gray-Scott (F = 0.04, k = 0.06) on n^D cells of size `cell`,
+// diffusion rates 0.2 and 0.1 cell^2 per unit time.
+template <int D>
+RDSettings benchGrayScott(int n, double cell, RDIntegrator integrator) {
+  RDSettings s;
+  s.model = "gray-scott";
+  s.resolution.assign(D, n);
+  s.size.assign(D, n * cell);
+  s.diffusion = {0.2 * cell * cell, 0.1 * cell * cell};
+  s.integrator = integrator;
+  return s;
+}
+
 // Pearson's start: u = 1, v = 0, a perturbed central square (u, v) = (1/2, 1/4).
 template <int D>
 void pearsonStart(RDSolver<D>* rd) {

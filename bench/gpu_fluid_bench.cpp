@@ -78,14 +78,7 @@ template <int D>
 nlohmann::json benchGpuCoupling(int n, double minSeconds, double peak) {
   const nlohmann::json fluid = benchGpuFluid<D>(n, minSeconds, peak);
   FluidSolver<D> host(benchCavity<D>(n));
-  RDSettings s;
-  s.model = "gray-scott";
-  s.resolution.assign(D, n);
-  s.size.assign(D, 1.0);
-  const double h2 = 1.0 / (double(n) * n);
-  s.diffusion = {0.2 * h2, 0.1 * h2};
-  s.integrator = RDIntegrator::KimLin;
-  RDSolver<D> rd(s, *findModel("gray-scott"));
+  RDSolver<D> rd(benchGrayScott<D>(n, 1.0 / n, RDIntegrator::KimLin), *findModel("gray-scott"));
   pearsonStart(&rd);
   const double dt = host.h();
   const double rdScale = 10.0 * 0.9 * rd.explicitDiffusionLimit() / dt;

@@ -31,12 +31,7 @@ namespace {
 
 template <int D>
 nlohmann::json benchGpuRD(int n, double minSeconds) {
-  RDSettings s;
-  s.model = "gray-scott";
-  s.resolution.assign(D, n);
-  s.size.assign(D, double(n));
-  s.diffusion = {0.2, 0.1};
-  s.integrator = RDIntegrator::ExplicitEuler;
+  const RDSettings s = benchGrayScott<D>(n, 1.0, RDIntegrator::ExplicitEuler);
   RDSolver<D> rd(s, *findModel(s.model));
   pearsonStart(&rd);
   const double dt = 0.9 * rd.explicitDiffusionLimit();
@@ -60,13 +55,7 @@ nlohmann::json benchGpuRD(int n, double minSeconds) {
 
 template <int D>
 nlohmann::json benchGpuKimLin(int n, double minSeconds) {
-  RDSettings s;
-  s.model = "gray-scott";
-  s.resolution.assign(D, n);
-  s.size.assign(D, double(n));
-  s.diffusion = {0.2, 0.1};
-  s.integrator = RDIntegrator::KimLin;
-  RDSolver<D> rd(s, *findModel(s.model));
+  RDSolver<D> rd(benchGrayScott<D>(n, 1.0, RDIntegrator::KimLin), *findModel("gray-scott"));
   pearsonStart(&rd);
   const double dt = 10.0 * 0.9 * rd.explicitDiffusionLimit();
   GpuRDLayer<D> gpu(rd);

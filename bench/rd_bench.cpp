@@ -26,13 +26,8 @@ namespace {
 template <int D>
 nlohmann::json benchRD(int n, bool implicit, int threads, double minSeconds) {
   ThreadLimit limit(threads);
-  RDSettings s;
-  s.model = "gray-scott";
-  s.resolution.assign(D, n);
-  s.size.assign(D, double(n));
-  s.diffusion = {0.2, 0.1};
-  s.integrator = implicit ? RDIntegrator::KimLin : RDIntegrator::ExplicitEuler;
-  RDSolver<D> rd(s, *findModel(s.model));
+  RDSolver<D> rd(benchGrayScott<D>(n, 1.0, implicit ? RDIntegrator::KimLin : RDIntegrator::ExplicitEuler),
+                 *findModel("gray-scott"));
   pearsonStart(&rd);
   const double dt = 0.9 * rd.explicitDiffusionLimit() * (implicit ? 10.0 : 1.0);
   rd.step(dt);  // warm-up: allocations, multigrid setup

@@ -12,7 +12,7 @@
 #include "core/random.h"
 #include "fluid/fluid_solver.h"
 #include "fluid/pressure_projection.h"
-#include "gpu/gl_context.h"
+#include "gpu_context.h"
 #include "gpu/gpu_fluid.h"
 #include "gpu/gpu_laplace.h"
 #include "gpu/gpu_multigrid.h"
@@ -22,15 +22,6 @@ using namespace morphoflow;
 
 namespace {
 
-bool noGpu(std::string* why) {
-  try {
-    GlContext::instance();
-    return false;
-  } catch (const GpuUnavailable& e) {
-    *why = e.what();
-    return true;
-  }
-}
 
 FluidSettings box(std::vector<int> res, bool obstacle, bool channel, bool periodicSpan) {
   FluidSettings s;
@@ -89,8 +80,7 @@ void pressureSolveMeetsTolerance(const FluidSettings& s) {
 }  // namespace
 
 TEST(GpuSolvers, MgpcgMeetsThePressureToleranceOnEveryKindOfBox) {
-  std::string why;
-  if (noGpu(&why)) GTEST_SKIP() << why;
+  if (const std::string why = gpuContextMissing(); !why.empty()) GTEST_SKIP() << why;
   pressureSolveMeetsTolerance<2>(box({64, 64}, false, false, false));   // closed: singular
   pressureSolveMeetsTolerance<2>(box({96, 48}, true, true, false));     // obstacle, inflow, outflow
   pressureSolveMeetsTolerance<2>(box({64, 32}, true, true, true));      // periodic span
@@ -139,8 +129,7 @@ std::pair<double, double> fluidDifference(const FluidSettings& s, int steps, dou
 // advection scheme and boundary kind (lid, inflow, outflow, obstacle,
 // periodic sides, buoyancy, body force, inflow dye).
 TEST(GpuFluid, EveryBoundaryKindAndSchemeMatchesTheCpuToRounding) {
-  std::string why;
-  if (noGpu(&why)) GTEST_SKIP() << why;
+  if (const std::string why = gpuContextMissing(); !why.empty()) GTEST_SKIP() << why;
   auto tight = [](FluidSettings s, double nu) {
     s.viscosity = nu;
     s.pressureTolerance = s.viscosityTolerance = 1e-10;
@@ -173,8 +162,7 @@ TEST(GpuFluid, EveryBoundaryKindAndSchemeMatchesTheCpuToRounding) {
 // difference where it switches on one backend and not the other: a few
 // 1e-4 of the largest speed (docs/gpu.md), while both projections converge.
 TEST(GpuFluid, AtTheSceneToleranceTheBackendsAgreeToTheLimitersSensitivity) {
-  std::string why;
-  if (noGpu(&why)) GTEST_SKIP() << why;
+  if (const std::string why = gpuContextMissing(); !why.empty()) GTEST_SKIP() << why;
   FluidSettings s = box({24, 16, 16}, false, false, false);
   s.viscosity = 2e-3;
   const auto [du, dd] = fluidDifference<3>(s, 30, 0.02);

@@ -8,7 +8,7 @@
 #include <cmath>
 
 #include "core/random.h"
-#include "gpu/gl_context.h"
+#include "gpu_context.h"
 #include "gpu/gpu_explicit_rd.h"
 #include "rd/model_registry.h"
 #include "rd/rd_solver.h"
@@ -16,11 +16,7 @@
 using namespace morphoflow;
 
 TEST(GpuModels, EveryTwoSpeciesReactionStepsAsOnTheCpu) {
-  try {
-    GlContext::instance();
-  } catch (const GpuUnavailable& e) {
-    GTEST_SKIP() << e.what();
-  }
+  if (const std::string why = gpuContextMissing(); !why.empty()) GTEST_SKIP() << why;
   int checked = 0;
   for (const ReactionModel* m : allModels()) {
     const ModelInfo& info = m->info();

@@ -9,7 +9,7 @@
 
 #include "core/parallel.h"
 #include "core/random.h"
-#include "gpu/gl_context.h"
+#include "gpu_context.h"
 #include "gpu/gpu_models.h"
 #include "gpu/gpu_rd_layer.h"
 #include "rd/cosine_lobe.h"
@@ -20,15 +20,6 @@ using namespace morphoflow;
 
 namespace {
 
-bool noGpu(std::string* why) {
-  try {
-    GlContext::instance();
-    return false;
-  } catch (const GpuUnavailable& e) {
-    *why = e.what();
-    return true;
-  }
-}
 
 // Steps both layers from the same random state near the model's default and
 // returns the largest difference over the largest change (both species).
@@ -70,8 +61,7 @@ double relativeDifference(RDSettings s, const ReactionModel& m, double dt, int s
 // (double, no fused multiply-adds) gives bitwise the CPU's roots, and fails
 // in the same cells, for every model (two to five species).
 TEST(GpuRD, KimLinNewtonIsBitwiseTheCpusForEveryModel) {
-  std::string why;
-  if (noGpu(&why)) GTEST_SKIP() << why;
+  if (const std::string why = gpuContextMissing(); !why.empty()) GTEST_SKIP() << why;
   int checked = 0;
   for (const ReactionModel* m : allModels()) {
     ASSERT_FALSE(gpuReaction(m->info().name, true).empty()) << m->info().name;
@@ -102,8 +92,7 @@ TEST(GpuRD, KimLinNewtonIsBitwiseTheCpusForEveryModel) {
 // With diffusion both sides solve to rd.tolerance (1e-8): the layers agree
 // to a millionth of the change over the run.
 TEST(GpuRD, EveryIntegratorMatchesTheCpuIn2DAnd3D) {
-  std::string why;
-  if (noGpu(&why)) GTEST_SKIP() << why;
+  if (const std::string why = gpuContextMissing(); !why.empty()) GTEST_SKIP() << why;
   const ReactionModel& gs = *findModel("gray-scott");
   for (RDIntegrator integ : {RDIntegrator::ExplicitEuler, RDIntegrator::SemiImplicit, RDIntegrator::KimLin,
                              RDIntegrator::CrankNicolson}) {
@@ -127,8 +116,7 @@ TEST(GpuRD, EveryIntegratorMatchesTheCpuIn2DAnd3D) {
 // parameter map, a fixed region and a frozen species: the GPU layer applies
 // each as the CPU does (both solves at 1e-12, so the agreement is rounding).
 TEST(GpuRD, MapsFixedCellsFrozenSpeciesAndDirichletWallsMatchTheCpu) {
-  std::string why;
-  if (noGpu(&why)) GTEST_SKIP() << why;
+  if (const std::string why = gpuContextMissing(); !why.empty()) GTEST_SKIP() << why;
   const ReactionModel& gs = *findModel("gray-scott");
   for (RDIntegrator integ : {RDIntegrator::ExplicitEuler, RDIntegrator::KimLin, RDIntegrator::CrankNicolson}) {
     for (int variant = 0; variant < 3; ++variant) {
@@ -195,8 +183,9 @@ DiffusionTensorSpec<D> turningTensor(const IVec<D>& cells) {
   return t;
 }
 
+// Gray-Scott on `cells` cells of 0.01, solves at 1e-12, and a random start (seed `seed`).
 template <int D>
-double tensorDifference(RDIntegrator integ, RDBoundary boundary, const IVec<D>& cells) {
+RDSettings grayScottBox(RDIntegrator integ, RDBoundary boundary, const IVec<D>& cells) {
   RDSettings s;
   s.model = "gray-scott";
   s.integrator = integ;
@@ -209,10 +198,20 @@ double tensorDifference(RDIntegrator integ, RDBoundary boundary, const IVec<D>& 
   s.diffusion = {2e-5, 1e-5};
   s.tolerance = 1e-12;
   s.boundary = boundary;
-  RDSolver<D> cpu(s, *findModel("gray-scott"));
+  s.dirichletValues = {0.9, 0.1};
+  return s;
+}
+template <int D>
+void randomStart(RDSolver<D>* rd, uint64_t seed) {
   for (int k = 0; k < 2; ++k)
-    for (size_t i = 0; i < cpu.field(k).size(); ++i)
-      cpu.field(k)[i] = (k == 0 ? 1.0 : 0.0) + 0.3 * (uniform01(9, uint64_t(k), i) - 0.5) * (k == 0 ? -1 : 1);
+    for (size_t i = 0; i < rd->field(k).size(); ++i)
+      rd->field(k)[i] = (k == 0 ? 1.0 : 0.0) + 0.3 * (uniform01(seed, uint64_t(k), i) - 0.5) * (k == 0 ? -1 : 1);
+}
+
+template <int D>
+double tensorDifference(RDIntegrator integ, RDBoundary boundary, const IVec<D>& cells) {
+  RDSolver<D> cpu(grayScottBox<D>(integ, boundary, cells), *findModel("gray-scott"));
+  randomStart(&cpu, 9);
   cpu.setDiffusionTensor(turningTensor<D>(cells));
   GpuRDLayer<D> gpu(cpu);
   const double dt = integ == RDIntegrator::ExplicitEuler ? 0.2 : 5.0;
@@ -234,8 +233,7 @@ double tensorDifference(RDIntegrator integ, RDBoundary boundary, const IVec<D>& 
 // terms) in 2D and 3D, periodic and walled, explicit and implicit: the GPU
 // layer diffuses as the CPU's (solves at 1e-12).
 TEST(GpuRD, AFixedDiffusionTensorMatchesTheCpuIn2DAnd3D) {
-  std::string why;
-  if (noGpu(&why)) GTEST_SKIP() << why;
+  if (const std::string why = gpuContextMissing(); !why.empty()) GTEST_SKIP() << why;
   for (RDIntegrator integ : {RDIntegrator::ExplicitEuler, RDIntegrator::KimLin, RDIntegrator::CrankNicolson})
     for (RDBoundary b : {RDBoundary::Periodic, RDBoundary::Neumann}) {
       EXPECT_LT(tensorDifference<2>(integ, b, IVec<2>(24, 20)), 1e-9) << int(integ) << " " << int(b);
@@ -247,27 +245,10 @@ namespace {
 
 template <int D>
 double lobeDifference(RDIntegrator integ, RDBoundary boundary, const IVec<D>& cells, bool witkinKass, double* fromIsotropic) {
-  RDSettings s;
-  s.model = "gray-scott";
-  s.integrator = integ;
-  s.resolution.clear();
-  s.size.clear();
-  for (int a = 0; a < D; ++a) {
-    s.resolution.push_back(cells[a]);
-    s.size.push_back(0.01 * cells[a]);
-  }
-  s.diffusion = {2e-5, 1e-5};
-  s.tolerance = 1e-12;
-  s.boundary = boundary;
-  s.dirichletValues = {0.9, 0.1};
-  auto start = [&](RDSolver<D>* rd) {
-    for (int k = 0; k < 2; ++k)
-      for (size_t i = 0; i < rd->field(k).size(); ++i)
-        rd->field(k)[i] = (k == 0 ? 1.0 : 0.0) + 0.3 * (uniform01(11, uint64_t(k), i) - 0.5) * (k == 0 ? -1 : 1);
-  };
+  const RDSettings s = grayScottBox<D>(integ, boundary, cells);
   RDSolver<D> cpu(s, *findModel("gray-scott")), iso(s, *findModel("gray-scott"));
-  start(&cpu);
-  start(&iso);
+  randomStart(&cpu, 11);
+  randomStart(&iso, 11);
   CosineLobeSpec spec;
   spec.witkinKass = witkinKass;
   spec.speeds = witkinKass ? std::vector<double>{1.5, 0.3} : std::vector<double>{1.0, 0.2, 0.6};
@@ -304,8 +285,7 @@ double lobeDifference(RDIntegrator integ, RDBoundary boundary, const IVec<D>& ce
 // the solves' last digits step by step (measured up to 1.4e-7 after five
 // Kim & Lin steps beside a Dirichlet wall), hence 1e-6.
 TEST(GpuRD, CosineLobesMatchTheCpuIn2DAnd3D) {
-  std::string why;
-  if (noGpu(&why)) GTEST_SKIP() << why;
+  if (const std::string why = gpuContextMissing(); !why.empty()) GTEST_SKIP() << why;
   for (RDIntegrator integ : {RDIntegrator::ExplicitEuler, RDIntegrator::KimLin, RDIntegrator::CrankNicolson})
     for (RDBoundary b : {RDBoundary::Periodic, RDBoundary::Neumann, RDBoundary::Dirichlet})
       for (bool wk : {false, true}) {
