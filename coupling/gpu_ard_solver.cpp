@@ -5,7 +5,7 @@
 #include <epoxy/gl.h>
 #include <fmt/format.h>
 
-#include "core/stage_trace.h"
+#include "gpu/gpu_stage_timer.h"
 #include "gpu/compute_program.h"
 #include "gpu/gpu_kernels.h"
 
@@ -27,6 +27,7 @@ GpuARDSolver<D>::GpuARDSolver(GpuRDLayer<D>* layer, const ChemicalDomain<D>& dom
                                     : std::vector<uint32_t>{0});
   for (GpuBuffer& b : scratch_) b = GpuBuffer(layer->cells() * sizeof(double));
   if (mode_ != CouplingMode::RDOnly) emptySolids();
+  timer_ = std::make_unique<GpuStageTimer>(ARDSolver<D>::kStages);
 }
 
 template <int D>
@@ -79,14 +80,14 @@ void GpuARDSolver<D>::advect(double dt, const GpuFluid<D>& fluid) {
 
 template <int D>
 void GpuARDSolver<D>::step(double dt, const GpuFluid<D>& fluid) {
-  const double t0 = traceClock();
+  timer_->mark(0);
   if (mode_ != CouplingMode::Passive) layer_->step(rdTimeScale_ * dt);  // eq. 6 then eq. 13
   if (mode_ == CouplingMode::ARD) emptySolids();                      // obstacles hold no chemical
-  glFinish();
-  const double t1 = traceClock();
+  timer_->mark(1);
   if (mode_ != CouplingMode::RDOnly) advect(dt, fluid);  // eq. 19-20
-  glFinish();
-  stageSeconds_ = {t1 - t0, traceClock() - t1};
+  timer_->mark(2);
+  const std::vector<double> seconds = timer_->endStep();
+  stageSeconds_ = {seconds[0], seconds[1]};
 }
 
 template class GpuARDSolver<2>;

@@ -8,6 +8,8 @@
 #include <array>
 #include <memory>
 
+#include "gpu/gpu_stage_timer.h"
+
 #include "coupling/ard_solver.h"
 #include "coupling/chemical_advection.h"
 #include "gpu/gpu_buffer.h"
@@ -29,7 +31,7 @@ class GpuARDSolver {
   void step(double dt, const GpuFluid<D>& fluid);
   // Sets the solid cells of both species to the solid values.
   void emptySolids();
-  // Wall seconds of the last step's two stages (the queue drained at each end).
+  // The GPU's seconds of the two stages of the step before the last (timer queries).
   const std::array<double, ARDSolver<D>::kStages>& stageSeconds() const { return stageSeconds_; }
 
  private:
@@ -46,6 +48,7 @@ class GpuARDSolver {
   GpuBuffer solid_;
   std::array<GpuBuffer, 2> scratch_;
   std::array<double, ARDSolver<D>::kStages> stageSeconds_{};
+  std::unique_ptr<class GpuStageTimer> timer_;
 };
 
 }  // namespace morphoflow

@@ -1,7 +1,6 @@
 #include "gpu/gpu_fluid.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 #include <epoxy/gl.h>
@@ -15,6 +14,7 @@
 #include "gpu/gpu_multigrid.h"
 #include "gpu/gpu_pcg.h"
 #include "gpu/gpu_reduction.h"
+#include "gpu/gpu_stage_timer.h"
 
 namespace morphoflow {
 
@@ -87,6 +87,7 @@ GpuFluid<D>::GpuFluid(const FluidSettings& s, const VelocityConstraints<D>& vc) 
   }
   dyeActive_ = s.inflowDyeStripes > 0;
   speed_ = std::make_unique<GpuReduction>();
+  timer_ = std::make_unique<GpuStageTimer>(FluidStepStats::kStages);
 }
 
 template <int D>
@@ -332,23 +333,18 @@ void GpuFluid<D>::project(double dt) {
 
 template <int D>
 void GpuFluid<D>::step(double dt) {
-  using Clock = std::chrono::steady_clock;
-  auto t0 = Clock::now();
-  auto lap = [&](int stage) {
-    glFinish();
-    const auto t1 = Clock::now();
-    stats_.seconds[size_t(stage)] = std::chrono::duration<double>(t1 - t0).count();
-    t0 = t1;
-  };
+  timer_->mark(0);
   forces(dt);
   applyConstraints(vel_);
-  lap(0);
+  timer_->mark(1);
   advect(dt);
-  lap(1);
+  timer_->mark(2);
   diffuse(dt);
-  lap(2);
+  timer_->mark(3);
   project(dt);
-  lap(3);
+  timer_->mark(4);
+  const std::vector<double> seconds = timer_->endStep();
+  for (int k = 0; k < FluidStepStats::kStages; ++k) stats_.seconds[size_t(k)] = seconds[size_t(k)];
 }
 
 template <int D>

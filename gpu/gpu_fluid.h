@@ -37,8 +37,8 @@ class GpuFluid {
   GpuFluid& operator=(const GpuFluid&) = delete;
 
   void step(double dt);
-  // The solvers' results and each stage's wall time (the queue drained at
-  // each stage's end, so a stage's time is its own).
+  // The solvers' results, and each stage's time on the GPU in the step
+  // before (timer queries: timing never waits on the GPU).
   const FluidStepStats& lastStats() const { return stats_; }
   // sqrt(D) max_a max |u_a|, as FluidSolver::maxSpeed (a bound of the speed).
   double maxSpeed() const;
@@ -90,6 +90,7 @@ class GpuFluid {
   double s_ = -1.0;
   FluidStepStats stats_;
   std::unique_ptr<class GpuReduction> speed_;
+  std::unique_ptr<class GpuStageTimer> timer_;
 };
 
 }  // namespace morphoflow
