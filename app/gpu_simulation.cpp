@@ -26,8 +26,6 @@ std::string missingStage(const Scene& s) {
   if (s.hasFluid && gpuSpecies(rd.settings.model) != 2)
     return "the chemicals' advection for a model of " + std::to_string(gpuSpecies(rd.settings.model)) +
            " species (the coupled gpu step carries two)";
-  if (rd.anisotropy.enabled && rd.anisotropy.shape != 0.0)
-    return "the shape term of anisotropic diffusion (rd.anisotropy.shape: a tensor rebuilt from the state every step)";
   if (rd.settings.lookupTable) return "the reaction lookup table (rd.lookup_table)";
   return "";
 }

@@ -49,6 +49,17 @@ void GpuLaplace::update(const LaplaceSystem<D>& A) {
   singular_ = A.singular();
 }
 
+GpuBuffer& GpuLaplace::crossBuffer(int k) {
+  if (!hasCross_) {
+    for (int q = 0; q < (dim_ == 3 ? 6 : 2); ++q) {
+      cross_[size_t(q)] = GpuBuffer(n_ * sizeof(float));
+      cross_[size_t(q)].zero();
+    }
+    hasCross_ = true;
+  }
+  return cross_[size_t(k)];
+}
+
 bool GpuLaplace::mixesColours() const {
   for (int a = 0; a < dim_; ++a)
     if (periodic_[size_t(a)] && dims_[size_t(a)] % 2 == 1) return true;

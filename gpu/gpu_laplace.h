@@ -37,6 +37,9 @@ class GpuLaplace {
   GpuBuffer& weights(int a) { return w_[size_t(a)]; }
   GpuBuffer& cBuffer() { return c_; }
   GpuBuffer& diagBuffer() { return diag_; }
+  // The mixed terms' couplings (up, down per plane), allocated (zero) if the
+  // system had none: for an operator rebuilt on the GPU.
+  GpuBuffer& crossBuffer(int k);
   // True when an odd periodic axis couples cells of one colour (the
   // red-black sweep would then race): such levels smooth by Jacobi.
   bool mixesColours() const;

@@ -7,6 +7,7 @@
 
 #include "core/multigrid.h"
 #include "rd/cosine_lobe.h"
+#include "rd/diffusion_tensor.h"
 #include "gpu/compute_program.h"
 #include "gpu/gpu_kernels.h"
 #include "gpu/gpu_laplace.h"
@@ -69,6 +70,16 @@ GpuRDLayer<D>::GpuRDLayer(const RDSolver<D>& rd) : rd_(rd), species_(rd.species(
     if (rd.settings().boundary == RDBoundary::Dirichlet) faces_[si] = GpuBuffer::of(rd.dirichletFaces(s));
   }
   for (int s : rd.settings().frozen) isFrozen_[size_t(s)] = true;
+  if (const DiffusionTensorSpec<D>* t = rd.diffusionTensorSpec(); t && t->dynamic()) {
+    std::vector<double> dir;
+    for (int a = 0; a < D; ++a) dir.insert(dir.end(), t->direction[size_t(a)].begin(), t->direction[size_t(a)].end());
+    direction_ = GpuBuffer::of(dir);
+    lambda1_ = GpuBuffer::of(t->lambda1);
+    lambda2_ = GpuBuffer::of(t->lambda2);
+    sigma_ = GpuBuffer(n_ * AnisotropicSystem<D>::kComponents * sizeof(double));
+    for (int s = 0; s < species_; ++s)
+      if (rd.anisotropic(s) && !faces_[size_t(s)].id()) faces_[size_t(s)] = GpuBuffer(n_ * sizeof(double));
+  }
   if (const CosineLobeSpec* lobes = rd.cosineLobes()) {
     lobeA_ = GpuBuffer(n_ * sizeof(double));
     std::vector<double> rot(lobes->theta0.empty() ? 2 : 2 * n_);
@@ -154,13 +165,14 @@ SolverResult GpuRDLayer<D>::diffuse(int s, double thetaDt) {
   const double d = rd_.diffusion()[size_t(s)];
   if (d == 0.0 || thetaDt == 0.0) return SolverResult{true, 0, 0.0};
   Diffusion& df = *diffusion_[size_t(s)];
-  if (rd_.lobed(s)) {  // rebuilt every step from this step's lobes: I + theta dt d (-div a grad)
+  if (rebuilt(s)) {  // rebuilt every step from this step's operator: I + theta dt d A
     if (!df.A) {
       df.A = std::make_unique<GpuLaplace>(rd_.diffusionOperator(s).shifted(thetaDt * d));
       df.pcg = std::make_unique<GpuPcg>(*df.A);
     }
     const double k = thetaDt * d / (rd_.h() * rd_.h());
     lobeKernel("MODE_SHIFT", df.A.get(), nullptr, operator_[size_t(s)].get(), k, nullptr);
+    if (!rd_.lobed(s)) tensorKernel("MODE_SHIFT", df.A.get(), operator_[size_t(s)].get(), k);
     lobeKernel("MODE_DIAG", df.A.get(), nullptr, nullptr, 0.0, nullptr);
     df.thetaDt = thetaDt;
   } else if (df.thetaDt != thetaDt) {
@@ -211,6 +223,7 @@ void GpuRDLayer<D>::step(double dt) {
     frozenTaken_ = true;
   }
   if (rd_.cosineLobes()) buildLobes();  // eq. 17: a(theta) from the state at the step's start
+  if (const DiffusionTensorSpec<D>* t = rd_.diffusionTensorSpec(); t && t->dynamic()) buildTensor();  // eq. 18-19
   react(dt, implicitReaction);
   for (int s = 0; s < species_; ++s) {
     // the theta scheme's explicit part: x += dt R + (1 - theta) dt d lap x
@@ -241,7 +254,8 @@ void GpuRDLayer<D>::step(double dt) {
 template <int D>
 void GpuRDLayer<D>::lobeKernel(const char* mode, GpuLaplace* target, const GpuBuffer* x, GpuLaplace* source, double k,
                                GpuBuffer* faces) {
-  const CosineLobeSpec& spec = *rd_.cosineLobes();
+  static const CosineLobeSpec none{{1.0}, false, {}, {}};  // (MODE_SHIFT and MODE_DIAG read no lobe)
+  const CosineLobeSpec& spec = rd_.cosineLobes() ? *rd_.cosineLobes() : none;
   const ComputeProgram& p = useKernel("rd_lobes.comp", fmt::format("#define DIM {}\n#define {}", D, mode));
   std::array<int, 3> dims{1, 1, 1};
   for (int a = 0; a < D; ++a) dims[size_t(a)] = rd_.cells()[a];
@@ -275,6 +289,58 @@ void GpuRDLayer<D>::lobeKernel(const char* mode, GpuLaplace* target, const GpuBu
   src->cBuffer().bind(12);
   dispatchFlat(n_, 8.0 + 4.0 * (D + 2));
   storageBarrier();
+}
+
+template <int D>
+bool GpuRDLayer<D>::rebuilt(int s) const {
+  const DiffusionTensorSpec<D>* t = rd_.diffusionTensorSpec();
+  return rd_.lobed(s) || (t && t->dynamic() && rd_.anisotropic(s));
+}
+
+template <int D>
+void GpuRDLayer<D>::tensorKernel(const char* mode, GpuLaplace* target, GpuLaplace* source, double k) {
+  const DiffusionTensorSpec<D>& spec = *rd_.diffusionTensorSpec();
+  const ComputeProgram& p = useKernel("rd_tensor.comp", fmt::format("#define DIM {}\n#define {}", D, mode));
+  std::array<int, 3> dims{1, 1, 1};
+  for (int a = 0; a < D; ++a) dims[size_t(a)] = rd_.cells()[a];
+  setUniform(p, "dims", dims);
+  setUniform(p, "periodic", rd_.settings().boundary == RDBoundary::Periodic ? 1 : 0);
+  setUniform(p, "dirichlet", rd_.settings().boundary == RDBoundary::Dirichlet ? 1 : 0);
+  setUniform(p, "shape", spec.shape);
+  setUniform(p, "floorFraction", kMinPrincipalFraction);
+  setUniform(p, "k", k);
+  const int mixed = D == 3 ? 6 : 2;
+  if (std::string(mode) == "MODE_SHIFT") {
+    for (int q = 0; q < mixed; ++q) {
+      source->crossBuffer(q).bind(q);
+      target->crossBuffer(q).bind(10 + q);
+    }
+  } else {
+    x_[size_t(spec.shapeSpecies)].bind(0);
+    direction_.bind(1);
+    lambda1_.bind(2);
+    lambda2_.bind(3);
+    sigma_.bind(4);
+    if (target) {
+      for (int a = 0; a < 3; ++a) target->weights(a < D ? a : 0).bind(5 + a);
+      target->cBuffer().bind(8);
+      for (int q = 0; q < mixed; ++q) target->crossBuffer(q).bind(10 + q);
+    }
+  }
+  dispatchFlat(n_, 8.0 * AnisotropicSystem<D>::kComponents + 4.0 * (D + 1 + mixed));
+  storageBarrier();
+}
+
+template <int D>
+void GpuRDLayer<D>::buildTensor() {
+  tensorKernel("MODE_SIGMA", nullptr, nullptr, 0.0);
+  for (int s = 0; s < species_; ++s) {
+    if (!rd_.anisotropic(s)) continue;
+    GpuLaplace* op = operator_[size_t(s)].get();
+    faces_[size_t(s)].bind(9);
+    tensorKernel("MODE_FACES", op, nullptr, 0.0);
+    lobeKernel("MODE_DIAG", op, nullptr, nullptr, 0.0, nullptr);
+  }
 }
 
 template <int D>

@@ -62,6 +62,10 @@ class GpuRDLayer {
                  double explicitD, double ghost) const;
   // Each lobed species' operator from its state at the step's start (eq. 14-17).
   void buildLobes();
+  // A shaped tensor's operator from the shape species at the step's start (seed 004 eq. 18-19).
+  void buildTensor();
+  void tensorKernel(const char* mode, GpuLaplace* target, GpuLaplace* source, double k);
+  bool rebuilt(int s) const;  // whether species s's operator is rebuilt every step
   void lobeKernel(const char* mode, GpuLaplace* target, const GpuBuffer* x, GpuLaplace* source, double k,
                   GpuBuffer* faces);
 
@@ -82,6 +86,7 @@ class GpuRDLayer {
   bool frozenTaken_ = false;
   GpuBuffer allHeld_;                 // a mask of ones (frozen species)
   GpuBuffer lobeA_, rot_;             // a(theta) per cell; cos, sin of theta0 per cell
+  GpuBuffer direction_, lambda1_, lambda2_, sigma_;  // a shaped tensor's spec and components
   std::array<std::unique_ptr<GpuLaplace>, kMax> operator_;  // -lap or -div(sigma grad) (scale 1/h^2): the explicit part
   std::array<std::unique_ptr<Diffusion>, kMax> diffusion_;
   RDStepStats stats_;

@@ -58,6 +58,7 @@ class RDSolver {
   // sigma from the current state at every step.
   void setDiffusionTensor(DiffusionTensorSpec<D> spec);
   bool anisotropic(int s) const { return !tensorSpecies_.empty() && tensorSpecies_[size_t(s)]; }
+  const DiffusionTensorSpec<D>* diffusionTensorSpec() const { return tensorSpec_.get(); }
   // Kim & Lin's cosine-lobe anisotropy (seed 001 eq. 14-17): the spec's
   // species diffuse by div(d a(theta) grad), a(theta) rebuilt from each
   // species' own gradient at every step. Not combined with a tensor.

@@ -96,7 +96,6 @@ TEST(Gpu, AStageWithNoGpuProgramIsRefusedNamingIt) {
   const std::string out = " --out " + (dir / "o").string();
   for (const auto& [args, stage] :
        {std::pair{sceneFile("coupled/cavity_gray_scott.toml") + " --set 'rd.lookup_table=true'", std::string("the reaction lookup table")},
-        std::pair{sceneFile("rd/seeds/sanderson_fig06.toml") + " --set rd.anisotropy.shape=0.5", std::string("the shape term of anisotropic diffusion")},
 
         std::pair{sceneFile("coupled/cavity_gray_scott.toml") + " --set 'rd.model=\"brusselator-coupled\"' --set 'rd.diffusion=[1,1,1,1]' --set 'rd.parameters={}' --set 'rd.initial={}' --set 'output.field=\"a1\"'", std::string("the chemicals' advection for a model of 4 species")}}) {
     CommandResult r = runMorphoflow("run " + args + " --backend gpu --quiet" + out);

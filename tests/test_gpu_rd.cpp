@@ -13,6 +13,7 @@
 #include "gpu/gpu_models.h"
 #include "gpu/gpu_rd_layer.h"
 #include "rd/cosine_lobe.h"
+#include "rd/diffusion_tensor.h"
 #include "rd/model_registry.h"
 #include "rd/rd_solver.h"
 
@@ -209,10 +210,13 @@ void randomStart(RDSolver<D>* rd, uint64_t seed) {
 }
 
 template <int D>
-double tensorDifference(RDIntegrator integ, RDBoundary boundary, const IVec<D>& cells) {
+double tensorDifference(RDIntegrator integ, RDBoundary boundary, const IVec<D>& cells, double shape = 0.0) {
   RDSolver<D> cpu(grayScottBox<D>(integ, boundary, cells), *findModel("gray-scott"));
   randomStart(&cpu, 9);
-  cpu.setDiffusionTensor(turningTensor<D>(cells));
+  DiffusionTensorSpec<D> tensor = turningTensor<D>(cells);
+  tensor.shape = shape;  // eq. 18-19: the diffusivities follow species 1's gradient
+  tensor.shapeSpecies = 1;
+  cpu.setDiffusionTensor(tensor);
   GpuRDLayer<D> gpu(cpu);
   const double dt = integ == RDIntegrator::ExplicitEuler ? 0.2 : 5.0;
   for (int n = 0; n < 10; ++n) {
@@ -238,6 +242,18 @@ TEST(GpuRD, AFixedDiffusionTensorMatchesTheCpuIn2DAnd3D) {
     for (RDBoundary b : {RDBoundary::Periodic, RDBoundary::Neumann}) {
       EXPECT_LT(tensorDifference<2>(integ, b, IVec<2>(24, 20)), 1e-9) << int(integ) << " " << int(b);
       EXPECT_LT(tensorDifference<3>(integ, b, IVec<3>(10, 8, 6)), 1e-9) << int(integ) << " " << int(b) << " 3D";
+    }
+}
+
+// The same with the shape term (seed 004 eq. 18-19: the principal
+// diffusivities follow a species' gradient), the tensor rebuilt on the GPU
+// every step, walled, periodic and Dirichlet.
+TEST(GpuRD, AShapedDiffusionTensorRebuiltEachStepMatchesTheCpu) {
+  if (const std::string why = gpuContextMissing(); !why.empty()) GTEST_SKIP() << why;
+  for (RDIntegrator integ : {RDIntegrator::ExplicitEuler, RDIntegrator::KimLin, RDIntegrator::CrankNicolson})
+    for (RDBoundary b : {RDBoundary::Periodic, RDBoundary::Neumann, RDBoundary::Dirichlet}) {
+      EXPECT_LT(tensorDifference<2>(integ, b, IVec<2>(24, 20), 0.4), 1e-9) << int(integ) << " " << int(b);
+      EXPECT_LT(tensorDifference<3>(integ, b, IVec<3>(10, 8, 6), 0.4), 1e-9) << int(integ) << " " << int(b) << " 3D";
     }
 }
 
