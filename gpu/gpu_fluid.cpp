@@ -33,6 +33,11 @@ std::string dimDefine(int D, const char* mode) { return fmt::format("#define DIM
 }  // namespace
 
 template <int D>
+std::array<int, 3> GpuFluid<D>::velocityOffsets() const {
+  return {int(off_[0]), int(off_[1]), int(off_[2])};
+}
+
+template <int D>
 size_t GpuFluid<D>::faces(int a) const {
   size_t n = 1;
   for (int b = 0; b < D; ++b) n *= size_t(cells_[size_t(b)] + (a == b ? 1 : 0));
@@ -132,7 +137,7 @@ void GpuFluid<D>::applyConstraints(const GpuBuffer& vel) {
       setUniform(p, "cells", cells_);
       setUniform(p, "axis", a);
       setUniform(p, "n", int(faces(a)));
-      setUniform(p, "velOff", std::array<int, 3>{int(off_[0]), int(off_[1]), int(off_[2])});
+      setUniform(p, "velOff", velocityOffsets());
       vel.bind(0);
       fixed_.bind(1);
       value_.bind(2);
@@ -151,7 +156,7 @@ void GpuFluid<D>::forces(double dt) {
     setUniform(p, "cells", cells_);
     setUniform(p, "axis", a);
     setUniform(p, "n", int(faces(a)));
-    setUniform(p, "velOff", std::array<int, 3>{int(off_[0]), int(off_[1]), int(off_[2])});
+    setUniform(p, "velOff", velocityOffsets());
     setUniform(p, "fa", f);
     setUniform(p, "fb", b);
     vel_.bind(0);
@@ -170,7 +175,7 @@ void GpuFluid<D>::advectField(const GpuBuffer& src, size_t srcOff, const std::ar
     const ComputeProgram& p = useKernel("advect.comp", fmt::format("#define DIM {}{}", D, limits ? "\n#define LIMITS" : ""));
     setUniform(p, "cells", cells_);
     setUniform(p, "periodic", periodic_);
-    setUniform(p, "velOff", std::array<int, 3>{int(off_[0]), int(off_[1]), int(off_[2])});
+    setUniform(p, "velOff", velocityOffsets());
     setUniform(p, "c", float(step / h_));
     setUniform(p, "sdims", dims);
     setUniform(p, "soff", offset);
@@ -273,7 +278,7 @@ void GpuFluid<D>::diffuse(double dt) {
       setUniform(p, "axis", a);
       setUniform(p, "n", int(V.host.A.size()));
       setUniform(p, "udims", udims);
-      setUniform(p, "velOff", std::array<int, 3>{int(off_[0]), int(off_[1]), int(off_[2])});
+      setUniform(p, "velOff", velocityOffsets());
       setUniform(p, "s", s);
       vel_.bind(0);
       fixed_.bind(1);
@@ -306,7 +311,7 @@ void GpuFluid<D>::project(double dt) {
     setUniform(p, "periodic", periodic_);
     setUniform(p, "axis", axis);
     setUniform(p, "n", int(n));
-    setUniform(p, "velOff", std::array<int, 3>{int(off_[0]), int(off_[1]), int(off_[2])});
+    setUniform(p, "velOff", velocityOffsets());
     setUniform(p, "invH", 1.0 / h_);
     setUniform(p, "dt", dt);
     setUniform(p, "lastDt", lastDt_);

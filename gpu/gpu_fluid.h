@@ -69,6 +69,7 @@ class GpuFluid {
   void diffuse(double dt);
   void project(double dt);
   size_t faces(int a) const;
+  std::array<int, 3> velocityOffsets() const;  // the components' offsets in the velocity buffer (uniform velOff)
 
   FluidSettings settings_;
   const VelocityConstraints<D>& vc_;

@@ -60,6 +60,44 @@ GpuBuffer& GpuLaplace::crossBuffer(int k) {
   return cross_[size_t(k)];
 }
 
+void GpuLaplace::recomputeDiagonal() {
+  const ComputeProgram& p = useKernel("laplace_build.comp", fmt::format("#define DIM {}\n#define MODE_DIAG", dim_));
+  setUniform(p, "dims", dims_);
+  for (int a = 0; a < 3; ++a) w_[size_t(a < dim_ ? a : 0)].bind(a);
+  c_.bind(3);
+  diag_.bind(4);
+  dispatchFlat(n_, 4.0 * (dim_ + 2));
+  storageBarrier();
+}
+
+void GpuLaplace::assignShifted(GpuLaplace& source, double k) {
+  const ComputeProgram& p = useKernel("laplace_build.comp", fmt::format("#define DIM {}\n#define MODE_SHIFT", dim_));
+  setUniform(p, "dims", dims_);
+  setUniform(p, "k", k);
+  for (int a = 0; a < 3; ++a) {
+    w_[size_t(a < dim_ ? a : 0)].bind(a);
+    source.w_[size_t(a < dim_ ? a : 0)].bind(5 + a);
+  }
+  c_.bind(3);
+  diag_.bind(4);
+  source.c_.bind(8);
+  dispatchFlat(n_, 8.0 * (dim_ + 1));
+  storageBarrier();
+  if (source.hasCross_) {
+    const int mixed = dim_ == 3 ? 6 : 2;
+    const ComputeProgram& q = useKernel("laplace_build.comp", fmt::format("#define DIM {}\n#define CROSS", dim_));
+    setUniform(q, "dims", dims_);
+    setUniform(q, "k", k);
+    for (int m = 0; m < mixed; ++m) {
+      source.cross_[size_t(m)].bind(m);
+      crossBuffer(m).bind(8 + m);
+    }
+    dispatchFlat(n_, 8.0 * mixed);
+    storageBarrier();
+  }
+  recomputeDiagonal();
+}
+
 bool GpuLaplace::mixesColours() const {
   for (int a = 0; a < dim_; ++a)
     if (periodic_[size_t(a)] && dims_[size_t(a)] % 2 == 1) return true;

@@ -40,6 +40,10 @@ class GpuLaplace {
   // The mixed terms' couplings (up, down per plane), allocated (zero) if the
   // system had none: for an operator rebuilt on the GPU.
   GpuBuffer& crossBuffer(int k);
+  // After kernels wrote the weights and c: diag = c + the face weights (finalize's order).
+  void recomputeDiagonal();
+  // This system becomes I + k A of `source`, a system of the same shape (AnisotropicSystem::shifted).
+  void assignShifted(GpuLaplace& source, double k);
   // True when an odd periodic axis couples cells of one colour (the
   // red-black sweep would then race): such levels smooth by Jacobi.
   bool mixesColours() const;

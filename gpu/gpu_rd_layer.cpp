@@ -171,9 +171,7 @@ SolverResult GpuRDLayer<D>::diffuse(int s, double thetaDt) {
       df.pcg = std::make_unique<GpuPcg>(*df.A);
     }
     const double k = thetaDt * d / (rd_.h() * rd_.h());
-    lobeKernel("MODE_SHIFT", df.A.get(), nullptr, operator_[size_t(s)].get(), k, nullptr);
-    if (!rd_.lobed(s)) tensorKernel("MODE_SHIFT", df.A.get(), operator_[size_t(s)].get(), k);
-    lobeKernel("MODE_DIAG", df.A.get(), nullptr, nullptr, 0.0, nullptr);
+    df.A->assignShifted(*operator_[size_t(s)], k);
     df.thetaDt = thetaDt;
   } else if (df.thetaDt != thetaDt) {
     df.host = rd_.diffusionOperator(s).shifted(thetaDt * d);
@@ -252,10 +250,8 @@ void GpuRDLayer<D>::step(double dt) {
 }
 
 template <int D>
-void GpuRDLayer<D>::lobeKernel(const char* mode, GpuLaplace* target, const GpuBuffer* x, GpuLaplace* source, double k,
-                               GpuBuffer* faces) {
-  static const CosineLobeSpec none{{1.0}, false, {}, {}};  // (MODE_SHIFT and MODE_DIAG read no lobe)
-  const CosineLobeSpec& spec = rd_.cosineLobes() ? *rd_.cosineLobes() : none;
+void GpuRDLayer<D>::lobeKernel(const char* mode, int species, GpuLaplace* target, GpuBuffer* faces) {
+  const CosineLobeSpec& spec = *rd_.cosineLobes();
   const ComputeProgram& p = useKernel("rd_lobes.comp", fmt::format("#define DIM {}\n#define {}", D, mode));
   std::array<int, 3> dims{1, 1, 1};
   for (int a = 0; a < D; ++a) dims[size_t(a)] = rd_.cells()[a];
@@ -276,17 +272,12 @@ void GpuRDLayer<D>::lobeKernel(const char* mode, GpuLaplace* target, const GpuBu
   glUniform1dv(p.uniform("speeds"), 8, speeds.data());
   glUniform1dv(p.uniform("centres"), 16, centres.data());
   setUniform(p, "meanA", meanLobeDiffusivity(spec));
-  setUniform(p, "k", k);
-  (x ? *x : lobeA_).bind(0);
+  x_[size_t(species)].bind(0);
   lobeA_.bind(1);
   for (int a = 0; a < 3; ++a) target->weights(a < D ? a : 0).bind(2 + a);
   target->cBuffer().bind(5);
-  target->diagBuffer().bind(6);
   (faces ? *faces : lobeA_).bind(7);
   rot_.bind(8);
-  GpuLaplace* src = source ? source : target;
-  for (int a = 0; a < 3; ++a) src->weights(a < D ? a : 0).bind(9 + a);
-  src->cBuffer().bind(12);
   dispatchFlat(n_, 8.0 + 4.0 * (D + 2));
   storageBarrier();
 }
@@ -298,7 +289,7 @@ bool GpuRDLayer<D>::rebuilt(int s) const {
 }
 
 template <int D>
-void GpuRDLayer<D>::tensorKernel(const char* mode, GpuLaplace* target, GpuLaplace* source, double k) {
+void GpuRDLayer<D>::tensorKernel(const char* mode, GpuLaplace* target) {
   const DiffusionTensorSpec<D>& spec = *rd_.diffusionTensorSpec();
   const ComputeProgram& p = useKernel("rd_tensor.comp", fmt::format("#define DIM {}\n#define {}", D, mode));
   std::array<int, 3> dims{1, 1, 1};
@@ -308,24 +299,16 @@ void GpuRDLayer<D>::tensorKernel(const char* mode, GpuLaplace* target, GpuLaplac
   setUniform(p, "dirichlet", rd_.settings().boundary == RDBoundary::Dirichlet ? 1 : 0);
   setUniform(p, "shape", spec.shape);
   setUniform(p, "floorFraction", kMinPrincipalFraction);
-  setUniform(p, "k", k);
   const int mixed = D == 3 ? 6 : 2;
-  if (std::string(mode) == "MODE_SHIFT") {
-    for (int q = 0; q < mixed; ++q) {
-      source->crossBuffer(q).bind(q);
-      target->crossBuffer(q).bind(10 + q);
-    }
-  } else {
-    x_[size_t(spec.shapeSpecies)].bind(0);
-    direction_.bind(1);
-    lambda1_.bind(2);
-    lambda2_.bind(3);
-    sigma_.bind(4);
-    if (target) {
-      for (int a = 0; a < 3; ++a) target->weights(a < D ? a : 0).bind(5 + a);
-      target->cBuffer().bind(8);
-      for (int q = 0; q < mixed; ++q) target->crossBuffer(q).bind(10 + q);
-    }
+  x_[size_t(spec.shapeSpecies)].bind(0);
+  direction_.bind(1);
+  lambda1_.bind(2);
+  lambda2_.bind(3);
+  sigma_.bind(4);
+  if (target) {
+    for (int a = 0; a < 3; ++a) target->weights(a < D ? a : 0).bind(5 + a);
+    target->cBuffer().bind(8);
+    for (int q = 0; q < mixed; ++q) target->crossBuffer(q).bind(10 + q);
   }
   dispatchFlat(n_, 8.0 * AnisotropicSystem<D>::kComponents + 4.0 * (D + 1 + mixed));
   storageBarrier();
@@ -333,13 +316,13 @@ void GpuRDLayer<D>::tensorKernel(const char* mode, GpuLaplace* target, GpuLaplac
 
 template <int D>
 void GpuRDLayer<D>::buildTensor() {
-  tensorKernel("MODE_SIGMA", nullptr, nullptr, 0.0);
+  tensorKernel("MODE_SIGMA", nullptr);
   for (int s = 0; s < species_; ++s) {
     if (!rd_.anisotropic(s)) continue;
     GpuLaplace* op = operator_[size_t(s)].get();
     faces_[size_t(s)].bind(9);
-    tensorKernel("MODE_FACES", op, nullptr, 0.0);
-    lobeKernel("MODE_DIAG", op, nullptr, nullptr, 0.0, nullptr);
+    tensorKernel("MODE_FACES", op);
+    op->recomputeDiagonal();
   }
 }
 
@@ -348,9 +331,9 @@ void GpuRDLayer<D>::buildLobes() {
   for (int s = 0; s < species_; ++s) {
     if (!rd_.lobed(s)) continue;
     GpuLaplace* op = operator_[size_t(s)].get();
-    lobeKernel("MODE_A", op, &x_[size_t(s)], nullptr, 0.0, nullptr);
-    lobeKernel("MODE_FACES", op, nullptr, nullptr, 0.0, &faces_[size_t(s)]);
-    lobeKernel("MODE_DIAG", op, nullptr, nullptr, 0.0, nullptr);
+    lobeKernel("MODE_A", s, op, nullptr);
+    lobeKernel("MODE_FACES", s, op, &faces_[size_t(s)]);
+    op->recomputeDiagonal();
   }
 }
 

@@ -64,10 +64,10 @@ class GpuRDLayer {
   void buildLobes();
   // A shaped tensor's operator from the shape species at the step's start (seed 004 eq. 18-19).
   void buildTensor();
-  void tensorKernel(const char* mode, GpuLaplace* target, GpuLaplace* source, double k);
+  void tensorKernel(const char* mode, GpuLaplace* target);
   bool rebuilt(int s) const;  // whether species s's operator is rebuilt every step
-  void lobeKernel(const char* mode, GpuLaplace* target, const GpuBuffer* x, GpuLaplace* source, double k,
-                  GpuBuffer* faces);
+  // rd_lobes.comp on `species` into `target` (and the Dirichlet faces' weights).
+  void lobeKernel(const char* mode, int species, GpuLaplace* target, GpuBuffer* faces);
 
   static constexpr int kMax = ReactionModel::kMaxSpecies;
   const RDSolver<D>& rd_;

@@ -6,21 +6,15 @@
 // MODE_A       a_i = a(theta) at each cell (its mean where the gradient is 0)
 // MODE_FACES   w[a]_i = mean of a over the face (0 across a wall), and with
 //              Dirichlet walls c_i = 2 sum of a over the cell's wall faces
-// MODE_SHIFT   the implicit system I + k A: w' = k w, c' = 1 + k c (AnisotropicSystem::shifted)
-// MODE_DIAG    diag = c + the face weights (LaplaceSystem::finalize, in its order)
+// (GpuLaplace::recomputeDiagonal and assignShifted complete the systems.)
 layout(std430, binding = 0) readonly buffer X { double x[]; };
 layout(std430, binding = 1) buffer A { double lobeA[]; };
 layout(std430, binding = 2) buffer W0 { float w0[]; };
 layout(std430, binding = 3) buffer W1 { float w1[]; };
 layout(std430, binding = 4) buffer W2 { float w2[]; };
 layout(std430, binding = 5) buffer C { float cTerm[]; };
-layout(std430, binding = 6) buffer Diag { float diag[]; };
 layout(std430, binding = 7) buffer Faces { double faces[]; };   // the Dirichlet faces' weights
 layout(std430, binding = 8) readonly buffer Rot { double rot[]; };  // cos, sin of theta0 per cell
-layout(std430, binding = 9) readonly buffer S0 { float s0[]; };   // MODE_SHIFT: the unshifted weights
-layout(std430, binding = 10) readonly buffer S1 { float s1[]; };
-layout(std430, binding = 11) readonly buffer S2 { float s2[]; };
-layout(std430, binding = 12) readonly buffer SC { float sc[]; };
 
 uniform ivec3 dims;
 uniform bool periodic, dirichlet, witkinKass, rotated;
@@ -28,9 +22,6 @@ uniform int lobes;              // j (eq. 16)
 uniform double speeds[8];       // a_n (eq. 16), or a1, a2 (eq. 15)
 uniform double centres[16];     // cos, sin of each lobe's centre 2 pi m / j
 uniform double meanA;           // a's mean over the circle
-uniform double k;               // MODE_SHIFT: theta dt d / h^2
-
-float weight(int a, int i) { return a == 0 ? w0[i] : a == 1 ? w1[i] : w2[i]; }
 
 // centralDifference: wrapped if periodic, one-sided at walls
 double difference(ivec3 c, int a) {
@@ -92,14 +83,5 @@ void main() {
   }
   faces[i] = dirichlet ? wall : 0.0lf;
   cTerm[i] = dirichlet ? float(2.0lf * wall) : 0.0;
-#elif defined(MODE_SHIFT)
-  w0[i] = float(double(s0[i]) * k);
-  w1[i] = float(double(s1[i]) * k);
-  if (DIM == 3) w2[i] = float(double(s2[i]) * k);
-  cTerm[i] = float(1.0lf + k * double(sc[i]));
-#elif defined(MODE_DIAG)
-  float d = cTerm[i];
-  for (int a = 0; a < DIM; ++a) d += weight(a, i) + weight(a, indexOf(stepWrapped(c, a, -1, dims), dims));
-  diag[i] = d;
 #endif
 }

@@ -5,7 +5,6 @@
 // MODE_SIGMA   the components (xx, yy, (zz,) xy, (xz, yz)) per cell, at sigma[k n + i]
 // MODE_FACES   the axis faces (the mean of sigma_aa over the face), the mixed
 //              couplings of each plane, and with Dirichlet walls c and the faces' weights
-// MODE_SHIFT   the mixed couplings of the implicit system I + k A (times k)
 #if defined(MODE_SIGMA)
 layout(std430, binding = 0) readonly buffer X { double x[]; };         // the shape species
 layout(std430, binding = 1) readonly buffer Dir { double dir[]; };     // the direction, axis a at a n + i
@@ -23,14 +22,10 @@ layout(std430, binding = 8) buffer C { float cTerm[]; };
 layout(std430, binding = 9) buffer Faces { double faces[]; };
 layout(std430, binding = 10) buffer Mixed { float v[]; } mixedK[2 * (DIM == 3 ? 3 : 1)];  // up, down per plane
 #endif
-#if defined(MODE_SHIFT)
-layout(std430, binding = 0) readonly buffer Source { float v[]; } source[2 * (DIM == 3 ? 3 : 1)];
-layout(std430, binding = 10) buffer Target { float v[]; } target[2 * (DIM == 3 ? 3 : 1)];
-#endif
 
 uniform ivec3 dims;
 uniform bool periodic, dirichlet;
-uniform double shape, floorFraction, k;
+uniform double shape, floorFraction;
 
 const int kPlanes = DIM == 3 ? 3 : 1;
 int n() { return dims.x * dims.y * dims.z; }
@@ -130,7 +125,5 @@ void main() {
   }
   faces[i] = dirichlet ? wall : 0.0lf;
   cTerm[i] = dirichlet ? float(2.0lf * wall) : 0.0;
-#elif defined(MODE_SHIFT)
-  for (int q = 0; q < 2 * kPlanes; ++q) target[q].v[i] = float(double(source[q].v[i]) * k);
 #endif
 }
