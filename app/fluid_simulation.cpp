@@ -48,6 +48,14 @@ std::vector<Grid<float, D>> fluidField(const FluidSolver<D>& f, const std::strin
     });
     return v;
   }
+  if (name == "velocity_mac") {  // component a on the faces normal to a, padded to cells + 1 per axis (zeros)
+    std::vector<Grid<float, D>> v(static_cast<size_t>(D), Grid<float, D>(f.cells() + IVec<D>(1), 0.0f));
+    for (int a = 0; a < D; ++a) {
+      const Grid<float, D>& u = f.velocity()[a];
+      for (size_t i = 0; i < u.size(); ++i) v[size_t(a)](u.coord(i)) = u[i];
+    }
+    return v;
+  }
   throw std::invalid_argument("no fluid field '" + name + "'");
 }
 

@@ -27,6 +27,7 @@ std::string missingStage(const Scene& s) {
     return "the chemicals' advection for a model of " + std::to_string(gpuSpecies(rd.settings.model)) +
            " species (the coupled gpu step carries two)";
   if (rd.settings.lookupTable) return "the reaction lookup table (rd.lookup_table)";
+  if (s.velocity.enabled) return "the layer carried by a given [velocity]";
   return "";
 }
 

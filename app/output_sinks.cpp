@@ -10,6 +10,7 @@
 #include "render/field_dump.h"
 #include "render/field_image.h"
 #include "render/image_io.h"
+#include "render/normal_map.h"
 #include "render/volume_preview.h"
 
 namespace morphoflow {
@@ -145,6 +146,64 @@ void FieldDumpSink<D>::restore(const nlohmann::json& s) {
 }
 
 template <int D>
+NormalMapSink<D>::NormalMapSink(const std::filesystem::path& out, const Scene& scene)
+    : normals_(out / "normals"), heights_(out / "height"), scene_(scene) {
+  createOutputFolder(normals_);
+  createOutputFolder(heights_);
+}
+
+template <int D>
+void NormalMapSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
+  if constexpr (D == 2) {
+    const OutputSettings& o = scene_.output;
+    const std::string name = o.colormap == kTwoSpeciesPalette ? sim.species()[0] : o.field;
+    Grid<float, 2> height = sim.field(name).front();
+    FieldImageOptions io;
+    io.autoRange = o.autoRange;
+    io.symmetric = sim.symmetric(name);
+    io.range[0] = o.range[0];
+    io.range[1] = o.range[1];
+    const std::array<double, 2> range = valueRange(height.data(), height.size(), io);
+    const double span = range[1] > range[0] ? range[1] - range[0] : 1.0;
+    for (float& v : height.values()) v = float(std::clamp((double(v) - range[0]) / span, 0.0, 1.0));
+    const bool periodic = scene_.rd.enabled ? scene_.rd.settings.boundary == RDBoundary::Periodic
+                                            : scene_.fluid.boundaries.sides[0].kind == BoundaryKind::Periodic;
+    const std::vector<uint8_t> rgb = normalMapRgb(height, {o.normalStrength, periodic});
+    std::string err;
+    const std::filesystem::path png = normals_ / fmt::format("{:06d}.png", at.frame);
+    if (!writeRgb8(png.string(), height.dim(0), height.dim(1), rgb, &err))
+      throw std::runtime_error("writing " + png.string() + ": " + err);
+    FieldDump d;
+    d.resolution = {height.dim(0), height.dim(1)};
+    d.names = {"height"};
+    d.channels = {height.values()};
+    d.time = sim.time();
+    d.step = at.step;
+    const std::filesystem::path exr = heights_ / fmt::format("{:06d}.exr", at.frame);
+    if (!writeFieldDump(exr.string(), d, &err)) throw std::runtime_error("writing " + exr.string() + ": " + err);
+    ++written_;
+    bytes_ += fileBytes(png) + fileBytes(exr);
+  }
+}
+
+template <int D>
+void NormalMapSink<D>::report(nlohmann::json* j) const {
+  (*j)["normal_maps_written"] = written_;
+  addBytes(j, "normal_maps", bytes_);
+}
+
+template <int D>
+nlohmann::json NormalMapSink<D>::state() const {
+  return {{"written", written_}, {"bytes", bytes_}};
+}
+
+template <int D>
+void NormalMapSink<D>::restore(const nlohmann::json& s) {
+  written_ = s.at("written").get<int>();
+  bytes_ = s.at("bytes").get<uintmax_t>();
+}
+
+template <int D>
 std::vector<std::unique_ptr<OutputSink<D>>> makeOutputSinks(const std::filesystem::path& out, const Scene& scene,
                                                             const std::function<bool()>& cancelled) {
   std::vector<std::unique_ptr<OutputSink<D>>> sinks;
@@ -155,6 +214,7 @@ std::vector<std::unique_ptr<OutputSink<D>>> makeOutputSinks(const std::filesyste
   }
   if (scene.output.fields) sinks.push_back(std::make_unique<FieldDumpSink<D>>(out));
   if (scene.output.vdb) sinks.push_back(std::make_unique<VdbSink<D>>(out, scene));
+  if (scene.output.normalMap) sinks.push_back(std::make_unique<NormalMapSink<D>>(out, scene));
   return sinks;
 }
 
@@ -162,6 +222,8 @@ template class ImageSink<2>;
 template class ImageSink<3>;
 template class FieldDumpSink<2>;
 template class FieldDumpSink<3>;
+template class NormalMapSink<2>;
+template class NormalMapSink<3>;
 template std::vector<std::unique_ptr<OutputSink<2>>> makeOutputSinks<2>(const std::filesystem::path&, const Scene&,
                                                                          const std::function<bool()>&);
 template std::vector<std::unique_ptr<OutputSink<3>>> makeOutputSinks<3>(const std::filesystem::path&, const Scene&,

@@ -80,6 +80,25 @@ class FieldDumpSink : public OutputSink<D> {
   uintmax_t bytes_ = 0;
 };
 
+// The shown field as a height field in [0, 1] (the frames' value range): its
+// tangent-space normal map (DIR/normals/NNNNNN.png) and the height itself as a
+// float EXR (DIR/height/NNNNNN.exr), seamless where the layer is periodic.
+template <int D>
+class NormalMapSink : public OutputSink<D> {
+ public:
+  NormalMapSink(const std::filesystem::path& out, const Scene& scene);
+  void write(const FrameInfo& at, const Simulation<D>& sim) override;
+  void report(nlohmann::json* run) const override;
+  nlohmann::json state() const override;
+  void restore(const nlohmann::json& state) override;
+
+ private:
+  std::filesystem::path normals_, heights_;
+  const Scene& scene_;
+  int written_ = 0;
+  uintmax_t bytes_ = 0;
+};
+
 // The sinks the scene's [output] asks for; `cancelled` stops a video encode.
 template <int D>
 std::vector<std::unique_ptr<OutputSink<D>>> makeOutputSinks(const std::filesystem::path& out, const Scene& scene,

@@ -1,5 +1,6 @@
 #include "app/rd_scene_setup.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -12,6 +13,7 @@
 #include "core/simulation.h"
 #include "core/spatial_field.h"
 #include "core/random.h"
+#include "rd/brush_strokes.h"
 #include "rd/coarse_to_fine.h"
 #include "rd/model_registry.h"
 #include "rd/rd_solver.h"
@@ -70,13 +72,24 @@ void applyScene(const Scene& scene, RDSolver<D>* rd) {
   }
   for (size_t k = 0; k < params.size(); ++k)
     if (!params[k].empty()) rd->setParameterField(int(k), std::move(params[k]));
+  // Brush strokes, their direction extended to every cell (Kim & Lin sec. 6).
+  PaintedStrokes<D> painted;
+  if (!scene.rd.strokes.empty()) {
+    std::vector<BrushStroke> strokes;
+    for (const RDStroke& s : scene.rd.strokes) strokes.push_back(s.stroke);
+    painted = paintStrokes<D>(strokes, n, rd->settings().size, rd->settings().boundary == RDBoundary::Periodic);
+  }
   // Inhomogeneous anisotropic diffusion (seed 004 eq. 11-19).
   if (const RDAnisotropy& an = scene.rd.anisotropy; an.enabled) {
     DiffusionTensorSpec<D> spec;
     spec.lambda1 = sampleSpatialField<D>(an.lambda1.field, n);
     spec.lambda2 = sampleSpatialField<D>(an.lambda2.field, n);
-    if (an.direction.empty()) {  // a = (cos theta, sin theta, 0)   (eq. 12)
-      const std::vector<double> theta = sampleSpatialField<D>(an.theta.field, n);
+    if (an.directionFromVelocity) {  // isotropic until the run sets a = u / |u| (GivenFlowSimulation)
+      for (int a = 0; a < D; ++a) spec.direction[size_t(a)].assign(cells, 0.0);
+    } else if (an.direction.empty()) {  // a = (cos theta, sin theta, 0)   (eq. 12)
+      std::vector<double> theta = an.thetaFromStrokes ? painted.angle : sampleSpatialField<D>(an.theta.field, n);
+      if (an.thetaFromStrokes)
+        for (double& t : theta) t += an.strokeAngle;
       for (int a = 0; a < D; ++a) spec.direction[size_t(a)].assign(cells, 0.0);
       for (size_t i = 0; i < cells; ++i) {
         spec.direction[0][i] = std::cos(theta[i]);
@@ -95,30 +108,44 @@ void applyScene(const Scene& scene, RDSolver<D>* rd) {
     CosineLobeSpec spec;
     spec.speeds = lb.speeds;
     spec.witkinKass = lb.witkinKass;
-    spec.theta0 = sampleSpatialField<D>(lb.theta0.field, n);
+    if (lb.theta0FromStrokes) {  // lobe 1 (centred at phi = theta + theta0 = 0) along the stroke, turned by strokeAngle
+      spec.theta0.resize(cells);
+      for (size_t i = 0; i < cells; ++i) spec.theta0[i] = -(painted.angle[i] + lb.strokeAngle);
+    } else {
+      spec.theta0 = sampleSpatialField<D>(lb.theta0.field, n);
+    }
     spec.species = lb.species;
     rd->setCosineLobes(std::move(spec));
   }
-  // Fixed regions: held at their values from the start (seed 004 fig. 20).
-  if (!scene.rd.fixed.empty()) {
-    const size_t ns = size_t(rd->species());
-    std::vector<std::vector<uint8_t>> mask(ns);
-    std::vector<std::vector<double>> values(ns);
-    for (const RDFixedRegion& fr : scene.rd.fixed) {
-      const std::vector<double> inside = sampleSpatialField<D>(fr.where.field, n);
-      for (size_t q = 0; q < fr.species.size(); ++q) {
-        const size_t s = size_t(fr.species[q]);
-        if (mask[s].empty()) mask[s].assign(cells, 0), values[s].assign(cells, 0.0);
-        for (size_t i = 0; i < cells; ++i)
-          if (inside[i] != 0.0) {
-            mask[s][i] = 1;
-            values[s][i] = fr.values[q];
-            rd->field(int(s))[i] = fr.values[q];
-          }
-      }
+  // Fixed regions and the chemical strokes deposit: held at their values from the start (seed 004 fig. 20, seed 001 fig. 3).
+  const size_t ns = size_t(rd->species());
+  std::vector<std::vector<uint8_t>> mask(ns);
+  std::vector<std::vector<double>> values(ns);
+  auto hold = [&](const std::vector<int>& species, const std::vector<double>& held, auto&& inside) {
+    for (size_t q = 0; q < species.size(); ++q) {
+      const size_t s = size_t(species[q]);
+      if (mask[s].empty()) mask[s].assign(cells, 0), values[s].assign(cells, 0.0);
+      for (size_t i = 0; i < cells; ++i)
+        if (inside(i)) {
+          mask[s][i] = 1;
+          values[s][i] = held[q];
+          rd->field(int(s))[i] = held[q];
+        }
     }
-    rd->setFixedCells(std::move(mask), std::move(values));
+  };
+  for (const RDFixedRegion& fr : scene.rd.fixed) {
+    const std::vector<double> inside = sampleSpatialField<D>(fr.where.field, n);
+    hold(fr.species, fr.values, [&](size_t i) { return inside[i] != 0.0; });
   }
+  for (const RDStroke& s : scene.rd.strokes) {
+    if (s.species.empty()) continue;
+    const std::vector<uint8_t> under =
+        strokeCoverage<D>(s.stroke, n, rd->settings().size, rd->settings().boundary == RDBoundary::Periodic);
+    hold(s.species, s.values, [&](size_t i) { return under[i] != 0; });
+  }
+  if (!scene.rd.fixed.empty() || std::any_of(scene.rd.strokes.begin(), scene.rd.strokes.end(),
+                                             [](const RDStroke& s) { return !s.species.empty(); }))
+    rd->setFixedCells(std::move(mask), std::move(values));
 }
 
 std::string rdStage(const RDSettings& s) {

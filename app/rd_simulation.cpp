@@ -82,15 +82,19 @@ nlohmann::json RDSimulation<D>::resolved() const {
 
 template <int D>
 void RDSimulation<D>::report(nlohmann::json* j) const {
-  const double steps = double(rd_.steps());
   (*j)["coarse_to_fine"] = coarseReport_;
-  (*j)["solvers"] = {{"newton_cells", stats_.newton.cells},
-                     {"newton_failures", stats_.newton.failures},
-                     {"newton_iterations_max", stats_.newton.maxIterations},
-                     {"newton_residual_max", stats_.newton.maxResidual},
-                     {"diffusion_iterations_mean", steps ? double(stats_.diffusionIterations) / steps : 0.0},
-                     {"diffusion_iterations_max", stats_.diffusionMax},
-                     {"diffusion_unconverged_steps", stats_.unconverged}};
+  reportRDSolvers(stats_, rd_.steps(), j);
+}
+
+void reportRDSolvers(const RDRunStats& stats, long rdSteps, nlohmann::json* j) {
+  const double steps = double(rdSteps);
+  (*j)["solvers"] = {{"newton_cells", stats.newton.cells},
+                     {"newton_failures", stats.newton.failures},
+                     {"newton_iterations_max", stats.newton.maxIterations},
+                     {"newton_residual_max", stats.newton.maxResidual},
+                     {"diffusion_iterations_mean", steps ? double(stats.diffusionIterations) / steps : 0.0},
+                     {"diffusion_iterations_max", stats.diffusionMax},
+                     {"diffusion_unconverged_steps", stats.unconverged}};
 }
 
 template std::vector<Grid<float, 2>> speciesField<2>(const RDSolver<2>&, const std::string&);

@@ -23,6 +23,9 @@ struct RDRunStats {
   void load(const StateReader& in);
 };
 
+// run.json's "solvers": the Newton and diffusion statistics of `rdSteps` steps.
+void reportRDSolvers(const RDRunStats& stats, long rdSteps, nlohmann::json* run);
+
 // The species of an RD layer as fields.
 template <int D>
 std::vector<Grid<float, D>> speciesField(const RDSolver<D>& rd, const std::string& name);

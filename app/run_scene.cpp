@@ -3,6 +3,7 @@
 
 #include "app/coupled_simulation.h"
 #include "app/fluid_simulation.h"
+#include "app/given_flow_simulation.h"
 #include "app/gpu_simulation.h"
 #include "app/memory_estimate.h"
 #include "app/rd_simulation.h"
@@ -24,6 +25,7 @@ std::unique_ptr<Simulation<D>> makeSimulation(const Scene& scene, const RunOptio
   if (opt.backend == "gpu" && !scene.hasFluid) return std::make_unique<GpuRDSimulation<D>>(scene, say);  // checkGpuRuns said it can
   if (opt.backend == "gpu" && scene.rd.enabled) return std::make_unique<CoupledSimulation<D>>(scene, CouplingBackend::Serial, warn, true);
   if (opt.backend == "gpu") return std::make_unique<FluidSimulation<D>>(scene, warn, true);
+  if (scene.velocity.enabled) return std::make_unique<GivenFlowSimulation<D>>(scene);
   if (!scene.hasFluid) return std::make_unique<RDSimulation<D>>(scene, say);
   if (scene.rd.enabled)
     return std::make_unique<CoupledSimulation<D>>(

@@ -14,16 +14,16 @@ namespace {
 
 template <int D>
 VolumeGrid volumeGrid(const std::string& name, VolumeGrid::Kind kind, std::vector<Grid<float, D>> components,
-                      double domainWidth) {
+                      double domainWidth, int extraVoxels = 0) {
   VolumeGrid g;
   g.name = name;
   g.kind = kind;
   const IVec<D>& n = components.front().dims();
   for (int a = 0; a < D; ++a) g.cells[size_t(a)] = n[a];
-  g.voxelSize = domainWidth / n[0];
+  g.voxelSize = domainWidth / (n[0] - extraVoxels);
   for (Grid<float, D>& c : components) g.values.push_back(c.values());
   // A 2D velocity has no z component; a volume's vector has three.
-  if (kind == VolumeGrid::Kind::Vector)
+  if (kind == VolumeGrid::Kind::Vector || kind == VolumeGrid::Kind::Staggered)
     while (g.values.size() < 3) g.values.emplace_back(g.values.front().size(), 0.0f);
   return g;
 }
@@ -47,6 +47,8 @@ std::vector<VolumeGrid> VdbSink<D>::grids(const Simulation<D>& sim) const {
   const std::vector<std::string> names = sim.fieldNames();
   if (std::find(names.begin(), names.end(), "velocity") != names.end())
     g.push_back(volumeGrid<D>("vel", K::Vector, sim.field("velocity"), width));
+  // The MAC faces exactly (cells + 1 voxels per axis), for a later run to read back (docs/vfx.md).
+  if (o.vdbMacVelocity) g.push_back(volumeGrid<D>("vel_mac", K::Staggered, sim.field("velocity_mac"), width, 1));
   for (const std::string& f : o.vdbFields) g.push_back(volumeGrid<D>(f, K::Scalar, sim.field(f), width));
   if (sim.hasObstacles()) g.push_back(volumeGrid<D>("obstacle", K::LevelSet, sim.field("obstacle"), width));
   return g;
@@ -64,6 +66,7 @@ void VdbSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
   meta.scene = scene_.name;
   meta.version = kVersion;
   meta.settingsHash = hash_;
+  for (int a = 0; a < D; ++a) meta.domain[size_t(a)] = scene_.fluid.size[size_t(a)];
   meta.units = "lengths in the scene's domain units (world space fills [0, domain.size]); time in its time units; "
                "vel in domain units per time unit";
   const VolumeOptions options{float(o.vdbTolerance), o.vdbHalf};

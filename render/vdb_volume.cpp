@@ -68,6 +68,7 @@ openvdb::GridBase::Ptr vectorGrid(const VolumeGrid& g, const VolumeOptions& o) {
   openvdb::tools::copyFromDense(dense, *grid, openvdb::Vec3s(0.0f));
   deactivateNearBackground(grid.get(), o.tolerance);
   grid->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
+  if (g.kind == VolumeGrid::Kind::Staggered) grid->setGridClass(openvdb::GRID_STAGGERED);
   return grid;
 }
 
@@ -91,7 +92,8 @@ openvdb::GridPtrVec buildGrids(const std::vector<VolumeGrid>& grids, const Volum
   initialiseOnce();
   openvdb::GridPtrVec out;
   for (const VolumeGrid& g : grids) {
-    openvdb::GridBase::Ptr grid = g.kind == VolumeGrid::Kind::Vector     ? vectorGrid(g, o)
+    const bool vector = g.kind == VolumeGrid::Kind::Vector || g.kind == VolumeGrid::Kind::Staggered;
+    openvdb::GridBase::Ptr grid = vector                                 ? vectorGrid(g, o)
                                   : g.kind == VolumeGrid::Kind::LevelSet ? levelSetGrid(g)
                                                                          : scalarGrid(g, o);
     grid->setName(g.name);
@@ -112,6 +114,7 @@ openvdb::MetaMap metaMap(const VolumeMetadata& m) {
   meta.insertMeta("morphoflow_version", openvdb::StringMetadata(m.version));
   meta.insertMeta("settings_hash", openvdb::StringMetadata(m.settingsHash));
   meta.insertMeta("units", openvdb::StringMetadata(m.units));
+  if (m.domain[0] > 0) meta.insertMeta("domain_size", openvdb::Vec3DMetadata(openvdb::Vec3d(m.domain[0], m.domain[1], m.domain[2])));
   return meta;
 }
 
@@ -166,6 +169,78 @@ std::string encodeNanoVdb(const std::vector<VolumeGrid>& grids, const VolumeMeta
   nanovdb::io::writeGrids<nanovdb::HostBuffer, std::vector>(os, handles, nanovdb::io::Codec::NONE);
   if (!os) throw std::runtime_error("the NanoVDB grids could not be serialised");
   return os.str();
+}
+
+bool readVdbTime(const std::string& path, double* time, bool* has, std::string* error) {
+  initialiseOnce();
+  try {
+    openvdb::io::File file(path);
+    file.open(/*delayLoad=*/true);
+    openvdb::MetaMap::Ptr meta = file.getMetadata();
+    file.close();
+    *has = false;
+    if (auto m = meta->getMetadata<openvdb::DoubleMetadata>("time")) *has = true, *time = m->value();
+    return true;
+  } catch (const std::exception& e) {
+    *error = e.what();
+    return false;
+  }
+}
+
+bool readVdbVelocity(const std::string& path, VelocityVolume* out, std::string* error) {
+  initialiseOnce();
+  try {
+    openvdb::io::File file(path);
+    file.open(/*delayLoad=*/false);
+    const bool mac = file.hasGrid("vel_mac");
+    if (!mac && !file.hasGrid("vel")) {
+      std::string names;
+      for (auto it = file.beginName(); it != file.endName(); ++it) names += (names.empty() ? "" : ", ") + it.gridName();
+      *error = "the file has no velocity grid 'vel' (its grids: " + (names.empty() ? std::string("none") : names) + ")";
+      return false;
+    }
+    openvdb::MetaMap::Ptr meta = file.getMetadata();
+    openvdb::GridBase::Ptr base = file.readGrid(mac ? "vel_mac" : "vel");
+    file.close();
+    auto grid = openvdb::gridPtrCast<openvdb::Vec3SGrid>(base);
+    if (!grid) {
+      *error = "the grid '" + base->getName() + "' is not a Vec3 float grid (it is " + base->valueType() + ")";
+      return false;
+    }
+    const openvdb::math::Transform& t = grid->transform();
+    const openvdb::Vec3d vs = t.voxelSize();
+    if (!t.isLinear() || std::abs(vs[0] - vs[1]) > 1e-9 * vs[0] || std::abs(vs[0] - vs[2]) > 1e-9 * vs[0]) {
+      *error = "the grid '" + grid->getName() + "' does not have cubic voxels on a linear transform";
+      return false;
+    }
+    VelocityVolume v;
+    v.grid = grid->getName();
+    v.staggered = mac || grid->getGridClass() == openvdb::GRID_STAGGERED;
+    v.voxelSize = vs[0];
+    const openvdb::Vec3d o = t.indexToWorld(openvdb::Vec3d(0.0));
+    v.indexOrigin = {o[0], o[1], o[2]};
+    if (auto m = meta->getMetadata<openvdb::DoubleMetadata>("time")) v.hasTime = true, v.time = m->value();
+    if (auto m = meta->getMetadata<openvdb::Vec3DMetadata>("domain_size"))
+      v.hasDomain = true, v.domain = {m->value()[0], m->value()[1], m->value()[2]};
+    const openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
+    if (!box.empty()) {
+      const openvdb::Coord d = box.dim();
+      for (int a = 0; a < 3; ++a) v.origin[size_t(a)] = box.min()[a], v.cells[size_t(a)] = d[a];
+      const size_t n = size_t(d[0]) * size_t(d[1]) * size_t(d[2]);
+      std::vector<openvdb::Vec3s> dense(n);
+      openvdb::tools::Dense<openvdb::Vec3s, openvdb::tools::LayoutXYZ> dst(box, dense.data());
+      openvdb::tools::copyToDense(*grid, dst);
+      for (int a = 0; a < 3; ++a) {
+        v.values[size_t(a)].resize(n);
+        for (size_t i = 0; i < n; ++i) v.values[size_t(a)][i] = dense[i][a];
+      }
+    }
+    *out = std::move(v);
+    return true;
+  } catch (const std::exception& e) {
+    *error = e.what();
+    return false;
+  }
 }
 
 }  // namespace morphoflow

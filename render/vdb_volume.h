@@ -18,6 +18,7 @@ struct VolumeGrid {
     Scalar,     // a FloatGrid
     FogVolume,  // a FloatGrid of class fog volume (the density)
     Vector,     // a Vec3SGrid, vector type contravariant-relative (velocity)
+    Staggered,  // the same, of class staggered: component a of voxel v on v's lower face along a (MAC velocity)
     LevelSet,   // `values` is a solid mask (nonzero inside): written as a narrow-band level set
   };
   std::string name;
@@ -31,6 +32,7 @@ struct VolumeMetadata {
   long frame = 0, step = 0;
   double time = 0.0, dt = 0.0;
   std::string scene, version, settingsHash, units;
+  std::array<double, 3> domain{0.0, 0.0, 0.0};  // the domain's extent (0: not written)
 };
 
 struct VolumeOptions {
@@ -43,5 +45,28 @@ struct VolumeOptions {
 std::string encodeVdb(const std::vector<VolumeGrid>& grids, const VolumeMetadata& meta, const VolumeOptions& options);
 // The same grids as a NanoVDB file (.nvdb), uncompressed, for GPU renderers.
 std::string encodeNanoVdb(const std::vector<VolumeGrid>& grids, const VolumeMetadata& meta, const VolumeOptions& options);
+
+// A velocity read back from a .vdb file: the grid `vel_mac` (staggered, as
+// morphoflow writes it with output.vdb_mac_velocity) if the file has one,
+// else `vel` (any Vec3 float grid, cell-centred), densely over its active
+// voxels' bounding box.
+struct VelocityVolume {
+  std::string grid;                      // the grid read
+  bool staggered = false;
+  std::array<int, 3> origin{0, 0, 0};    // index of the box's first voxel
+  std::array<int, 3> cells{0, 0, 0};     // the box's voxels per axis (all 0: no active voxel)
+  double voxelSize = 1.0;
+  std::array<double, 3> indexOrigin{};   // world position of index (0, 0, 0)
+  std::array<std::vector<float>, 3> values;  // per component, x fastest over the box
+  bool hasTime = false, hasDomain = false;
+  double time = 0.0;
+  std::array<double, 3> domain{};        // the writer's domain_size metadata
+};
+
+// False and a message (what is missing, or what OpenVDB said) when the file
+// cannot be read or has no velocity grid.
+bool readVdbVelocity(const std::string& path, VelocityVolume* out, std::string* error);
+// The file's `time` metadata (*has false when it has none), without reading its grids.
+bool readVdbTime(const std::string& path, double* time, bool* has, std::string* error);
 
 }  // namespace morphoflow

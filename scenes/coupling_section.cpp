@@ -9,11 +9,11 @@ void parseCoupling(SceneContext& c, Scene* sp) {
   Scene& s = *sp;
   const std::vector<std::string>& species = c.species;
   if (const toml::table* ct = r.table(root, "", "coupling")) {
-    if (!s.rd.enabled || !s.hasFluid)
-      r.fail(ct, "coupling", "[coupling] joins a [fluid] and an [rd] layer, and this scene lacks one of them",
+    if (!s.rd.enabled || !(s.hasFluid || s.velocity.enabled))
+      r.fail(ct, "coupling", "[coupling] joins a [fluid] (or a given [velocity]) and an [rd] layer, and this scene lacks one of them",
              "add the missing table or drop [coupling]");
   }
-  if (s.rd.enabled && s.hasFluid) {
+  if (s.rd.enabled && (s.hasFluid || s.velocity.enabled)) {
     const toml::table* ct = r.table(root, "", "coupling");
     CouplingScene& C = s.coupling;
     C.enabled = true;

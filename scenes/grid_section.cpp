@@ -51,6 +51,7 @@ void parseGrid(SceneContext& c, Scene* sp) {
 
   c.D = D;
   c.rdOnly = rdOnly;
+  c.givenVelocity = root.contains("velocity");
   c.res = res;
   c.size = size;
 }

@@ -35,8 +35,13 @@ void parseVdbOutput(SceneContext& c, const toml::table* out, Scene& s) {
   o.vdbTolerance = r.number(out, "output.", "vdb_tolerance", 0.0, 0.0, 1e30);
   o.vdbHalf = r.boolean(out, "output.", "vdb_half", false);
   o.nanovdb = r.boolean(out, "output.", "nanovdb", false);
+  const toml::node* mac = r.node(out, "output.", "vdb_mac_velocity");
+  o.vdbMacVelocity = r.boolean(out, "output.", "vdb_mac_velocity", false);
+  if (o.vdbMacVelocity && !s.hasFluid)
+    r.fail(mac, "output.vdb_mac_velocity", "this scene has no fluid, so it has no velocity of its own to write",
+           "drop output.vdb_mac_velocity");
   if (!o.vdb)
-    for (const char* k : {"vdb_density", "vdb_fields", "vdb_tolerance", "vdb_half", "nanovdb"})
+    for (const char* k : {"vdb_density", "vdb_fields", "vdb_tolerance", "vdb_half", "nanovdb", "vdb_mac_velocity"})
       if (const toml::node* n = r.node(out, "output.", k); n && !(n->is_boolean() && !n->value<bool>().value()))
         r.fail(n, std::string("output.") + k, "only applies with output.vdb = true", "add output.vdb = true or drop it");
 }
@@ -105,6 +110,13 @@ void parseOutput(SceneContext& c, Scene* sp) {
            "drop output.view, or set it to \"slice\"");
   s.output.imageSize = int(r.integer(out, "output.", "image_size", 512, 16, 8192));
   s.output.slice = int(r.integer(out, "output.", "slice", -1, -1, D == 3 ? long(res[2]) - 1 : -1));
+  // Normal and height maps of the shown field (seed 000 fig. 7).
+  const toml::node* nm = r.node(out, "output.", "normal_map");
+  s.output.normalMap = r.boolean(out, "output.", "normal_map", false);
+  if (s.output.normalMap && D == 3)
+    r.fail(nm, "output.normal_map", "normal maps are of 2D patterns read as height fields; this scene is 3D",
+           "drop output.normal_map, or run the pattern in 2D");
+  s.output.normalStrength = r.number(out, "output.", "normal_strength", 4.0, 0.0, 1e6, true);
 }
 
 }  // namespace morphoflow

@@ -9,6 +9,21 @@
 
 namespace morphoflow {
 
+namespace {
+
+// theta = "strokes": the direction painted by [[rd.strokes]] (seed 001 sec. 6).
+bool isStrokes(const toml::node* n) { return n && n->is_string() && n->value<std::string>().value() == "strokes"; }
+
+double strokeAngle(Reader& r, const toml::table* t, const std::string& p, const std::string& key, const RDScene& R,
+                   const toml::node* th) {
+  if (R.strokes.empty())
+    r.fail(th, p + key, "\"strokes\" takes the direction of [[rd.strokes]], but the scene has none",
+           "add a stroke, e.g. [[rd.strokes]] points = [[0.2, 0.5], [0.8, 0.5]]");
+  return r.number(t, p, "stroke_angle", 0.0, -1e3, 1e3);
+}
+
+}  // namespace
+
 void parseRD(SceneContext& c, Scene* sp) {
   Reader& r = c.r;
   toml::table& root = c.root;
@@ -75,19 +90,8 @@ void parseRD(SceneContext& c, Scene* sp) {
     const std::string ls = r.string(rdt, "rd.", "linear_solver", "mgpcg", {"mgpcg", "icpcg"});
     st.linearSolver = ls == "icpcg" ? RDLinearSolver::ICPCG : RDLinearSolver::MGPCG;
     st.tolerance = r.number(rdt, "rd.", "tolerance", 1e-8, 0, 1, true);
-    // An array of species names, as indices (rd.frozen, fixed regions, anisotropy).
     auto speciesList = [&](const toml::node* sp, const std::string& key, bool allowEmpty) {
-      std::vector<int> out;
-      const toml::array* sa = sp->as_array();
-      if (!sa || (sa->empty() && !allowEmpty))
-        r.fail(sp, key, "expected an array of species names", "species: " + join(species));
-      for (const toml::node& e : *sa) {
-        auto v = e.value<std::string>();
-        auto f = v ? std::find(species.begin(), species.end(), *v) : species.end();
-        if (f == species.end()) r.fail(&e, key, "expected species names of " + model + ": " + join(species));
-        out.push_back(int(f - species.begin()));
-      }
-      return out;
+      return speciesIndices(r, sp, key, species, model, allowEmpty);
     };
     if (const toml::node* fr = r.node(rdt, "rd.", "frozen")) st.frozen = speciesList(fr, "rd.frozen", true);
     // [rd.parameters]: uniform values by name.
@@ -137,6 +141,13 @@ void parseRD(SceneContext& c, Scene* sp) {
           r.fail(&v, "rd.maps." + name, "not a parameter of " + model,
                  "did you mean '" + nearest(name, pnames) + "'? parameters: " + join(pnames));
         r.node(mp, "rd.maps.", name);
+        if (v.is_string() && v.value<std::string>().value() == "speed") {  // seed 004 fig. 24: magnitude -> rate
+          if (!c.givenVelocity)
+            r.fail(&v, "rd.maps." + name, "\"speed\" maps the given velocity's magnitude, but the scene has no [velocity]",
+                   "add [velocity] field = [...] or vdb = \"...\"");
+          R.speedMaps.push_back(int(pi - pnames.begin()));
+          continue;
+        }
         R.parameterMaps.push_back({int(pi - pnames.begin()), r.field(&v, "rd.maps." + name, sceneDir)});
       }
     }
@@ -165,6 +176,7 @@ void parseRD(SceneContext& c, Scene* sp) {
         R.fixed.push_back(std::move(fr));
       }
     }
+    parseStrokes(c, *rdt, &R);
     // [rd.anisotropy]: inhomogeneous anisotropic tensor diffusion (seed 004 eq. 11-19).
     if (const toml::table* an = r.table(*rdt, "rd.", "anisotropy")) {
       RDAnisotropy& A = R.anisotropy;
@@ -181,7 +193,18 @@ void parseRD(SceneContext& c, Scene* sp) {
       A.lambda1 = fieldOr("lambda1", "1");
       A.lambda2 = fieldOr("lambda2", "1");
       const toml::node* th = r.node(an, p, "theta");
-      if (const toml::node* dn = r.node(an, p, "direction")) {
+      A.thetaFromStrokes = isStrokes(th);
+      if (A.thetaFromStrokes) A.strokeAngle = strokeAngle(r, an, p, "theta", R, th);
+      const toml::node* dn = r.node(an, p, "direction");
+      A.directionFromVelocity = dn && dn->is_string() && dn->value<std::string>().value() == "velocity";
+      if (A.directionFromVelocity && !c.givenVelocity)
+        r.fail(dn, p + "direction", "\"velocity\" orients the tensor along the given velocity, but the scene has no [velocity]",
+               "add [velocity] field = [...] or vdb = \"...\"");
+      if (A.directionFromVelocity && th)
+        r.fail(th, p + "theta", "give either theta or direction = \"velocity\", not both", "drop one of them");
+      if (A.directionFromVelocity) {
+        // a = u / |u| per cell, set by the run from the velocity it samples
+      } else if (dn) {
         if (th)
           r.fail(th, p + "theta", "give either theta (an angle in the xy plane) or direction (a vector field), not both",
                  "drop one of them");
@@ -191,7 +214,7 @@ void parseRD(SceneContext& c, Scene* sp) {
                  "expected an array of " + std::to_string(D) + " fields (one per axis), e.g. [\"y - 0.5\", \"x - 0.5\"]");
         for (size_t q = 0; q < arr->size(); ++q)
           A.direction.push_back(r.field(arr->get(q), p + "direction." + std::to_string(q), sceneDir));
-      } else {
+      } else if (!A.thetaFromStrokes) {
         A.theta = fieldOr("theta", "0");
       }
       if (const toml::node* sp = r.node(an, p, "species")) A.species = speciesList(sp, p + "species", false);
@@ -217,7 +240,11 @@ void parseRD(SceneContext& c, Scene* sp) {
       if (std::all_of(L.speeds.begin(), L.speeds.end(), [](double v) { return v == 0.0; }))
         r.fail(sn, p + "speeds", "every lobe speed is 0, so the lobed species would not diffuse at all",
                "give at least one lobe a positive speed");
-      if (const toml::node* th = r.node(cl, p, "theta0")) {
+      const toml::node* th = r.node(cl, p, "theta0");
+      L.theta0FromStrokes = isStrokes(th);
+      if (L.theta0FromStrokes) {
+        L.strokeAngle = strokeAngle(r, cl, p, "theta0", R, th);
+      } else if (th) {
         L.theta0 = r.field(th, p + "theta0", sceneDir);
       } else {
         L.theta0.field.expression = "0";
@@ -228,9 +255,9 @@ void parseRD(SceneContext& c, Scene* sp) {
     }
     // [rd.coarse_to_fine]: grow the pattern on coarser grids first.
     if (const toml::table* cf = r.table(*rdt, "rd.", "coarse_to_fine")) {
-      if (!rdOnly)
+      if (!rdOnly || c.givenVelocity)
         r.fail(cf, "rd.coarse_to_fine", "coarse-to-fine growth is for reaction-diffusion-only scenes",
-               "drop [rd.coarse_to_fine] from a scene with [fluid]");
+               "drop [rd.coarse_to_fine] from a scene with [fluid] or [velocity]");
       const toml::node* lv = r.node(cf, "rd.coarse_to_fine.", "levels");
       R.coarseLevels = int(r.integer(cf, "rd.coarse_to_fine.", "levels", 2, 1, 8));
       R.coarseSteps = r.integer(cf, "rd.coarse_to_fine.", "steps", 1000, 0, 1'000'000'000);
@@ -287,10 +314,10 @@ void parseRD(SceneContext& c, Scene* sp) {
       const RDAnisotropy& A = s.rd.anisotropy;
       check(A.lambda1, false, true);
       check(A.lambda2, false, true);
-      if (A.direction.empty()) check(A.theta, false);
+      if (A.direction.empty() && !A.thetaFromStrokes && !A.directionFromVelocity) check(A.theta, false);
       for (const SceneField& f : A.direction) check(f, false);
     }
-    if (s.rd.lobes.enabled) check(s.rd.lobes.theta0, false);
+    if (s.rd.lobes.enabled && !s.rd.lobes.theta0FromStrokes) check(s.rd.lobes.theta0, false);
   }
 }
 

@@ -10,6 +10,7 @@
 #include "core/error.h"
 #include "core/spatial_field.h"
 #include "fluid/fluid_settings.h"
+#include "rd/brush_strokes.h"
 #include "rd/rd_settings.h"
 
 namespace morphoflow {
@@ -31,6 +32,7 @@ struct OutputSettings {
   double vdbTolerance = 0.0;        // |value| <= this: inactive voxel
   bool vdbHalf = false;             // floats saved as half
   bool nanovdb = false;             // also DIR/vdb/<name>.NNNNNN.nvdb
+  bool vdbMacVelocity = false;      // also `vel_mac`: the MAC face velocities exactly (staggered)
   bool video = false;               // encode the PNG frames into OUT/<name>.mp4 (ffmpeg)
   int fps = 30;                     // video frames per second
   std::string field = "vorticity"; // speed | vorticity | dye | pressure
@@ -42,6 +44,8 @@ struct OutputSettings {
   int slice = -1;                  // 3D: z slice for images (-1 = middle)
   std::string view = "slice";      // 3D: "volume" (ray marched, the default) or "slice"; 2D: "slice"
   int imageSize = 512;             // frames are at least this many pixels wide
+  bool normalMap = false;           // 2D: DIR/normals/NNNNNN.png and DIR/height/NNNNNN.exr of the shown field
+  double normalStrength = 4.0;      // normal map slope per unit of height (0..1 over the range) per cell
   int checkpointEvery = 10;        // frames between checkpoints (0: only at the end and on a stop)
 };
 
@@ -90,7 +94,10 @@ struct RDAnisotropy {
   bool enabled = false;
   SceneField lambda1, lambda2;        // principal diffusivities along and across a (> 0)
   SceneField theta;                   // angle of a in the xy plane, radians (when direction is empty)
+  bool thetaFromStrokes = false;      // theta = "strokes": the painted strokes' direction + strokeAngle
+  double strokeAngle = 0.0;
   std::vector<SceneField> direction;  // or a, one field per axis (normalised per cell; zero = isotropic)
+  bool directionFromVelocity = false; // direction = "velocity": a = u / |u| of the given velocity
   std::vector<int> species;           // the anisotropic species (empty: all)
   double shape = 0.0;                 // eq. 18's I (0: off)
   int shapeSpecies = 0;               // whose gradient shapes the tensor
@@ -103,7 +110,19 @@ struct RDCosineLobes {
   std::vector<double> speeds;         // a_n per lobe (eq. 16), or a1, a2 (eq. 15)
   bool witkinKass = false;            // eq. 15
   SceneField theta0;                  // rotation, radians (a field)
+  bool theta0FromStrokes = false;     // theta0 = "strokes": lobe 1 along the strokes' direction + strokeAngle
+  double strokeAngle = 0.0;
   std::vector<int> species;           // the lobed species (empty: all)
+};
+
+// A brush stroke, [[rd.strokes]] (seed 001 sec. 6): its direction may steer
+// the anisotropy, and it may deposit chemical (the cells under it held fixed).
+struct RDStroke {
+  BrushStroke stroke;
+  std::vector<int> species;           // deposited species (empty: none)
+  std::vector<double> values;         // one per deposited species
+  SourceLocation where;
+  std::string key;
 };
 
 struct RDScene {
@@ -112,8 +131,10 @@ struct RDScene {
   RDInitial initial;
   std::vector<std::pair<int, SceneField>> initialMaps;  // species index -> its initial field
   std::vector<std::pair<int, SceneField>> parameterMaps;  // parameter index -> its field ([rd.maps])
+  std::vector<int> speedMaps;        // parameters mapped from the given velocity's speed ([rd.maps] P = "speed")
   std::vector<std::pair<int, double>> perturb;  // parameter index, Gaussian sigma in percent (seed 004 sec. 3.1)
   std::vector<RDFixedRegion> fixed;
+  std::vector<RDStroke> strokes;
   RDAnisotropy anisotropy;
   RDCosineLobes lobes;
   int coarseLevels = 0;              // coarse-to-fine: grids 2^L, ..., 2 times coarser first (seed 002, 000)
@@ -131,6 +152,19 @@ struct CouplingScene {
   std::vector<double> solidValues;      // per species, inside obstacles
 };
 
+// [velocity]: a given velocity carrying the [rd] layer instead of a fluid
+// (flow visualisation, seed 004 sec. 3, fig. 24).
+struct VelocityScene {
+  bool enabled = false;
+  std::vector<std::string> field;    // one expression per axis in x, y, z (domain units) and t
+  std::string vdb;                   // or a VDB sequence: a path whose '#'s stand for the frame number
+  double frameTime = 0.0;            // time between VDB frames that carry no `time` metadata
+  double speedRange[2] = {0.0, 1.0}; // [rd.maps] P = "speed": P = lo + (hi - lo) |u| / referenceSpeed
+  double referenceSpeed = 0.0;       // 0: the largest speed of the first velocity sampled
+  SourceLocation where;              // of the field or vdb key, for errors at run time
+  std::string key;
+};
+
 struct Scene {
   std::string path;                // the file it came from
   std::string name;
@@ -143,7 +177,8 @@ struct Scene {
   DyeSettings dye;
   bool hasFluid = true;            // false for reaction-diffusion-only scenes
   RDScene rd;
-  CouplingScene coupling;          // hasFluid && rd.enabled
+  CouplingScene coupling;          // rd.enabled && (hasFluid || velocity.enabled)
+  VelocityScene velocity;
   double reynolds = 0.0;           // resolved Re = U L / nu
   std::string resolvedJson;        // the scene as resolved (JSON text), for run.json
   long totalSteps() const;         // resolved from steps or duration/dt

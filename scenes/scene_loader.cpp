@@ -102,6 +102,7 @@ Scene parseScene(const std::string& text, const std::string& path, const std::ve
   parseObstacles(c, &s);
   parseFluid(c, &s);
   parseRD(c, &s);
+  parseVelocity(c, &s);
   parseCoupling(c, &s);
   parseOutput(c, &s);
   checkBackTraces(c, s);

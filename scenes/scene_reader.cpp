@@ -81,4 +81,18 @@ void applyOverride(toml::table& root, const std::string& kv, std::map<std::strin
   (*locs)[key] = {origin, 1, int(eq) + 2};
 }
 
+std::vector<int> speciesIndices(Reader& r, const toml::node* n, const std::string& key,
+                                const std::vector<std::string>& species, const std::string& model, bool allowEmpty) {
+  std::vector<int> out;
+  const toml::array* sa = n->as_array();
+  if (!sa || (sa->empty() && !allowEmpty)) r.fail(n, key, "expected an array of species names", "species: " + join(species));
+  for (const toml::node& e : *sa) {
+    auto v = e.value<std::string>();
+    auto f = v ? std::find(species.begin(), species.end(), *v) : species.end();
+    if (f == species.end()) r.fail(&e, key, "expected species names of " + model + ": " + join(species));
+    out.push_back(int(f - species.begin()));
+  }
+  return out;
+}
+
 }  // namespace morphoflow

@@ -185,6 +185,10 @@ class Reader {
   std::map<const toml::table*, std::set<std::string>> known_;
 };
 
+// An array of species names of `model` (one of `species`), as indices.
+std::vector<int> speciesIndices(Reader& r, const toml::node* n, const std::string& key,
+                                const std::vector<std::string>& species, const std::string& model, bool allowEmpty);
+
 // Applies one --set key.path=value override (the value in TOML syntax) and
 // remembers where it came from, for messages.
 void applyOverride(toml::table& root, const std::string& kv, std::map<std::string, SourceLocation>* locs);
@@ -201,6 +205,7 @@ struct SceneContext {
   const std::map<std::string, SourceLocation>& overrideLocs;
   int D = 2;
   bool rdOnly = false;              // [rd] without [fluid]
+  bool givenVelocity = false;       // [velocity]: the [rd] layer is carried by a given field
   std::vector<double> res, size;    // [grid] cells and [domain] extent per axis
   int inflowSide = -1;              // index of the inflow side (x_min, x_max, ...), -1: none
   std::vector<std::string> species; // of the [rd] model
@@ -215,6 +220,8 @@ void parseBoundary(SceneContext& c, Scene* s);    // [boundary], [inflow]
 void parseObstacles(SceneContext& c, Scene* s);   // [[obstacles]]
 void parseFluid(SceneContext& c, Scene* s);       // [fluid], [dye], [probes]
 void parseRD(SceneContext& c, Scene* s);          // [rd] and its tables
+void parseStrokes(SceneContext& c, const toml::table& rd, RDScene* out);  // [[rd.strokes]] (called by parseRD)
+void parseVelocity(SceneContext& c, Scene* s);    // [velocity] (after [rd])
 void parseCoupling(SceneContext& c, Scene* s);    // [coupling]
 void parseOutput(SceneContext& c, Scene* s);      // [output]
 

@@ -136,6 +136,29 @@ INSTANTIATE_TEST_SUITE_P(
                  "5:1", "use one"},
         BadScene{"rd_lobes_unknown_key", "[rd]\nmodel = \"gray-scott\"\n[rd.cosine_lobes]\nspeeds = [1]\ntheta_0 = 1\n", "5:1",
                  "did you mean 'rd.cosine_lobes.theta0'"},
+        BadScene{"stroke_outside", "[rd]\nmodel = \"gray-scott\"\n[[rd.strokes]]\npoints = [[1, 1], [900, 1]]\n", "4:19",
+                 "outside the domain"},
+        BadScene{"stroke_one_point", "[rd]\nmodel = \"gray-scott\"\n[[rd.strokes]]\npoints = [[1, 1]]\n", "4:10",
+                 "at least two points"},
+        BadScene{"stroke_point_length", "[rd]\nmodel = \"gray-scott\"\n[[rd.strokes]]\npoints = [[1, 1], [2]]\n", "4:19",
+                 "expected a point [x, y]"},
+        BadScene{"stroke_deposit_without_values", "[rd]\nmodel = \"gray-scott\"\n[[rd.strokes]]\npoints = [[1, 1], [2, 2]]\nspecies = [\"v\"]\n",
+                 "3:1", "needs values"},
+        BadScene{"strokes_theta0_without_strokes", "[rd]\nmodel = \"gray-scott\"\n[rd.cosine_lobes]\nspeeds = [1]\ntheta0 = \"strokes\"\n",
+                 "5:10", "but the scene has none"},
+        BadScene{"stroke_image_missing", "[rd]\nmodel = \"gray-scott\"\n[[rd.strokes]]\nimage = \"dark.png\"\n", "4:9", "cannot read"},
+        BadScene{"normal_map_3d", "[grid]\nresolution = [8, 8, 8]\n[output]\nnormal_map = true\n", "4:14", "this scene is 3D"},
+        BadScene{"normal_strength_zero", "[output]\nnormal_map = true\nnormal_strength = 0\n", "3:19", "output.normal_strength"},
+        BadScene{"velocity_wrong_length", "[rd]\nmodel = \"gray-scott\"\n[velocity]\nfield = [\"1\"]\n", "4:9",
+                 "expected two expressions"},
+        BadScene{"velocity_unknown_variable", "[rd]\nmodel = \"gray-scott\"\n[velocity]\nfield = [\"1\", \"q\"]\n", "4:16",
+                 "in the velocity expression"},
+        BadScene{"velocity_with_fluid", "[fluid]\nreynolds = 100\n[rd]\nmodel = \"gray-scott\"\n[velocity]\nfield = [\"1\", \"0\"]\n",
+                 "5:1", "has a [fluid]"},
+        BadScene{"velocity_both", "[rd]\nmodel = \"gray-scott\"\n[velocity]\nfield = [\"1\", \"0\"]\nvdb = \"a.vdb\"\n", "5:7",
+                 "not both"},
+        BadScene{"speed_map_without_velocity", "[rd]\nmodel = \"turing-sanderson\"\n[rd.maps]\ns = \"speed\"\n", "4:5",
+                 "has no [velocity]"},
         BadScene{"coupling_without_rd", "[fluid]\nreynolds = 100\n[coupling]\nmode = \"ard\"\n", "3:1", "lacks one of them"},
         BadScene{"coupling_bad_mode", "[fluid]\nreynolds = 100\n[rd]\nmodel = \"gray-scott\"\n[coupling]\nmode = \"pasive\"\n",
                  "6:8", "did you mean 'passive'"},
@@ -340,6 +363,66 @@ TEST(Cli, CosineLobeScenesRun) {
     dumps.push_back(d);
   }
   EXPECT_NE(dumps[1].channels, dumps[2].channels) << "the lobe speeds must reach the solver";
+  fs::remove_all(dir);
+}
+
+// Kim & Lin's painting (seed 001 fig. 3) at 64^2: the stroke's cells hold the
+// deposited values, and its direction steering the lobe changes the pattern.
+TEST(Cli, PaintedStrokesDepositAndSteerTheLobes) {
+  auto dir = tempDir("paint");
+  std::vector<morphoflow::FieldDump> dumps;
+  for (const char* name : {"kim_lin_paint_deposit", "kim_lin_paint_lobe"}) {
+    const std::string file = sceneFile(std::string("rd/seeds/") + name + ".toml");
+    CommandResult r = runMorphoflow("run " + file + " --set grid.resolution=[64,64] --set time.steps=40 --set output.every=40" +
+                                    " --set output.fields=true --quiet --out " + (dir / name).string());
+    ASSERT_EQ(r.status, 0) << name << ": " << r.output;
+    morphoflow::FieldDump d;
+    std::string err;
+    ASSERT_TRUE(morphoflow::readFieldDump((dir / name / "fields" / "000001.exr").string(), &d, &err)) << err;
+    // The spiral starts at (1.25 + 0.12, 1.25) in a 2.5 domain: cell (34, 32) at 64^2 is on it.
+    const size_t onStroke = 32 * 64 + 34;
+    EXPECT_EQ(d.channels[0][onStroke], 0.5f) << name;
+    EXPECT_EQ(d.channels[1][onStroke], 0.25f) << name;
+    dumps.push_back(d);
+  }
+  EXPECT_NE(dumps[0].channels[1], dumps[1].channels[1]) << "theta0 = \"strokes\" must reach the lobes";
+  fs::remove_all(dir);
+}
+
+// output.normal_map: the normal map read back (an independent PNG decode)
+// agrees with the normals of the height EXR written beside it, wrapped on the
+// periodic layer, at output.normal_strength.
+TEST(Cli, NormalMapsAgreeWithTheirHeightField) {
+  auto dir = tempDir("normals");
+  CommandResult r = runMorphoflow("run " + sceneFile("rd/gray_scott_pearson.toml") +
+                                  " --set grid.resolution=[48,48] --set domain.size=[0.46875,0.46875] --set time.steps=200" +
+                                  " --set output.every=200 --set output.normal_map=true --set output.normal_strength=6 --quiet --out " +
+                                  (dir / "out").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  morphoflow::FieldDump height, normals;
+  std::string err;
+  ASSERT_TRUE(morphoflow::readFieldDump((dir / "out" / "height" / "000001.exr").string(), &height, &err)) << err;
+  ASSERT_TRUE(morphoflow::readFieldDump((dir / "out" / "normals" / "000001.png").string(), &normals, &err)) << err;
+  ASSERT_EQ(height.resolution, (std::vector<int>{48, 48}));
+  ASSERT_EQ(normals.resolution, height.resolution);
+  ASSERT_GE(normals.channels.size(), 3u);
+  const std::vector<float>& hv = height.channels[0];
+  float lo = 1, hi = 0;
+  for (float v : hv) lo = std::min(lo, v), hi = std::max(hi, v);
+  EXPECT_EQ(lo, 0.0f);
+  EXPECT_EQ(hi, 1.0f);  // the frames' automatic range
+  auto at = [&](int x, int y) { return double(hv[size_t(((y + 48) % 48) * 48 + (x + 48) % 48)]); };
+  double worst = 0;
+  for (int y = 0; y < 48; ++y)
+    for (int x = 0; x < 48; ++x) {
+      const double nx = -6.0 * 0.5 * (at(x + 1, y) - at(x - 1, y)), ny = -6.0 * 0.5 * (at(x, y + 1) - at(x, y - 1));
+      const double len = std::sqrt(nx * nx + ny * ny + 1.0);
+      const size_t i = size_t(y * 48 + x);
+      worst = std::max({worst, std::abs(2.0 * normals.channels[0][i] - 1.0 - nx / len),
+                        std::abs(2.0 * normals.channels[1][i] - 1.0 - ny / len),
+                        std::abs(2.0 * normals.channels[2][i] - 1.0 - 1.0 / len)});
+    }
+  EXPECT_LT(worst, 1.01 / 255.0);  // 8-bit rounding
   fs::remove_all(dir);
 }
 

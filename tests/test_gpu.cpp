@@ -346,14 +346,15 @@ TEST(Gpu, BenchSuitesTimeTheFluidTheLayerAndTheCoupling) {
 // Shipped scenes with parameter maps (an image, a Pearson F x k map), a fixed
 // region, the four-species coupled Brusselator, fixed diffusion tensors (a
 // saddle, circles, a four-species layer) and Kim & Lin's cosine lobes (three
-// lobes, Witkin-Kass), at 64^2 for 40 steps with
+// lobes, Witkin-Kass, a painted spiral steering one lobe), at 64^2 for 40 steps with
 // the solves at 1e-12: every species within 1e-6 of its largest value
 // (measured: float rounding of the dumps, or exactly equal).
 TEST(Gpu, ShippedMapFixedAndMultiSpeciesScenesMatchTheCpu) {
   if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
   std::vector<std::string> scenes;
   for (const char* s : {"lawlor_image_growth", "pearson_map", "sanderson_fig20", "sanderson_fig10", "sanderson_fig21",
-                        "sanderson_fig06", "sanderson_fig07", "sanderson_fig18", "kim_lin_lobes3", "kim_lin_witkin_kass"})
+                        "sanderson_fig06", "sanderson_fig07", "sanderson_fig18", "kim_lin_lobes3", "kim_lin_witkin_kass",
+                        "kim_lin_paint_deposit", "kim_lin_paint_lobe"})
     scenes.push_back(sceneFile(std::string("rd/seeds/") + s + ".toml") + " --set grid.resolution=[64,64] --set rd.tolerance=1e-12 --set time.steps=40 --set output.every=20");
   expectScenesAgree("gpu_map_scenes", scenes, "000002.exr", {1e-6, 0.0, false});
 }

@@ -1,0 +1,101 @@
+// [velocity]: a given velocity field carrying the [rd] layer in place of a
+// fluid (seed 004 sec. 3, fig. 24): analytic expressions, or a VDB sequence
+// whose frames are found and whose first frame is read and checked here.
+#include <array>
+
+#include "coupling/given_velocity.h"
+#include "scenes/scene_reader.h"
+
+namespace morphoflow {
+
+namespace {
+
+// The first frame read and resampled, so that a missing grid or another
+// domain stops `validate` rather than the run.
+template <int D>
+void checkFirstFrame(const std::vector<VelocityFrame>& frames, const Scene& s) {
+  std::array<double, D> domain{};
+  IVec<D> cells;
+  std::array<bool, D> periodic{};
+  for (int a = 0; a < D; ++a) {
+    domain[size_t(a)] = s.rd.settings.size[size_t(a)];
+    cells[a] = s.rd.settings.resolution[size_t(a)];
+  }
+  VdbVelocitySequence<D> seq({frames.front()}, domain);
+  MacVelocity<D> u(cells, domain[0] / cells[0], periodic);
+  seq.sample(frames.front().time, &u);
+}
+
+}  // namespace
+
+void parseVelocity(SceneContext& c, Scene* sp) {
+  Reader& r = c.r;
+  Scene& s = *sp;
+  const toml::table* vt = r.table(c.root, "", "velocity");
+  if (!vt) return;
+  const std::string p = "velocity.";
+  if (!s.rd.enabled)
+    r.fail(vt, "velocity", "[velocity] carries a reaction-diffusion layer, and this scene has no [rd]",
+           "add [rd] model = \"...\"");
+  if (c.root.contains("fluid"))
+    r.fail(vt, "velocity", "[velocity] gives the flow in place of a fluid, and this scene has a [fluid]",
+           "drop one of [velocity] and [fluid]");
+  VelocityScene& V = s.velocity;
+  V.enabled = true;
+  const toml::node* fn = r.node(vt, p, "field");
+  const toml::node* vn = r.node(vt, p, "vdb");
+  if (fn && vn) r.fail(vn, p + "vdb", "give either field (expressions) or vdb (a volume sequence), not both");
+  if (!fn && !vn)
+    r.fail(vt, p + "field", "[velocity] needs field = [\"u(x, y, t)\", \"v(x, y, t)\"] or vdb = \"path/name.####.vdb\"");
+  const std::string axes = c.D == 2 ? "two" : "three";
+  if (fn) {
+    V.where = r.where(fn, p + "field");
+    V.key = p + "field";
+    const toml::array* arr = fn->as_array();
+    if (!arr || arr->size() != size_t(c.D))
+      r.fail(fn, p + "field",
+             "expected " + axes + " expressions, one per axis, in x, y" + (c.D == 3 ? ", z" : "") + " (domain units) and t" +
+                 (arr ? ", found " + std::to_string(arr->size()) : ""),
+             c.D == 2 ? "e.g. field = [\"-(y - 0.5)\", \"x - 0.5\"] (a rigid rotation about the centre of a unit domain)" : "");
+    for (size_t q = 0; q < arr->size(); ++q) {
+      const toml::node* e = arr->get(q);
+      const std::string key = p + "field." + std::to_string(q);
+      if (!e->is_string() && !e->is_number()) r.fail(e, key, "expected an expression string, found " + describe(*e));
+      const std::string text = e->is_string() ? e->value<std::string>().value() : std::to_string(e->value<double>().value());
+      try {
+        Expression(text, ExpressionVelocity<3>::variables());
+      } catch (const ExpressionError& err) {
+        SourceLocation at = r.where(e, key);
+        if (at.line > 0 && e->is_string()) at.column += 1 + int(err.column());
+        throw UserError(at, key, std::string("in the velocity expression: ") + err.what(),
+                        "the variables are x, y, z (domain units) and t");
+      }
+      V.field.push_back(text);
+    }
+  }
+  V.frameTime = r.number(vt, p, "frame_time", 0.0, 0.0, 1e12);
+  if (vn) {
+    V.where = r.where(vn, p + "vdb");
+    V.key = p + "vdb";
+    const std::string file = r.string(vt, p, "vdb", "");
+    std::filesystem::path fp(file);
+    if (fp.is_relative()) fp = c.sceneDir / fp;
+    V.vdb = fp.string();
+    try {
+      const std::vector<VelocityFrame> frames = findVelocityFrames(V.vdb, V.frameTime);
+      if (c.D == 2) checkFirstFrame<2>(frames, s);
+      else checkFirstFrame<3>(frames, s);
+    } catch (const VelocityFileError& e) {
+      r.fail(vn, p + "vdb", e.path() + ": " + e.what(),
+             "give a sequence of .vdb files with a Vec3 grid 'vel' over the scene's domain, e.g. written by "
+             "`morphoflow run` with output.vdb = true");
+    }
+  }
+  const toml::node* rn = nullptr;
+  const std::vector<double> range = r.numbers(vt, p, "speed_range", {0.0, 1.0}, 2, 2, -1e12, 1e12, false, &rn);
+  V.speedRange[0] = range[0];
+  V.speedRange[1] = range[1];
+  V.referenceSpeed = r.number(vt, p, "reference_speed", 0.0, 0.0, 1e12);
+}
+
+}  // namespace morphoflow
