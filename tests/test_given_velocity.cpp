@@ -8,6 +8,8 @@
 #include <cmath>
 #include <fstream>
 
+#include <nlohmann/json.hpp>
+
 #include "render/field_dump.h"
 #include "test_support.h"
 
@@ -169,5 +171,36 @@ TEST(GivenVelocity, VolumesThatCannotServeAreRefusedWithTheirPath) {
   r = runMorphoflow("validate " + none.string());
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("cannot list the folder"), std::string::npos) << r.output;
+  fs::remove_all(dir);
+}
+
+// The shipped flow scenes run (briefly): the dipole's speed map and
+// velocity-aligned tensor, and the shipped VDB sequence blended in time; the
+// gpu backend refuses a given velocity at once.
+TEST(GivenVelocity, ShippedFlowScenesRunAndTheGpuBackendRefusesThem) {
+  const fs::path dir = tempDir("flow_scenes");
+  for (const char* name : {"sanderson_fig24_dipole", "cavity_vdb_gray_scott"}) {
+    const std::string file = sceneFile(std::string("flow/") + name + ".toml");
+    CommandResult r = runMorphoflow("run " + file + " --set grid.resolution=[64,64] --set time.steps=50 --set output.every=50" +
+                                    " --set output.fields=true --quiet --out " + (dir / name).string());
+    ASSERT_EQ(r.status, 0) << name << ": " << r.output;
+    const morphoflow::FieldDump d = dump(dir / name / "fields" / "000001.exr");
+    for (const std::vector<float>& c : d.channels)
+      for (float v : c) ASSERT_TRUE(std::isfinite(v)) << name;
+    nlohmann::json j = nlohmann::json::parse(std::ifstream(dir / name / "run.json"));
+    EXPECT_TRUE(j["resolved"].contains("velocity")) << name;
+    r = runMorphoflow("run " + file + " --backend gpu --quiet --out " + (dir / "gpu").string());
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("given [velocity]"), std::string::npos) << r.output;
+  }
+  // The speed map reaches the solver: a uniform s (an empty speed range) grows another pattern.
+  CommandResult r = runMorphoflow("run " + sceneFile("flow/sanderson_fig24_dipole.toml") +
+                                  " --set grid.resolution=[64,64] --set time.steps=50 --set output.every=50 --set output.fields=true"
+                                  " --set velocity.speed_range=[0.0078125,0.0078125] --quiet --out " + (dir / "uniform").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(dump(dir / "uniform" / "fields" / "000001.exr").channels,
+            dump(dir / "sanderson_fig24_dipole" / "fields" / "000001.exr").channels);
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(dir / "uniform" / "run.json"));
+  EXPECT_EQ(j["velocity_reference_speed"].get<double>(), 1.0);
   fs::remove_all(dir);
 }
