@@ -28,6 +28,7 @@ std::string missingStage(const Scene& s) {
            " species (the coupled gpu step carries two)";
   if (rd.settings.lookupTable) return "the reaction lookup table (rd.lookup_table)";
   if (s.velocity.enabled) return "the layer carried by a given [velocity]";
+  if (rd.generalized.enabled) return "generalized (non-Gaussian) diffusion ([rd.generalized])";
   return "";
 }
 

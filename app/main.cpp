@@ -148,6 +148,15 @@ int main(int argc, char** argv) {
   analyzeCmd->add_option("--slice", analyze.slice, "z slice of a 3D dump (default: the middle)")->check(CLI::Range(0, 1 << 20));
   analyzeCmd->add_option("--csv", analyze.csv, "also write the variogram per lag and direction");
 
+  PlotOptions plot;
+  CLI::App* plotCmd = app.add_subcommand("plot", "plots: `plot propagator SCENE --out FILE.png` (seed 000 fig. 1)");
+  plotCmd->add_option("what", plot.what, "propagator")->required();
+  plotCmd->add_option("scene", plot.scene, "a scene with [rd.generalized]")->required();
+  plotCmd->add_option("--out", plot.out, "the image (.png)")->required();
+  plotCmd->add_option("--set", plot.overrides, "key.path=value overrides, as for run");
+  plotCmd->add_option("--tau", plot.tau, "the propagator's time")->capture_default_str();
+  plotCmd->add_option("--radius", plot.radius, "|r| of the circle plotted")->capture_default_str();
+  plotCmd->add_option("--size", plot.size, "pixels")->capture_default_str()->check(CLI::Range(64, 8192));
   TextonOptions texton;
   CLI::App* textonCmd = app.add_subcommand("texton", "random-walk texton texture (seed 003 eq. 6)");
   textonCmd->add_option("--out", texton.out, "output image (.png or .exr)")->required();
@@ -231,6 +240,7 @@ int main(int argc, char** argv) {
       return 0;
     }
     if (*analyzeCmd) return analyzeCommand(analyze);
+    if (*plotCmd) return plotCommand(plot);
     if (*textonCmd) {
       texton.walk.height = texton.walk.width;
       return textonCommand(texton);

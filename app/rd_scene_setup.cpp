@@ -117,6 +117,15 @@ void applyScene(const Scene& scene, RDSolver<D>* rd) {
     spec.species = lb.species;
     rd->setCosineLobes(std::move(spec));
   }
+  // McGraw's generalized diffusion (seed 000), one 5 x 5 operator on this grid.
+  if (const RDGeneralized& g = scene.rd.generalized; g.enabled) {
+    if constexpr (D == 2)
+      rd->setGeneralizedDiffusion(
+          std::make_shared<const GeneralizedDiffusion>(g.tensors, n[0], n[1], rd->h(),
+                                                       g.savitzkyGolaySecond ? SecondDerivatives::SavitzkyGolay
+                                                                             : SecondDerivatives::CentralDifferences),
+          g.species);
+  }
   // Fixed regions and the chemical strokes deposit: held at their values from the start (seed 004 fig. 20, seed 001 fig. 3).
   const size_t ns = size_t(rd->species());
   std::vector<std::vector<uint8_t>> mask(ns);

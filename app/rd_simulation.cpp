@@ -69,6 +69,29 @@ void RDSimulation<D>::load(const StateReader& in) {
 
 template <int D>
 nlohmann::json RDSimulation<D>::resolved() const {
+  nlohmann::json j = resolvedLayer();
+  // Seed 000 sec. 5: the step's spectral radius on this grid, per species, and the largest step within the bound.
+  if (const GeneralizedDiffusion* g = rd_.generalizedDiffusion()) {
+    const RDIntegrator integ = rd_.settings().integrator;
+    const double theta = integ == RDIntegrator::ExplicitEuler ? 0.0 : integ == RDIntegrator::CrankNicolson ? 0.5 : 1.0;
+    nlohmann::json radius = nlohmann::json::object(), largest = nlohmann::json::object();
+    for (int s = 0; s < rd_.species(); ++s) {
+      if (!rd_.generalized(s)) continue;
+      const double d = rd_.diffusion()[size_t(s)], dt = scene_.time.dt;
+      const std::string& name = rd_.model().info().species[size_t(s)];
+      radius[name] = g->spectralRadius(dt * d, theta);
+      largest[name] = g->largestStableStep(d, theta, 1e6 * dt, scene_.rd.generalized.maxSpectralRadius);
+    }
+    j["generalized_diffusion"] = {{"spectral_radius", radius},
+                                  {"max_spectral_radius", scene_.rd.generalized.maxSpectralRadius},
+                                  {"largest_stable_dt", largest},
+                                  {"kernel", g->kernel()}};
+  }
+  return j;
+}
+
+template <int D>
+nlohmann::json RDSimulation<D>::resolvedLayer() const {
   return {{"dimension", D},
           {"model", rd_.model().info().name},
           {"species", species()},

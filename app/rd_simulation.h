@@ -50,6 +50,8 @@ class RDSimulation : public Simulation<D> {
   void report(nlohmann::json* run) const override;
 
  private:
+  nlohmann::json resolvedLayer() const;
+
   const Scene& scene_;
   RDSolver<D> rd_;
   nlohmann::json coarseReport_ = nlohmann::json::array();

@@ -13,6 +13,9 @@
 #include "render/field_dump.h"
 #include "render/field_image.h"
 #include "render/image_io.h"
+#include "render/polar_plot.h"
+#include "rd/generalized_diffusion.h"
+#include "scenes/scene_loader.h"
 #include "rd/variogram.h"
 
 namespace morphoflow {
@@ -109,6 +112,29 @@ int textonCommand(TextonOptions o) {
   std::cout << fmt::format("{}: {} of {} textons after {} steps of {} cells\n", o.out, at.size(), s.elements, s.steps,
                            s.stepSize);
   if (o.analyze) printReg("variogram", variogram(img, s.width, s.height));
+  return 0;
+}
+
+int plotCommand(const PlotOptions& o) {
+  if (o.what != "propagator")
+    throw UserError({"plot", 0, 0}, "", "unknown plot '" + o.what + "'", "plots: propagator");
+  const Scene scene = loadScene(o.scene, o.overrides);
+  if (!scene.rd.generalized.enabled)
+    throw UserError({o.scene, 0, 0}, "rd.generalized",
+                    "the scene has no [rd.generalized] tensors, so its diffusion is Gaussian (a plain ellipse)",
+                    "add [rd.generalized] preset = \"d\" (Table 2's columns a to f) or tensors d2, d3, d4");
+  if (!(o.tau > 0) || !(o.radius > 0)) throw UserError({"--tau", 0, 0}, "", "--tau and --radius must be > 0");
+  std::vector<double> p(1440);
+  for (size_t k = 0; k < p.size(); ++k) {
+    const double a = 2 * M_PI * double(k) / double(p.size());
+    p[k] = gramCharlierPropagator(scene.rd.generalized.tensors, o.tau, o.radius * std::cos(a), o.radius * std::sin(a));
+  }
+  std::string err;
+  if (!writeRgb8(o.out, o.size, o.size, polarPlotRgb(p, o.size), &err))
+    throw UserError({o.out, 0, 0}, "--out", "cannot write the plot: " + err);
+  const auto peak = std::max_element(p.begin(), p.end());
+  std::cout << fmt::format("{}: the propagator at |r| = {:g}, tau = {:g}; its largest value {:.4g} at {:.1f} degrees\n", o.out,
+                           o.radius, o.tau, *peak, 360.0 * double(peak - p.begin()) / double(p.size()));
   return 0;
 }
 

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "rd/texton_walk.h"
 
@@ -25,5 +26,18 @@ struct TextonOptions {
   bool analyze = false;         // also print REG of the result
 };
 int textonCommand(TextonOptions options);
+
+// `morphoflow plot propagator SCENE --out FILE.png`: the Gram-Charlier
+// propagator (seed 000 eq. 23-24) of the scene's [rd.generalized] tensors as a
+// polar plot of p(r) on |r| = radius at time tau (seed 000 fig. 1: 1 and 0.1).
+struct PlotOptions {
+  std::string what;     // "propagator"
+  std::string scene;
+  std::vector<std::string> overrides;
+  std::string out;
+  double tau = 0.1, radius = 1.0;
+  int size = 512;
+};
+int plotCommand(const PlotOptions& options);
 
 }  // namespace morphoflow

@@ -119,6 +119,15 @@ void RDSolver<D>::setDiffusionTensor(DiffusionTensorSpec<D> spec) {
 }
 
 template <int D>
+void RDSolver<D>::setGeneralizedDiffusion(std::shared_ptr<const GeneralizedDiffusion> op, std::vector<int> species) {
+  if (D != 2 || settings_.boundary != RDBoundary::Periodic)
+    throw std::invalid_argument("generalized diffusion is for periodic 2D layers");
+  general_ = std::move(op);
+  generalSpecies_.assign(size_t(this->species()), species.empty() ? 1 : 0);
+  for (int s : species) generalSpecies_[size_t(s)] = 1;
+}
+
+template <int D>
 void RDSolver<D>::setCosineLobes(CosineLobeSpec spec) {
   if (tensorSpec_) throw std::invalid_argument("rd: a diffusion tensor and cosine lobes cannot be combined");
   validateCosineLobes(spec);
@@ -182,13 +191,21 @@ double RDSolver<D>::explicitDiffusionLimit() const {
   const double tensorBound = tensorSpec_ ? tensor_.maxRowAbsSum() : 0.0;
   // a(theta) <= max a_n, so lobes are bounded by the Laplacian's bound times that.
   const double lobeBound = lobeSpec_ ? lapBound * maxLobeDiffusivity(*lobeSpec_) : 0.0;
+  double generalBound = 0.0;  // Gershgorin for the 5 x 5 kernel, in -h^2 A's units
+  if (general_)
+    for (const auto& row : general_->kernel())
+      for (double k : row) generalBound += std::abs(k) * h_ * h_;
   for (int s = 0; s < species(); ++s)
-    worst = std::max(worst, d_[size_t(s)] * (lobed(s) ? lobeBound : anisotropic(s) ? tensorBound : lapBound));
+    worst = std::max(worst, d_[size_t(s)] * (generalized(s) ? generalBound
+                                             : lobed(s)     ? lobeBound
+                                             : anisotropic(s) ? tensorBound
+                                                              : lapBound));
   return worst > 0 ? 2.0 * h_ * h_ / worst : INFINITY;
 }
 
 template <int D>
 void RDSolver<D>::applyLaplacian(int s, const Vector& x, Vector* out) const {
+  if (generalized(s)) return general_->apply(x, out);  // seed 000 eq. 37
   diffusionOperator(s).apply(x, out);
   Vector& o = *out;
   const double g = settings_.boundary == RDBoundary::Dirichlet ? settings_.dirichletValues[size_t(s)] : 0.0;
@@ -212,6 +229,7 @@ template <int D>
 SolverResult RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
   const double d = d_[size_t(s)];
   if (d == 0.0 || thetaDt == 0.0) return SolverResult{true, 0, 0.0};
+  if (generalized(s)) return general_->solve(thetaDt * d, rhs, settings_.tolerance);  // eq. 28
   Diffusion& df = *diffusion_[size_t(s)];
   const double scale = thetaDt * d / (h_ * h_);
   const long version = anisotropic(s) || lobed(s) ? operatorVersion_ : 0;

@@ -16,6 +16,7 @@
 #include "core/state_archive.h"
 #include "rd/cosine_lobe.h"
 #include "rd/diffusion_tensor.h"
+#include "rd/generalized_diffusion.h"
 #include "rd/rd_settings.h"
 #include "rd/reaction_lut.h"
 #include "rd/reaction_model.h"
@@ -65,6 +66,12 @@ class RDSolver {
   void setCosineLobes(CosineLobeSpec spec);
   const CosineLobeSpec* cosineLobes() const { return lobeSpec_.get(); }
   bool lobed(int s) const { return !lobeSpecies_.empty() && lobeSpecies_[size_t(s)]; }
+  // McGraw's generalized (non-Gaussian) diffusion (seed 000 eq. 19-37): the
+  // species (empty: all) diffuse by d A, A the 5 x 5 Kramers-Moyal operator,
+  // in place of the Laplacian. 2D and periodic only (throws otherwise).
+  void setGeneralizedDiffusion(std::shared_ptr<const GeneralizedDiffusion> op, std::vector<int> species);
+  const GeneralizedDiffusion* generalizedDiffusion() const { return general_.get(); }
+  bool generalized(int s) const { return !generalSpecies_.empty() && generalSpecies_[size_t(s)]; }
   // The operator -h^2 div(sigma grad) (or -h^2 lap) that species s diffuses by.
   const AnisotropicSystem<D>& diffusionOperator(int s) const {
     return lobed(s) ? lobeSystem_[size_t(s)] : anisotropic(s) ? tensor_ : laplacian_;
@@ -123,6 +130,8 @@ class RDSolver {
   std::vector<uint8_t> lobeSpecies_;
   std::vector<AnisotropicSystem<D>> lobeSystem_;  // per species (used where lobed)
   std::vector<Vector> lobeBoundary_;
+  std::shared_ptr<const GeneralizedDiffusion> general_;
+  std::vector<uint8_t> generalSpecies_;
   long operatorVersion_ = 0;          // bumped whenever a tensor or lobe operator is rebuilt
   std::vector<std::unique_ptr<Diffusion>> diffusion_;
   std::vector<Vector> scratch_, rates_;

@@ -253,6 +253,7 @@ void parseRD(SceneContext& c, Scene* sp) {
       }
       if (const toml::node* sp = r.node(cl, p, "species")) L.species = speciesList(sp, p + "species", false);
     }
+    parseGeneralized(c, *rdt, &s);
     // [rd.coarse_to_fine]: grow the pattern on coarser grids first.
     if (const toml::table* cf = r.table(*rdt, "rd.", "coarse_to_fine")) {
       if (!rdOnly || c.givenVelocity)

@@ -11,6 +11,7 @@
 #include "core/spatial_field.h"
 #include "fluid/fluid_settings.h"
 #include "rd/brush_strokes.h"
+#include "rd/generalized_diffusion.h"
 #include "rd/rd_settings.h"
 
 namespace morphoflow {
@@ -115,6 +116,19 @@ struct RDCosineLobes {
   std::vector<int> species;           // the lobed species (empty: all)
 };
 
+// McGraw's generalized (non-Gaussian) diffusion, [rd.generalized] (seed 000):
+// the Kramers-Moyal tensors of rank 2 to 4 (a Table 2 preset, components, a rotation).
+struct RDGeneralized {
+  bool enabled = false;
+  KramersMoyalTensors tensors;        // after the rotation
+  std::string preset;                 // Table 2's column, or "" (components given)
+  double rotation = 0.0;              // radians
+  bool savitzkyGolaySecond = false;   // second derivatives by Savitzky-Golay too (else central differences)
+  std::vector<int> species;           // empty: all
+  double maxSpectralRadius = 1.05;    // a step whose spectral radius exceeds this is refused
+  SourceLocation where;
+};
+
 // A brush stroke, [[rd.strokes]] (seed 001 sec. 6): its direction may steer
 // the anisotropy, and it may deposit chemical (the cells under it held fixed).
 struct RDStroke {
@@ -137,6 +151,7 @@ struct RDScene {
   std::vector<RDStroke> strokes;
   RDAnisotropy anisotropy;
   RDCosineLobes lobes;
+  RDGeneralized generalized;
   int coarseLevels = 0;              // coarse-to-fine: grids 2^L, ..., 2 times coarser first (seed 002, 000)
   long coarseSteps = 0;              // steps on each coarse grid
   bool coarseScaleDt = false;        // a grid 2^l times coarser steps 4^l dt (explicit limits scale with h^2)

@@ -221,6 +221,7 @@ void parseObstacles(SceneContext& c, Scene* s);   // [[obstacles]]
 void parseFluid(SceneContext& c, Scene* s);       // [fluid], [dye], [probes]
 void parseRD(SceneContext& c, Scene* s);          // [rd] and its tables
 void parseStrokes(SceneContext& c, const toml::table& rd, RDScene* out);  // [[rd.strokes]] (called by parseRD)
+void parseGeneralized(SceneContext& c, const toml::table& rd, Scene* s);  // [rd.generalized] (called by parseRD)
 void parseVelocity(SceneContext& c, Scene* s);    // [velocity] (after [rd])
 void parseCoupling(SceneContext& c, Scene* s);    // [coupling]
 void parseOutput(SceneContext& c, Scene* s);      // [output]

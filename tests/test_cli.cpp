@@ -149,6 +149,17 @@ INSTANTIATE_TEST_SUITE_P(
         BadScene{"stroke_image_missing", "[rd]\nmodel = \"gray-scott\"\n[[rd.strokes]]\nimage = \"dark.png\"\n", "4:9", "cannot read"},
         BadScene{"normal_map_3d", "[grid]\nresolution = [8, 8, 8]\n[output]\nnormal_map = true\n", "4:14", "this scene is 3D"},
         BadScene{"normal_strength_zero", "[output]\nnormal_map = true\nnormal_strength = 0\n", "3:19", "output.normal_strength"},
+        BadScene{"generalized_unknown_preset", "[rd]\nmodel = \"gray-scott\"\n[rd.generalized]\npreset = \"g\"\n", "4:10",
+                 "is not one of"},
+        BadScene{"generalized_wrong_rank", "[rd]\nmodel = \"gray-scott\"\n[rd.generalized]\nd3 = [1, 0, 0, 1, 0]\n", "4:6",
+                 "rank-3 tensor: 4 unique components"},
+        BadScene{"generalized_3d", "[grid]\nresolution = [8, 8, 8]\n[rd]\nmodel = \"gray-scott\"\n[rd.generalized]\npreset = \"d\"\n",
+                 "5:1", "this scene is 3D"},
+        BadScene{"generalized_walls", "[rd]\nmodel = \"gray-scott\"\nboundary = \"neumann\"\n[rd.generalized]\npreset = \"d\"\n", "4:1",
+                 "needs a periodic layer"},
+        BadScene{"generalized_unstable",
+                 "[time]\ndt = 1.0\n[rd]\nmodel = \"gray-scott\"\nintegrator = \"explicit\"\ndiffusion = [0.2, 0.1]\n[rd.generalized]\npreset = \"d\"\n",
+                 "7:1", "the largest step within the bound"},
         BadScene{"velocity_wrong_length", "[rd]\nmodel = \"gray-scott\"\n[velocity]\nfield = [\"1\"]\n", "4:9",
                  "expected two expressions"},
         BadScene{"velocity_unknown_variable", "[rd]\nmodel = \"gray-scott\"\n[velocity]\nfield = [\"1\", \"q\"]\n", "4:16",
@@ -386,6 +397,39 @@ TEST(Cli, PaintedStrokesDepositAndSteerTheLobes) {
     dumps.push_back(d);
   }
   EXPECT_NE(dumps[0].channels[1], dumps[1].channels[1]) << "theta0 = \"strokes\" must reach the lobes";
+  fs::remove_all(dir);
+}
+
+// McGraw's generalized diffusion: run.json reports the step's spectral radius
+// and the largest step within the bound; `plot propagator` draws fig. 1's
+// polar plot (refusing a scene without tensors); the gpu backend refuses it.
+TEST(Cli, GeneralizedDiffusionReportsItsSpectralRadiusAndPlotsItsPropagator) {
+  auto dir = tempDir("generalized");
+  const std::string scene = sceneFile("rd/seeds/mcgraw_fig3_gray_scott_d.toml");
+  CommandResult r = runMorphoflow("run " + scene + " --set grid.resolution=[32,32] --set domain.size=[70.4,70.4]" +
+                                  " --set time.steps=20 --set output.every=20 --quiet --out " + (dir / "out").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(dir / "out" / "run.json"));
+  const nlohmann::json& g = j["resolved"]["generalized_diffusion"];
+  EXPECT_LE(g["spectral_radius"]["u"].get<double>(), 1.05);
+  EXPECT_GE(g["spectral_radius"]["u"].get<double>(), 1.0);
+  EXPECT_GE(g["largest_stable_dt"]["v"].get<double>(), 1.0);
+  r = runMorphoflow("plot propagator " + scene + " --out " + (dir / "d.png").string() + " --size 128");
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("at 0.0 degrees"), std::string::npos) << r.output;  // (d) peaks on the axes
+  morphoflow::FieldDump img;
+  std::string err;
+  ASSERT_TRUE(morphoflow::readFieldDump((dir / "d.png").string(), &img, &err)) << err;
+  EXPECT_EQ(img.resolution, (std::vector<int>{128, 128}));
+  size_t ink = 0;
+  for (float v : img.channels[0]) ink += v < 0.5f;
+  EXPECT_GT(ink, 100u);
+  r = runMorphoflow("plot propagator " + sceneFile("rd/gray_scott_pearson.toml") + " --out " + (dir / "x.png").string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("no [rd.generalized]"), std::string::npos) << r.output;
+  r = runMorphoflow("run " + scene + " --backend gpu --quiet --out " + (dir / "gpu").string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("generalized"), std::string::npos) << r.output;
   fs::remove_all(dir);
 }
 
