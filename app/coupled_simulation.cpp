@@ -45,10 +45,6 @@ ChemicalDomain<D> chemicalDomain(const Scene& scene, const FluidSolver<D>& fluid
   return d;
 }
 
-CouplingMode couplingMode(const std::string& mode) {
-  return mode == "passive" ? CouplingMode::Passive : mode == "rd-only" ? CouplingMode::RDOnly : CouplingMode::ARD;
-}
-
 }  // namespace
 
 template <int D>

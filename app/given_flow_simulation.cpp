@@ -19,10 +19,6 @@ std::unique_ptr<GivenVelocity<D>> velocitySource(const VelocityScene& v, const R
   return std::make_unique<VdbVelocitySequence<D>>(findVelocityFrames(v.vdb, v.frameTime), domain);
 }
 
-CouplingMode couplingMode(const std::string& mode) {
-  return mode == "passive" ? CouplingMode::Passive : mode == "rd-only" ? CouplingMode::RDOnly : CouplingMode::ARD;
-}
-
 }  // namespace
 
 template <int D>
@@ -172,15 +168,7 @@ void GivenFlowSimulation<D>::load(const StateReader& in) {
 template <int D>
 nlohmann::json GivenFlowSimulation<D>::resolved() const {
   const VelocityScene& v = scene_.velocity;
-  nlohmann::json j = {{"dimension", D},
-                      {"model", rd_.model().info().name},
-                      {"species", species()},
-                      {"resolution", scene_.rd.settings.resolution},
-                      {"size", scene_.rd.settings.size},
-                      {"cell_size", rd_.h()},
-                      {"diffusion", rd_.diffusion()},
-                      {"dt", scene_.time.dt},
-                      {"explicit_diffusion_limit", rd_.explicitDiffusionLimit()}};
+  nlohmann::json j = resolvedLayer<D>(scene_, rd_);
   if (!v.field.empty()) j["velocity"] = {{"field", v.field}};
   else j["velocity"] = {{"vdb", v.vdb}};
   return j;

@@ -69,38 +69,38 @@ void RDSimulation<D>::load(const StateReader& in) {
 
 template <int D>
 nlohmann::json RDSimulation<D>::resolved() const {
-  nlohmann::json j = resolvedLayer();
+  return resolvedLayer<D>(scene_, rd_);
+}
+
+template <int D>
+nlohmann::json resolvedLayer(const Scene& scene, const RDSolver<D>& rd) {
+  nlohmann::json j = {{"dimension", D},
+                      {"model", rd.model().info().name},
+                      {"species", rd.model().info().species},
+                      {"resolution", scene.rd.settings.resolution},
+                      {"size", scene.rd.settings.size},
+                      {"cell_size", rd.h()},
+                      {"diffusion", rd.diffusion()},
+                      {"dt", scene.time.dt},
+                      {"explicit_diffusion_limit", rd.explicitDiffusionLimit()}};
   // Seed 000 sec. 5: the step's spectral radius on this grid, per species, and the largest step within the bound.
-  if (const GeneralizedDiffusion* g = rd_.generalizedDiffusion()) {
-    const RDIntegrator integ = rd_.settings().integrator;
+  if (const GeneralizedDiffusion* g = rd.generalizedDiffusion()) {
+    const RDIntegrator integ = rd.settings().integrator;
     const double theta = integ == RDIntegrator::ExplicitEuler ? 0.0 : integ == RDIntegrator::CrankNicolson ? 0.5 : 1.0;
     nlohmann::json radius = nlohmann::json::object(), largest = nlohmann::json::object();
-    for (int s = 0; s < rd_.species(); ++s) {
-      if (!rd_.generalized(s)) continue;
-      const double d = rd_.diffusion()[size_t(s)], dt = scene_.time.dt;
-      const std::string& name = rd_.model().info().species[size_t(s)];
+    for (int s = 0; s < rd.species(); ++s) {
+      if (!rd.generalized(s)) continue;
+      const double d = rd.diffusion()[size_t(s)], dt = scene.time.dt;
+      const std::string& name = rd.model().info().species[size_t(s)];
       radius[name] = g->spectralRadius(dt * d, theta);
-      largest[name] = g->largestStableStep(d, theta, 1e6 * dt, scene_.rd.generalized.maxSpectralRadius);
+      largest[name] = g->largestStableStep(d, theta, 1e6 * dt, scene.rd.generalized.maxSpectralRadius);
     }
     j["generalized_diffusion"] = {{"spectral_radius", radius},
-                                  {"max_spectral_radius", scene_.rd.generalized.maxSpectralRadius},
+                                  {"max_spectral_radius", scene.rd.generalized.maxSpectralRadius},
                                   {"largest_stable_dt", largest},
                                   {"kernel", g->kernel()}};
   }
   return j;
-}
-
-template <int D>
-nlohmann::json RDSimulation<D>::resolvedLayer() const {
-  return {{"dimension", D},
-          {"model", rd_.model().info().name},
-          {"species", species()},
-          {"resolution", scene_.rd.settings.resolution},
-          {"size", scene_.rd.settings.size},
-          {"cell_size", rd_.h()},
-          {"diffusion", rd_.diffusion()},
-          {"dt", scene_.time.dt},
-          {"explicit_diffusion_limit", rd_.explicitDiffusionLimit()}};
 }
 
 template <int D>
@@ -122,6 +122,8 @@ void reportRDSolvers(const RDRunStats& stats, long rdSteps, nlohmann::json* j) {
 
 template std::vector<Grid<float, 2>> speciesField<2>(const RDSolver<2>&, const std::string&);
 template std::vector<Grid<float, 3>> speciesField<3>(const RDSolver<3>&, const std::string&);
+template nlohmann::json resolvedLayer<2>(const Scene&, const RDSolver<2>&);
+template nlohmann::json resolvedLayer<3>(const Scene&, const RDSolver<3>&);
 template class RDSimulation<2>;
 template class RDSimulation<3>;
 

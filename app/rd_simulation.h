@@ -26,6 +26,11 @@ struct RDRunStats {
 // run.json's "solvers": the Newton and diffusion statistics of `rdSteps` steps.
 void reportRDSolvers(const RDRunStats& stats, long rdSteps, nlohmann::json* run);
 
+// run.json's "resolved" values of a scene's RD layer (with the generalized
+// diffusion's spectral radius where it has one).
+template <int D>
+nlohmann::json resolvedLayer(const Scene& scene, const RDSolver<D>& rd);
+
 // The species of an RD layer as fields.
 template <int D>
 std::vector<Grid<float, D>> speciesField(const RDSolver<D>& rd, const std::string& name);
@@ -50,8 +55,6 @@ class RDSimulation : public Simulation<D> {
   void report(nlohmann::json* run) const override;
 
  private:
-  nlohmann::json resolvedLayer() const;
-
   const Scene& scene_;
   RDSolver<D> rd_;
   nlohmann::json coarseReport_ = nlohmann::json::array();

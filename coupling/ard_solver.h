@@ -7,6 +7,7 @@
 #pragma once
 
 #include <array>
+#include <string>
 
 #include "coupling/chemical_advection.h"
 #include "rd/rd_solver.h"
@@ -14,6 +15,11 @@
 namespace morphoflow {
 
 enum class CouplingMode { ARD, Passive, RDOnly };
+
+// The scene's coupling.mode: "ard", "passive" or "rd-only".
+inline CouplingMode couplingMode(const std::string& mode) {
+  return mode == "passive" ? CouplingMode::Passive : mode == "rd-only" ? CouplingMode::RDOnly : CouplingMode::ARD;
+}
 
 template <int D>
 class ARDSolver {
