@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "app/rd_scene_setup.h"
+#include "rd/fused_explicit.h"
 #include "rd/model_registry.h"
 
 namespace morphoflow {
@@ -37,39 +38,99 @@ std::vector<Grid<float, D>> speciesField(const RDSolver<D>& rd, const std::strin
   return {toFloat<D>(rd.field(int(it - names.begin())))};
 }
 
+bool fusedExplicitFits(const Scene& s) {
+  const RDScene& r = s.rd;
+  const bool deposits = std::any_of(r.strokes.begin(), r.strokes.end(), [](const RDStroke& k) { return !k.species.empty(); });
+  return r.settings.integrator == RDIntegrator::ExplicitEuler && r.settings.boundary != RDBoundary::Dirichlet &&
+         r.settings.frozen.empty() && r.parameterMaps.empty() && r.perturb.empty() && r.speedMaps.empty() &&
+         r.fixed.empty() && !deposits && !r.anisotropy.enabled && !r.lobes.enabled && !r.generalized.enabled;
+}
+
 template <int D>
 RDSimulation<D>::RDSimulation(const Scene& scene, const Log& log)
     : scene_(scene), rd_(scene.rd.settings, *findModel(scene.rd.settings.model)) {
   if (!growCoarseToFine<D>(scene, &rd_, log, &coarseReport_)) initialState<D>(scene, &rd_);
   applyScene<D>(scene, &rd_);
+  if (fusedExplicitFits(scene)) {
+    std::vector<double> p;
+    for (size_t k = 0; k < rd_.model().info().parameters.size(); ++k) p.push_back(rd_.parameter(int(k)));
+    fused_ = FusedExplicitRD<D>::create(rd_.model().info().name, rd_.cells(), rd_.h(),
+                                        rd_.settings().boundary == RDBoundary::Periodic, rd_.diffusion(), p);
+    if (fused_) toFused();
+  }
+}
+
+template <int D>
+void RDSimulation<D>::toFused() {
+  for (int s = 0; s < rd_.species(); ++s) {
+    const std::vector<double>& v = rd_.field(s).values();
+    std::vector<float>& f = fused_->field(s);
+    for (size_t i = 0; i < v.size(); ++i) f[i] = float(v[i]);
+  }
+  hostStale_ = false;
+}
+
+// The float state copied into the RDSolver's fields, for frames, checks and checkpoints.
+template <int D>
+void RDSimulation<D>::syncHost() const {
+  if (!fused_ || !hostStale_) return;
+  for (int s = 0; s < rd_.species(); ++s) {
+    const std::vector<float>& f = fused_->field(s);
+    std::vector<double>& v = rd_.field(s).values();
+    for (size_t i = 0; i < v.size(); ++i) v[i] = double(f[i]);
+  }
+  hostStale_ = false;
 }
 
 template <int D>
 void RDSimulation<D>::step(double dt) {
+  if (fused_) {
+    fused_->step(dt);
+    time_ += dt;
+    ++steps_;
+    hostStale_ = true;
+    return;
+  }
   rd_.step(dt);
   stats_.add(rd_.lastStats());
 }
 
 template <int D>
+std::vector<Grid<float, D>> RDSimulation<D>::field(const std::string& name) const {
+  syncHost();
+  return speciesField<D>(rd_, name);
+}
+
+template <int D>
 void RDSimulation<D>::checkFinite(const std::string& when) const {
+  syncHost();
   morphoflow::checkFinite<D>(rd_, when, rdStage(rd_.settings()));
 }
 
 template <int D>
 void RDSimulation<D>::save(StateWriter* out) const {
+  syncHost();
   rd_.save(out);
   stats_.save(out);
+  if (fused_) out->put("rd.fused.time", time_), out->put("rd.fused.steps", steps_);
 }
 
 template <int D>
 void RDSimulation<D>::load(const StateReader& in) {
   rd_.load(in);
   stats_.load(in);
+  if (fused_) {
+    in.get("rd.fused.time", &time_);
+    in.get("rd.fused.steps", &steps_);
+    toFused();
+  }
 }
 
 template <int D>
 nlohmann::json RDSimulation<D>::resolved() const {
-  return resolvedLayer<D>(scene_, rd_);
+  nlohmann::json j = resolvedLayer<D>(scene_, rd_);
+  j["explicit_step"] = fused_ ? "fused, float species (rd/fused_explicit.h)" : "RDSolver, double species";
+  return j;
 }
 
 template <int D>

@@ -4,14 +4,19 @@
 #pragma once
 
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "core/simulation.h"
+#include "rd/fused_explicit.h"
 #include "rd/rd_solver.h"
 #include "scenes/scene.h"
 
 namespace morphoflow {
+
+// Whether the scene's layer takes the fused explicit step (rd/fused_explicit.h).
+bool fusedExplicitFits(const Scene& scene);
 
 // Statistics of an RD layer's steps, for run.json.
 struct RDRunStats {
@@ -42,12 +47,12 @@ class RDSimulation : public Simulation<D> {
   RDSimulation(const Scene& scene, const Log& log);
 
   void step(double dt) override;
-  double time() const override { return rd_.time(); }
-  long steps() const override { return rd_.steps(); }
+  double time() const override { return fused_ ? time_ : rd_.time(); }
+  long steps() const override { return fused_ ? steps_ : rd_.steps(); }
   std::vector<std::string> fieldNames() const override { return species(); }
   std::vector<std::string> species() const override { return rd_.model().info().species; }
   std::vector<std::string> dumpFieldNames() const override { return species(); }
-  std::vector<Grid<float, D>> field(const std::string& name) const override { return speciesField<D>(rd_, name); }
+  std::vector<Grid<float, D>> field(const std::string& name) const override;
   void checkFinite(const std::string& when) const override;
   void save(StateWriter* out) const override;
   void load(const StateReader& in) override;
@@ -55,8 +60,18 @@ class RDSimulation : public Simulation<D> {
   void report(nlohmann::json* run) const override;
 
  private:
+  void toFused();
+  void syncHost() const;
+
   const Scene& scene_;
-  RDSolver<D> rd_;
+  mutable RDSolver<D> rd_;
+  // The explicit step of a plain layer (uniform parameters, no tensor, lobes
+  // or held cells): float species, one fused pass (rd/fused_explicit.h); the
+  // RDSolver then only builds the start and holds a copy for outputs.
+  std::unique_ptr<FusedExplicitRD<D>> fused_;
+  double time_ = 0.0;
+  long steps_ = 0;
+  mutable bool hostStale_ = false;
   nlohmann::json coarseReport_ = nlohmann::json::array();
   RDRunStats stats_;
 };

@@ -1,6 +1,7 @@
 // Suite `rd`: cell updates per second of a reaction-diffusion step, Gray-Scott
 // (Pearson, F = 0.04, k = 0.06, unit cells) by explicit Euler at 0.9 of its
-// diffusion limit and by Kim & Lin's implicit split (Newton reaction, MGPCG
+// diffusion limit (RDSolver's doubles, and the fused float step of
+// rd/fused_explicit.h) and by Kim & Lin's implicit split (Newton reaction, MGPCG
 // diffusion to 1e-8) at 10 times that step; 2D 256^2..2048^2 and 3D 128^3,
 // 1 and 2 threads.
 #include <algorithm>
@@ -16,6 +17,7 @@
 #include "bench/bench_suites.h"
 #include "bench/bench_timing.h"
 #include "core/parallel.h"
+#include "rd/fused_explicit.h"
 #include "rd/model_registry.h"
 #include "rd/rd_solver.h"
 
@@ -51,6 +53,35 @@ nlohmann::json benchRD(int n, bool implicit, int threads, double minSeconds) {
           {"diffusion_iterations_mean", diffIt / double(times.size())}};
 }
 
+// The fused float step (rd/fused_explicit.h) on the same start and dt.
+template <int D>
+nlohmann::json benchFused(int n, int threads, double minSeconds) {
+  ThreadLimit limit(threads);
+  const RDSettings st = benchGrayScott<D>(n, 1.0, RDIntegrator::ExplicitEuler);
+  RDSolver<D> rd(st, *findModel("gray-scott"));
+  pearsonStart(&rd);
+  const double dt = 0.9 * rd.explicitDiffusionLimit();
+  auto e = FusedExplicitRD<D>::create("gray-scott", rd.cells(), 1.0, true, st.diffusion, {});
+  for (int s = 0; s < 2; ++s)
+    for (size_t i = 0; i < rd.field(s).size(); ++i) e->field(s)[i] = float(rd.field(s)[i]);
+  e->step(dt);
+  const std::vector<double> times = timeSteps(minSeconds, [&] { e->step(dt); }, [] {});
+  const double med = median(times);
+  double cells = 1;
+  for (int a = 0; a < D; ++a) cells *= n;
+  return {{"dim", D},
+          {"n", n},
+          {"integrator", "fused"},
+          {"threads", threads},
+          {"dt", dt},
+          {"steps", times.size()},
+          {"ms_per_step_median", 1e3 * med},
+          {"cell_updates_per_second", cells / med},
+          {"bytes_per_cell_update", 16},
+          {"newton_iterations_max", 0},
+          {"diffusion_iterations_mean", 0}};
+}
+
 }  // namespace
 
 bool runRDBench(const BenchOptions& o) {
@@ -59,10 +90,13 @@ bool runRDBench(const BenchOptions& o) {
   std::cout << fmt::format("{:>4} {:>6} {:>10} {:>7} {:>12} {:>14} {:>9} {:>9}\n", "dim", "n", "integrator", "threads",
                            "ms/step(med)", "Mcell-updates/s", "newton", "pcg-its");
   for (BenchCase c : cases)
-    for (bool implicit : {false, true})
+    for (int kind : {0, 1, 2})  // explicit (double), fused explicit (float), Kim & Lin
       for (int threads : {1, 2}) {
-        nlohmann::json j = c.dim == 2 ? benchRD<2>(c.n, implicit, threads, o.minSeconds)
-                                      : benchRD<3>(c.n, implicit, threads, o.minSeconds);
+        const bool implicit = kind == 2;
+        nlohmann::json j = kind == 1 ? (c.dim == 2 ? benchFused<2>(c.n, threads, o.minSeconds)
+                                                   : benchFused<3>(c.n, threads, o.minSeconds))
+                           : c.dim == 2 ? benchRD<2>(c.n, implicit, threads, o.minSeconds)
+                                        : benchRD<3>(c.n, implicit, threads, o.minSeconds);
         std::cout << fmt::format("{:>4} {:>6} {:>10} {:>7} {:>12.2f} {:>14.2f} {:>9.0f} {:>9.1f}\n", c.dim, c.n,
                                  j["integrator"].get<std::string>(), threads, j["ms_per_step_median"].get<double>(),
                                  1e-6 * j["cell_updates_per_second"].get<double>(),

@@ -128,6 +128,10 @@ INSTANTIATE_TEST_SUITE_P(
         ResumeCase{"rd_only_3d", "rd/turing_lawlor.toml",
                    with({"grid.resolution=[24,24,24]", "domain.size=[24,24,24]", "time.steps=1500", "output.every=50"},
                         kCheckpointOften)},
+        ResumeCase{"rd_fused_explicit", "rd/turing_lawlor.toml",
+                   with({"grid.resolution=[128,128]", "domain.size=[128,128]", "rd.integrator=\"explicit\"", "time.dt=0.5",
+                         "time.steps=100000", "output.every=5000"},
+                        kCheckpointOften)},
         ResumeCase{"fluid_probes", "flow_past_obstacle.toml",
                    with({"grid.resolution=[220,41]", "time.duration=4", "output.every=40"}, kCheckpointOften)}),
     [](const ::testing::TestParamInfo<ResumeCase>& i) { return i.param.name; });

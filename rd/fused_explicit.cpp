@@ -1,0 +1,281 @@
+#include "rd/fused_explicit.h"
+
+#include <cstring>
+#include <type_traits>
+
+#include "core/parallel.h"
+#include "core/simd_dispatch.h"
+#include "rd/models.h"
+#include "rd/newton_batch.h"
+
+#pragma GCC diagnostic ignored "-Wpsabi"  // 32-byte lanes passed between always-inline helpers only
+
+namespace morphoflow {
+
+namespace {
+
+#define MF_INLINE __attribute__((always_inline)) inline
+
+typedef float vf4x __attribute__((vector_size(16)));
+typedef float vf8x __attribute__((vector_size(32)));
+// The same with float alignment, for unaligned loads and stores that stay
+// typed as float (a memcpy would let the compiler assume a store may change
+// the loop's constants, and reload them every iteration).
+typedef float vf4u __attribute__((vector_size(16), aligned(4)));
+typedef float vf8u __attribute__((vector_size(32), aligned(4)));
+
+// Float lanes for the models whose rates are plain arithmetic: every double
+// (a parameter, a constant) is rounded to float first and every operation is
+// a float one, so one lane and eight give the same bits.
+template <class V>
+struct FL {
+  V v;
+  FL() : v{} {}
+  FL(V x) : v(x) {}
+  FL(double d) : v(V{} + float(d)) {}
+};
+template <class V> MF_INLINE FL<V> operator+(FL<V> a, FL<V> b) { return FL<V>(a.v + b.v); }
+template <class V> MF_INLINE FL<V> operator-(FL<V> a, FL<V> b) { return FL<V>(a.v - b.v); }
+template <class V> MF_INLINE FL<V> operator*(FL<V> a, FL<V> b) { return FL<V>(a.v * b.v); }
+template <class V> MF_INLINE FL<V> operator/(FL<V> a, FL<V> b) { return FL<V>(a.v / b.v); }
+template <class V> MF_INLINE FL<V> operator-(FL<V> a) { return FL<V>(-a.v); }
+template <class V> MF_INLINE FL<V> operator+(FL<V> a, double b) { return a + FL<V>(b); }
+template <class V> MF_INLINE FL<V> operator-(FL<V> a, double b) { return a - FL<V>(b); }
+template <class V> MF_INLINE FL<V> operator*(FL<V> a, double b) { return a * FL<V>(b); }
+template <class V> MF_INLINE FL<V> operator/(FL<V> a, double b) { return a / FL<V>(b); }
+template <class V> MF_INLINE FL<V> operator+(double a, FL<V> b) { return FL<V>(a) + b; }
+template <class V> MF_INLINE FL<V> operator-(double a, FL<V> b) { return FL<V>(a) - b; }
+template <class V> MF_INLINE FL<V> operator*(double a, FL<V> b) { return FL<V>(a) * b; }
+template <class V> MF_INLINE FL<V> operator/(double a, FL<V> b) { return FL<V>(a) / b; }
+
+// The models whose rates take float lanes (no comparisons in them).
+template <class M>
+constexpr bool kFloatLanes =
+    std::is_same_v<M, models::Turing> || std::is_same_v<M, models::TuringSanderson> ||
+    std::is_same_v<M, models::GrayScott> || std::is_same_v<M, models::GrayScottSanderson> ||
+    std::is_same_v<M, models::FitzHughNagumo> || std::is_same_v<M, models::Barkley> ||
+    std::is_same_v<M, models::BarkleyTurbulent> || std::is_same_v<M, models::Brusselator>;
+
+MF_INLINE double load(const float* p, double) { return double(*p); }
+MF_INLINE NewtonLanes load(const float* p, NewtonLanes) {
+  return __builtin_convertvector(vf4x(*reinterpret_cast<const vf4u*>(p)), NewtonLanes);
+}
+MF_INLINE FL<float> load(const float* p, FL<float>) { return FL<float>(*p); }
+MF_INLINE FL<vf4x> load(const float* p, FL<vf4x>) { return FL<vf4x>(vf4x(*reinterpret_cast<const vf4u*>(p))); }
+MF_INLINE FL<vf8x> load(const float* p, FL<vf8x>) { return FL<vf8x>(vf8x(*reinterpret_cast<const vf8u*>(p))); }
+MF_INLINE void store(float* p, double v) { *p = float(v); }
+MF_INLINE void store(float* p, NewtonLanes v) { *reinterpret_cast<vf4u*>(p) = __builtin_convertvector(v, vf4x); }
+MF_INLINE void store(float* p, FL<float> v) { *p = v.v; }
+MF_INLINE void store(float* p, FL<vf4x> v) { *reinterpret_cast<vf4u*>(p) = v.v; }
+MF_INLINE void store(float* p, FL<vf8x> v) { *reinterpret_cast<vf8u*>(p) = v.v; }
+// max(v, 0) as the comparison v < 0 picks it (a NaN stays NaN).
+MF_INLINE double clampZero(double v) { return v < 0.0 ? 0.0 : v; }
+MF_INLINE NewtonLanes clampZero(NewtonLanes v) { return v < 0.0 ? NewtonLanes{} : v; }
+MF_INLINE FL<float> clampZero(FL<float> v) { return FL<float>(v.v < 0.0f ? 0.0f : v.v); }
+template <class V>
+MF_INLINE FL<V> clampZero(FL<V> v) {
+  return FL<V>(v.v < 0.0f ? V{} : v.v);
+}
+template <class L>
+constexpr int lanes() {
+  if constexpr (std::is_same_v<L, double> || std::is_same_v<L, FL<float>>) return 1;
+  else if constexpr (std::is_same_v<L, NewtonLanes>) return 4;
+  else return int(sizeof(L) / sizeof(float));
+}
+// The lane family of a model: float lanes where its rates allow, else doubles.
+template <class M>
+using Scalar = std::conditional_t<kFloatLanes<M>, FL<float>, double>;
+
+// The rows a cell's stencil reads: its own and its neighbours along y (and
+// z), wrapped or (zero flux) the row itself at a wall, per species.
+template <int D, int N>
+struct RowJob {
+  const float* c[N];
+  const float* nb[N][2 * (D - 1)];
+  float* out[N];
+  int nx;
+  bool periodic;
+  double dt, kd[N];  // kd = d / h^2
+  const double* p;
+  unsigned clamped;  // bit per species
+};
+
+// Cells x, x + 1, ... (L's lanes at a time; the x neighbours at x +- 1 inside the row).
+template <class M, int D, class L>
+MF_INLINE void cellsAt(const RowJob<D, M::N>& j, int x, const L* xm, const L* xp) {
+  constexpr int N = M::N;
+  L c[N], r[N];
+  for (int s = 0; s < N; ++s) c[s] = load(j.c[s] + x, L());
+  M::rates(c, j.p, r);  // the model's own rates (rd/models.h)
+  for (int s = 0; s < N; ++s) {
+    L lap = xm[s] + xp[s];
+    for (int k = 0; k < 2 * (D - 1); ++k) lap = lap + load(j.nb[s][k] + x, L());
+    lap = lap - double(2 * D) * c[s];
+    L v = c[s] + j.dt * (r[s] + j.kd[s] * lap);
+    if (j.clamped >> s & 1u) v = clampZero(v);  // the model's clamped species (e.g. Turing's b)
+    store(j.out[s] + x, v);
+  }
+}
+
+template <class M, int D, class L>
+MF_INLINE int interior(const RowJob<D, M::N>& job, int x, int end) {
+  constexpr int N = M::N, n = lanes<L>();
+  // Local copies: nothing the loop stores can change them, so they stay in registers.
+  RowJob<D, N> j = job;
+  double p[M::P];
+  for (int k = 0; k < M::P; ++k) p[k] = job.p[k];
+  j.p = p;
+  for (; x + n <= end; x += n) {
+    L xm[N], xp[N];
+    for (int s = 0; s < N; ++s) xm[s] = load(j.c[s] + x - 1, L()), xp[s] = load(j.c[s] + x + 1, L());
+    cellsAt<M, D, L>(j, x, xm, xp);
+  }
+  return x;
+}
+
+// The row's cells from x on, in the widest lanes that fit (returns the first left).
+template <class M, int D>
+int interiorSse(const RowJob<D, M::N>& j, int x, int end) {
+  if constexpr (kFloatLanes<M>) return interior<M, D, FL<vf4x>>(j, x, end);
+  else return interior<M, D, NewtonLanes>(j, x, end);
+}
+#if MORPHOFLOW_AVX2_KERNELS
+template <class M, int D>
+__attribute__((target("avx2"))) int interiorAvx2(const RowJob<D, M::N>& j, int x, int end) {
+  if constexpr (kFloatLanes<M>) x = interior<M, D, FL<vf8x>>(j, x, end);
+  return interior<M, D, std::conditional_t<kFloatLanes<M>, FL<vf4x>, NewtonLanes>>(j, x, end);
+}
+#endif
+
+// One cell by the scalar code, its x neighbours wrapped or mirrored at the row's ends.
+template <class M, int D>
+void edgeCell(const RowJob<D, M::N>& j, int x) {
+  constexpr int N = M::N;
+  const int lo = x > 0 ? x - 1 : j.periodic ? j.nx - 1 : x, hi = x + 1 < j.nx ? x + 1 : j.periodic ? 0 : x;
+  using L = Scalar<M>;
+  L xm[N], xp[N];
+  for (int s = 0; s < N; ++s) xm[s] = load(j.c[s] + lo, L()), xp[s] = load(j.c[s] + hi, L());
+  cellsAt<M, D, L>(j, x, xm, xp);
+}
+
+template <class M>
+constexpr bool kLaneRates = requires(const NewtonLanes* y, const double* q, NewtonLanes* r) { M::rates(y, q, r); };
+static_assert(!kFloatLanes<models::MeinhardtLateral>);
+
+template <int D, class M>
+class Engine final : public FusedExplicitRD<D> {
+  static constexpr int N = M::N;
+
+ public:
+  Engine(const IVec<D>& cells, double h, bool periodic, const std::vector<double>& d, const std::vector<double>& p)
+      : h_(h), periodic_(periodic), d_(d), p_(p) {
+    this->cells_ = cells;
+    size_t n = 1;
+    for (int a = 0; a < D; ++a) n *= size_t(cells[a]);
+    const ModelInfo info = M::info();
+    this->x_.assign(N, std::vector<float>(n, 0.0f));
+    this->next_ = this->x_;
+    for (int s : info.clamped) clamped_ |= 1u << s;
+    if (p_.empty())
+      for (const ParameterInfo& q : info.parameters) p_.push_back(q.value);
+    if (d_.empty()) d_ = info.diffusion;
+  }
+
+  void step(double dt, int steps) override {
+    const IVec<D>& n = this->cells_;
+    size_t rows = 1;
+    for (int a = 1; a < D; ++a) rows *= size_t(n[a]);
+    [[maybe_unused]] const bool wide = useAvx2();
+    for (int k = 0; k < steps; ++k) {
+      auto row = [&](size_t r) {
+        RowJob<D, N> j;
+        j.nx = n[0];
+        j.periodic = periodic_;
+        j.dt = dt;
+        j.p = p_.data();
+        j.clamped = clamped_;
+        int yz[2] = {int(r % size_t(n[1])), D == 3 ? int(r / size_t(n[1])) : 0};
+        for (int s = 0; s < N; ++s) {
+          j.kd[s] = d_[size_t(s)] / (h_ * h_);
+          const float* base = this->x_[size_t(s)].data();
+          j.c[s] = base + r * size_t(n[0]);
+          j.out[s] = this->next_[size_t(s)].data() + r * size_t(n[0]);
+          for (int a = 1; a < D; ++a)
+            for (int side = 0; side < 2; ++side) {
+              int q = yz[a - 1] + (side ? 1 : -1);
+              if (q < 0 || q >= n[a]) q = periodic_ ? (q + n[a]) % n[a] : yz[a - 1];
+              int c2[2] = {yz[0], yz[1]};
+              c2[a - 1] = q;
+              j.nb[s][2 * (a - 1) + side] = base + (size_t(c2[1]) * size_t(n[1]) + size_t(c2[0])) * size_t(n[0]);
+            }
+        }
+        edgeCell<M, D>(j, 0);
+        int x = 1;
+        if constexpr (kLaneRates<M>) {
+#if MORPHOFLOW_AVX2_KERNELS
+          if (wide) x = interiorAvx2<M, D>(j, x, n[0] - 1);
+#endif
+          x = interiorSse<M, D>(j, x, n[0] - 1);
+        }
+        x = interior<M, D, Scalar<M>>(j, x, n[0] - 1);
+        if (n[0] > 1) edgeCell<M, D>(j, n[0] - 1);
+      };
+      if (this->rowsPerTask_ > 0) {
+        const size_t per = this->rowsPerTask_;
+        parallelFor((rows + per - 1) / per, [&](size_t t) {
+          for (size_t r = t * per; r < std::min(rows, (t + 1) * per); ++r) row(r);
+        });
+      } else {
+        parallelFor(rows, row, rowGrain<D>(n));
+      }
+      std::swap(this->x_, this->next_);
+    }
+  }
+
+ private:
+  double h_;
+  bool periodic_;
+  std::vector<double> d_, p_;
+  unsigned clamped_ = 0;
+};
+
+template <int D, class M>
+std::unique_ptr<FusedExplicitRD<D>> make(const std::string& model, const IVec<D>& cells, double h, bool periodic,
+                                         const std::vector<double>& d, const std::vector<double>& p) {
+  if (model != M::info().name) return nullptr;
+  return std::make_unique<Engine<D, M>>(cells, h, periodic, d, p);
+}
+
+}  // namespace
+
+template <int D>
+std::unique_ptr<FusedExplicitRD<D>> FusedExplicitRD<D>::create(const std::string& model, const IVec<D>& cells, double h,
+                                                               bool periodic, const std::vector<double>& d,
+                                                               const std::vector<double>& p) {
+  std::unique_ptr<FusedExplicitRD<D>> e;
+  auto tryModel = [&](auto tag) {
+    using M = typename decltype(tag)::type;
+    if (!e) e = make<D, M>(model, cells, h, periodic, d, p);
+  };
+  using namespace models;
+  tryModel(std::type_identity<Turing>{});
+  tryModel(std::type_identity<TuringSanderson>{});
+  tryModel(std::type_identity<GrayScott>{});
+  tryModel(std::type_identity<GrayScottSanderson>{});
+  tryModel(std::type_identity<FitzHughNagumo>{});
+  tryModel(std::type_identity<Barkley>{});
+  tryModel(std::type_identity<BarkleyTurbulent>{});
+  tryModel(std::type_identity<MeinhardtSpots>{});
+  tryModel(std::type_identity<Brusselator>{});
+  tryModel(std::type_identity<GiererMeinhardt>{});
+  tryModel(std::type_identity<Oregonator>{});
+  tryModel(std::type_identity<MeinhardtLateral>{});
+  tryModel(std::type_identity<CoupledBrusselator>{});
+  tryModel(std::type_identity<OregonatorThreeLayer>{});
+  return e;
+}
+
+template class FusedExplicitRD<2>;
+template class FusedExplicitRD<3>;
+
+}  // namespace morphoflow
