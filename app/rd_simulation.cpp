@@ -43,7 +43,7 @@ bool fusedExplicitFits(const Scene& s) {
   const bool deposits = std::any_of(r.strokes.begin(), r.strokes.end(), [](const RDStroke& k) { return !k.species.empty(); });
   return r.settings.integrator == RDIntegrator::ExplicitEuler && r.settings.boundary != RDBoundary::Dirichlet &&
          r.settings.frozen.empty() && r.parameterMaps.empty() && r.perturb.empty() && r.speedMaps.empty() &&
-         r.fixed.empty() && !deposits && !r.anisotropy.enabled && !r.lobes.enabled && !r.generalized.enabled;
+         r.fixed.empty() && !deposits && !r.anisotropy.enabled && !r.lobes.enabled;
 }
 
 template <int D>
@@ -56,6 +56,7 @@ RDSimulation<D>::RDSimulation(const Scene& scene, const Log& log)
     for (size_t k = 0; k < rd_.model().info().parameters.size(); ++k) p.push_back(rd_.parameter(int(k)));
     fused_ = FusedExplicitRD<D>::create(rd_.model().info().name, rd_.cells(), rd_.h(),
                                         rd_.settings().boundary == RDBoundary::Periodic, rd_.diffusion(), p);
+    if (fused_ && rd_.generalizedDiffusion()) fused_->setKernel(rd_.generalizedDiffusion()->kernel(), scene.rd.generalized.species);
     if (fused_) toFused();
   }
 }

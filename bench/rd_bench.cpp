@@ -18,6 +18,7 @@
 #include "bench/bench_timing.h"
 #include "core/parallel.h"
 #include "rd/fused_explicit.h"
+#include "rd/generalized_diffusion.h"
 #include "rd/model_registry.h"
 #include "rd/rd_solver.h"
 
@@ -55,13 +56,16 @@ nlohmann::json benchRD(int n, bool implicit, int threads, double minSeconds) {
 
 // The fused float step (rd/fused_explicit.h) on the same start and dt.
 template <int D>
-nlohmann::json benchFused(int n, int threads, double minSeconds) {
+nlohmann::json benchFused(int n, int threads, double minSeconds, bool kernel5 = false) {
   ThreadLimit limit(threads);
   const RDSettings st = benchGrayScott<D>(n, 1.0, RDIntegrator::ExplicitEuler);
   RDSolver<D> rd(st, *findModel("gray-scott"));
   pearsonStart(&rd);
   const double dt = 0.9 * rd.explicitDiffusionLimit();
   auto e = FusedExplicitRD<D>::create("gray-scott", rd.cells(), 1.0, true, st.diffusion, {});
+  // Seed 000's 5 x 5 kernel: Table 2 (d) on cells of 2.2 (docs/models.md), the same d per cell.
+  if constexpr (D == 2)
+    if (kernel5) e->setKernel(GeneralizedDiffusion(*kramersMoyalPreset("d"), n, n, 2.2).kernel(), {});
   for (int s = 0; s < 2; ++s)
     for (size_t i = 0; i < rd.field(s).size(); ++i) e->field(s)[i] = float(rd.field(s)[i]);
   e->step(dt);
@@ -71,7 +75,7 @@ nlohmann::json benchFused(int n, int threads, double minSeconds) {
   for (int a = 0; a < D; ++a) cells *= n;
   return {{"dim", D},
           {"n", n},
-          {"integrator", "fused"},
+          {"integrator", kernel5 ? "fused-5x5" : "fused"},
           {"threads", threads},
           {"dt", dt},
           {"steps", times.size()},
@@ -90,11 +94,12 @@ bool runRDBench(const BenchOptions& o) {
   std::cout << fmt::format("{:>4} {:>6} {:>10} {:>7} {:>12} {:>14} {:>9} {:>9}\n", "dim", "n", "integrator", "threads",
                            "ms/step(med)", "Mcell-updates/s", "newton", "pcg-its");
   for (BenchCase c : cases)
-    for (int kind : {0, 1, 2})  // explicit (double), fused explicit (float), Kim & Lin
+    for (int kind : {0, 1, 3, 2})  // explicit (double), fused (float), fused 5 x 5 (2D), Kim & Lin
       for (int threads : {1, 2}) {
         const bool implicit = kind == 2;
-        nlohmann::json j = kind == 1 ? (c.dim == 2 ? benchFused<2>(c.n, threads, o.minSeconds)
-                                                   : benchFused<3>(c.n, threads, o.minSeconds))
+        if (kind == 3 && c.dim != 2) continue;
+        nlohmann::json j = kind == 1 || kind == 3 ? (c.dim == 2 ? benchFused<2>(c.n, threads, o.minSeconds, kind == 3)
+                                                                : benchFused<3>(c.n, threads, o.minSeconds))
                            : c.dim == 2 ? benchRD<2>(c.n, implicit, threads, o.minSeconds)
                                         : benchRD<3>(c.n, implicit, threads, o.minSeconds);
         std::cout << fmt::format("{:>4} {:>6} {:>10} {:>7} {:>12.2f} {:>14.2f} {:>9.0f} {:>9.1f}\n", c.dim, c.n,

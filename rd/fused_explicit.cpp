@@ -1,6 +1,9 @@
 #include "rd/fused_explicit.h"
 
+#include <algorithm>
+#include <array>
 #include <cstring>
+#include <stdexcept>
 #include <type_traits>
 
 #include "core/parallel.h"
@@ -95,29 +98,46 @@ struct RowJob {
   float* out[N];
   int nx;
   bool periodic;
-  double dt, kd[N];  // kd = d / h^2
+  double dt, kd[N];  // d / h^2 for the Laplacian, d for the 5 x 5 kernel (in physical units)
   const double* p;
   unsigned clamped;  // bit per species
+  unsigned kernel;   // bit per species diffusing by the 5 x 5 kernel (2D)
+  const float* krow[N][5];  // its rows y - 2 .. y + 2
+  double tw[25];             // its weights, row-major (dy, then dx)
 };
 
-// Cells x, x + 1, ... (L's lanes at a time; the x neighbours at x +- 1 inside the row).
-template <class M, int D, class L>
-MF_INLINE void cellsAt(const RowJob<D, M::N>& j, int x, const L* xm, const L* xp) {
+// The kernel's weights as lanes, converted once per row.
+template <class L, int D, int N>
+MF_INLINE void laneWeights(const RowJob<D, N>& j, L* w) {
+  for (int t = 0; t < 25; ++t) w[t] = L{} + j.tw[t];  // (L{} + d: a splat for every lane type)
+}
+
+// Cells x, x + 1, ... (L's lanes at a time); at(row, dx) reads a row at x + dx.
+template <class M, int D, class L, bool K, class At>
+MF_INLINE void cellsAt(const RowJob<D, M::N>& j, int x, const L* w, At at) {
   constexpr int N = M::N;
   L c[N], r[N];
-  for (int s = 0; s < N; ++s) c[s] = load(j.c[s] + x, L());
+  for (int s = 0; s < N; ++s) c[s] = at(j.c[s], 0);
   M::rates(c, j.p, r);  // the model's own rates (rd/models.h)
   for (int s = 0; s < N; ++s) {
-    L lap = xm[s] + xp[s];
-    for (int k = 0; k < 2 * (D - 1); ++k) lap = lap + load(j.nb[s][k] + x, L());
-    lap = lap - double(2 * D) * c[s];
+    L lap;
+    if (K && (j.kernel >> s & 1u)) {  // seed 000 eq. 37: one 5 x 5 convolution
+      const float* const* rows = j.krow[s];
+      lap = w[0] * at(rows[0], -2);
+#pragma GCC unroll 25
+      for (int t = 1; t < 25; ++t) lap = lap + w[t] * at(rows[t / 5], t % 5 - 2);  // row-major over the 5 x 5 taps
+    } else {
+      lap = at(j.c[s], -1) + at(j.c[s], 1);
+      for (int k = 0; k < 2 * (D - 1); ++k) lap = lap + at(j.nb[s][k], 0);
+      lap = lap - double(2 * D) * c[s];
+    }
     L v = c[s] + j.dt * (r[s] + j.kd[s] * lap);
     if (j.clamped >> s & 1u) v = clampZero(v);  // the model's clamped species (e.g. Turing's b)
     store(j.out[s] + x, v);
   }
 }
 
-template <class M, int D, class L>
+template <class M, int D, class L, bool K>
 MF_INLINE int interior(const RowJob<D, M::N>& job, int x, int end) {
   constexpr int N = M::N, n = lanes<L>();
   // Local copies: nothing the loop stores can change them, so they stay in registers.
@@ -125,37 +145,37 @@ MF_INLINE int interior(const RowJob<D, M::N>& job, int x, int end) {
   double p[M::P];
   for (int k = 0; k < M::P; ++k) p[k] = job.p[k];
   j.p = p;
-  for (; x + n <= end; x += n) {
-    L xm[N], xp[N];
-    for (int s = 0; s < N; ++s) xm[s] = load(j.c[s] + x - 1, L()), xp[s] = load(j.c[s] + x + 1, L());
-    cellsAt<M, D, L>(j, x, xm, xp);
-  }
+  L w[25];
+  laneWeights(j, w);
+  for (; x + n <= end; x += n) cellsAt<M, D, L, K>(j, x, w, [&](const float* row, int dx) { return load(row + x + dx, L()); });
   return x;
 }
 
 // The row's cells from x on, in the widest lanes that fit (returns the first left).
-template <class M, int D>
+template <class M, int D, bool K>
 int interiorSse(const RowJob<D, M::N>& j, int x, int end) {
-  if constexpr (kFloatLanes<M>) return interior<M, D, FL<vf4x>>(j, x, end);
-  else return interior<M, D, NewtonLanes>(j, x, end);
+  if constexpr (kFloatLanes<M>) return interior<M, D, FL<vf4x>, K>(j, x, end);
+  else return interior<M, D, NewtonLanes, K>(j, x, end);
 }
 #if MORPHOFLOW_AVX2_KERNELS
-template <class M, int D>
+template <class M, int D, bool K>
 __attribute__((target("avx2"))) int interiorAvx2(const RowJob<D, M::N>& j, int x, int end) {
-  if constexpr (kFloatLanes<M>) x = interior<M, D, FL<vf8x>>(j, x, end);
-  return interior<M, D, std::conditional_t<kFloatLanes<M>, FL<vf4x>, NewtonLanes>>(j, x, end);
+  if constexpr (kFloatLanes<M>) x = interior<M, D, FL<vf8x>, K>(j, x, end);
+  return interior<M, D, std::conditional_t<kFloatLanes<M>, FL<vf4x>, NewtonLanes>, K>(j, x, end);
 }
 #endif
 
 // One cell by the scalar code, its x neighbours wrapped or mirrored at the row's ends.
 template <class M, int D>
 void edgeCell(const RowJob<D, M::N>& j, int x) {
-  constexpr int N = M::N;
-  const int lo = x > 0 ? x - 1 : j.periodic ? j.nx - 1 : x, hi = x + 1 < j.nx ? x + 1 : j.periodic ? 0 : x;
   using L = Scalar<M>;
-  L xm[N], xp[N];
-  for (int s = 0; s < N; ++s) xm[s] = load(j.c[s] + lo, L()), xp[s] = load(j.c[s] + hi, L());
-  cellsAt<M, D, L>(j, x, xm, xp);
+  L w[25];
+  laneWeights(j, w);
+  cellsAt<M, D, L, true>(j, x, w, [&](const float* row, int dx) {
+    int q = x + dx;
+    if (q < 0 || q >= j.nx) q = j.periodic ? (q % j.nx + j.nx) % j.nx : std::clamp(q, 0, j.nx - 1);
+    return load(row + q, L());
+  });
 }
 
 template <class M>
@@ -181,6 +201,14 @@ class Engine final : public FusedExplicitRD<D> {
     if (d_.empty()) d_ = info.diffusion;
   }
 
+  void setKernel(const std::array<std::array<double, 5>, 5>& kernel, const std::vector<int>& species) override {
+    if (D != 2 || !periodic_) throw std::invalid_argument("the 5 x 5 kernel is for periodic 2D layers");
+    kernel_ = kernel;
+    kernelSpecies_ = 0;
+    for (int s = 0; s < N; ++s)
+      if (species.empty() || std::find(species.begin(), species.end(), s) != species.end()) kernelSpecies_ |= 1u << s;
+  }
+
   void step(double dt, int steps) override {
     const IVec<D>& n = this->cells_;
     size_t rows = 1;
@@ -194,11 +222,15 @@ class Engine final : public FusedExplicitRD<D> {
         j.dt = dt;
         j.p = p_.data();
         j.clamped = clamped_;
+        j.kernel = kernelSpecies_;
+        for (int t = 0; t < 25; ++t) j.tw[t] = kernel_[size_t(t / 5)][size_t(t % 5)];
         int yz[2] = {int(r % size_t(n[1])), D == 3 ? int(r / size_t(n[1])) : 0};
         for (int s = 0; s < N; ++s) {
-          j.kd[s] = d_[size_t(s)] / (h_ * h_);
+          j.kd[s] = d_[size_t(s)] / ((kernelSpecies_ >> s & 1u) ? 1.0 : h_ * h_);
           const float* base = this->x_[size_t(s)].data();
           j.c[s] = base + r * size_t(n[0]);
+          for (int dy = -2; dy <= 2; ++dy)  // (periodic only: setKernel refuses walls)
+            j.krow[s][dy + 2] = base + size_t((yz[0] + dy + n[1]) % n[1]) * size_t(n[0]);
           j.out[s] = this->next_[size_t(s)].data() + r * size_t(n[0]);
           for (int a = 1; a < D; ++a)
             for (int side = 0; side < 2; ++side) {
@@ -209,16 +241,12 @@ class Engine final : public FusedExplicitRD<D> {
               j.nb[s][2 * (a - 1) + side] = base + (size_t(c2[1]) * size_t(n[1]) + size_t(c2[0])) * size_t(n[0]);
             }
         }
-        edgeCell<M, D>(j, 0);
-        int x = 1;
-        if constexpr (kLaneRates<M>) {
-#if MORPHOFLOW_AVX2_KERNELS
-          if (wide) x = interiorAvx2<M, D>(j, x, n[0] - 1);
-#endif
-          x = interiorSse<M, D>(j, x, n[0] - 1);
-        }
-        x = interior<M, D, Scalar<M>>(j, x, n[0] - 1);
-        if (n[0] > 1) edgeCell<M, D>(j, n[0] - 1);
+        // The cells whose stencil leaves the row take the scalar code with wrapped (or mirrored) neighbours.
+        const int reach = std::min(kernelSpecies_ ? 2 : 1, n[0]);
+        for (int x = 0; x < reach; ++x) edgeCell<M, D>(j, x);
+        const int end = std::max(reach, n[0] - reach);
+        const int x = kernelSpecies_ ? interiorRow<true>(j, reach, end, wide) : interiorRow<false>(j, reach, end, wide);
+        for (int e = std::max(x, end); e < n[0]; ++e) edgeCell<M, D>(j, e);
       };
       if (this->rowsPerTask_ > 0) {
         const size_t per = this->rowsPerTask_;
@@ -233,10 +261,23 @@ class Engine final : public FusedExplicitRD<D> {
   }
 
  private:
+  // Cells [x, end) of a row: the widest lanes, then one at a time; K: some species take the 5 x 5 kernel.
+  template <bool K>
+  static int interiorRow(const RowJob<D, N>& j, int x, int end, [[maybe_unused]] bool wide) {
+    if constexpr (kLaneRates<M>) {
+#if MORPHOFLOW_AVX2_KERNELS
+      if (wide) x = interiorAvx2<M, D, K>(j, x, end);
+#endif
+      x = interiorSse<M, D, K>(j, x, end);
+    }
+    return interior<M, D, Scalar<M>, K>(j, x, end);
+  }
+
   double h_;
   bool periodic_;
   std::vector<double> d_, p_;
-  unsigned clamped_ = 0;
+  unsigned clamped_ = 0, kernelSpecies_ = 0;
+  std::array<std::array<double, 5>, 5> kernel_{};
 };
 
 template <int D, class M>

@@ -8,11 +8,13 @@
 // reads only the previous state, so the result does not depend on the
 // lanes, the rows' tiling or the thread count.
 //
-// It covers what a plain explicit layer needs: uniform parameters and the
-// model's clamped species. Maps, tensors, lobes, fixed cells and Dirichlet
-// walls stay with RDSolver.
+// It covers what a plain explicit layer needs: uniform parameters, the
+// model's clamped species, and McGraw's 5 x 5 generalized kernel in place of
+// the Laplacian. Maps, tensors, lobes, fixed cells and Dirichlet walls stay
+// with RDSolver.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <string>
 #include <vector>
@@ -29,6 +31,10 @@ class FusedExplicitRD {
                                                  const std::vector<double>& diffusion, const std::vector<double>& parameters);
   virtual ~FusedExplicitRD() = default;
 
+  // McGraw's generalized diffusion (seed 000 eq. 37): the species (empty:
+  // all) diffuse by d K * x, K the 5 x 5 kernel in physical units
+  // (weights[dy + 2][dx + 2]), in place of the Laplacian. Periodic 2D only.
+  virtual void setKernel(const std::array<std::array<double, 5>, 5>& kernel, const std::vector<int>& species) = 0;
   // `steps` explicit steps of dt.
   virtual void step(double dt, int steps = 1) = 0;
   // Rows per task: any value gives bitwise the same fields (tests vary it).
