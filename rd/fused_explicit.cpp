@@ -145,8 +145,8 @@ MF_INLINE int interior(const RowJob<D, M::N>& job, int x, int end) {
   double p[M::P];
   for (int k = 0; k < M::P; ++k) p[k] = job.p[k];
   j.p = p;
-  L w[25];
-  laneWeights(j, w);
+  L w[K ? 25 : 1];
+  if constexpr (K) laneWeights(j, w);
   for (; x + n <= end; x += n) cellsAt<M, D, L, K>(j, x, w, [&](const float* row, int dx) { return load(row + x + dx, L()); });
   return x;
 }
