@@ -80,6 +80,7 @@ bool runCouplingBench(const BenchOptions& o);  // coupling_bench.cpp
 bool runGpuRDBench(const BenchOptions& o);     // gpu_rd_bench.cpp
 bool runGpuFluidBench(const BenchOptions& o);  // gpu_fluid_bench.cpp
 bool runGpuCouplingBench(const BenchOptions& o);
+bool runRooflineBench(const BenchOptions& o);  // roofline_bench.cpp
 
 bool runBenchSuite(const std::string& suite, const BenchOptions& o) {
   if (o.backend == "gpu") {
@@ -91,9 +92,10 @@ bool runBenchSuite(const std::string& suite, const BenchOptions& o) {
   if (suite == "fluid") return runFluidBench(o);
   if (suite == "rd") return runRDBench(o);
   if (suite == "coupling") return runCouplingBench(o);
+  if (suite == "roofline") return runRooflineBench(o);
   return false;
 }
 
-const char* benchSuiteNames() { return "fluid, rd, coupling"; }
+const char* benchSuiteNames() { return "fluid, rd, coupling, roofline"; }
 
 }  // namespace morphoflow

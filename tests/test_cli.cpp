@@ -601,6 +601,27 @@ TEST(Cli, CouplingBenchWritesAChromeTrace) {
   fs::remove_all(dir);
 }
 
+// `bench roofline`: the triad's bandwidth with 1 and 2 threads, and every
+// kernel's bytes, rate and fraction of it (consistent with each other).
+TEST(Cli, RooflineBenchRelatesEveryKernelToTheTriad) {
+  auto dir = tempDir("roofline");
+  CommandResult r = runMorphoflow("bench roofline --size 48 --seconds 0 --json " + (dir / "r.json").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(dir / "r.json"));
+  for (const char* t : {"1", "2"}) EXPECT_GT(j["triad"][t].get<double>(), 0.1);
+  std::set<std::string> names;
+  for (const auto& k : j["kernels"]) {
+    names.insert(k["kernel"].get<std::string>());
+    const double gbs = k["cell_updates_per_second"].get<double>() * k["bytes_per_cell_update"].get<double>() / 1e9;
+    EXPECT_NEAR(k["gb_per_second"].get<double>(), gbs, 1e-9 * gbs);
+    EXPECT_NEAR(k["fraction_of_triad"].get<double>(), gbs / j["triad"][std::to_string(k["threads"].get<int>())].get<double>(), 1e-9);
+  }
+  for (const char* k : {"rd explicit (double)", "rd fused (float)", "rd fused 5x5 (float)", "coupling chemical advection",
+                        "fluid velocity advection"})
+    EXPECT_TRUE(names.count(k)) << k;
+  fs::remove_all(dir);
+}
+
 // output.video: with ffmpeg an mp4 holding every frame; without it (or when
 // it fails) a warning, exit 0, every frame kept and no half-written video.
 TEST(Cli, VideoWithAndWithoutFfmpeg) {
