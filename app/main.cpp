@@ -15,6 +15,7 @@
 #include "app/run_options.h"
 #include "app/texture_commands.h"
 #include "app/version.h"
+#include "app/memory_bench.h"
 #include "bench/bench_suites.h"
 #include "core/error.h"
 #include "core/number_text.h"
@@ -253,8 +254,9 @@ int main(int argc, char** argv) {
         throw UserError({"--size", 0, 0}, "", fmt::format("a {0} x {0} case needs about {1}; this machine has {2} free", bench.size,
                                                           humanBytes(need), humanBytes(availableBytes())),
                         "give a smaller --size");
+      if (suite == "memory" && bench.backend != "gpu") return runMemoryBench(bench) ? 0 : 1;
       if (!runBenchSuite(suite, bench))
-        throw UserError({"bench", 0, 0}, "", "unknown suite '" + suite + "'", std::string("suites: ") + benchSuiteNames());
+        throw UserError({"bench", 0, 0}, "", "unknown suite '" + suite + "'", std::string("suites: ") + benchSuiteNames() + ", memory");
       return 0;
     }
   } catch (const UserError& e) {

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "app/rd_simulation.h"
 #include "core/error.h"
 
 namespace morphoflow {
@@ -20,6 +21,7 @@ namespace {
 constexpr double kFluidBytesPerCell[2] = {455.0, 590.0};  // 2D, 3D
 constexpr double kSpeciesBytesPerCell = 170.0;             // reaction-diffusion only
 constexpr double kCoupledSpeciesBytesPerCell = 230.0;      // carried by a fluid
+constexpr double kFusedSpeciesBytesPerCell = 85.0;         // the fused explicit step (bench memory: 84 at 1024^2)
 constexpr double kFixedBytes = 135.0 * (1 << 20);          // the program, its libraries and thread pools
 
 double cellsOf(const std::vector<int>& res) {
@@ -55,8 +57,9 @@ uintmax_t estimateRunBytes(const Scene& s) {
   if (s.hasFluid) bytes += cellsOf(s.fluid.resolution) * kFluidBytesPerCell[d];
   if (s.rd.enabled) {
     const double species = double(s.rd.initial.values.size());
+    const bool fused = !s.hasFluid && !s.velocity.enabled && fusedExplicitFits(s);
     bytes += cellsOf(s.rd.settings.resolution) * species *
-             (s.hasFluid ? kCoupledSpeciesBytesPerCell : kSpeciesBytesPerCell);
+             (s.hasFluid ? kCoupledSpeciesBytesPerCell : fused ? kFusedSpeciesBytesPerCell : kSpeciesBytesPerCell);
   }
   return uintmax_t(bytes);
 }

@@ -622,6 +622,25 @@ TEST(Cli, RooflineBenchRelatesEveryKernelToTheTriad) {
   fs::remove_all(dir);
 }
 
+// `bench memory`: each case runs in a process of its own and reports its
+// peak (above the fixed overhead of a tiny run) and the run's estimate.
+TEST(Cli, MemoryBenchReportsEveryCasesPeakAndEstimate) {
+  auto dir = tempDir("membench");
+  CommandResult r = runMorphoflow("bench memory --size 48 --json " + (dir / "m.json").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  nlohmann::json j = nlohmann::json::parse(std::ifstream(dir / "m.json"));
+  const double overhead = j["overhead_bytes"].get<double>();
+  EXPECT_GT(overhead, 1e6);
+  ASSERT_EQ(j["cases"].size(), 7u);
+  for (const auto& c : j["cases"]) {
+    const double peak = c["peak_bytes"].get<double>();
+    EXPECT_GT(peak, 0.8 * overhead) << c.dump();
+    EXPECT_NEAR(c["estimate_bytes"].get<double>() / peak, 1.0, 0.3) << c.dump();
+    EXPECT_NEAR(c["bytes_per_cell"].get<double>(), (peak - overhead) / c["cells"].get<double>(), 1e-6) << c.dump();
+  }
+  fs::remove_all(dir);
+}
+
 // output.video: with ffmpeg an mp4 holding every frame; without it (or when
 // it fails) a warning, exit 0, every frame kept and no half-written video.
 TEST(Cli, VideoWithAndWithoutFfmpeg) {
