@@ -122,10 +122,17 @@ MF_INLINE void cellsAt(const RowJob<D, M::N>& j, int x, const L* w, At at) {
   for (int s = 0; s < N; ++s) {
     L lap;
     if (K && (j.kernel >> s & 1u)) {  // seed 000 eq. 37: one 5 x 5 convolution
+      // One sum per kernel row, then the five together: short dependency chains (a single running sum of
+      // 25 taps would wait on the add latency), in the same order at every width.
       const float* const* rows = j.krow[s];
-      lap = w[0] * at(rows[0], -2);
-#pragma GCC unroll 25
-      for (int t = 1; t < 25; ++t) lap = lap + w[t] * at(rows[t / 5], t % 5 - 2);  // row-major over the 5 x 5 taps
+      L acc[5];
+#pragma GCC unroll 5
+      for (int dy = 0; dy < 5; ++dy) {
+        acc[dy] = w[5 * dy] * at(rows[dy], -2);
+#pragma GCC unroll 4
+        for (int dx = 1; dx < 5; ++dx) acc[dy] = acc[dy] + w[5 * dy + dx] * at(rows[dy], dx - 2);
+      }
+      lap = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + acc[4];
     } else {
       lap = at(j.c[s], -1) + at(j.c[s], 1);
       for (int k = 0; k < 2 * (D - 1); ++k) lap = lap + at(j.nb[s][k], 0);
