@@ -46,14 +46,17 @@ fs::path checkpointFile(const fs::path& out, long step) {
   return checkpointDir(out) / fmt::format("{:010d}.ckpt", step);
 }
 
-fs::path writeCheckpoint(const fs::path& out, long step, const nlohmann::json& header, const std::string& state) {
+fs::path writeCheckpoint(const fs::path& out, long step, const nlohmann::json& header, StateWriter* state) {
   createOutputFolder(checkpointDir(out));
   const std::string h = header.dump();
-  std::string bytes(kMagic, 8);
+  const size_t n = state->serialisedSize();
+  std::string bytes;
+  bytes.reserve(8 + 8 + h.size() + 8 + n + 8);  // one allocation: no copy of the state while it grows
+  bytes.assign(kMagic, 8);
   append64(&bytes, h.size());
   bytes += h;
-  append64(&bytes, state.size());
-  bytes += state;
+  append64(&bytes, n);
+  state->serialiseInto(&bytes);
   append64(&bytes, XXH64(bytes.data(), bytes.size(), 0));
   const fs::path file = checkpointFile(out, step);
   writeFileAtomically(file, bytes);

@@ -11,6 +11,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/state_archive.h"
+
 namespace morphoflow {
 
 struct Checkpoint {
@@ -23,9 +25,10 @@ struct Checkpoint {
 std::filesystem::path checkpointDir(const std::filesystem::path& out);
 std::filesystem::path checkpointFile(const std::filesystem::path& out, long step);
 
-// Writes a checkpoint and removes all but the two newest. Returns the file.
+// Writes a checkpoint of `state` (emptied: it is moved into the file's
+// bytes section by section) and removes all but the two newest. Returns the file.
 std::filesystem::path writeCheckpoint(const std::filesystem::path& out, long step, const nlohmann::json& header,
-                                      const std::string& state);
+                                      StateWriter* state);
 
 // Reads one checkpoint; throws UserError naming the file when it is cut
 // short, corrupted or not a checkpoint.

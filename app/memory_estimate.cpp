@@ -12,17 +12,18 @@ namespace morphoflow {
 
 namespace {
 
-// Peak bytes per cell, measured (/usr/bin/time's maximum resident size over
-// 32^3-96^3 and 256^2-1024^2 grids, docs/performance.md "Memory"): the fluid
-// (velocity, its scratch and MacCormack copies, pressure and viscosity
-// systems with their multigrid levels and Krylov vectors) and each species of
-// a reaction-diffusion layer (double state, diffusion system, solver vectors;
-// in a coupled run also its advection scratch).
-constexpr double kFluidBytesPerCell[2] = {455.0, 590.0};  // 2D, 3D
-constexpr double kSpeciesBytesPerCell = 170.0;             // reaction-diffusion only
-constexpr double kCoupledSpeciesBytesPerCell = 230.0;      // carried by a fluid
-constexpr double kFusedSpeciesBytesPerCell = 85.0;         // the fused explicit step (bench memory: 84 at 1024^2)
-constexpr double kFixedBytes = 135.0 * (1 << 20);          // the program, its libraries and thread pools
+// Peak bytes per cell beyond the fixed overhead, measured by `bench memory`
+// (2D 1024^2, 3D 128^3, two steps and the final checkpoint;
+// docs/performance.md "Memory"): the fluid (velocity, its scratch and
+// MacCormack copies, pressure and viscosity systems with their multigrid
+// levels and Krylov vectors) and each species of a reaction-diffusion layer
+// (double state, diffusion system, solver vectors; in a coupled run also its
+// advection scratch; float state for the fused explicit step).
+constexpr double kFluidBytesPerCell[2] = {500.0, 490.0};        // 2D, 3D
+constexpr double kSpeciesBytesPerCell = 135.0;                   // reaction-diffusion only
+constexpr double kCoupledSpeciesBytesPerCell[2] = {115.0, 206.0}; // carried by a fluid, 2D, 3D
+constexpr double kFusedSpeciesBytesPerCell = 68.0;               // the fused explicit step
+constexpr double kFixedBytes = 126.0 * (1 << 20);                // the program, its libraries and thread pools
 
 double cellsOf(const std::vector<int>& res) {
   double n = 1;
@@ -59,7 +60,7 @@ uintmax_t estimateRunBytes(const Scene& s) {
     const double species = double(s.rd.initial.values.size());
     const bool fused = !s.hasFluid && !s.velocity.enabled && fusedExplicitFits(s);
     bytes += cellsOf(s.rd.settings.resolution) * species *
-             (s.hasFluid ? kCoupledSpeciesBytesPerCell : fused ? kFusedSpeciesBytesPerCell : kSpeciesBytesPerCell);
+             (s.hasFluid ? kCoupledSpeciesBytesPerCell[d] : fused ? kFusedSpeciesBytesPerCell : kSpeciesBytesPerCell);
   }
   return uintmax_t(bytes);
 }

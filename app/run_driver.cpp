@@ -151,7 +151,7 @@ class Driver {
     const nlohmann::json header = {{"version", kVersion},      {"scene_hash", hash_},      {"scene", scene_.resolvedJson},
                                    {"step", sim_.steps()},     {"time", sim_.time()},      {"last_frame", lastFrame_},
                                    {"sinks", sinks},           {"log", log_.text()},       {"checkpoint_bytes", checkpointBytes_}};
-    const fs::path file = writeCheckpoint(out_, sim_.steps(), header, w.serialise());
+    const fs::path file = writeCheckpoint(out_, sim_.steps(), header, &w);
     checkpointBytes_ += fileBytes(file);
     return file;
   }

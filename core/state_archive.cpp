@@ -20,8 +20,27 @@ T take(const std::string& in, size_t* at) {
 
 }  // namespace
 
+size_t StateWriter::serialisedSize() const {
+  size_t n = 0;
+  for (const auto& [name, data] : sections_) n += sizeof(uint32_t) + name.size() + sizeof(uint64_t) + data.size();
+  return n;
+}
+
+void StateWriter::serialiseInto(std::string* out) {
+  out->reserve(out->size() + serialisedSize());
+  for (auto& [name, data] : sections_) {
+    append<uint32_t>(out, uint32_t(name.size()));
+    *out += name;
+    append<uint64_t>(out, uint64_t(data.size()));
+    *out += data;
+    std::string().swap(data);
+  }
+  sections_.clear();
+}
+
 std::string StateWriter::serialise() const {
   std::string out;
+  out.reserve(serialisedSize());
   for (const auto& [name, data] : sections_) {
     append<uint32_t>(&out, uint32_t(name.size()));
     out += name;

@@ -36,6 +36,12 @@ class StateWriter {
   }
   // The sections as one byte string (each: name length, name, size, bytes).
   std::string serialise() const;
+  // The length serialise() would return.
+  size_t serialisedSize() const;
+  // Appends serialise()'s bytes to *out and empties the writer, freeing each
+  // section once it is copied: the whole state is held once, not twice (a
+  // checkpoint of a large run is the run's peak memory otherwise).
+  void serialiseInto(std::string* out);
 
  private:
   std::map<std::string, std::string> sections_;
