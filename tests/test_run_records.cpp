@@ -105,7 +105,7 @@ TEST(RunRecords, TheMemoryEstimateMatchesThePeakAndATooLargeRunIsRefused) {
     ASSERT_EQ(r.status, 0) << r.output;
     const nlohmann::json j = runJson(dir / "out");
     const double peak = j["peak_memory_bytes"].get<double>(), estimate = j["memory_estimate_bytes"].get<double>();
-    EXPECT_NEAR(estimate / peak, 1.0, 0.25) << sets << ": estimate " << estimate << ", peak " << peak;
+    EXPECT_NEAR(estimate / peak, 1.0, 0.10) << sets << ": estimate " << estimate << ", peak " << peak;
   }
   CommandResult v = runMorphoflow("validate " + sceneFile("coupled/cavity_gray_scott_3d.toml"));
   EXPECT_NE(v.output.find("needs about"), std::string::npos) << v.output;
