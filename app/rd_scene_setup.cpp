@@ -152,8 +152,7 @@ void applyScene(const Scene& scene, RDSolver<D>* rd) {
         strokeCoverage<D>(s.stroke, n, rd->settings().size, rd->settings().boundary == RDBoundary::Periodic);
     hold(s.species, s.values, [&](size_t i) { return under[i] != 0; });
   }
-  if (!scene.rd.fixed.empty() || std::any_of(scene.rd.strokes.begin(), scene.rd.strokes.end(),
-                                             [](const RDStroke& s) { return !s.species.empty(); }))
+  if (!scene.rd.fixed.empty() || scene.rd.strokesDeposit())
     rd->setFixedCells(std::move(mask), std::move(values));
 }
 

@@ -40,10 +40,9 @@ std::vector<Grid<float, D>> speciesField(const RDSolver<D>& rd, const std::strin
 
 bool fusedExplicitFits(const Scene& s) {
   const RDScene& r = s.rd;
-  const bool deposits = std::any_of(r.strokes.begin(), r.strokes.end(), [](const RDStroke& k) { return !k.species.empty(); });
   return r.settings.integrator == RDIntegrator::ExplicitEuler && r.settings.boundary != RDBoundary::Dirichlet &&
          r.settings.frozen.empty() && r.parameterMaps.empty() && r.perturb.empty() && r.speedMaps.empty() &&
-         r.fixed.empty() && !deposits && !r.anisotropy.enabled && !r.lobes.enabled;
+         r.fixed.empty() && !r.strokesDeposit() && !r.anisotropy.enabled && !r.lobes.enabled;
 }
 
 template <int D>
@@ -147,8 +146,7 @@ nlohmann::json resolvedLayer(const Scene& scene, const RDSolver<D>& rd) {
                       {"explicit_diffusion_limit", rd.explicitDiffusionLimit()}};
   // Seed 000 sec. 5: the step's spectral radius on this grid, per species, and the largest step within the bound.
   if (const GeneralizedDiffusion* g = rd.generalizedDiffusion()) {
-    const RDIntegrator integ = rd.settings().integrator;
-    const double theta = integ == RDIntegrator::ExplicitEuler ? 0.0 : integ == RDIntegrator::CrankNicolson ? 0.5 : 1.0;
+    const double theta = diffusionTheta(rd.settings().integrator);
     nlohmann::json radius = nlohmann::json::object(), largest = nlohmann::json::object();
     for (int s = 0; s < rd.species(); ++s) {
       if (!rd.generalized(s)) continue;

@@ -210,7 +210,7 @@ void GpuRDLayer<D>::step(double dt) {
   stats_.diffusion.converged = true;
   const RDIntegrator integ = rd_.settings().integrator;
   const bool implicitReaction = integ == RDIntegrator::KimLin;
-  const double theta = integ == RDIntegrator::ExplicitEuler ? 0.0 : integ == RDIntegrator::CrankNicolson ? 0.5 : 1.0;
+  const double theta = diffusionTheta(integ);
   stats_buffer_.zero();
   if (!frozenTaken_) {  // frozen species keep the values they start the run with
     for (int s = 0; s < species_; ++s)

@@ -13,6 +13,12 @@ enum class RDIntegrator {
   CrankNicolson,  // (1 - dt/2 d lap) x' = (1 + dt/2 d lap) x + dt R(x)   (seed 004 sec. 4)
 };
 
+// The integrator's weight on the implicit diffusion: every integrator is a
+// theta scheme (1 - theta dt d lap) x' = ... (explicit 0, Crank-Nicolson 1/2, else 1).
+inline double diffusionTheta(RDIntegrator i) {
+  return i == RDIntegrator::ExplicitEuler ? 0.0 : i == RDIntegrator::CrankNicolson ? 0.5 : 1.0;
+}
+
 enum class RDBoundary { Periodic, Neumann, Dirichlet };
 
 enum class RDLinearSolver { MGPCG, ICPCG };

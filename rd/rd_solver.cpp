@@ -377,7 +377,7 @@ void RDSolver<D>::step(double dt) {
   // with R = R(x) lagged, or for Kim & Lin the implicit reaction step first.
   const RDIntegrator integ = settings_.integrator;
   const bool implicitReaction = integ == RDIntegrator::KimLin;
-  const double theta = integ == RDIntegrator::ExplicitEuler ? 0.0 : integ == RDIntegrator::CrankNicolson ? 0.5 : 1.0;
+  const double theta = diffusionTheta(integ);
   react(dt, implicitReaction);  // Kim & Lin: updates x in place (projected per cell)
   // The species are independent from here on: run them side by side (each
   // still splits into row tasks).

@@ -11,11 +11,6 @@ namespace morphoflow {
 
 namespace {
 
-// The theta of the integrator's diffusion: explicit 0, Crank-Nicolson 1/2, else 1.
-double diffusionTheta(RDIntegrator i) {
-  return i == RDIntegrator::ExplicitEuler ? 0.0 : i == RDIntegrator::CrankNicolson ? 0.5 : 1.0;
-}
-
 template <size_t N>
 void components(Reader& r, const toml::table* t, const std::string& p, const char* key, const char* names,
                 std::array<double, N>* out) {
@@ -49,7 +44,7 @@ void parseGeneralized(SceneContext& c, const toml::table& rdt, Scene* sp) {
     r.fail(g, "rd.generalized", "[rd.generalized] replaces the diffusion operator, as [rd.anisotropy] and [rd.cosine_lobes] do; use one",
            "drop the other table");
   const std::vector<std::string> presets = kramersMoyalPresets();
-  if (const toml::node* pn = r.node(g, p, "preset")) {
+  if (r.node(g, p, "preset")) {
     G.preset = r.string(g, p, "preset", "", presets);
     G.tensors = *kramersMoyalPreset(G.preset);
   } else if (!r.node(g, p, "d2") && !r.node(g, p, "d3") && !r.node(g, p, "d4")) {

@@ -152,6 +152,12 @@ struct RDScene {
   RDAnisotropy anisotropy;
   RDCosineLobes lobes;
   RDGeneralized generalized;
+  // Whether any stroke deposits chemical (holds its cells).
+  bool strokesDeposit() const {
+    for (const RDStroke& s : strokes)
+      if (!s.species.empty()) return true;
+    return false;
+  }
   int coarseLevels = 0;              // coarse-to-fine: grids 2^L, ..., 2 times coarser first (seed 002, 000)
   long coarseSteps = 0;              // steps on each coarse grid
   bool coarseScaleDt = false;        // a grid 2^l times coarser steps 4^l dt (explicit limits scale with h^2)
