@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cstring>
 #include <fstream>
-#include <sstream>
+#include <memory>
 #include <vector>
 
 #include <fmt/format.h>
@@ -19,8 +19,6 @@ namespace morphoflow {
 namespace {
 
 constexpr char kMagic[8] = {'M', 'F', 'C', 'K', 'P', 'T', '0', '1'};
-
-void append64(std::string* s, uint64_t v) { s->append(reinterpret_cast<const char*>(&v), 8); }
 
 uint64_t read64(const std::string& s, size_t at) {
   uint64_t v;
@@ -46,20 +44,39 @@ fs::path checkpointFile(const fs::path& out, long step) {
   return checkpointDir(out) / fmt::format("{:010d}.ckpt", step);
 }
 
-fs::path writeCheckpoint(const fs::path& out, long step, const nlohmann::json& header, StateWriter* state) {
+fs::path writeCheckpoint(const fs::path& out, long step, const nlohmann::json& header,
+                         const std::function<void(StateWriter*)>& save) {
   createOutputFolder(checkpointDir(out));
   const std::string h = header.dump();
-  const size_t n = state->serialisedSize();
-  std::string bytes;
-  bytes.reserve(8 + 8 + h.size() + 8 + n + 8);  // one allocation: no copy of the state while it grows
-  bytes.assign(kMagic, 8);
-  append64(&bytes, h.size());
-  bytes += h;
-  append64(&bytes, n);
-  state->serialiseInto(&bytes);
-  append64(&bytes, XXH64(bytes.data(), bytes.size(), 0));
+  // The state's length comes first in the file: one pass counts it, the
+  // next streams the sections straight from the solvers into the file.
+  uint64_t n = 0;
+  StateWriter counter([&](std::string_view frame, const void*, size_t bytes) { n += frame.size() + bytes; });
+  save(&counter);
   const fs::path file = checkpointFile(out, step);
-  writeFileAtomically(file, bytes);
+  AtomicFile f(file);
+  std::unique_ptr<XXH64_state_t, decltype(&XXH64_freeState)> hash(XXH64_createState(), &XXH64_freeState);
+  XXH64_reset(hash.get(), 0);
+  auto put = [&](const void* data, size_t bytes) {
+    f.write(data, bytes);
+    XXH64_update(hash.get(), data, bytes);
+  };
+  auto put64 = [&](uint64_t v) { put(&v, 8); };
+  put(kMagic, 8);
+  put64(h.size());
+  put(h.data(), h.size());
+  put64(n);
+  uint64_t written = 0;
+  StateWriter streamer([&](std::string_view frame, const void* data, size_t bytes) {
+    put(frame.data(), frame.size());
+    put(data, bytes);
+    written += frame.size() + bytes;
+  });
+  save(&streamer);
+  if (written != n) throw std::logic_error("checkpoint: the state changed between its two passes");
+  const uint64_t digest = XXH64_digest(hash.get());
+  f.write(&digest, 8);
+  f.commit();
   const std::vector<fs::path> all = checkpointsNewestFirst(checkpointDir(out));
   std::error_code ec;
   for (size_t i = 2; i < all.size(); ++i) fs::remove(all[i], ec);
@@ -75,9 +92,8 @@ Checkpoint readCheckpoint(const fs::path& file) {
   if (!fs::is_regular_file(fs::symlink_status(file, ec))) throw bad("it is not a regular file");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw bad("it cannot be opened");
-  std::stringstream buf;
-  buf << in.rdbuf();
-  const std::string bytes = buf.str();
+  std::string bytes(size_t(fs::file_size(file, ec)), '\0');
+  if (ec || !in.read(bytes.data(), std::streamsize(bytes.size()))) throw bad("it cannot be read");
   if (bytes.size() < 8 + 8 + 8 + 8 || std::memcmp(bytes.data(), kMagic, 8) != 0) throw bad("it is not a morphoflow checkpoint, or it is cut short");
   const size_t body = bytes.size() - 8;
   if (XXH64(bytes.data(), body, 0) != read64(bytes, body)) throw bad("its checksum does not match (cut short or corrupted)");
@@ -92,7 +108,10 @@ Checkpoint readCheckpoint(const fs::path& file) {
   } catch (const std::exception& e) {
     throw bad(std::string("its header is not JSON: ") + e.what());
   }
-  c.state = bytes.substr(16 + hn + 8, sn);
+  // The state stays in the bytes read (no copy of a large run's state).
+  bytes.resize(body);
+  bytes.erase(0, 16 + hn + 8);
+  c.state = std::move(bytes);
   return c;
 }
 

@@ -25,10 +25,11 @@ struct Checkpoint {
 std::filesystem::path checkpointDir(const std::filesystem::path& out);
 std::filesystem::path checkpointFile(const std::filesystem::path& out, long step);
 
-// Writes a checkpoint of `state` (emptied: it is moved into the file's
-// bytes section by section) and removes all but the two newest. Returns the file.
+// Writes a checkpoint of the state `save` puts (called twice: to measure
+// it, then to stream it into the file, so it is never copied whole) and
+// removes all but the two newest. Returns the file.
 std::filesystem::path writeCheckpoint(const std::filesystem::path& out, long step, const nlohmann::json& header,
-                                      StateWriter* state);
+                                      const std::function<void(StateWriter*)>& save);
 
 // Reads one checkpoint; throws UserError naming the file when it is cut
 // short, corrupted or not a checkpoint.

@@ -144,14 +144,12 @@ class Driver {
   }
 
   fs::path saveCheckpoint() {
-    StateWriter w;
-    sim_.save(&w);
     nlohmann::json sinks = nlohmann::json::array();
     for (const auto& s : sinks_) sinks.push_back(s->state());
     const nlohmann::json header = {{"version", kVersion},      {"scene_hash", hash_},      {"scene", scene_.resolvedJson},
                                    {"step", sim_.steps()},     {"time", sim_.time()},      {"last_frame", lastFrame_},
                                    {"sinks", sinks},           {"log", log_.text()},       {"checkpoint_bytes", checkpointBytes_}};
-    const fs::path file = writeCheckpoint(out_, sim_.steps(), header, &w);
+    const fs::path file = writeCheckpoint(out_, sim_.steps(), header, [this](StateWriter* w) { sim_.save(w); });
     checkpointBytes_ += fileBytes(file);
     return file;
   }
@@ -167,7 +165,7 @@ class Driver {
                       "resume with the scene as it was, add --force to continue anyway, or run without --resume");
     }
     try {
-      sim_.load(StateReader(c.state));
+      sim_.load(StateReader(std::move(c.state)));
     } catch (const StateError& e) {
       throw UserError({c.file.string(), 0, 0}, "--resume", std::string("the checkpoint does not fit this scene: ") + e.what(),
                       "run the scene without --resume to start it afresh");

@@ -41,42 +41,61 @@ void checkReplaceable(const fs::path& path) {
                       "move it away or choose another --out");
 }
 
-void writeFileAtomically(const fs::path& path, std::string_view bytes) {
-  checkReplaceable(path);
-  fs::path tmp = path;
-  tmp += ".tmp";
-  checkReplaceable(tmp);
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | O_NOFOLLOW, 0644);
-  if (fd < 0) fail(path, "cannot create the file", errno);
+AtomicFile::AtomicFile(const fs::path& path) : path_(path), tmp_(path) {
+  checkReplaceable(path_);
+  tmp_ += ".tmp";
+  checkReplaceable(tmp_);
+  fd_ = ::open(tmp_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | O_NOFOLLOW, 0644);
+  if (fd_ < 0) fail(path_, "cannot create the file", errno);
+}
+
+AtomicFile::~AtomicFile() {
+  if (fd_ >= 0) abandon();
+}
+
+void AtomicFile::abandon() {
+  ::close(fd_);
+  fd_ = -1;
+  ::unlink(tmp_.c_str());
+}
+
+void AtomicFile::failWith(const char* what, int err) {
+  abandon();
+  fail(path_, what, err);
+}
+
+void AtomicFile::write(const void* data, size_t bytes) {
+  const char* p = static_cast<const char*>(data);
   size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+  while (done < bytes) {
+    const ssize_t n = ::write(fd_, p + done, bytes - done);
     if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const int err = n < 0 ? errno : ENOSPC;
-      ::close(fd);
-      ::unlink(tmp.c_str());
-      fail(path, "cannot write the file", err);
-    }
+    if (n <= 0) failWith("cannot write the file", n < 0 ? errno : ENOSPC);
     done += size_t(n);
   }
+}
+
+void AtomicFile::commit() {
   // A full disk may only show at fsync or close (delayed allocation, NFS).
-  if (::fsync(fd) != 0 && errno != EINVAL && errno != EROFS) {
-    const int err = errno;
-    ::close(fd);
-    ::unlink(tmp.c_str());
-    fail(path, "cannot write the file", err);
-  }
+  if (::fsync(fd_) != 0 && errno != EINVAL && errno != EROFS) failWith("cannot write the file", errno);
+  const int fd = fd_;
+  fd_ = -1;
   if (::close(fd) != 0) {
     const int err = errno;
-    ::unlink(tmp.c_str());
-    fail(path, "cannot write the file", err);
+    ::unlink(tmp_.c_str());
+    fail(path_, "cannot write the file", err);
   }
-  if (::rename(tmp.c_str(), path.c_str()) != 0) {
+  if (::rename(tmp_.c_str(), path_.c_str()) != 0) {
     const int err = errno;
-    ::unlink(tmp.c_str());
-    fail(path, "cannot move the finished file into place", err);
+    ::unlink(tmp_.c_str());
+    fail(path_, "cannot move the finished file into place", err);
   }
+}
+
+void writeFileAtomically(const fs::path& path, std::string_view bytes) {
+  AtomicFile f(path);
+  f.write(bytes.data(), bytes.size());
+  f.commit();
 }
 
 void createOutputFolder(const fs::path& dir) {

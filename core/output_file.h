@@ -19,6 +19,25 @@ class OutputError : public UserError {
       : UserError({path.string(), 0, 0}, "", message, hint) {}
 };
 
+// A file written piece by piece under a temporary name beside `path`, every
+// write checked; commit() fsyncs it and renames it into place. Destroyed
+// without commit() (an error, an exception), it removes the temporary file.
+class AtomicFile {
+ public:
+  explicit AtomicFile(const std::filesystem::path& path);
+  ~AtomicFile();
+  AtomicFile(const AtomicFile&) = delete;
+  AtomicFile& operator=(const AtomicFile&) = delete;
+  void write(const void* data, size_t bytes);
+  void commit();
+
+ private:
+  void abandon();
+  [[noreturn]] void failWith(const char* what, int err);
+  std::filesystem::path path_, tmp_;
+  int fd_ = -1;
+};
+
 // Writes `bytes` to `path` (temporary name, checked writes, fsync, rename).
 void writeFileAtomically(const std::filesystem::path& path, std::string_view bytes);
 

@@ -20,51 +20,29 @@ T take(const std::string& in, size_t* at) {
 
 }  // namespace
 
-size_t StateWriter::serialisedSize() const {
-  size_t n = 0;
-  for (const auto& [name, data] : sections_) n += sizeof(uint32_t) + name.size() + sizeof(uint64_t) + data.size();
-  return n;
+void StateWriter::putBytes(const std::string& name, const void* data, size_t bytes) {
+  std::string frame;
+  append<uint32_t>(&frame, uint32_t(name.size()));
+  frame += name;
+  append<uint64_t>(&frame, uint64_t(bytes));
+  sink_(frame, data, bytes);
 }
 
-void StateWriter::serialiseInto(std::string* out) {
-  out->reserve(out->size() + serialisedSize());
-  for (auto& [name, data] : sections_) {
-    append<uint32_t>(out, uint32_t(name.size()));
-    *out += name;
-    append<uint64_t>(out, uint64_t(data.size()));
-    *out += data;
-    std::string().swap(data);
-  }
-  sections_.clear();
-}
-
-std::string StateWriter::serialise() const {
-  std::string out;
-  out.reserve(serialisedSize());
-  for (const auto& [name, data] : sections_) {
-    append<uint32_t>(&out, uint32_t(name.size()));
-    out += name;
-    append<uint64_t>(&out, uint64_t(data.size()));
-    out += data;
-  }
-  return out;
-}
-
-StateReader::StateReader(const std::string& in) {
+StateReader::StateReader(std::string in) : all_(std::move(in)) {
   size_t at = 0;
-  while (at < in.size()) {
-    const uint32_t n = take<uint32_t>(in, &at);
-    if (in.size() - at < n) throw StateError("the state ends inside a section name");
-    std::string name = in.substr(at, n);
+  while (at < all_.size()) {
+    const uint32_t n = take<uint32_t>(all_, &at);
+    if (all_.size() - at < n) throw StateError("the state ends inside a section name");
+    std::string name = all_.substr(at, n);
     at += n;
-    const uint64_t bytes = take<uint64_t>(in, &at);
-    if (in.size() - at < bytes) throw StateError("section '" + name + "' is cut short");
-    sections_[name] = in.substr(at, bytes);
+    const uint64_t bytes = take<uint64_t>(all_, &at);
+    if (all_.size() - at < bytes) throw StateError("section '" + name + "' is cut short");
+    sections_[name] = std::string_view(all_).substr(at, bytes);
     at += bytes;
   }
 }
 
-const std::string& StateReader::bytes(const std::string& name, size_t expected) const {
+std::string_view StateReader::bytes(const std::string& name, size_t expected) const {
   auto it = sections_.find(name);
   if (it == sections_.end()) throw StateError("the state has no section '" + name + "'");
   if (it->second.size() != expected)

@@ -1,13 +1,15 @@
 // A simulation's complete state as named binary sections, for checkpoints:
-// a StateWriter collects the sections, a StateReader hands them back and
-// checks that each one is there with the size the reader expects.
+// a StateWriter streams the sections to a sink, a StateReader hands them
+// back and checks that each one is there with the size the reader expects.
 #pragma once
 
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <map>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <type_traits>
 #include <vector>
 
@@ -17,9 +19,13 @@ namespace morphoflow {
 
 class StateWriter {
  public:
-  void putBytes(const std::string& name, const void* data, size_t bytes) {
-    sections_[name].assign(static_cast<const char*>(data), static_cast<const char*>(data) + bytes);
-  }
+  // Receives each section as it is put: its frame (name length, name and
+  // size, as StateReader parses them), then its bytes. Nothing is held in
+  // between, so a checkpoint streams a large state to its file uncopied.
+  using Sink = std::function<void(std::string_view frame, const void* data, size_t bytes)>;
+  explicit StateWriter(Sink sink) : sink_(std::move(sink)) {}
+
+  void putBytes(const std::string& name, const void* data, size_t bytes);
   template <class T>
   void put(const std::string& name, const T& value) {
     static_assert(std::is_trivially_copyable_v<T>);
@@ -34,17 +40,9 @@ class StateWriter {
   void putGrid(const std::string& name, const Grid<T, D>& g) {
     putVector(name, g.values());
   }
-  // The sections as one byte string (each: name length, name, size, bytes).
-  std::string serialise() const;
-  // The length serialise() would return.
-  size_t serialisedSize() const;
-  // Appends serialise()'s bytes to *out and empties the writer, freeing each
-  // section once it is copied: the whole state is held once, not twice (a
-  // checkpoint of a large run is the run's peak memory otherwise).
-  void serialiseInto(std::string* out);
 
  private:
-  std::map<std::string, std::string> sections_;
+  Sink sink_;
 };
 
 // Thrown for a missing section or one of the wrong size: the state was
@@ -55,9 +53,13 @@ class StateError : public std::runtime_error {
 
 class StateReader {
  public:
-  // Parses serialise()'s output; throws StateError when it is malformed.
-  explicit StateReader(const std::string& bytes);
-  const std::string& bytes(const std::string& name, size_t expected) const;
+  // Parses the sections a StateWriter put, one after another, keeping
+  // `bytes` (moved in) and pointing into it; throws StateError when they
+  // are malformed.
+  explicit StateReader(std::string bytes);
+  StateReader(const StateReader&) = delete;  // sections_ points into all_
+  StateReader& operator=(const StateReader&) = delete;
+  std::string_view bytes(const std::string& name, size_t expected) const;
   template <class T>
   void get(const std::string& name, T* value) const {
     std::memcpy(value, bytes(name, sizeof(T)).data(), sizeof(T));
@@ -65,18 +67,19 @@ class StateReader {
   // Fills v, whose size is already the expected one.
   template <class T>
   void getVector(const std::string& name, std::vector<T>* v) const {
-    const std::string& b = bytes(name, v->size() * sizeof(T));
+    const std::string_view b = bytes(name, v->size() * sizeof(T));
     if (!b.empty()) std::memcpy(v->data(), b.data(), b.size());
   }
   template <class T, int D>
   void getGrid(const std::string& name, Grid<T, D>* g) const {
-    const std::string& b = bytes(name, g->size() * sizeof(T));
+    const std::string_view b = bytes(name, g->size() * sizeof(T));
     if (!b.empty()) std::memcpy(g->data(), b.data(), b.size());
   }
   bool has(const std::string& name) const { return sections_.count(name) != 0; }
 
  private:
-  std::map<std::string, std::string> sections_;
+  std::string all_;
+  std::map<std::string, std::string_view> sections_;
 };
 
 }  // namespace morphoflow
