@@ -84,7 +84,7 @@ void stepRow(const LaplaceSystem<D>& A, size_t row, size_t y, size_t z, const fl
     return;
   }
   general(0, span.lo);
-  const float inv = A.template invDiag<float>()[s.base + span.lo];
+  const float inv = A.invDiag()[s.base + span.lo];
   const bool weighted = span.w != 1.0f;
   // The neighbour rows (their cell 0); in 2D the z pair repeats the y pair, unused.
   const float *yl = s.xlo[1], *yh = s.xhi[1], *zl = s.xlo[D - 1], *zh = s.xhi[D - 1];
@@ -104,7 +104,8 @@ void stepRow(const LaplaceSystem<D>& A, size_t row, size_t y, size_t z, const fl
 }  // namespace
 
 template <int D>
-Chebyshev<D>::Chebyshev(const LaplaceSystem<D>& A, const ChebyshevLayout& layout) : A_(A), layout_(layout) {
+Chebyshev<D>::Chebyshev(const LaplaceSystem<D>& A, const ChebyshevLayout& layout, ChebyshevWork* work)
+    : A_(A), layout_(layout), work_(work ? work : &own_) {
   layout_.stepsPerPass = std::max(1, layout_.stepsPerPass);
   if (layout_.slabs <= 0) layout_.slabs = hardwareThreads();
   zeros_.assign(size_t(A.dims[0]), 0.0f);
@@ -136,7 +137,7 @@ void Chebyshev<D>::refresh() {
     packedStart_[row + 1] = packedStart_[row] + (nx - (span.hi - span.lo)) * kPacked<D>;
   }
   packed_.resize(packedStart_[rows]);
-  const float* invDiag = A_.template invDiag<float>();
+  const float* invDiag = A_.invDiag();
   parallelForRows<D>(A_.dims, [&](size_t row) {
     const RowStencil<D, float> s = rowStencil<D, float>(A_, zerosOf(), zerosOf(), zerosOf(), row);
     const auto& span = A_.sweepSpan(row);
@@ -217,14 +218,14 @@ void Chebyshev<D>::rows(size_t q, auto&& fn) const {
 
 template <int D>
 void Chebyshev<D>::step(int level, size_t q) {
-  const float* cur = e_[(level - 1) & 1].data();
-  float* e = e_[level & 1].data();
+  const float* cur = work_->e[(level - 1) & 1].data();
+  float* e = work_->e[level & 1].data();
   const float omega = omega_[std::min(size_t(level), omega_.size() - 1)];
   rows(q, [&](size_t row, size_t y, size_t z) {
     if (level == 2)
-      stepRow<D, true>(A_, row, y, z, cur, e, g_.data(), zeros_.data(), packedRow(row), omega);
+      stepRow<D, true>(A_, row, y, z, cur, e, work_->g.data(), zeros_.data(), packedRow(row), omega);
     else
-      stepRow<D, false>(A_, row, y, z, cur, e, g_.data(), zeros_.data(), packedRow(row), omega);
+      stepRow<D, false>(A_, row, y, z, cur, e, work_->g.data(), zeros_.data(), packedRow(row), omega);
   });
 }
 
@@ -240,12 +241,12 @@ void Chebyshev<D>::residualPlane(const Vector& b, const Vector& x, size_t q) {
   rows(q, [&](size_t row, size_t, size_t) {
     sum += A_.residualRow(row, b, x, buffer.data());
     const size_t base = row * nx;
-    const double* __restrict inv = A_.template invDiag<double>() + base;
+    const float* __restrict inv = A_.invDiag() + base;
     const double* __restrict rr = buffer.data();
-    float* __restrict g = g_.data() + base;
-    float* __restrict e = e_[1].data() + base;
+    float* __restrict g = work_->g.data() + base;
+    float* __restrict e = work_->e[1].data() + base;
     for (size_t i = 0; i < nx; ++i) {
-      g[i] = float(rr[i] * sc * inv[i]);
+      g[i] = float(rr[i] * sc * double(inv[i]));
       e[i] = g[i];
     }
   });
@@ -272,8 +273,8 @@ SolverResult Chebyshev<D>::solve(const Vector& b, Vector* xp, const SolverOption
     result.converged = true;
     return result;
   }
-  for (auto& v : e_) v.resize(n);
-  g_.resize(n);
+  for (auto& v : work_->e) v.resize(n);
+  work_->g.resize(n);
   planeSquares_.assign(size_t(A_.dims[D - 1]), 0.0);
   // g of order 1 in float for any residual from 1e-30 ||b|| up.
   rscale_ = std::sqrt(double(n)) / bnorm;
@@ -298,7 +299,7 @@ SolverResult Chebyshev<D>::solve(const Vector& b, Vector* xp, const SolverOption
     }
     // x += e / rscale on plane q, then the new residual (and the next
     // round's g) on plane q - 1, whose neighbours are then all updated.
-    const float* e = e_[steps & 1].data();
+    const float* e = work_->e[steps & 1].data();
     const double inv = 1.0 / rscale_;
     pipeline(2, [&](int t, size_t q) {
       if (t == 2) return residualPlane(b, x, q);

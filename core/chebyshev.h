@@ -36,10 +36,18 @@ struct ChebyshevLayout {
   int slabs = 0;         // tasks per pass (at most); 0: one per thread
 };
 
+// The iteration's work vectors (single precision). Solvers that run one
+// after another may share one (the viscosity's components do).
+struct ChebyshevWork {
+  std::vector<float> e[2];  // step k lives in e[k & 1]
+  std::vector<float> g;     // D^-1 r, scaled
+};
+
 template <int D>
 class Chebyshev {
  public:
-  explicit Chebyshev(const LaplaceSystem<D>& A, const ChebyshevLayout& layout = {});
+  // work: shared work vectors (null: its own).
+  explicit Chebyshev(const LaplaceSystem<D>& A, const ChebyshevLayout& layout = {}, ChebyshevWork* work = nullptr);
 
   // The system's coefficients changed, not its shape: bound the spectrum again.
   void refresh();
@@ -83,8 +91,8 @@ class Chebyshev {
   ChebyshevLayout layout_;
   double rho_ = 1.0;
   double diagRatio_ = 1.0;    // max / min diagonal over active cells
-  std::vector<float> e_[2];   // step k lives in e_[k & 1]
-  std::vector<float> g_;      // D^-1 r, scaled
+  ChebyshevWork own_;
+  ChebyshevWork* work_;       // &own_ unless shared
   std::vector<float> zeros_;  // a row of zeros: beyond a non-periodic edge
   const float* zerosOf() const { return zeros_.data(); }
   // Per row, from packedStart_[row]: the coefficients of its cells outside

@@ -73,6 +73,14 @@ class Grid {
   const std::vector<T>& values() const { return data_; }
 
   void fill(T v) { std::fill(data_.begin(), data_.end(), v); }
+  // Takes the shape `dims`, its values unspecified; storage is reused (no
+  // allocation while the grid has held as many values before).
+  void reshape(const IVec<D>& dims) {
+    size_t n = 1;
+    for (int a = 0; a < D; ++a) n *= size_t(dims[a]);
+    dims_ = dims;
+    data_.resize(n);
+  }
 
  private:
   IVec<D> dims_{};

@@ -224,7 +224,6 @@ void LaplaceSystem<D>::finalize() {
     }
   });
   invDiag_.resize(size());  // every entry is written below
-  invDiagF_.resize(size());
   forEachCell<D>(dims, [&](const IVec<D>& cell, size_t i) {
     float d = c[i];
     for (int a = 0; a < D; ++a) {
@@ -233,8 +232,7 @@ void LaplaceSystem<D>::finalize() {
       d += w[a][i] + w[a][w[a].index(lo)];
     }
     diag[i] = d;
-    invDiag_[i] = d > 0 ? 1.0 / double(d) : 0.0;
-    invDiagF_[i] = float(invDiag_[i]);
+    invDiag_[i] = d > 0 ? float(1.0 / double(d)) : 0.0f;
   });
   const size_t nx = size_t(dims[0]);
   const size_t rows = size() / nx;
@@ -444,7 +442,7 @@ void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, 
     const size_t parity = y + z;
     const float* wa[D];
     for (int a = 0; a < D; ++a) wa[a] = w[a].data() + s.base;
-    const T* rd = invDiag<T>() + s.base;
+    const float* rd = invDiag() + s.base;
     const T* br = b.data() + s.base;
     T* xr = x.data() + s.base;
     // x_i = (b_i / scale + sum_f w_f x_j) / diag_i; invDiag is 0 on inactive cells.

@@ -67,14 +67,9 @@ struct LaplaceSystem {
     uint32_t lo = 0, hi = 0;
     float w = 1.0f;
   };
-  // 1 / diag per cell (0 on inactive cells), in double or float.
-  template <class T>
-  const T* invDiag() const {
-    if constexpr (std::is_same_v<T, double>)
-      return invDiag_.data();
-    else
-      return invDiagF_.data();
-  }
+  // 1 / diag per cell (0 on inactive cells), in single precision (a
+  // smoother's or preconditioner's factor: the double kernels widen it).
+  const float* invDiag() const { return invDiag_.data(); }
   // A row's span for sweeps that read the neighbours' values only (the
   // smoother, the Chebyshev iteration): its faces across a non-periodic
   // domain edge may weigh 0, as the row of zeros beyond adds 0 either way.
@@ -95,8 +90,7 @@ struct LaplaceSystem {
 
   bool singular_ = false;
   size_t active_ = 0;
-  Vector invDiag_;              // 1 / diag, 0 on inactive cells
-  std::vector<float> invDiagF_; // the same in float
+  std::vector<float> invDiag_;  // 1 / diag, 0 on inactive cells
   Vector zerosX_;               // a row of zeros: the neighbour beyond a wall
   std::vector<float> zerosW_;   // (also the float row of zeros)
   std::vector<Span> uniformSpan_;

@@ -402,6 +402,7 @@ void advectField(const Grid<float, D>& src, const Layout<D>& layout, const MacVe
   }
   // BFECC: phi_bar = phi + (phi - A^-1 A phi) / 2, then A(phi_bar), limited.
   Grid<float, D>& fwd = s.fwd;
+  fwd.reshape(src.dims());
   semiLagrangian<D>(src, layout, u, dt, &fwd, nullptr, nullptr, {&s.start, false});
   semiLagrangian<D>(fwd, layout, u, -dt, &back, nullptr, nullptr, {&s.start, true});
   Grid<float, D>& corrected = fwd;  // fwd is no longer needed

@@ -12,21 +12,20 @@
 
 namespace morphoflow {
 
-// Scratch grids of the second-order schemes, kept between steps.
+// Scratch grids of the second-order schemes, kept between steps: one set,
+// reshaped for each field advected (the fields are advected one after
+// another), so it costs one grid shape's worth, not one per shape.
 template <int D>
 struct AdvectionScratch {
   struct Set {
-    Grid<float, D> lo, hi, back, fwd;
+    Grid<float, D> lo, hi, back, fwd;  // fwd: BFECC's only (reshaped there)
     std::array<Grid<float, D>, D> start;  // u at the samples, shared by a scheme's passes
   };
-  std::vector<Set> sets;  // one per grid shape (each velocity component, cells)
+  Set set;
   Set& forShape(const IVec<D>& dims) {
-    for (Set& s : sets)
-      if (s.lo.dims() == dims) return s;
-    Set& s = sets.emplace_back();
-    for (Grid<float, D>* g : {&s.lo, &s.hi, &s.back, &s.fwd}) *g = Grid<float, D>(dims);
-    for (Grid<float, D>& g : s.start) g = Grid<float, D>(dims);
-    return s;
+    for (Grid<float, D>* g : {&set.lo, &set.hi, &set.back}) g->reshape(dims);
+    for (Grid<float, D>& g : set.start) g.reshape(dims);
+    return set;
   }
 };
 

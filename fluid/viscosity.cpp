@@ -72,8 +72,6 @@ ViscositySolver<D>::ViscositySolver(const VelocityConstraints<D>& vc, const Solv
   for (int a = 0; a < D; ++a) {
     Component& C = comp_[size_t(a)];
     static_cast<ViscousSystem<D>&>(C) = viscousSystem<D>(vc_, a);
-    C.b.assign(C.A.size(), 0.0);
-    C.x.assign(C.A.size(), 0.0);
   }
 }
 
@@ -85,37 +83,43 @@ namespace {
 const MultigridOptions kViscosityCycle{3, 3, 4};
 }  // namespace
 
+// Unknown i of component a's system is face gi of its grid: the same index
+// unless a periodic axis drops the duplicate face layer.
+template <int D>
+static void eachUnknown(const IVec<D>& dims, const Grid<float, D>& g, auto&& fn) {
+  if (dims == g.dims())
+    parallelFor(g.size(), [&](size_t i) { fn(i, i); }, 4096);
+  else
+    forEachCell<D>(dims, [&](const IVec<D>& k, size_t i) { fn(i, g.index(k)); });
+}
+
+template <int D>
+double ViscositySolver<D>::rightHandSide(const MacVelocity<D>& u, int a, double s) {
+  const Component& C = comp_[size_t(a)];
+  const Grid<float, D>& g = u[a];
+  const Grid<uint8_t, D>& fixed = vc_.fixed[a];
+  b_.resize(C.A.size());
+  eachUnknown<D>(C.dims, g, [&](size_t i, size_t gi) {
+    b_[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * C.boundaryRhs[i];
+  });
+  return dot(b_, b_);
+}
+
 template <int D>
 SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt) {
   SolverResult result;
   result.converged = true;
   if (nu <= 0 || dt <= 0) return result;
   const double s = nu * dt / (vc_.h * vc_.h);
-  // Unknown i is face gi of component a's grid: the same index unless a
-  // periodic axis drops the duplicate face layer.
-  auto eachUnknown = [&](int a, auto&& fn) {
-    const Component& C = comp_[size_t(a)];
-    const Grid<float, D>& g = (*u)[a];
-    if (C.dims == g.dims())
-      parallelFor(C.A.size(), [&](size_t i) { fn(i, i); }, 4096);
-    else
-      forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) { fn(i, g.index(k)); });
-  };
-  // The components' systems are independent: set up and solve them side by
-  // side (each still splits into row tasks), so the small loops of the
-  // coarse multigrid levels of one overlap with another's work.
   std::array<double, D> bb{};  // ||b_a||^2
-  parallelFor(size_t(D), [&](size_t ai) {
-    const int a = int(ai);
-    Component& C = comp_[ai];
-    const Grid<float, D>& g = (*u)[a];
-    const Grid<uint8_t, D>& fixed = vc_.fixed[a];
+  for (int a = D - 1; a >= 0; --a) {  // last: component 0, the first solved
+    Component& C = comp_[size_t(a)];
     if (s != s_) {  // A = s (c + sum w (x_i - x_j)), c = 1/s + boundary terms
       C.setRate(s);
       if (C.chebyshev)
         C.chebyshev->refresh();
       else
-        C.chebyshev = std::make_unique<Chebyshev<D>>(C.A);
+        C.chebyshev = std::make_unique<Chebyshev<D>>(C.A, ChebyshevLayout{}, &chebyshevWork_);
       if (C.chebyshev->quick())
         C.multigrid.reset();
       else if (C.multigrid)
@@ -123,22 +127,8 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
       else
         C.multigrid = std::make_unique<Multigrid<D>>(C.A, kViscosityCycle);
     }
-    // Warm start: the increment's rate, linearly extrapolated in steps.
-    const std::vector<float> &r1 = C.rate[0], &r0 = C.rate[1];
-    const int history = C.history;
-    auto setUp = [&](size_t i, size_t gi) {
-      const double rate = history >= 2 ? 2.0 * double(r1[i]) - double(r0[i]) : history == 1 ? double(r1[i]) : 0.0;
-      C.x[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * rate;
-      C.b[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * C.boundaryRhs[i];
-      return C.b[i] * C.b[i];
-    };
-    if (C.dims == g.dims())  // ||b||^2 in the same pass (the same sum as dot(b, b))
-      bb[ai] = deterministicSum(C.A.size(), [&](size_t i) { return setUp(i, i); });
-    else {
-      eachUnknown(a, setUp);
-      bb[ai] = dot(C.b, C.b);
-    }
-  });
+    bb[size_t(a)] = rightHandSide(*u, a, s);
+  }
   // The D systems are blocks of one linear system, (I - nu dt lap) u = u*
   // on the MAC velocity, solved to a relative residual of that system:
   // sum_a ||r_a||^2 <= tol^2 sum_a ||b_a||^2. Block a may leave
@@ -148,39 +138,40 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
   // own size, which would cost iterations and buy nothing.
   double bAll = 0.0;
   for (double v : bb) bAll += v;
-  std::array<SolverResult, D> results;
-  std::array<double, D> rr{};  // ||r_a||^2 at the end
-  parallelFor(size_t(D), [&](size_t ai) {
-    const int a = int(ai);
-    Component& C = comp_[ai];
+  double rAll = 0.0;
+  for (int a = 0; a < D; ++a) {
+    Component& C = comp_[size_t(a)];
     Grid<float, D>& g = (*u)[a];
     const Grid<uint8_t, D>& fixed = vc_.fixed[a];
+    const double ba = bb[size_t(a)];
+    if (a > 0) rightHandSide(*u, a, s);  // b_ holds component 0's already
+    // Warm start: the increment's rate, linearly extrapolated in steps.
+    const std::vector<float> &r1 = C.rate[0], &r0 = C.rate[1];
+    const int history = C.history;
+    x_.resize(C.A.size());
+    eachUnknown<D>(C.dims, g, [&](size_t i, size_t gi) {
+      const double rate = history >= 2 ? 2.0 * double(r1[i]) - double(r0[i]) : history == 1 ? double(r1[i]) : 0.0;
+      x_[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * rate;
+    });
     SolverOptions options = options_;
-    if (bb[ai] > 0.0)
-      options.tolerance = options_.tolerance * std::sqrt(0.5 * (bb[ai] + bAll / D) / bb[ai]);
-    if (C.multigrid)
-      results[ai] = solvePCG<D>(C.A, C.b, &C.x, C.multigrid.get(), options, nullptr, &C.workspace);
-    else
-      results[ai] = C.chebyshev->solve(C.b, &C.x, options, std::sqrt(bb[ai]));
-    rr[ai] = results[ai].residual * results[ai].residual * bb[ai];
+    if (ba > 0.0) options.tolerance = options_.tolerance * std::sqrt(0.5 * (ba + bAll / D) / ba);
+    const SolverResult r = C.multigrid ? solvePCG<D>(C.A, b_, &x_, C.multigrid.get(), options, nullptr, &pcgWork_)
+                                       : C.chebyshev->solve(b_, &x_, options, std::sqrt(ba));
+    rAll += r.residual * r.residual * ba;
+    result.iterations = std::max(result.iterations, r.iterations);
     std::swap(C.rate[0], C.rate[1]);  // the older slot takes the new rate
     std::vector<float>& rate = C.rate[0];
     rate.resize(C.A.size());
     const double invS = 1.0 / s;
-    eachUnknown(a, [&](size_t i, size_t gi) {
+    eachUnknown<D>(C.dims, g, [&](size_t i, size_t gi) {
       if (fixed[gi]) {
         rate[i] = 0.0f;
         return;
       }
-      rate[i] = float((C.x[i] - double(g[gi])) * invS);
-      g[gi] = float(C.x[i]);
+      rate[i] = float((x_[i] - double(g[gi])) * invS);
+      g[gi] = float(x_[i]);
     });
     C.history = std::min(C.history + 1, 2);
-  });
-  double rAll = 0.0;
-  for (int a = 0; a < D; ++a) {
-    rAll += rr[size_t(a)];
-    result.iterations = std::max(result.iterations, results[size_t(a)].iterations);
   }
   result.residual = bAll > 0.0 ? std::sqrt(rAll / bAll) : 0.0;
   result.converged = result.residual <= options_.tolerance * 1.0001;

@@ -56,18 +56,23 @@ class ViscositySolver {
 
  private:
   struct Component : ViscousSystem<D> {
-    Vector b, x;
     // The last two solves' (x - u*) / s, newest first: the next warm start
     // (a guess only, so single precision: half the memory traffic).
     std::array<std::vector<float>, 2> rate;
     int history = 0;            // how many of them are set
     std::unique_ptr<Chebyshev<D>> chebyshev;  // bounds the spectrum; solves while it is quick
     std::unique_ptr<Multigrid<D>> multigrid;  // present while it solves instead
-    PcgWorkspace workspace;
   };
+  // Component a's right-hand side into b_ (its unknowns' count); returns ||b||^2.
+  double rightHandSide(const MacVelocity<D>& u, int a, double s);
   const VelocityConstraints<D>& vc_;
   SolverOptions options_;
   std::array<Component, D> comp_;
+  // The components are solved one after another and share their work
+  // vectors: one component's worth, not D.
+  Vector b_, x_;
+  ChebyshevWork chebyshevWork_;
+  PcgWorkspace pcgWork_;
   double s_ = -1.0;  // nu dt / h^2 the diagonals were built for
 };
 
