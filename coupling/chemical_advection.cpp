@@ -197,7 +197,7 @@ ChemicalAdvector<D>::ChemicalAdvector(ChemicalDomain<D> domain, ChemicalInterpol
   for (int a = 0; a < D; ++a) n *= size_t(domain_.cells[a]);
   if (!domain_.solid.empty() && domain_.solid.size() != n) throw std::invalid_argument("coupling: solid mask has the wrong size");
   for (auto& f : feet_) f.assign(n, 0.0f);
-  fromInflow_.assign(n, 0);
+  if (!domain_.inflowValues.empty()) fromInflow_.assign(n, 0);
 }
 
 template <int D>
@@ -269,7 +269,7 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
         dst[s][i] = w * in[s] + (1.0 - w) * sampleChemical<D>(*species[s], d.periodic, c, interpolation_);
     }
   };
-  const size_t cells = fromInflow_.size();
+  const size_t cells = feet_[0].size();
   bool walls = true;
   for (int a = 0; a < D; ++a) walls = walls && !d.periodic[size_t(a)];
   [[maybe_unused]] const bool wide = linear && walls && cells < (size_t(1) << 31) && useAvx2();

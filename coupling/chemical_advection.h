@@ -52,7 +52,7 @@ class ChemicalAdvector {
   // Foot of every cell (grid coordinates, per axis; single precision, as
   // the fluid's own traces: 1e-7 of the domain, far below a cell).
   std::array<std::vector<float>, D> feet_;
-  std::vector<double> fromInflow_;  // weight of the inflow value (1: the foot left through an inflow side)
+  std::vector<double> fromInflow_;  // weight of the inflow value (1: the foot left through an inflow side); empty without inflow
   std::vector<Grid<double, D>> scratch_;  // one per species
 };
 

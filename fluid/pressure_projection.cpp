@@ -92,8 +92,8 @@ SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double
     ratePrev_.resize(phi_.size());
     parallelFor(phi_.size(), [&](size_t i) {
       const double rate = phi_[i] * inv;
-      phi_[i] = dt * (extrapolate ? 2.0 * rate - ratePrev_[i] : rate);
-      ratePrev_[i] = rate;
+      phi_[i] = dt * (extrapolate ? 2.0 * rate - double(ratePrev_[i]) : rate);
+      ratePrev_[i] = float(rate);
     }, 4096);
   }
   SolverResult r;

@@ -51,7 +51,9 @@ class PressureProjection {
   std::unique_ptr<Multigrid<D>> multigrid_;
   std::unique_ptr<MIC0Preconditioner<D>> mic_;
   Vector phi_, rhs_;
-  Vector ratePrev_;  // phi / dt of the projection before the last (once solves >= 2)
+  // phi / dt of the projection before the last (once solves >= 2); a warm
+  // start's guess only, so single precision.
+  std::vector<float> ratePrev_;
   PcgWorkspace workspace_;
   double lastDt_ = 0.0, lastDensity_ = 1.0;
   int solves_ = 0;  // projections with dt > 0 since the start, capped at 2

@@ -54,7 +54,7 @@ ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
       }
     }
     C.cBoundary[i] = float(c);
-    C.boundaryRhs[i] = extra;
+    C.boundaryRhs[i] = float(extra);
   });
   return C;
 }
@@ -100,7 +100,7 @@ double ViscositySolver<D>::rightHandSide(const MacVelocity<D>& u, int a, double 
   const Grid<uint8_t, D>& fixed = vc_.fixed[a];
   b_.resize(C.A.size());
   eachUnknown<D>(C.dims, g, [&](size_t i, size_t gi) {
-    b_[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * C.boundaryRhs[i];
+    b_[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * double(C.boundaryRhs[i]);
   });
   return dot(b_, b_);
 }

@@ -87,7 +87,8 @@ GpuFluid<D>::GpuFluid(const FluidSettings& s, const VelocityConstraints<D>& vc) 
     v->pcg = std::make_unique<GpuPcg>(*v->A);
     v->b = GpuBuffer(v->host.A.size() * sizeof(double));
     v->x = GpuBuffer(v->host.A.size() * sizeof(double));
-    v->boundaryRhs = GpuBuffer::of(v->host.boundaryRhs);
+    const std::vector<float>& rhs = v->host.boundaryRhs;  // the shader reads doubles
+    v->boundaryRhs = GpuBuffer::of(std::vector<double>(rhs.begin(), rhs.end()));
     viscous_[size_t(a)] = std::move(v);
   }
   dyeActive_ = s.inflowDyeStripes > 0;

@@ -75,8 +75,10 @@ RDSolver<D>::RDSolver(const RDSettings& s, const ReactionModel& model) : setting
   if (s.boundary == RDBoundary::Dirichlet && int(s.dirichletValues.size()) != n)
     throw std::invalid_argument("rd: Dirichlet boundaries need one value per species");
   for (int sp = 0; sp < n; ++sp) diffusion_.push_back(std::make_unique<Diffusion>());
-  scratch_.assign(size_t(n), Vector(laplacian_.size(), 0.0));
-  rates_.assign(size_t(n), Vector(laplacian_.size(), 0.0));
+  // Sized where an integrator uses them (Kim & Lin's implicit reaction and
+  // diffusion need neither).
+  scratch_.assign(size_t(n), Vector());
+  rates_.assign(size_t(n), Vector());
 }
 
 template <int D>
@@ -306,6 +308,7 @@ void RDSolver<D>::react(double dt, bool implicit) {
   double* rs[ReactionModel::kMaxSpecies];
   for (int s = 0; s < n; ++s) {
     xs[s] = x_[size_t(s)].data();
+    if (!implicit) rates_[size_t(s)].resize(cells);
     rs[s] = rates_[size_t(s)].data();
   }
   if (!implicit) {  // rates_ = R(x)
@@ -389,7 +392,10 @@ void RDSolver<D>::step(double dt) {
     const double explicitD = (1.0 - theta) * dt * d_[size_t(s)];
     // The explicit part carries its Dirichlet term inside L; the implicit
     // part adds its own through solveDiffusion.
-    if (explicitD > 0) applyLaplacian(s, x, &scratch_[size_t(s)]);
+    if (explicitD > 0) {
+      scratch_[si].resize(cells);
+      applyLaplacian(s, x, &scratch_[si]);
+    }
     if (!implicitReaction && explicitD > 0)
       parallelFor(cells, [&](size_t i) { x[i] += dt * R[i] + explicitD * L[i]; }, kChunk);
     else if (!implicitReaction)
