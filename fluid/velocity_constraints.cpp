@@ -1,5 +1,7 @@
 #include "fluid/velocity_constraints.h"
 
+#include <algorithm>
+
 #include "core/parallel.h"
 
 namespace morphoflow {
@@ -11,7 +13,7 @@ VelocityConstraints<D>::VelocityConstraints(const IVec<D>& c, double hh, const D
   for (int a = 0; a < D; ++a) {
     IVec<D> fd = cells + unitVector<D>(a);
     fixed[a] = Grid<uint8_t, D>(fd, 0);
-    value[a] = Grid<float, D>(fd, 0.0f);
+    Grid<float, D> value(fd, 0.0f);
     Layout<D> layout = Layout<D>::face(a, h, cells, periodic());
     forEachCell<D>(fd, [&](const IVec<D>& k, size_t i) {
       bool boundary = !boundaries.periodic(a) && (k[a] == 0 || k[a] == cells[a]);
@@ -23,7 +25,7 @@ VelocityConstraints<D>::VelocityConstraints(const IVec<D>& c, double hh, const D
         } else if (side.kind == BoundaryKind::Inflow) {
           fixed[a][i] = 1;
           double speed = inflowSpeed(a, layout.toWorld(k));
-          value[a][i] = float(high ? -speed : speed);
+          value[i] = float(high ? -speed : speed);
         }
       }
       // A face touching a solid cell is held at the obstacle's (zero) velocity.
@@ -34,11 +36,14 @@ VelocityConstraints<D>::VelocityConstraints(const IVec<D>& c, double hh, const D
       bool solidLo = lo[a] >= 0 && solid(lo), solidHi = hi[a] < cells[a] && solid(hi);
       if (solidLo || solidHi) {
         fixed[a][i] = 1;
-        value[a][i] = 0.0f;
+        value[i] = 0.0f;
       }
     });
     for (size_t i = 0; i < fixed[a].size(); ++i)
-      if (fixed[a][i]) fixedFaces[a].push_back(i);
+      if (fixed[a][i]) {
+        fixedFaces[a].push_back(i);
+        fixedValues[a].push_back(value[i]);
+      }
   }
 }
 
@@ -67,9 +72,9 @@ template <int D>
 void VelocityConstraints<D>::apply(MacVelocity<D>* u) const {
   for (int a = 0; a < D; ++a) {
     Grid<float, D>& g = (*u)[a];
-    const Grid<float, D>& v = value[a];
+    const std::vector<float>& v = fixedValues[a];
     const std::vector<size_t>& faces = fixedFaces[a];
-    parallelFor(faces.size(), [&](size_t k) { g[faces[k]] = v[faces[k]]; }, 8192);
+    parallelFor(faces.size(), [&](size_t k) { g[faces[k]] = v[k]; }, 8192);
     if (boundaries.periodic(a)) {  // the layer k_a = n_a only
       const size_t stride = g.stride(a);
       IVec<D> layer = g.dims();
@@ -82,6 +87,20 @@ void VelocityConstraints<D>::apply(MacVelocity<D>* u) const {
       });
     }
   }
+}
+
+template <int D>
+float VelocityConstraints<D>::prescribed(int a, size_t i) const {
+  const std::vector<size_t>& faces = fixedFaces[a];
+  auto it = std::lower_bound(faces.begin(), faces.end(), i);
+  return it != faces.end() && *it == i ? fixedValues[a][size_t(it - faces.begin())] : 0.0f;
+}
+
+template <int D>
+std::vector<float> VelocityConstraints<D>::prescribedGrid(int a) const {
+  std::vector<float> v(fixed[a].size(), 0.0f);
+  for (size_t k = 0; k < fixedFaces[a].size(); ++k) v[fixedFaces[a][k]] = fixedValues[a][k];
+  return v;
 }
 
 template struct VelocityConstraints<2>;

@@ -13,12 +13,11 @@ ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
   const IVec<D>& n = vc.cells;
   const std::array<bool, D> periodic = vc.periodic();
   const Grid<uint8_t, D>& fixed = vc.fixed[a];
-  const Grid<float, D>& value = vc.value[a];
   // Unknowns: the face grid, less the duplicate face n_a on a periodic axis.
   C.dims = n + unitVector<D>(a);
   if (periodic[size_t(a)]) C.dims[a] = n[a];
   C.A = LaplaceSystem<D>(C.dims, periodic, 1.0);
-  C.cBoundary = Grid<float, D>(C.dims, 0.0f);
+  C.cBoundary = Grid<uint8_t, D>(C.dims, 0);
   C.boundaryRhs.assign(C.A.size(), 0.0);
   C.unknownFixed = Grid<uint8_t, D>(C.dims, 0);
   forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) {
@@ -47,13 +46,13 @@ ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
         size_t ni = fixed.index(nb);
         if (fixed[ni]) {
           c += 1.0;
-          extra += double(value[ni]);
+          extra += double(vc.prescribed(a, ni));
         } else if (dir > 0) {
           C.A.w[bx][i] = 1.0f;
         }
       }
     }
-    C.cBoundary[i] = float(c);
+    C.cBoundary[i] = uint8_t(c);  // whole: 2 per wall ghost, 1 per prescribed neighbour
     C.boundaryRhs[i] = float(extra);
   });
   return C;
@@ -62,7 +61,7 @@ ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
 template <int D>
 void ViscousSystem<D>::setRate(double s) {
   A.scale = s;
-  parallelFor(A.size(), [&](size_t i) { A.c[i] = unknownFixed[i] ? 0.0f : float(1.0 / s + cBoundary[i]); }, 4096);
+  parallelFor(A.size(), [&](size_t i) { A.c[i] = unknownFixed[i] ? 0.0f : float(1.0 / s + double(cBoundary[i])); }, 4096);
   A.finalize();
 }
 

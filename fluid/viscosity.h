@@ -35,7 +35,7 @@ template <int D>
 struct ViscousSystem {
   IVec<D> dims;
   LaplaceSystem<D> A;
-  Grid<float, D> cBoundary;     // diagonal terms from walls and prescribed neighbours
+  Grid<uint8_t, D> cBoundary;   // diagonal terms from walls and prescribed neighbours (whole numbers)
   std::vector<float> boundaryRhs;  // their prescribed values, times the coupling
   Grid<uint8_t, D> unknownFixed;  // 1 where the face is prescribed (inactive)
   // A for s = nu dt / h^2: c = 1/s + boundary terms, 0 on prescribed faces.

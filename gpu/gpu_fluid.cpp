@@ -59,7 +59,8 @@ GpuFluid<D>::GpuFluid(const FluidSettings& s, const VelocityConstraints<D>& vc) 
     faceCount_ += faces(a);
     maxGrid_ = std::max(maxGrid_, faces(a));
     fixed.insert(fixed.end(), vc.fixed[a].values().begin(), vc.fixed[a].values().end());
-    value.insert(value.end(), vc.value[a].values().begin(), vc.value[a].values().end());
+    const std::vector<float> v = vc.prescribedGrid(a);
+    value.insert(value.end(), v.begin(), v.end());
   }
   vel_ = GpuBuffer(faceCount_ * sizeof(float));
   velScratch_ = GpuBuffer(faceCount_ * sizeof(float));

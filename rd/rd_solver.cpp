@@ -22,9 +22,9 @@ struct RDSolver<D>::Diffusion {
   std::unique_ptr<Chebyshev<D>> chebyshev;  // for an operator without mixed terms
   bool useChebyshev = false;                 // it solves instead of PCG: it is the quicker
   std::unique_ptr<Preconditioner> M;
-  PcgWorkspace ws;
-  Vector x;
-  Vector increment;  // the last solve's x - b: the next one's warm start
+  // The last solve's x - b: the next one's warm start (a guess only, so
+  // single precision).
+  std::vector<float> increment;
   double incrementThetaDt = 0.0;  // the theta dt it was made over
   double thetaDt = -1.0;
   long version = -1;  // tensor version it was built from
@@ -77,7 +77,6 @@ RDSolver<D>::RDSolver(const RDSettings& s, const ReactionModel& model) : setting
   for (int sp = 0; sp < n; ++sp) diffusion_.push_back(std::make_unique<Diffusion>());
   // Sized where an integrator uses them (Kim & Lin's implicit reaction and
   // diffusion need neither).
-  scratch_.assign(size_t(n), Vector());
   rates_.assign(size_t(n), Vector());
 }
 
@@ -253,7 +252,7 @@ SolverResult RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
     if (chebyshev && df.chebyshev)
       df.chebyshev->refresh();  // it reads df.A.axis, assigned in place above
     else if (chebyshev)
-      df.chebyshev = std::make_unique<Chebyshev<D>>(df.A.axis);
+      df.chebyshev = std::make_unique<Chebyshev<D>>(df.A.axis, ChebyshevLayout{}, &chebyshevWork_);
     df.useChebyshev = chebyshev && df.chebyshev->quick();
     if (df.useChebyshev)
       df.M.reset();
@@ -278,24 +277,25 @@ SolverResult RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
   // (rescaled to this theta dt), which a slowly evolving pattern repeats, as
   // the fluid's viscosity does. The same pass forms ||b|| for the Chebyshev
   // iteration (norm2's sum, so bitwise its value).
-  df.x.resize(b.size());
+  Vector& x = solveX_;  // shared: the species are solved one after another
+  x.resize(b.size());
   double bnorm = -1.0;  // not known: the solver computes it
   if (df.increment.size() == b.size()) {
     const double ratio = thetaDt / df.incrementThetaDt;
     bnorm = std::sqrt(deterministicSum(b.size(), [&](size_t i) {
-      df.x[i] = b[i] + ratio * df.increment[i];
+      x[i] = b[i] + ratio * double(df.increment[i]);
       return b[i] * b[i];
     }));
   } else {
-    df.x = b;
+    x = b;
   }
   SolverOptions o{settings_.tolerance, 2000};
-  SolverResult r = df.useChebyshev ? df.chebyshev->solve(b, &df.x, o, bnorm)
-                                   : solvePCG<D>(df.A, b, &df.x, df.M.get(), o, nullptr, &df.ws);
+  SolverResult r = df.useChebyshev ? df.chebyshev->solve(b, &x, o, bnorm)
+                                   : solvePCG<D>(df.A, b, &x, df.M.get(), o, nullptr, &pcgWork_);
   df.increment.resize(b.size());
-  parallelFor(b.size(), [&](size_t i) { df.increment[i] = df.x[i] - b[i]; }, kChunk);
+  parallelFor(b.size(), [&](size_t i) { df.increment[i] = float(x[i] - b[i]); }, kChunk);
   df.incrementThetaDt = thetaDt;
-  std::swap(b, df.x);
+  std::swap(b, x);
   return r;
 }
 
@@ -382,26 +382,26 @@ void RDSolver<D>::step(double dt) {
   const bool implicitReaction = integ == RDIntegrator::KimLin;
   const double theta = diffusionTheta(integ);
   react(dt, implicitReaction);  // Kim & Lin: updates x in place (projected per cell)
-  // The species are independent from here on: run them side by side (each
-  // still splits into row tasks).
+  // The species are independent from here on: one after another (each
+  // splits into row tasks), sharing the solvers' work vectors.
   std::vector<SolverResult> solves(size_t(n), SolverResult{true, 0, 0.0});
-  parallelFor(size_t(n), [&](size_t si) {
+  for (size_t si = 0; si < size_t(n); ++si) {
     const int s = int(si);
     Vector& x = x_[si].values();
-    const Vector &L = scratch_[si], &R = rates_[si];
+    const Vector &L = scratch_, &R = rates_[si];
     const double explicitD = (1.0 - theta) * dt * d_[size_t(s)];
     // The explicit part carries its Dirichlet term inside L; the implicit
     // part adds its own through solveDiffusion.
     if (explicitD > 0) {
-      scratch_[si].resize(cells);
-      applyLaplacian(s, x, &scratch_[si]);
+      scratch_.resize(cells);
+      applyLaplacian(s, x, &scratch_);
     }
     if (!implicitReaction && explicitD > 0)
       parallelFor(cells, [&](size_t i) { x[i] += dt * R[i] + explicitD * L[i]; }, kChunk);
     else if (!implicitReaction)
       parallelFor(cells, [&](size_t i) { x[i] += dt * R[i]; }, kChunk);
     solves[si] = solveDiffusion(s, theta * dt, &x);
-  });
+  }
   for (const SolverResult& r : solves) foldWorst(&stats_.diffusion, r);
   for (int s : model_.info().clamped) {
     Grid<double, D>& g = x_[size_t(s)];
@@ -439,7 +439,7 @@ void RDSolver<D>::load(const StateReader& in) {
     in.getGrid(p + "x", &x_[size_t(s)]);
     size_t n = 0;
     in.get(p + "increment_size", &n);
-    df.increment.assign(n == 0 ? 0 : laplacian_.size(), 0.0);
+    df.increment.assign(n == 0 ? 0 : laplacian_.size(), 0.0f);
     in.getVector(p + "increment", &df.increment);
     in.get(p + "increment_theta_dt", &df.incrementThetaDt);
     in.get(p + "frozen_size", &n);

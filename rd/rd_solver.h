@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "core/anisotropic_system.h"
+#include "core/chebyshev.h"
 #include "core/grid.h"
 #include "core/pcg.h"
 #include "core/solver_result.h"
@@ -134,7 +135,12 @@ class RDSolver {
   std::vector<uint8_t> generalSpecies_;
   long operatorVersion_ = 0;          // bumped whenever a tensor or lobe operator is rebuilt
   std::vector<std::unique_ptr<Diffusion>> diffusion_;
-  std::vector<Vector> scratch_, rates_;
+  Vector scratch_;              // an explicit part's Laplacian (the species take turns)
+  std::vector<Vector> rates_;   // per species: R(x) of an explicit reaction
+  // The diffusion solves' work vectors, shared: the species take turns.
+  Vector solveX_;
+  ChebyshevWork chebyshevWork_;
+  PcgWorkspace pcgWork_;
   std::vector<std::vector<uint8_t>> fixedMasks_;
   std::vector<std::vector<double>> fixedValues_;
   std::vector<std::vector<double>> frozenValues_;

@@ -87,7 +87,7 @@ void checkProjection(const FluidSettings& s) {
   for (int a = 0; a < D; ++a)
     for (size_t i = 0; i < u[a].size(); ++i)
       if (f.constraints().fixed[a][i]) {
-        ASSERT_EQ(u[a][i], f.constraints().value[a][i]);
+        ASSERT_EQ(u[a][i], f.constraints().prescribed(a, i));
       }
 }
 
