@@ -23,8 +23,8 @@ SolverResult pcg(const Op& A, const Vector& bIn, Vector* xp, Preconditioner* M, 
   for (Vector* v : {&ws.r, &ws.p, &ws.q}) v->resize(n);
   if (!recompute) ws.z.resize(n);
   const Vector* bp = &bIn;
-  if (A.singular()) {  // keep the system consistent
-    ws.b = bIn;
+  if (A.singular()) {  // keep the system consistent (in place when b is ws.b)
+    if (&bIn != &ws.b) ws.b = bIn;
     A.removeNullSpace(&ws.b);
     bp = &ws.b;
   }

@@ -20,7 +20,9 @@ struct PcgWorkspace {
   Vector b, r, z, p, q;
 };
 
-// Solves A x = b starting from *x. M may be null (plain CG).
+// Solves A x = b starting from *x. M may be null (plain CG). b may be the
+// workspace's own b (then it may be changed: a singular system's b loses its
+// mean in place, with no copy).
 template <int D>
 SolverResult solvePCG(const LaplaceSystem<D>& A, const Vector& b, Vector* x, Preconditioner* M,
                       const SolverOptions& options, Interrupter* interrupter = nullptr,

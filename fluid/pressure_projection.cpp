@@ -37,7 +37,7 @@ PressureProjection<D>::PressureProjection(const VelocityConstraints<D>& vc, Pres
   else
     multigrid_ = std::make_unique<Multigrid<D>>(A_);
   phi_.assign(A_.size(), 0.0);
-  rhs_.assign(A_.size(), 0.0);
+  workspace_.b.assign(A_.size(), 0.0);  // the right-hand side (PCG takes it in place)
 }
 
 template <int D>
@@ -82,7 +82,7 @@ void PressureProjection<D>::divergenceTimes(const MacVelocity<D>& u, double fact
 
 template <int D>
 SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double density) {
-  divergenceTimes(*u, -1.0 / vc_.h, &rhs_);  // rhs = -div u
+  divergenceTimes(*u, -1.0 / vc_.h, &workspace_.b);  // rhs = -div u
   // Warm start: phi / dt (the pressure over the density) linearly
   // extrapolated from the last two projections, times this dt; after one
   // projection, the last phi scaled to this dt.
@@ -98,9 +98,9 @@ SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double
   }
   SolverResult r;
   if (solver_ == PressureSolver::Multigrid)
-    r = multigrid_->solve(rhs_, &phi_, options_);
+    r = multigrid_->solve(workspace_.b, &phi_, options_);
   else
-    r = solvePCG<D>(A_, rhs_, &phi_, solver_ == PressureSolver::ICPCG
+    r = solvePCG<D>(A_, workspace_.b, &phi_, solver_ == PressureSolver::ICPCG
                                           ? static_cast<Preconditioner*>(mic_.get())
                                           : static_cast<Preconditioner*>(multigrid_.get()),
                     options_, nullptr, &workspace_);

@@ -50,11 +50,11 @@ class PressureProjection {
   LaplaceSystem<D> A_;
   std::unique_ptr<Multigrid<D>> multigrid_;
   std::unique_ptr<MIC0Preconditioner<D>> mic_;
-  Vector phi_, rhs_;
+  Vector phi_;
   // phi / dt of the projection before the last (once solves >= 2); a warm
   // start's guess only, so single precision.
   std::vector<float> ratePrev_;
-  PcgWorkspace workspace_;
+  PcgWorkspace workspace_;  // its b holds the right-hand side
   double lastDt_ = 0.0, lastDensity_ = 1.0;
   int solves_ = 0;  // projections with dt > 0 since the start, capped at 2
 };

@@ -58,7 +58,7 @@ RDSolver<D>::RDSolver(const RDSettings& s, const ReactionModel& model) : setting
   std::array<bool, D> periodic{};
   for (int a = 0; a < D; ++a) periodic[size_t(a)] = s.boundary == RDBoundary::Periodic;
   LaplaceSystem<D> lap(cells_, periodic, 1.0 / (h_ * h_));
-  boundaryFaces_.assign(lap.size(), 0.0);
+  if (s.boundary == RDBoundary::Dirichlet) boundaryFaces_.assign(lap.size(), 0.0);
   forEachCell<D>(cells_, [&](const IVec<D>& k, size_t i) {
     int faces = 0;
     for (int a = 0; a < D; ++a) {
@@ -209,8 +209,11 @@ void RDSolver<D>::applyLaplacian(int s, const Vector& x, Vector* out) const {
   if (generalized(s)) return general_->apply(x, out);  // seed 000 eq. 37
   diffusionOperator(s).apply(x, out);
   Vector& o = *out;
-  const double g = settings_.boundary == RDBoundary::Dirichlet ? settings_.dirichletValues[size_t(s)] : 0.0;
-  const double k = 2.0 * g / (h_ * h_);
+  if (settings_.boundary != RDBoundary::Dirichlet) {
+    parallelFor(o.size(), [&](size_t i) { o[i] = -o[i]; }, kChunk);
+    return;
+  }
+  const double k = 2.0 * settings_.dirichletValues[size_t(s)] / (h_ * h_);
   const Vector& faces = boundaryWeights(s);
   parallelFor(o.size(), [&](size_t i) { o[i] = -o[i] + k * faces[i]; }, kChunk);
 }

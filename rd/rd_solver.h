@@ -122,7 +122,7 @@ class RDSolver {
   ParameterValues params_;
   std::vector<std::vector<double>> fields_;
   AnisotropicSystem<D> laplacian_;    // -h^2 lap, with c = 2 per Dirichlet face
-  Vector boundaryFaces_;              // Dirichlet faces per cell
+  Vector boundaryFaces_;              // Dirichlet faces per cell (empty unless Dirichlet)
   std::unique_ptr<DiffusionTensorSpec<D>> tensorSpec_;
   std::vector<uint8_t> tensorSpecies_;
   AnisotropicSystem<D> tensor_;       // -h^2 div(sigma grad), c = 2 sigma_aa per Dirichlet face
