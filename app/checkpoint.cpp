@@ -92,8 +92,10 @@ Checkpoint readCheckpoint(const fs::path& file) {
   if (!fs::is_regular_file(fs::symlink_status(file, ec))) throw bad("it is not a regular file");
   std::ifstream in(file, std::ios::binary);
   if (!in) throw bad("it cannot be opened");
-  std::string bytes(size_t(fs::file_size(file, ec)), '\0');
-  if (ec || !in.read(bytes.data(), std::streamsize(bytes.size()))) throw bad("it cannot be read");
+  const uintmax_t size = fs::file_size(file, ec);
+  if (ec) throw bad("it cannot be read");
+  std::string bytes(size_t(size), '\0');
+  if (!in.read(bytes.data(), std::streamsize(bytes.size()))) throw bad("it cannot be read");
   if (bytes.size() < 8 + 8 + 8 + 8 || std::memcmp(bytes.data(), kMagic, 8) != 0) throw bad("it is not a morphoflow checkpoint, or it is cut short");
   const size_t body = bytes.size() - 8;
   if (XXH64(bytes.data(), body, 0) != read64(bytes, body)) throw bad("its checksum does not match (cut short or corrupted)");

@@ -102,12 +102,33 @@ Multigrid<D>::Multigrid(const LaplaceSystem<D>& fine, const MultigridOptions& op
     cur = &levels_.back().A;
   }
   for (size_t l = 0; l + 1 < levels_.size(); ++l) buildTransfer(int(l));
-  for (size_t l = 0; l < levels_.size(); ++l) {
+  for (size_t l = 1; l < levels_.size(); ++l) {  // level 0's: at the first cycle (ensureFine)
     size_t n = level(int(l)).size();
     levels_[l].x.assign(n, 0.0f);
     levels_[l].b.assign(n, 0.0f);
     levels_[l].r.assign(n, 0.0f);
   }
+}
+
+template <int D>
+void Multigrid<D>::ensureFine() {
+  const size_t n = fine_.size();
+  for (FVector* v : {&levels_[0].x, &levels_[0].b, &levels_[0].r})
+    if (v->size() != n) v->assign(n, 0.0f);
+}
+
+template <int D>
+void Multigrid<D>::borrowFine(WorkPool* pool) {
+  const size_t n = fine_.size();
+  for (FVector* v : {&levels_[0].x, &levels_[0].b, &levels_[0].r}) {
+    pool->lend(v);
+    v->assign(n, 0.0f);  // every entry defined, as ensureFine() makes them
+  }
+}
+
+template <int D>
+void Multigrid<D>::giveBackFine(WorkPool* pool) {
+  for (FVector* v : {&levels_[0].x, &levels_[0].b, &levels_[0].r}) pool->give(v);
 }
 
 template <int D>
@@ -339,6 +360,7 @@ void Multigrid<D>::cycle(int l) {
 
 template <int D>
 double Multigrid<D>::scaledCycle(const Vector& r, double rscale, Vector* z, bool withDot) {
+  ensureFine();
   Level& L0 = levels_[0];
   if (rscale == 0.0 || !std::isfinite(rscale)) {  // zero in, zero out; an overflow stays visible
     std::fill(L0.x.begin(), L0.x.end(), 0.0f);

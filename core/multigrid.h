@@ -21,6 +21,7 @@
 #include "core/pcg.h"
 #include "core/preconditioner.h"
 #include "core/solver_result.h"
+#include "core/work_pool.h"
 
 namespace morphoflow {
 
@@ -51,6 +52,11 @@ class Multigrid final : public Preconditioner {
   // as the constructor would, without reallocating anything.
   void refresh();
 
+  // The finest level's work vectors (the largest) come from `pool` for one
+  // solve and go back to it: a solver lends them only while it solves.
+  void borrowFine(WorkPool* pool);
+  void giveBackFine(WorkPool* pool);
+
   int levels() const { return int(levels_.size()); }
   const LaplaceSystem<D>& level(int l) const { return l == 0 ? fine_ : levels_[size_t(l)].A; }
 
@@ -76,6 +82,7 @@ class Multigrid final : public Preconditioner {
     std::array<AxisTransfer, D> transfer;  // to level + 1 (absent on the coarsest)
   };
   void buildTransfer(int l);
+  void ensureFine();  // level 0's vectors, sized (allocated on first use)
   void cycle(int l);
   // The cycle on r / rscale (single precision must neither underflow nor
   // overflow), z = rscale * result (unless z is null); returns r . z when

@@ -8,13 +8,15 @@
 #include <vector>
 
 #include "core/mac_velocity.h"
+#include "core/work_pool.h"
 #include "fluid/fluid_settings.h"
 
 namespace morphoflow {
 
-// Scratch grids of the second-order schemes, kept between steps: one set,
-// reshaped for each field advected (the fields are advected one after
-// another), so it costs one grid shape's worth, not one per shape.
+// Scratch grids of the second-order schemes: one set, reshaped for each
+// field advected (the fields are advected one after another), so it costs
+// one grid shape's worth, not one per shape; a solver lends it storage from
+// its WorkPool for the advection stage only.
 template <int D>
 struct AdvectionScratch {
   struct Set {
@@ -22,10 +24,27 @@ struct AdvectionScratch {
     std::array<Grid<float, D>, D> start;  // u at the samples, shared by a scheme's passes
   };
   Set set;
+  // Borrows the grids' storage from a pool for one advection stage, and
+  // gives it back.
+  void borrow(WorkPool* pool, AdvectionScheme scheme) {
+    if (scheme == AdvectionScheme::SemiLagrangian) return;  // it uses none
+    each([&](std::vector<float>& v) { pool->lend(&v); }, scheme == AdvectionScheme::Bfecc);
+  }
+  void giveBack(WorkPool* pool) {
+    each([&](std::vector<float>& v) { pool->give(&v); }, true);
+  }
   Set& forShape(const IVec<D>& dims) {
     for (Grid<float, D>* g : {&set.lo, &set.hi, &set.back}) g->reshape(dims);
     for (Grid<float, D>& g : set.start) g.reshape(dims);
     return set;
+  }
+
+ private:
+  template <class F>
+  void each(F&& f, bool withFwd) {
+    for (Grid<float, D>* g : {&set.lo, &set.hi, &set.back}) f(g->values());
+    if (withFwd) f(set.fwd.values());
+    for (Grid<float, D>& g : set.start) f(g.values());
   }
 };
 

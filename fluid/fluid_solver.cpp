@@ -69,21 +69,23 @@ void FluidSolver<D>::step(double dt) {
   constraints_.apply(&u_);
   lap(0);
   // 2. advect (velocity through itself, dye through the same field)
+  advectionScratch_.borrow(&pool_, settings_.advection);
   advectVelocity<D>(u_, dt, settings_.advection, &scratch_, &advectionScratch_);
   // An all-zero dye (no dye in the scene yet) advects to zero: skip the work.
   if (std::any_of(dye_.values().begin(), dye_.values().end(), [](float v) { return v != 0.0f; })) {
     advectField<D>(dye_, cellLayout(), u_, dt, settings_.advection, &dyeScratch_, &advectionScratch_);
     std::swap(dye_, dyeScratch_);
   }
+  advectionScratch_.giveBack(&pool_);
   std::swap(u_, scratch_);
   constraints_.apply(&u_);
   injectInflowDye();
   lap(1);
   // 3. diffuse (implicit viscosity)
-  stats_.viscosity = viscosity_->diffuse(&u_, settings_.viscosity, dt);
+  stats_.viscosity = viscosity_->diffuse(&u_, settings_.viscosity, dt, &pool_);
   lap(2);
   // 4. project
-  stats_.pressure = projection_->project(&u_, dt, settings_.density);
+  stats_.pressure = projection_->project(&u_, dt, settings_.density, &pool_);
   lap(3);
   time_ += dt;
   ++steps_;

@@ -72,6 +72,7 @@ class FluidSolver {
   MacVelocity<D> u_, scratch_;
   Grid<float, D> dye_, dyeScratch_;
   AdvectionScratch<D> advectionScratch_;
+  WorkPool pool_;  // the stages' work vectors, lent to each in turn
   double time_ = 0.0;
   long steps_ = 0;
   FluidStepStats stats_;

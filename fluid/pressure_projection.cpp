@@ -37,7 +37,6 @@ PressureProjection<D>::PressureProjection(const VelocityConstraints<D>& vc, Pres
   else
     multigrid_ = std::make_unique<Multigrid<D>>(A_);
   phi_.assign(A_.size(), 0.0);
-  workspace_.b.assign(A_.size(), 0.0);  // the right-hand side (PCG takes it in place)
 }
 
 template <int D>
@@ -81,7 +80,13 @@ void PressureProjection<D>::divergenceTimes(const MacVelocity<D>& u, double fact
 }
 
 template <int D>
-SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double density) {
+SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double density, WorkPool* pool) {
+  PcgWorkspace& w = workspace_;
+  const std::array<Vector*, 5> work = {&w.b, &w.r, &w.z, &w.p, &w.q};
+  if (pool) {
+    for (Vector* v : work) pool->lend(v);
+    if (multigrid_) multigrid_->borrowFine(pool);
+  }
   divergenceTimes(*u, -1.0 / vc_.h, &workspace_.b);  // rhs = -div u
   // Warm start: phi / dt (the pressure over the density) linearly
   // extrapolated from the last two projections, times this dt; after one
@@ -104,6 +109,10 @@ SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double
                                           ? static_cast<Preconditioner*>(mic_.get())
                                           : static_cast<Preconditioner*>(multigrid_.get()),
                     options_, nullptr, &workspace_);
+  if (pool) {
+    for (Vector* v : work) pool->give(v);
+    if (multigrid_) multigrid_->giveBackFine(pool);
+  }
   lastDt_ = dt;
   lastDensity_ = density;
   solves_ = dt > 0 ? std::min(solves_ + 1, 2) : 0;

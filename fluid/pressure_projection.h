@@ -12,6 +12,7 @@
 #include "core/mic0.h"
 #include "core/solver_result.h"
 #include "core/state_archive.h"
+#include "core/work_pool.h"
 #include "fluid/fluid_settings.h"
 #include "fluid/velocity_constraints.h"
 
@@ -28,7 +29,8 @@ class PressureProjection {
   PressureProjection(const VelocityConstraints<D>& constraints, PressureSolver solver,
                      const SolverOptions& options);
 
-  SolverResult project(MacVelocity<D>* u, double dt, double density);
+  // Its work vectors come from `pool` (when given) and go back to it.
+  SolverResult project(MacVelocity<D>* u, double dt, double density, WorkPool* pool = nullptr);
   // Cell divergence of u (0 on solid cells).
   void divergence(const MacVelocity<D>& u, Vector* div) const;
   // Takes phi of a projection computed elsewhere (the GPU backend) as the

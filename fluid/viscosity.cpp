@@ -105,11 +105,26 @@ double ViscositySolver<D>::rightHandSide(const MacVelocity<D>& u, int a, double 
 }
 
 template <int D>
-SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt) {
+SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt, WorkPool* pool) {
+  if (nu <= 0 || dt <= 0) return SolverResult{true, 0, 0.0};
+  std::vector<Vector*> doubles = {&b_, &x_, &pcgWork_.b, &pcgWork_.r, &pcgWork_.z, &pcgWork_.p, &pcgWork_.q};
+  std::vector<std::vector<float>*> floats = {&chebyshevWork_.e[0], &chebyshevWork_.e[1], &chebyshevWork_.g};
+  if (pool) {
+    for (Vector* v : doubles) pool->lend(v);
+    for (std::vector<float>* v : floats) pool->lend(v);
+  }
+  const SolverResult result = solveComponents(u, nu * dt / (vc_.h * vc_.h));
+  if (pool) {
+    for (Vector* v : doubles) pool->give(v);
+    for (std::vector<float>* v : floats) pool->give(v);
+  }
+  return result;
+}
+
+template <int D>
+SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
   SolverResult result;
   result.converged = true;
-  if (nu <= 0 || dt <= 0) return result;
-  const double s = nu * dt / (vc_.h * vc_.h);
   std::array<double, D> bb{};  // ||b_a||^2
   for (int a = D - 1; a >= 0; --a) {  // last: component 0, the first solved
     Component& C = comp_[size_t(a)];

@@ -23,6 +23,7 @@
 #include "core/pcg.h"
 #include "core/solver_result.h"
 #include "core/state_archive.h"
+#include "core/work_pool.h"
 #include "fluid/velocity_constraints.h"
 
 namespace morphoflow {
@@ -48,8 +49,9 @@ template <int D>
 class ViscositySolver {
  public:
   ViscositySolver(const VelocityConstraints<D>& constraints, const SolverOptions& options);
-  // Diffuses u in place; returns the worst of the component solves.
-  SolverResult diffuse(MacVelocity<D>* u, double viscosity, double dt);
+  // Diffuses u in place; returns the worst of the component solves. Its
+  // work vectors come from `pool` (when given) and go back to it.
+  SolverResult diffuse(MacVelocity<D>* u, double viscosity, double dt, WorkPool* pool = nullptr);
   // The warm starts of the next solve (checkpoints).
   void save(StateWriter* out) const;
   void load(const StateReader& in);
@@ -63,6 +65,7 @@ class ViscositySolver {
     std::unique_ptr<Chebyshev<D>> chebyshev;  // bounds the spectrum; solves while it is quick
     std::unique_ptr<Multigrid<D>> multigrid;  // present while it solves instead
   };
+  SolverResult solveComponents(MacVelocity<D>* u, double s);
   // Component a's right-hand side into b_ (its unknowns' count); returns ||b||^2.
   double rightHandSide(const MacVelocity<D>& u, int a, double s);
   const VelocityConstraints<D>& vc_;

@@ -55,23 +55,18 @@ RDSolver<D>::RDSolver(const RDSettings& s, const ReactionModel& model) : setting
   fields_.assign(params_.constant.size(), {});
   for (int sp = 0; sp < n; ++sp) x_.emplace_back(cells_, info.initial[size_t(sp)]);
 
-  std::array<bool, D> periodic{};
-  for (int a = 0; a < D; ++a) periodic[size_t(a)] = s.boundary == RDBoundary::Periodic;
-  LaplaceSystem<D> lap(cells_, periodic, 1.0 / (h_ * h_));
-  if (s.boundary == RDBoundary::Dirichlet) boundaryFaces_.assign(lap.size(), 0.0);
-  forEachCell<D>(cells_, [&](const IVec<D>& k, size_t i) {
-    int faces = 0;
-    for (int a = 0; a < D; ++a) {
-      lap.w[a][i] = 1.0f;  // finalize() cuts the wrap on non-periodic axes
-      if (!periodic[size_t(a)]) faces += (k[a] == 0) + (k[a] == cells_[a] - 1);
-    }
-    if (s.boundary == RDBoundary::Dirichlet) {
+  cellCount_ = x_[0].size();
+  if (s.boundary == RDBoundary::Dirichlet) {
+    boundaryFaces_.assign(cellCount_, 0.0);
+    forEachCell<D>(cells_, [&](const IVec<D>& k, size_t i) {
+      int faces = 0;
+      for (int a = 0; a < D; ++a) faces += (k[a] == 0) + (k[a] == cells_[a] - 1);
       boundaryFaces_[i] = faces;
-      lap.c[i] = float(2 * faces);
-    }
-  });
-  lap.finalize();
-  laplacian_ = AnisotropicSystem<D>(std::move(lap));
+    });
+  }
+  // The Laplacian itself is built only where something applies it (an
+  // explicit part, the GPU backend): the implicit systems are built directly.
+  lapBound_ = AnisotropicSystem<D>(isotropicSystem(std::nullopt)).maxRowAbsSum();
   if (s.boundary == RDBoundary::Dirichlet && int(s.dirichletValues.size()) != n)
     throw std::invalid_argument("rd: Dirichlet boundaries need one value per species");
   for (int sp = 0; sp < n; ++sp) diffusion_.push_back(std::make_unique<Diffusion>());
@@ -81,11 +76,37 @@ RDSolver<D>::RDSolver(const RDSettings& s, const ReactionModel& model) : setting
 }
 
 template <int D>
+LaplaceSystem<D> RDSolver<D>::isotropicSystem(std::optional<double> shift) const {
+  std::array<bool, D> periodic{};
+  for (int a = 0; a < D; ++a) periodic[size_t(a)] = settings_.boundary == RDBoundary::Periodic;
+  // -h^2 lap: w = 1, c = 2 per Dirichlet face, scale 1 / h^2; shifted by s
+  // (AnisotropicSystem::shifted's arithmetic): I + s lap with k = s / h^2,
+  // w = k, c = 1 + k c, scale 1.
+  const double k = shift ? *shift * (1.0 / (h_ * h_)) : 1.0;
+  LaplaceSystem<D> lap(cells_, periodic, shift ? 1.0 : 1.0 / (h_ * h_));
+  const float w = shift ? float(double(1.0f) * k) : 1.0f;
+  const bool dirichlet = settings_.boundary == RDBoundary::Dirichlet;
+  parallelFor(lap.size(), [&](size_t i) {
+    for (int a = 0; a < D; ++a) lap.w[a][i] = w;  // finalize() cuts the wrap on non-periodic axes
+    const float c = dirichlet ? float(2.0 * boundaryFaces_[i]) : 0.0f;
+    lap.c[i] = shift ? float(1.0 + k * double(c)) : c;
+  }, kChunk);
+  lap.finalize();
+  return lap;
+}
+
+template <int D>
+const AnisotropicSystem<D>& RDSolver<D>::laplacian() const {
+  if (!laplacian_) laplacian_ = std::make_unique<AnisotropicSystem<D>>(isotropicSystem(std::nullopt));
+  return *laplacian_;
+}
+
+template <int D>
 RDSolver<D>::~RDSolver() = default;
 
 template <int D>
 void RDSolver<D>::setParameterField(int k, std::vector<double> values) {
-  if (values.size() != laplacian_.size()) throw std::invalid_argument("rd: parameter field has the wrong size");
+  if (values.size() != cellCount_) throw std::invalid_argument("rd: parameter field has the wrong size");
   fields_[size_t(k)] = std::move(values);
   params_.field[size_t(k)] = fields_[size_t(k)].data();
   lut_ = ReactionLUT();
@@ -100,7 +121,7 @@ void RDSolver<D>::setFixedCells(std::vector<std::vector<uint8_t>> masks, std::ve
 template <int D>
 void RDSolver<D>::setDiffusionTensor(DiffusionTensorSpec<D> spec) {
   if (lobeSpec_) throw std::invalid_argument("rd: a diffusion tensor and cosine lobes cannot be combined");
-  const size_t cells = laplacian_.size();
+  const size_t cells = cellCount_;
   for (int a = 0; a < D; ++a)
     if (spec.direction[size_t(a)].size() != cells) throw std::invalid_argument("rd: tensor direction has the wrong size");
   if (spec.lambda1.size() != cells || spec.lambda2.size() != cells)
@@ -132,7 +153,7 @@ template <int D>
 void RDSolver<D>::setCosineLobes(CosineLobeSpec spec) {
   if (tensorSpec_) throw std::invalid_argument("rd: a diffusion tensor and cosine lobes cannot be combined");
   validateCosineLobes(spec);
-  if (!spec.theta0.empty() && spec.theta0.size() != laplacian_.size())
+  if (!spec.theta0.empty() && spec.theta0.size() != cellCount_)
     throw std::invalid_argument("rd: the lobes' theta0 field has the wrong size");
   lobeSpecies_.assign(size_t(species()), spec.species.empty() ? 1 : 0);
   for (int s : spec.species) {
@@ -188,7 +209,7 @@ void RDSolver<D>::buildLobes() {
 template <int D>
 double RDSolver<D>::explicitDiffusionLimit() const {
   double worst = 0.0;
-  const double lapBound = laplacian_.maxRowAbsSum();
+  const double lapBound = lapBound_;
   const double tensorBound = tensorSpec_ ? tensor_.maxRowAbsSum() : 0.0;
   // a(theta) <= max a_n, so lobes are bounded by the Laplacian's bound times that.
   const double lobeBound = lobeSpec_ ? lapBound * maxLobeDiffusivity(*lobeSpec_) : 0.0;
@@ -241,7 +262,12 @@ SolverResult RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
     // x + scale (c_b x + sum (x_i - x_j)): unit scale with w = scale keeps the
     // identity exact (c = 1 away from Dirichlet walls), so a zero-flux run
     // conserves mass to round-off.
-    df.A = diffusionOperator(s).shifted(thetaDt * d);
+    if (anisotropic(s) || lobed(s))
+      df.A = diffusionOperator(s).shifted(thetaDt * d);
+    else {
+      df.A = AnisotropicSystem<D>();  // free the old one first
+      df.A = AnisotropicSystem<D>(isotropicSystem(thetaDt * d));
+    }
     // The default solver takes the Chebyshev iteration where it is the
     // quicker (an isotropic operator, diffusion not too far beyond the
     // identity: core/chebyshev.h). Else PCG: with MIC(0) on request; else
@@ -305,7 +331,7 @@ SolverResult RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
 template <int D>
 void RDSolver<D>::react(double dt, bool implicit) {
   const int n = species();
-  const size_t cells = laplacian_.size();
+  const size_t cells = cellCount_;
   const size_t chunks = (cells + kChunk - 1) / kChunk;
   double* xs[ReactionModel::kMaxSpecies];
   double* rs[ReactionModel::kMaxSpecies];
@@ -377,7 +403,7 @@ void RDSolver<D>::step(double dt) {
   stats_.diffusion.converged = true;
   if (tensorSpec_ && tensorSpec_->dynamic()) buildTensor();  // eq. 18-19 from the state at the step's start
   if (lobeSpec_) buildLobes();  // eq. 17: a(theta) from the state at the step's start
-  const size_t cells = laplacian_.size();
+  const size_t cells = cellCount_;
   // Every integrator is a theta scheme on the diffusion,
   //   (1 - theta dt d lap) x' = x + dt R + (1 - theta) dt d lap x,
   // with R = R(x) lagged, or for Kim & Lin the implicit reaction step first.
@@ -442,11 +468,11 @@ void RDSolver<D>::load(const StateReader& in) {
     in.getGrid(p + "x", &x_[size_t(s)]);
     size_t n = 0;
     in.get(p + "increment_size", &n);
-    df.increment.assign(n == 0 ? 0 : laplacian_.size(), 0.0f);
+    df.increment.assign(n == 0 ? 0 : cellCount_, 0.0f);
     in.getVector(p + "increment", &df.increment);
     in.get(p + "increment_theta_dt", &df.incrementThetaDt);
     in.get(p + "frozen_size", &n);
-    frozenValues_[size_t(s)].assign(n == 0 ? 0 : laplacian_.size(), 0.0);
+    frozenValues_[size_t(s)].assign(n == 0 ? 0 : cellCount_, 0.0);
     if (n) in.getVector(p + "frozen", &frozenValues_[size_t(s)]);
   }
 }

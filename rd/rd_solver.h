@@ -6,6 +6,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -75,7 +76,7 @@ class RDSolver {
   bool generalized(int s) const { return !generalSpecies_.empty() && generalSpecies_[size_t(s)]; }
   // The operator -h^2 div(sigma grad) (or -h^2 lap) that species s diffuses by.
   const AnisotropicSystem<D>& diffusionOperator(int s) const {
-    return lobed(s) ? lobeSystem_[size_t(s)] : anisotropic(s) ? tensor_ : laplacian_;
+    return lobed(s) ? lobeSystem_[size_t(s)] : anisotropic(s) ? tensor_ : laplacian();
   }
 
   // Per cell, the weight of its Dirichlet faces in species s's operator (the
@@ -99,6 +100,10 @@ class RDSolver {
 
  private:
   struct Diffusion;  // per-species implicit system and its solver state
+  // The isotropic -h^2 lap, or with a shift s the implicit system I + s lap
+  // as AnisotropicSystem::shifted(s) makes it, built directly.
+  LaplaceSystem<D> isotropicSystem(std::optional<double> shift) const;
+  const AnisotropicSystem<D>& laplacian() const;
   void react(double dt, bool implicit);
   void applyLaplacian(int s, const Vector& x, Vector* out) const;  // out = lap x (with boundary terms)
   // Returns the solve's result (converged, no iterations when d or theta dt is 0).
@@ -121,7 +126,10 @@ class RDSolver {
   std::vector<double> d_;
   ParameterValues params_;
   std::vector<std::vector<double>> fields_;
-  AnisotropicSystem<D> laplacian_;    // -h^2 lap, with c = 2 per Dirichlet face
+  size_t cellCount_ = 0;
+  // -h^2 lap, with c = 2 per Dirichlet face: built on first use (laplacian()).
+  mutable std::unique_ptr<AnisotropicSystem<D>> laplacian_;
+  double lapBound_ = 0.0;             // its maxRowAbsSum()
   Vector boundaryFaces_;              // Dirichlet faces per cell (empty unless Dirichlet)
   std::unique_ptr<DiffusionTensorSpec<D>> tensorSpec_;
   std::vector<uint8_t> tensorSpecies_;
