@@ -14,18 +14,20 @@ namespace {
 
 // Peak bytes per cell beyond the fixed overhead, measured by `bench memory`
 // (2D 1024^2, 3D 128^3, two steps and the final checkpoint;
-// docs/performance.md "Memory"): the fluid (velocity, its scratch and
-// MacCormack copies, pressure and viscosity systems with their multigrid
-// levels and Krylov vectors) and each species of a reaction-diffusion layer
-// (double state, diffusion system, solver vectors; in a coupled run also its
-// advection scratch; float state for the fused explicit step).
-constexpr double kFluidBytesPerCell[2] = {500.0, 490.0};        // 2D, 3D
-// A coupled run's fluid and species, 3D from two runs (128^3 / 128^3 and
-// the shipped 128^3 / 256^3 cavity) solved for the two unknowns.
-constexpr double kCoupledFluidBytesPerCell[2] = {500.0, 620.0};
-constexpr double kSpeciesBytesPerCell = 135.0;                   // reaction-diffusion only
-constexpr double kCoupledSpeciesBytesPerCell[2] = {112.0, 140.0}; // carried by a fluid, 2D, 3D
-constexpr double kFusedSpeciesBytesPerCell = 68.0;               // the fused explicit step
+// docs/performance.md "Memory"): the fluid (velocity and its advected copy,
+// pressure and viscosity systems, their warm starts, and the work vectors
+// its stages borrow in turn) and each species of a reaction-diffusion layer
+// (double state, its implicit system and warm start, a share of the solves'
+// vectors; in a coupled run also its advection scratch and feet; float
+// state for the fused explicit step).
+constexpr double kFluidBytesPerCell[2] = {265.0, 237.0};        // 2D, 3D
+// A coupled run's fluid and species, each from two runs (the same grid for
+// both, and chemicals twice as fine: 2D 512^2 / 1024^2, 3D the shipped
+// 128^3 / 256^3 cavity) solved for the two unknowns.
+constexpr double kCoupledFluidBytesPerCell[2] = {206.0, 278.0};
+constexpr double kSpeciesBytesPerCell[2] = {42.0, 47.0};         // reaction-diffusion only
+constexpr double kCoupledSpeciesBytesPerCell[2] = {58.0, 64.0};  // carried by a fluid
+constexpr double kFusedSpeciesBytesPerCell = 21.0;               // the fused explicit step
 constexpr double kFixedBytes = 126.0 * (1 << 20);                // the program, its libraries and thread pools
 
 double cellsOf(const std::vector<int>& res) {
@@ -63,7 +65,7 @@ uintmax_t estimateRunBytes(const Scene& s) {
     const double species = double(s.rd.initial.values.size());
     const bool fused = !s.hasFluid && !s.velocity.enabled && fusedExplicitFits(s);
     bytes += cellsOf(s.rd.settings.resolution) * species *
-             (s.hasFluid ? kCoupledSpeciesBytesPerCell[d] : fused ? kFusedSpeciesBytesPerCell : kSpeciesBytesPerCell);
+             (s.hasFluid ? kCoupledSpeciesBytesPerCell[d] : fused ? kFusedSpeciesBytesPerCell : kSpeciesBytesPerCell[d]);
   }
   return uintmax_t(bytes);
 }
