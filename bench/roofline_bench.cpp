@@ -1,7 +1,9 @@
 // Suite `roofline`: the machine's memory bandwidth, STREAM's triad
 // (a = b + s c over arrays far larger than the caches, 24 bytes an element),
-// with 1 and 2 threads; then, against it, the memory-bound kernels of the rd,
-// coupling and fluid suites at their 2D 1024^2 and 3D 128^3 sizes: each one's
+// with 1 and 2 threads; then, against it, the kernels of the rd, coupling
+// and fluid suites (their explicit steps, advections, the pressure operator
+// and V-cycle, the viscosity's Chebyshev steps, Kim & Lin's step) at their
+// 2D 1024^2 and 3D 128^3 sizes: each one's
 // compulsory bytes per cell update (what it must read and write at least
 // once), its measured rate, and the fraction of the triad's bandwidth that
 // rate moves. A fraction near 1 says the kernel runs at memory speed; far
@@ -19,8 +21,12 @@
 #include "bench/bench_suites.h"
 #include "bench/bench_timing.h"
 #include "core/parallel.h"
+#include "core/chebyshev.h"
+#include "core/multigrid.h"
 #include "coupling/chemical_advection.h"
 #include "fluid/advection.h"
+#include "fluid/fluid_solver.h"
+#include "fluid/viscosity.h"
 #include "rd/fused_explicit.h"
 #include "rd/generalized_diffusion.h"
 #include "rd/model_registry.h"
@@ -46,7 +52,8 @@ struct Kernel {
   std::string name;
   int dim, n;
   double bytes;                  // compulsory bytes per cell update
-  std::function<void()> step;    // one pass over the grid
+  std::function<void()> step;    // one pass over the grid (or `passes` of them)
+  std::shared_ptr<int> passes;   // set by step: its passes over the grid (null: 1)
 };
 
 double cellsOf(int dim, int n) { return dim == 2 ? double(n) * n : double(n) * n * n; }
@@ -56,6 +63,46 @@ IVec<D> cube(int n) {
   IVec<D> c;
   for (int a = 0; a < D; ++a) c[a] = n;
   return c;
+}
+
+// The solvers' kernels on the fluid suite's cavity and the rd suite's layer.
+// A solve's rate counts one cell update per cell and iteration (Chebyshev
+// step); its compulsory bytes are one pass over its vectors and, where the
+// kernel must read them, its coefficients (c, diag and D face weights:
+// 4 (D + 2) bytes).
+template <int D>
+void addSolverKernels(int n, double explicitDt, std::vector<Kernel>* out) {
+  const double coefficients = 4.0 * (D + 2);
+  auto fluid = std::make_shared<FluidSolver<D>>(benchCavity<D>(n));
+  fluid->step(1.0 / n);  // a flow to solve for
+  const LaplaceSystem<D>& P = fluid->projection().system();
+  auto x = std::make_shared<Vector>(P.size()), y = std::make_shared<Vector>(P.size());
+  for (size_t i = 0; i < x->size(); ++i) (*x)[i] = std::sin(0.001 * double(i));
+  P.removeNullSpace(x.get());
+  // y = A x in double: read x and the coefficients, write y.
+  out->push_back({"pressure A x (double)", D, n, 16.0, [fluid, &P, x, y] { P.apply(*x, y.get()); }});
+  // One V-cycle from zero (MGPCG's preconditioner): read r, write z, the
+  // fine coefficients at least once; the cycle's sweeps are on top.
+  auto mg = std::make_shared<Multigrid<D>>(P);
+  out->push_back({"pressure V-cycle (float levels)", D, n, 16.0 + coefficients, [fluid, mg, x, y] { mg->apply(*x, y.get()); }});
+  // The viscosity's Chebyshev iteration on the x velocity at the suite's
+  // step (dt = h): a step reads two float iterates and g, writes one.
+  auto visc = std::make_shared<ViscousSystem<D>>(viscousSystem<D>(fluid->constraints(), 0));
+  const double h = 1.0 / n;
+  visc->setRate(fluid->settings().viscosity * h / (h * h));
+  auto cheb = std::make_shared<Chebyshev<D>>(visc->A);
+  auto b = std::make_shared<Vector>(visc->A.size()), u = std::make_shared<Vector>(visc->A.size());
+  for (size_t i = 0; i < b->size(); ++i) (*b)[i] = visc->A.c[i] > 0 ? std::sin(0.002 * double(i)) : 0.0;
+  auto steps = std::make_shared<int>(0);
+  out->push_back({"viscosity Chebyshev step (float)", D, n, 16.0, [visc, cheb, b, u, steps] {
+                    std::fill(u->begin(), u->end(), 0.0);
+                    *steps = cheb->solve(*b, u.get(), SolverOptions{1e-6, 1000}).iterations;
+                  }, steps});
+  // Kim & Lin's step at ten times the explicit limit (Newton per cell, one
+  // implicit diffusion solve per species): two double species read and written.
+  auto kl = std::make_shared<RDSolver<D>>(benchGrayScott<D>(n, 1.0, RDIntegrator::KimLin), *findModel("gray-scott"));
+  pearsonStart(kl.get());
+  out->push_back({"rd Kim & Lin step", D, n, 32, [kl, explicitDt] { kl->step(10.0 * explicitDt); }});
 }
 
 // The kernels, each with the state it steps (kept alive by the closures).
@@ -99,6 +146,7 @@ void addKernels(int n, std::vector<Kernel>* out) {
   out->push_back({"fluid velocity advection", D, n, 8.0 * D, [vel, dst] {
                     advectVelocity(*vel, 0.5 / 1024, AdvectionScheme::SemiLagrangian, dst.get());
                   }});
+  addSolverKernels<D>(n, dt, out);
 }
 
 }  // namespace
@@ -122,7 +170,8 @@ bool runRooflineBench(const BenchOptions& o) {
       for (int threads : {1, 2}) {
         ThreadLimit limit(threads);
         k.step();
-        const double rate = cellsOf(k.dim, k.n) / median(timeSteps(o.minSeconds, k.step, [] {}));
+        const double passes = k.passes ? double(std::max(1, *k.passes)) : 1.0;
+        const double rate = passes * cellsOf(k.dim, k.n) / median(timeSteps(o.minSeconds, k.step, [] {}));
         const double gbs = rate * k.bytes / 1e9;
         std::cout << fmt::format("{:<30} {:>4} {:>6} {:>7} {:>10.0f} {:>16.1f} {:>10.1f} {:>9.2f}\n", k.name, k.dim, k.n,
                                  threads, k.bytes, rate / 1e6, gbs, gbs / bw[threads])
