@@ -20,14 +20,14 @@ namespace {
 // (double state, its implicit system and warm start, a share of the solves'
 // vectors; in a coupled run also its advection scratch and feet; float
 // state for the fused explicit step).
-constexpr double kFluidBytesPerCell[2] = {265.0, 237.0};        // 2D, 3D
+constexpr double kFluidBytesPerCell[2] = {244.0, 220.0};        // 2D, 3D
 // A coupled run's fluid and species, each from two runs (the same grid for
 // both, and chemicals twice as fine: 2D 512^2 / 1024^2, 3D the shipped
 // 128^3 / 256^3 cavity) solved for the two unknowns.
-constexpr double kCoupledFluidBytesPerCell[2] = {206.0, 278.0};
-constexpr double kSpeciesBytesPerCell[2] = {42.0, 47.0};         // reaction-diffusion only
-constexpr double kCoupledSpeciesBytesPerCell[2] = {58.0, 64.0};  // carried by a fluid
-constexpr double kFusedSpeciesBytesPerCell = 21.0;               // the fused explicit step
+constexpr double kCoupledFluidBytesPerCell[2] = {192.0, 261.0};
+constexpr double kSpeciesBytesPerCell[2] = {38.0, 43.0};         // reaction-diffusion only
+constexpr double kCoupledSpeciesBytesPerCell[2] = {55.0, 60.0};  // carried by a fluid
+constexpr double kFusedSpeciesBytesPerCell = 20.0;               // the fused explicit step
 constexpr double kFixedBytes = 126.0 * (1 << 20);                // the program, its libraries and thread pools
 
 double cellsOf(const std::vector<int>& res) {

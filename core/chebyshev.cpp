@@ -84,7 +84,7 @@ void stepRow(const LaplaceSystem<D>& A, size_t row, size_t y, size_t z, const fl
     return;
   }
   general(0, span.lo);
-  const float inv = A.invDiag()[s.base + span.lo];
+  const float inv = A.invDiag(s.base + span.lo);
   const bool weighted = span.w != 1.0f;
   // The neighbour rows (their cell 0); in 2D the z pair repeats the y pair, unused.
   const float *yl = s.xlo[1], *yh = s.xhi[1], *zl = s.xlo[D - 1], *zh = s.xhi[D - 1];
@@ -137,7 +137,6 @@ void Chebyshev<D>::refresh() {
     packedStart_[row + 1] = packedStart_[row] + (nx - (span.hi - span.lo)) * kPacked<D>;
   }
   packed_.resize(packedStart_[rows]);
-  const float* invDiag = A_.invDiag();
   parallelForRows<D>(A_.dims, [&](size_t row) {
     const RowStencil<D, float> s = rowStencil<D, float>(A_, zerosOf(), zerosOf(), zerosOf(), row);
     const auto& span = A_.sweepSpan(row);
@@ -145,7 +144,7 @@ void Chebyshev<D>::refresh() {
     for (size_t i = 0; i < nx; ++i) {
       if (i >= span.lo && i < span.hi) continue;
       const size_t il = i == 0 ? nx - 1 : i - 1;
-      *out++ = invDiag[s.base + i];
+      *out++ = A_.invDiag(s.base + i);
       *out++ = A_.w[0][s.base + i];
       *out++ = (i == 0 && !A_.periodic[0]) ? 0.0f : A_.w[0][s.base + il];
       for (int a = 1; a < D; ++a) {
@@ -241,14 +240,29 @@ void Chebyshev<D>::residualPlane(const Vector& b, const Vector& x, size_t q) {
   rows(q, [&](size_t row, size_t, size_t) {
     sum += A_.residualRow(row, b, x, buffer.data());
     const size_t base = row * nx;
-    const float* __restrict inv = A_.invDiag() + base;
     const double* __restrict rr = buffer.data();
     float* __restrict g = work_->g.data() + base;
     float* __restrict e = work_->e[1].data() + base;
-    for (size_t i = 0; i < nx; ++i) {
-      g[i] = float(rr[i] * sc * double(inv[i]));
-      e[i] = g[i];
+    // D^-1: one value on the row's uniform span, packed (first of each
+    // cell's coefficients) outside it.
+    const auto& span = A_.sweepSpan(row);
+    const size_t lo = std::min<size_t>(span.lo, span.hi), hi = span.hi;
+    const float* packed = packedRow(row);
+    auto outside = [&](size_t from, size_t to) {
+      for (size_t i = from; i < to; ++i, packed += kPacked<D>) {
+        g[i] = float(rr[i] * sc * double(*packed));
+        e[i] = g[i];
+      }
+    };
+    outside(0, lo);
+    if (lo < hi) {
+      const double inv = double(A_.invDiag(base + lo));
+      for (size_t i = lo; i < hi; ++i) {
+        g[i] = float(rr[i] * sc * inv);
+        e[i] = g[i];
+      }
     }
+    outside(hi, nx);
   });
   planeSquares_[q] = sum;
 }

@@ -223,7 +223,6 @@ void LaplaceSystem<D>::finalize() {
       if (last && !periodic[a]) std::fill_n(w[a].data() + row * nxCells, nxCells, 0.0f);
     }
   });
-  invDiag_.resize(size());  // every entry is written below
   forEachCell<D>(dims, [&](const IVec<D>& cell, size_t i) {
     float d = c[i];
     for (int a = 0; a < D; ++a) {
@@ -232,7 +231,6 @@ void LaplaceSystem<D>::finalize() {
       d += w[a][i] + w[a][w[a].index(lo)];
     }
     diag[i] = d;
-    invDiag_[i] = d > 0 ? float(1.0 / double(d)) : 0.0f;
   });
   const size_t nx = size_t(dims[0]);
   const size_t rows = size() / nx;
@@ -442,14 +440,14 @@ void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, 
     const size_t parity = y + z;
     const float* wa[D];
     for (int a = 0; a < D; ++a) wa[a] = w[a].data() + s.base;
-    const float* rd = invDiag() + s.base;
+    auto rd = [&](size_t i) { return invDiag(s.base + i); };
     const T* br = b.data() + s.base;
     T* xr = x.data() + s.base;
     // x_i = (b_i / scale + sum_f w_f x_j) / diag_i; invDiag is 0 on inactive cells.
     auto edge = [&](size_t i) {
       size_t il = i == 0 ? nx - 1 : i - 1, ih = i + 1 == nx ? 0 : i + 1;
       float wl = (i == 0 && !px) ? 0.0f : wa[0][il];
-      xr[i] = (br[i] * inv + neighbourSum<D, T>(s, wa, xr, i, il, ih, wl)) * rd[i];
+      xr[i] = (br[i] * inv + neighbourSum<D, T>(s, wa, xr, i, il, ih, wl)) * rd(i);
     };
     size_t i = (size_t(colour) + parity) & 1;
     if (i == 0) {
@@ -458,7 +456,7 @@ void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, 
     }
     auto general = [&](size_t end) {
       for (; i < end; i += 2)
-        xr[i] = (br[i] * inv + neighbourSum<D, T>(s, wa, xr, i, i - 1, i + 1, wa[0][i - 1])) * rd[i];
+        xr[i] = (br[i] * inv + neighbourSum<D, T>(s, wa, xr, i, i - 1, i + 1, wa[0][i - 1])) * rd(i);
     };
     // The row's uniform span (one weight wu, one c): the same sums without
     // the weight loads, four or eight cells at a time in float.
@@ -466,7 +464,7 @@ void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, 
       constexpr bool W = decltype(weighted)::value;
       const size_t hi = span.hi;
       if (span.lo >= hi) return;
-      const T r0 = rd[span.lo], wu = T(span.w);
+      const T r0 = rd(span.lo), wu = T(span.w);
       if constexpr (std::is_same_v<T, float>) {
         // The colour's last cells of the span in one more block, placed to
         // end at the span's end: the cells it repeats get the same values

@@ -67,9 +67,14 @@ struct LaplaceSystem {
     uint32_t lo = 0, hi = 0;
     float w = 1.0f;
   };
-  // 1 / diag per cell (0 on inactive cells), in single precision (a
+  // 1 / diag of cell i (0 on inactive cells), in single precision (a
   // smoother's or preconditioner's factor: the double kernels widen it).
-  const float* invDiag() const { return invDiag_.data(); }
+  // Formed when asked, not stored: the kernels need it only outside the
+  // uniform spans (where it is one value) and once per residual pass.
+  float invDiag(size_t i) const {
+    const float d = diag[i];
+    return d > 0 ? 1.0f / d : 0.0f;
+  }
   // A row's span for sweeps that read the neighbours' values only (the
   // smoother, the Chebyshev iteration): its faces across a non-periodic
   // domain edge may weigh 0, as the row of zeros beyond adds 0 either way.
@@ -90,7 +95,6 @@ struct LaplaceSystem {
 
   bool singular_ = false;
   size_t active_ = 0;
-  std::vector<float> invDiag_;  // 1 / diag, 0 on inactive cells
   Vector zerosX_;               // a row of zeros: the neighbour beyond a wall
   std::vector<float> zerosW_;   // (also the float row of zeros)
   std::vector<Span> uniformSpan_;
