@@ -80,11 +80,11 @@ void addSolverKernels(int n, double explicitDt, std::vector<Kernel>* out) {
   for (size_t i = 0; i < x->size(); ++i) (*x)[i] = std::sin(0.001 * double(i));
   P.removeNullSpace(x.get());
   // y = A x in double: read x and the coefficients, write y.
-  out->push_back({"pressure A x (double)", D, n, 16.0, [fluid, &P, x, y] { P.apply(*x, y.get()); }});
+  out->push_back({"pressure A x (double)", D, n, 16.0, [fluid, &P, x, y] { P.apply(*x, y.get()); }, nullptr});
   // One V-cycle from zero (MGPCG's preconditioner): read r, write z, the
   // fine coefficients at least once; the cycle's sweeps are on top.
   auto mg = std::make_shared<Multigrid<D>>(P);
-  out->push_back({"pressure V-cycle (float levels)", D, n, 16.0 + coefficients, [fluid, mg, x, y] { mg->apply(*x, y.get()); }});
+  out->push_back({"pressure V-cycle (float levels)", D, n, 16.0 + coefficients, [fluid, mg, x, y] { mg->apply(*x, y.get()); }, nullptr});
   // The viscosity's Chebyshev iteration on the x velocity at the suite's
   // step (dt = h): a step reads two float iterates and g, writes one.
   auto visc = std::make_shared<ViscousSystem<D>>(viscousSystem<D>(fluid->constraints(), 0));
@@ -102,7 +102,7 @@ void addSolverKernels(int n, double explicitDt, std::vector<Kernel>* out) {
   // implicit diffusion solve per species): two double species read and written.
   auto kl = std::make_shared<RDSolver<D>>(benchGrayScott<D>(n, 1.0, RDIntegrator::KimLin), *findModel("gray-scott"));
   pearsonStart(kl.get());
-  out->push_back({"rd Kim & Lin step", D, n, 32, [kl, explicitDt] { kl->step(10.0 * explicitDt); }});
+  out->push_back({"rd Kim & Lin step", D, n, 32, [kl, explicitDt] { kl->step(10.0 * explicitDt); }, nullptr});
 }
 
 // The kernels, each with the state it steps (kept alive by the closures).
@@ -112,19 +112,19 @@ void addKernels(int n, std::vector<Kernel>* out) {
   auto rd = std::make_shared<RDSolver<D>>(benchGrayScott<D>(n, 1.0, RDIntegrator::ExplicitEuler), *findModel("gray-scott"));
   pearsonStart(rd.get());
   const double dt = 0.9 * rd->explicitDiffusionLimit();
-  out->push_back({"rd explicit (double)", D, n, 32, [rd, dt] { rd->step(dt); }});
+  out->push_back({"rd explicit (double)", D, n, 32, [rd, dt] { rd->step(dt); }, nullptr});
   // rd: the fused float step (two float species read and written: 16 B), and with the 5 x 5 kernel in 2D.
   auto fused = std::shared_ptr<FusedExplicitRD<D>>(
       FusedExplicitRD<D>::create("gray-scott", cube<D>(n), 1.0, true, {0.2, 0.1}, {}).release());
   for (int s = 0; s < 2; ++s)
     for (size_t i = 0; i < fused->field(s).size(); ++i) fused->field(s)[i] = float(rd->field(s)[i]);
-  out->push_back({"rd fused (float)", D, n, 16, [fused, dt] { fused->step(dt); }});
+  out->push_back({"rd fused (float)", D, n, 16, [fused, dt] { fused->step(dt); }, nullptr});
   if constexpr (D == 2) {
     auto k5 = std::shared_ptr<FusedExplicitRD<D>>(
         FusedExplicitRD<D>::create("gray-scott", cube<D>(n), 1.0, true, {0.2, 0.1}, {}).release());
     k5->setKernel(GeneralizedDiffusion(*kramersMoyalPreset("d"), n, n, 2.2).kernel(), {});
     for (int s = 0; s < 2; ++s) k5->field(s) = fused->field(s);
-    out->push_back({"rd fused 5x5 (float)", D, n, 16, [k5, dt] { k5->step(dt); }});
+    out->push_back({"rd fused 5x5 (float)", D, n, 16, [k5, dt] { k5->step(dt); }, nullptr});
   }
   // coupling: two double species traced back through a float MAC velocity on the same grid (read 2 x 8 + D x 4, write 2 x 8).
   std::array<bool, D> walls{};
@@ -140,12 +140,12 @@ void addKernels(int n, std::vector<Kernel>* out) {
   for (Grid<double, D>& g : *chem) g = Grid<double, D>(cube<D>(n), 0.5);
   out->push_back({"coupling chemical advection", D, n, 32.0 + 4.0 * D, [adv, vel, chem] {
                     adv->advect(*vel, 0.5 / 1024, {&(*chem)[0], &(*chem)[1]});
-                  }});
+                  }, nullptr});
   // fluid: semi-Lagrangian advection of the velocity through itself (read and write D floats).
   auto dst = std::make_shared<MacVelocity<D>>(cube<D>(n), 1.0 / n, walls);
   out->push_back({"fluid velocity advection", D, n, 8.0 * D, [vel, dst] {
                     advectVelocity(*vel, 0.5 / 1024, AdvectionScheme::SemiLagrangian, dst.get());
-                  }});
+                  }, nullptr});
   addSolverKernels<D>(n, dt, out);
 }
 
