@@ -119,16 +119,16 @@ void Multigrid<D>::ensureFine() {
 
 template <int D>
 void Multigrid<D>::borrowFine(WorkPool* pool) {
-  const size_t n = fine_.size();
-  for (FVector* v : {&levels_[0].x, &levels_[0].b, &levels_[0].r}) {
-    pool->lend(v);
-    v->assign(n, 0.0f);  // every entry defined, as ensureFine() makes them
-  }
+  Level& L0 = levels_[0];
+  pool->lend({&L0.x, &L0.b, &L0.r});
+  for (FVector* v : {&L0.x, &L0.b, &L0.r}) v->clear();  // ensureFine() zeroes them, as on first use
+  ensureFine();
 }
 
 template <int D>
 void Multigrid<D>::giveBackFine(WorkPool* pool) {
-  for (FVector* v : {&levels_[0].x, &levels_[0].b, &levels_[0].r}) pool->give(v);
+  Level& L0 = levels_[0];
+  pool->give({&L0.x, &L0.b, &L0.r});
 }
 
 template <int D>

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <algorithm>
+#include <initializer_list>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -25,6 +26,15 @@ class WorkPool {
   void give(std::vector<T>* v) {
     if (v->capacity() > 0) heldOf<T>().push_back(std::move(*v));
     *v = std::vector<T>();
+  }
+  // The same for a stage's set of vectors.
+  template <class T>
+  void lend(std::initializer_list<std::vector<T>*> vs) {
+    for (std::vector<T>* v : vs) lend(v);
+  }
+  template <class T>
+  void give(std::initializer_list<std::vector<T>*> vs) {
+    for (std::vector<T>* v : vs) give(v);
   }
 
  private:

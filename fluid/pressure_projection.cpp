@@ -82,9 +82,9 @@ void PressureProjection<D>::divergenceTimes(const MacVelocity<D>& u, double fact
 template <int D>
 SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double density, WorkPool* pool) {
   PcgWorkspace& w = workspace_;
-  const std::array<Vector*, 5> work = {&w.b, &w.r, &w.z, &w.p, &w.q};
+  const std::initializer_list<Vector*> work = {&w.b, &w.r, &w.z, &w.p, &w.q};
   if (pool) {
-    for (Vector* v : work) pool->lend(v);
+    pool->lend(work);
     if (multigrid_) multigrid_->borrowFine(pool);
   }
   divergenceTimes(*u, -1.0 / vc_.h, &workspace_.b);  // rhs = -div u
@@ -110,7 +110,7 @@ SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double
                                           : static_cast<Preconditioner*>(multigrid_.get()),
                     options_, nullptr, &workspace_);
   if (pool) {
-    for (Vector* v : work) pool->give(v);
+    pool->give(work);
     if (multigrid_) multigrid_->giveBackFine(pool);
   }
   lastDt_ = dt;

@@ -107,17 +107,11 @@ double ViscositySolver<D>::rightHandSide(const MacVelocity<D>& u, int a, double 
 template <int D>
 SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt, WorkPool* pool) {
   if (nu <= 0 || dt <= 0) return SolverResult{true, 0, 0.0};
-  std::vector<Vector*> doubles = {&b_, &x_, &pcgWork_.b, &pcgWork_.r, &pcgWork_.z, &pcgWork_.p, &pcgWork_.q};
-  std::vector<std::vector<float>*> floats = {&chebyshevWork_.e[0], &chebyshevWork_.e[1], &chebyshevWork_.g};
-  if (pool) {
-    for (Vector* v : doubles) pool->lend(v);
-    for (std::vector<float>* v : floats) pool->lend(v);
-  }
+  const std::initializer_list<Vector*> doubles = {&b_, &x_, &pcgWork_.b, &pcgWork_.r, &pcgWork_.z, &pcgWork_.p, &pcgWork_.q};
+  const std::initializer_list<std::vector<float>*> floats = {&chebyshevWork_.e[0], &chebyshevWork_.e[1], &chebyshevWork_.g};
+  if (pool) pool->lend(doubles), pool->lend(floats);
   const SolverResult result = solveComponents(u, nu * dt / (vc_.h * vc_.h));
-  if (pool) {
-    for (Vector* v : doubles) pool->give(v);
-    for (std::vector<float>* v : floats) pool->give(v);
-  }
+  if (pool) pool->give(doubles), pool->give(floats);
   return result;
 }
 
