@@ -62,7 +62,7 @@ AnisotropicSystem<D> AnisotropicSystem<D>::fromTensor(const IVec<D>& dims, const
     for (int a = 0; a < D; ++a) {
       bool in = true;
       size_t j = shiftedIndex<D>(dims, periodic, c, unit<D>(a), &in);
-      s.axis.w[a][i] = in ? float(0.5 * (sigma[size_t(a)][i] + sigma[size_t(a)][j])) : 0.0f;
+      s.axis.w[a].at(i) = in ? float(0.5 * (sigma[size_t(a)][i] + sigma[size_t(a)][j])) : 0.0f;
     }
     // Mixed terms: the 2x2 block's two other cells (seed 004 eq. 17, second order).
     for (int p = 0; p < kPlanes && s.hasCross; ++p) {
@@ -140,9 +140,8 @@ AnisotropicSystem<D> AnisotropicSystem<D>::shifted(double s) const {
   AnisotropicSystem<D> t = *this;
   t.axis.scale = 1.0;
   const double k = s * axis.scale;
-  for (int a = 0; a < D; ++a)
-    for (size_t i = 0; i < size(); ++i) t.axis.w[a][i] = float(double(axis.w[a][i]) * k);
-  for (size_t i = 0; i < size(); ++i) t.axis.c[i] = float(1.0 + k * double(axis.c[i]));
+  for (int a = 0; a < D; ++a) t.axis.w[a].transform([k](float v) { return float(double(v) * k); });
+  t.axis.c.transform([k](float v) { return float(1.0 + k * double(v)); });
   t.axis.finalize();
   if (hasCross)
     for (int p = 0; p < kPlanes; ++p)

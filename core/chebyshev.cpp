@@ -114,23 +114,25 @@ Chebyshev<D>::Chebyshev(const LaplaceSystem<D>& A, const ChebyshevLayout& layout
 
 template <int D>
 void Chebyshev<D>::refresh() {
-  const size_t n = A_.size();
+  const size_t n = A_.size(), nx = size_t(A_.dims[0]), rows = n / nx;
+  // The largest of f(diag_i, c_i) over the cells (a maximum: any order).
+  auto maxOver = [&](auto&& f) {
+    return deterministicMax(rows, [&](size_t row) {
+      const float *d = A_.diag.row(row), *c = A_.c.row(row);
+      double m = 0.0;
+      for (size_t i = 0; i < nx; ++i) m = std::max(m, f(double(d[i]), double(c[i])));
+      return m;
+    });
+  };
   // rho = max (diag - c) / diag: diag sums c and the cell's face weights.
-  rho_ = deterministicMax(n, [&](size_t i) {
-    const double d = A_.diag[i];
-    return d > 0 ? (d - double(A_.c[i])) / d : 0.0;
-  });
+  rho_ = maxOver([](double d, double c) { return d > 0 ? (d - c) / d : 0.0; });
   // The face weights' float sum may round below diag - c: a margin far
   // above it (it costs nothing in the steps' count).
   rho_ = std::min(1.0, rho_ * (1.0 + 1e-5));
-  const double dmax = deterministicMax(n, [&](size_t i) { return double(A_.diag[i]); });
-  const double dminInv = deterministicMax(n, [&](size_t i) {
-    const double d = A_.diag[i];
-    return d > 0 ? 1.0 / d : 0.0;
-  });
+  const double dmax = maxOver([](double d, double) { return d; });
+  const double dminInv = maxOver([](double d, double) { return d > 0 ? 1.0 / d : 0.0; });
   diagRatio_ = dmax > 0 ? dmax * dminInv : 1.0;
   // The coefficients of the cells outside each row's uniform span, packed.
-  const size_t nx = size_t(A_.dims[0]), rows = n / nx;
   packedStart_.assign(rows + 1, 0);
   for (size_t row = 0; row < rows; ++row) {
     const auto& span = A_.sweepSpan(row);
@@ -141,14 +143,15 @@ void Chebyshev<D>::refresh() {
     const RowStencil<D, float> s = rowStencil<D, float>(A_, zerosOf(), zerosOf(), zerosOf(), row);
     const auto& span = A_.sweepSpan(row);
     float* out = packed_.data() + packedStart_[row];
+    const float *dr = A_.diag.row(row), *w0 = A_.w[0].row(row);
     for (size_t i = 0; i < nx; ++i) {
       if (i >= span.lo && i < span.hi) continue;
       const size_t il = i == 0 ? nx - 1 : i - 1;
-      *out++ = A_.invDiag(s.base + i);
-      *out++ = A_.w[0][s.base + i];
-      *out++ = (i == 0 && !A_.periodic[0]) ? 0.0f : A_.w[0][s.base + il];
+      *out++ = LaplaceSystem<D>::inverse(dr[i]);
+      *out++ = w0[i];
+      *out++ = (i == 0 && !A_.periodic[0]) ? 0.0f : w0[il];
       for (int a = 1; a < D; ++a) {
-        *out++ = A_.w[a][s.base + i];
+        *out++ = A_.w[a].row(row)[i];
         *out++ = s.wlo[a][i];
       }
     }

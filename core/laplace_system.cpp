@@ -194,8 +194,8 @@ __attribute__((target("avx2"))) size_t applyUniformAvx(const RowStencil<D, T>& s
 
 template <int D>
 LaplaceSystem<D>::LaplaceSystem(const IVec<D>& d, const std::array<bool, D>& p, double s)
-    : dims(d), periodic(p), scale(s), c(d, 0.0f), diag(d, 0.0f) {
-  for (int a = 0; a < D; ++a) w[a] = Grid<float, D>(d, 0.0f);
+    : dims(d), periodic(p), scale(s), c(d, 0.0f) {
+  for (int a = 0; a < D; ++a) w[a] = RowField<D>(d, 0.0f);
   zerosX_.assign(size_t(d[0]), 0.0);
   zerosW_.assign(size_t(d[0]), 0.0f);
 }
@@ -213,27 +213,36 @@ template <int D>
 void LaplaceSystem<D>::finalize() {
   // Zero the couplings that would wrap across a non-periodic edge: the last
   // cell of every row along x, the whole last rows along y (and z).
-  const size_t nxCells = size_t(dims[0]);
+  const size_t nx = size_t(dims[0]);
+  const size_t rows = size() / nx;
   parallelForRows<D>(dims, [&](size_t row) {
-    if (!periodic[0]) w[0][row * nxCells + nxCells - 1] = 0.0f;
+    if (!periodic[0] && w[0].dense()) w[0].at(row * nx + nx - 1) = 0.0f;
     size_t rest = row;
     for (int a = 1; a < D; ++a) {
       const bool last = int(rest % size_t(dims[a])) == dims[a] - 1;
       rest /= size_t(dims[a]);
-      if (last && !periodic[a]) std::fill_n(w[a].data() + row * nxCells, nxCells, 0.0f);
+      if (last && !periodic[a] && w[a].dense()) std::fill_n(w[a].mutableRow(row), nx, 0.0f);
     }
   });
-  forEachCell<D>(dims, [&](const IVec<D>& cell, size_t i) {
-    float d = c[i];
-    for (int a = 0; a < D; ++a) {
-      IVec<D> lo = cell;
-      lo[a] = cell[a] == 0 ? dims[a] - 1 : cell[a] - 1;
-      d += w[a][i] + w[a][w[a].index(lo)];
+  // diag_i = c_i + sum over the 2D faces of w (the low faces' weights are the
+  // row's own for x, the neighbour rows' for y and z; wrapped, or 0 beyond a
+  // non-periodic edge: finalize zeroed those).
+  diag = RowField<D>(dims, 0.0f);
+  parallelForRows<D>(dims, [&](size_t row) {
+    RowStencil<D, double> s = rowStencil<D>(*this, zerosX_.data(), zerosX_.data(), zerosW_.data(), row);
+    const float* cr = c.row(row);
+    const float* w0 = w[0].row(row);
+    float* d = diag.mutableRow(row);
+    for (size_t i = 0; i < nx; ++i) {
+      float v = cr[i];
+      v += w0[i] + w0[i == 0 ? nx - 1 : i - 1];
+      for (int a = 1; a < D; ++a) v += w[a].row(row)[i] + s.wlo[a][i];
+      d[i] = v;
     }
-    diag[i] = d;
   });
-  const size_t nx = size_t(dims[0]);
-  const size_t rows = size() / nx;
+  c.compact();
+  for (int a = 0; a < D; ++a) w[a].compact();
+  diag.compact();
   // The longest run of interior cells per row that are uniform among
   // themselves (one weight wu > 0 on every face, one c, hence one diagonal).
   uniformSpan_.assign(rows, {});
@@ -241,8 +250,8 @@ void LaplaceSystem<D>::finalize() {
   parallelForRows<D>(dims, [&](size_t row) {
     if (nx < 3) return;
     RowStencil<D, double> s = rowStencil<D>(*this, zerosX_.data(), zerosX_.data(), zerosW_.data(), row);
-    const float* cr = c.data() + s.base;
-    const float* w0 = w[0].data() + s.base;
+    const float* cr = c.row(row);
+    const float* w0 = w[0].row(row);
     // The smoother also takes a face across a non-periodic domain edge:
     // there the general sum adds 0 * 0 from the row of zeros, and the
     // uniform one wu times that row's 0 (bitwise the same; not so A x, whose
@@ -258,7 +267,7 @@ void LaplaceSystem<D>::finalize() {
     auto uniform = [&](size_t i, float wu, bool edges) {
       if (w0[i] != wu || w0[i - 1] != wu) return false;
       for (int a = 1; a < D; ++a) {
-        const float hi = w[a][s.base + i];
+        const float hi = w[a].row(row)[i];
         if (!(hi == wu || (edges && edgeHi[a] && hi == 0.0f)) || !(s.wlo[a][i] == wu || (edges && edgeLo[a])))
           return false;
       }
@@ -282,8 +291,14 @@ void LaplaceSystem<D>::finalize() {
     uniformSpan_[row] = longest(false);
     sweepSpan_[row] = longest(true);
   });
-  active_ = size_t(deterministicSum(diag.size(), [&](size_t i) { return diag[i] > 0 ? 1.0 : 0.0; }));
-  singular_ = deterministicMax(c.size(), [&](size_t i) { return c[i]; }) <= 0.0;
+  active_ = size_t(deterministicRowSum<D>(dims, [&](size_t row) {
+    const float* d = diag.row(row);
+    return double(std::count_if(d, d + nx, [](float v) { return v > 0; }));
+  }));
+  singular_ = deterministicRowSum<D>(dims, [&](size_t row) {
+    const float* cr = c.row(row);
+    return double(std::count_if(cr, cr + nx, [](float v) { return v > 0; }));
+  }) == 0.0;
 }
 
 template <int D>
@@ -294,8 +309,8 @@ double LaplaceSystem<D>::applyRow(size_t row, const T* x, T* y, const T* b) cons
   const T sc = T(scale);
   RowStencil<D, T> s = rowStencil<D>(*this, x, zeros<T>(), zerosW_.data(), row);
   const float* wa[D];
-  for (int a = 0; a < D; ++a) wa[a] = w[a].data() + s.base;
-  const float* cr = c.data() + s.base;
+  for (int a = 0; a < D; ++a) wa[a] = w[a].row(row);
+  const float* cr = c.row(row);
   const T* xr = x + s.base;
   T* yr = y;  // the row's own values
   auto edge = [&](size_t i) {
@@ -373,7 +388,7 @@ double LaplaceSystem<D>::defectRow(size_t row, const T* b, const T* x, T* r) con
   const size_t nx = size_t(dims[0]), base = row * nx;
   T* __restrict rr = r;
   const T* __restrict br = b + base;
-  const float* __restrict dr = diag.data() + base;
+  const float* __restrict dr = diag.row(row);
   // b - A x where the cell is active, else 0, as a bit mask: a branch (or
   // a select GCC must assume may trap) would keep the loop scalar.
   using Bits = std::conditional_t<sizeof(T) == 4, uint32_t, uint64_t>;
@@ -439,8 +454,9 @@ void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, 
     RowStencil<D, T> s = rowStencil<D, T>(*this, x.data(), zeros<T>(), zerosW_.data(), row, y, z);
     const size_t parity = y + z;
     const float* wa[D];
-    for (int a = 0; a < D; ++a) wa[a] = w[a].data() + s.base;
-    auto rd = [&](size_t i) { return invDiag(s.base + i); };
+    for (int a = 0; a < D; ++a) wa[a] = w[a].row(row);
+    const float* dr = diag.row(row);
+    auto rd = [&](size_t i) { return inverse(dr[i]); };
     const T* br = b.data() + s.base;
     T* xr = x.data() + s.base;
     // x_i = (b_i / scale + sum_f w_f x_j) / diag_i; invDiag is 0 on inactive cells.
@@ -540,9 +556,19 @@ template <int D>
 void LaplaceSystem<D>::removeNullSpace(Vector* xp) const {
   Vector& x = *xp;
   if (active_ == 0) return;
-  double mean = deterministicSum(x.size(), [&](size_t i) { return diag[i] > 0 ? x[i] : 0.0; }) /
-                double(active_);
-  parallelFor(x.size(), [&](size_t i) { x[i] = diag[i] > 0 ? x[i] - mean : 0.0; }, 4096);
+  const size_t nx = size_t(dims[0]);
+  const double mean = deterministicRowSum<D>(dims, [&](size_t row) {
+    const float* d = diag.row(row);
+    const double* xr = x.data() + row * nx;
+    double s = 0.0;
+    for (size_t i = 0; i < nx; ++i) s += d[i] > 0 ? xr[i] : 0.0;
+    return s;
+  }) / double(active_);
+  parallelForRows<D>(dims, [&](size_t row) {
+    const float* d = diag.row(row);
+    double* xr = x.data() + row * nx;
+    for (size_t i = 0; i < nx; ++i) xr[i] = d[i] > 0 ? xr[i] - mean : 0.0;
+  });
 }
 
 template <int D>

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "core/grid.h"
+#include "core/row_field.h"
 
 namespace morphoflow {
 
@@ -25,16 +26,19 @@ struct LaplaceSystem {
   IVec<D> dims{0};
   std::array<bool, D> periodic{};
   double scale = 1.0;               // 1 / h^2 for a Laplacian
-  Grid<float, D> c;                 // diagonal-only term
-  std::array<Grid<float, D>, D> w;  // w[a](i): coupling of i and i + e_a (wrapped if periodic)
-  Grid<float, D> diag;              // c + sum of the 2D face weights; 0 = inactive
+  // Coefficient fields, each row stored once per distinct content (written
+  // dense, compacted by finalize()).
+  RowField<D> c;                 // diagonal-only term
+  std::array<RowField<D>, D> w;  // w[a](i): coupling of i and i + e_a (wrapped if periodic)
+  RowField<D> diag;              // c + sum of the 2D face weights; 0 = inactive
 
   LaplaceSystem() = default;
   LaplaceSystem(const IVec<D>& dims, const std::array<bool, D>& periodic, double scale);
 
   size_t size() const { return c.size(); }
-  // Zeroes couplings across non-periodic domain edges and computes diag. Call
-  // after filling c and w.
+  // Zeroes couplings across non-periodic domain edges, computes diag and
+  // compacts the fields. Call after filling c and w (a field already
+  // compacted by an earlier finalize() may stay so).
   void finalize();
   // True when no c_i > 0: constants are then in the null space, and solvers
   // work on mean-free vectors.
@@ -71,10 +75,8 @@ struct LaplaceSystem {
   // smoother's or preconditioner's factor: the double kernels widen it).
   // Formed when asked, not stored: the kernels need it only outside the
   // uniform spans (where it is one value) and once per residual pass.
-  float invDiag(size_t i) const {
-    const float d = diag[i];
-    return d > 0 ? 1.0f / d : 0.0f;
-  }
+  float invDiag(size_t i) const { return inverse(diag[i]); }
+  static float inverse(float d) { return d > 0 ? 1.0f / d : 0.0f; }
   // A row's span for sweeps that read the neighbours' values only (the
   // smoother, the Chebyshev iteration): its faces across a non-periodic
   // domain edge may weigh 0, as the row of zeros beyond adds 0 either way.

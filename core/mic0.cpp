@@ -8,7 +8,7 @@ namespace morphoflow {
 template <int D>
 MIC0Preconditioner<D>::MIC0Preconditioner(const LaplaceSystem<D>& A, double tau, double sigma)
     : A_(A), precon_(A.size(), 0.0), q_(A.size(), 0.0) {
-  const Grid<float, D>& diag = A.diag;
+  const RowField<D>& diag = A.diag;
   for (size_t i = 0; i < A.size(); ++i) {
     if (diag[i] <= 0) continue;
     IVec<D> c = diag.coord(i);
@@ -37,7 +37,7 @@ template <int D>
 void MIC0Preconditioner<D>::apply(const Vector& r, Vector* zp) {
   Vector& z = *zp;
   z.resize(r.size());
-  const Grid<float, D>& diag = A_.diag;
+  const RowField<D>& diag = A_.diag;
   const double inv = 1.0 / A_.scale;
   size_t stride[D];
   for (int a = 0; a < D; ++a) stride[a] = diag.stride(a);

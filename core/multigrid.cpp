@@ -45,6 +45,8 @@ void coarsenInto(const LaplaceSystem<D>& F, LaplaceSystem<D>* Cp) {
   const IVec<D> cd = C.dims;
   C.scale = F.scale / 4.0;
   const double inv2D = 1.0 / double(1 << D);
+  C.c = RowField<D>(cd, 0.0f);
+  for (int a = 0; a < D; ++a) C.w[a] = RowField<D>(cd, 0.0f);
   forEachCell<D>(cd, [&](const IVec<D>& cc, size_t ci) {
     // Identity terms: Galerkin mean (scaled: coarse scale is fine scale / 4).
     double csum = 0.0;
@@ -57,7 +59,7 @@ void coarsenInto(const LaplaceSystem<D>& F, LaplaceSystem<D>* Cp) {
       }
       if (inside) csum += F.c(f);
     }
-    C.c[ci] = float(4.0 * csum * inv2D);
+    C.c.at(ci) = float(4.0 * csum * inv2D);
     // Face between cc and cc + e_a: the 2^(D-1) fine faces at fine index 2 cc_a + 1.
     for (int a = 0; a < D; ++a) {
       double wsum = 0.0;
@@ -73,7 +75,7 @@ void coarsenInto(const LaplaceSystem<D>& F, LaplaceSystem<D>* Cp) {
         ++count;
         if (inside) wsum += F.w[a](f);
       }
-      C.w[a][ci] = float(wsum / count);
+      C.w[a].at(ci) = float(wsum / count);
     }
   });
   C.finalize();
@@ -254,7 +256,7 @@ void Multigrid<D>::restrict(int l) {
     for (size_t X = lo; X < hi; ++X)  // the same sum without the tables
       br[X] = 0.25f * cy[2 * X - 1] + 0.75f * cy[2 * X] + 0.75f * cy[2 * X + 1] + 0.25f * cy[2 * X + 2];
     for (size_t X = hi; X < ncx; ++X) table(X);
-    const float* cd = C.diag.data() + row * ncx;
+    const float* cd = C.diag.row(row);
     for (size_t X = 0; X < ncx; ++X) br[X] = cd[X] > 0 ? br[X] * inv2D : 0.0f;
   });
 }
@@ -301,7 +303,7 @@ void Multigrid<D>::prolongAdd(int l) {
     for (size_t X = 0; X < ncx; ++X) cy[X] = cw[0] * crow[0][X];
     for (int k = 1; k < nrows; ++k)
       for (size_t X = 0; X < ncx; ++X) cy[X] += cw[k] * crow[k][X];
-    const float* fd = F.diag.data() + row * nfx;
+    const float* fd = F.diag.row(row);
     float* xr = x.data() + row * nfx;
     const int* lo = T[0].lo.data();
     const int* hi = T[0].hi.data();

@@ -34,7 +34,7 @@ inline RowStencil<D, T> rowStencil(const LaplaceSystem<D>& A, const T* x, const 
     if (k > 0 || p) {
       size_t lo = k > 0 ? s.base - stride : s.base + (n - 1) * stride;
       s.xlo[a] = x + lo;
-      s.wlo[a] = A.w[a].data() + lo;
+      s.wlo[a] = A.w[a].row(lo / nx);
     } else {
       s.xlo[a] = zx;
       s.wlo[a] = zw;

@@ -16,10 +16,10 @@ LaplaceSystem<D> pressureSystem(const VelocityConstraints<D>& vc) {
     for (int a = 0; a < D; ++a) {
       IVec<D> up = k + unitVector<D>(a);
       if (up[a] == n[a]) up[a] = 0;  // wraps on periodic axes; zeroed by finalize otherwise
-      if (!vc.solid(up)) A.w[a][i] = 1.0f;
+      if (!vc.solid(up)) A.w[a].at(i) = 1.0f;
       // p = 0 on an outflow side, through a ghost cell mirrored about the face.
-      if (k[a] == 0 && vc.boundaries.side(a, false).kind == BoundaryKind::Outflow) A.c[i] += 2.0f;
-      if (k[a] == n[a] - 1 && vc.boundaries.side(a, true).kind == BoundaryKind::Outflow) A.c[i] += 2.0f;
+      if (k[a] == 0 && vc.boundaries.side(a, false).kind == BoundaryKind::Outflow) A.c.at(i) += 2.0f;
+      if (k[a] == n[a] - 1 && vc.boundaries.side(a, true).kind == BoundaryKind::Outflow) A.c.at(i) += 2.0f;
     }
   });
   A.finalize();

@@ -48,20 +48,22 @@ ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
           c += 1.0;
           extra += double(vc.prescribed(a, ni));
         } else if (dir > 0) {
-          C.A.w[bx][i] = 1.0f;
+          C.A.w[bx].at(i) = 1.0f;
         }
       }
     }
     C.cBoundary[i] = uint8_t(c);  // whole: 2 per wall ghost, 1 per prescribed neighbour
     C.boundaryRhs[i] = float(extra);
   });
+  C.A.finalize();  // the weights compacted now; c follows at setRate
   return C;
 }
 
 template <int D>
 void ViscousSystem<D>::setRate(double s) {
   A.scale = s;
-  parallelFor(A.size(), [&](size_t i) { A.c[i] = unknownFixed[i] ? 0.0f : float(1.0 / s + double(cBoundary[i])); }, 4096);
+  A.c = RowField<D>(A.dims, 0.0f);
+  parallelFor(A.size(), [&](size_t i) { A.c.at(i) = unknownFixed[i] ? 0.0f : float(1.0 / s + double(cBoundary[i])); }, 4096);
   A.finalize();
 }
 

@@ -42,9 +42,9 @@ void GpuLaplace::update(const AnisotropicSystem<D>& A) {
 
 template <int D>
 void GpuLaplace::update(const LaplaceSystem<D>& A) {
-  for (int a = 0; a < D; ++a) w_[size_t(a)].upload(A.w[a].values());
-  diag_.upload(A.diag.values());
-  c_.upload(A.c.values());
+  for (int a = 0; a < D; ++a) w_[size_t(a)].upload(A.w[a].expanded());
+  diag_.upload(A.diag.expanded());
+  c_.upload(A.c.expanded());
   scale_ = A.scale;
   singular_ = A.singular();
 }

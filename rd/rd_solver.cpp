@@ -87,9 +87,9 @@ LaplaceSystem<D> RDSolver<D>::isotropicSystem(std::optional<double> shift) const
   const float w = shift ? float(double(1.0f) * k) : 1.0f;
   const bool dirichlet = settings_.boundary == RDBoundary::Dirichlet;
   parallelFor(lap.size(), [&](size_t i) {
-    for (int a = 0; a < D; ++a) lap.w[a][i] = w;  // finalize() cuts the wrap on non-periodic axes
+    for (int a = 0; a < D; ++a) lap.w[a].at(i) = w;  // finalize() cuts the wrap on non-periodic axes
     const float c = dirichlet ? float(2.0 * boundaryFaces_[i]) : 0.0f;
-    lap.c[i] = shift ? float(1.0 + k * double(c)) : c;
+    lap.c.at(i) = shift ? float(1.0 + k * double(c)) : c;
   }, kChunk);
   lap.finalize();
   return lap;
@@ -177,11 +177,12 @@ void RDSolver<D>::assemble(const std::array<std::vector<double>, AnisotropicSyst
   *system = AnisotropicSystem<D>::fromTensor(cells_, per, 1.0 / (h_ * h_), ptr);
   boundary->assign(system->size(), 0.0);
   if (settings_.boundary == RDBoundary::Dirichlet) {
+    system->axis.c.densify();
     forEachCell<D>(cells_, [&](const IVec<D>& k, size_t i) {
       double w = 0.0;
       for (int a = 0; a < D; ++a) w += sigma[size_t(a)][i] * ((k[a] == 0) + (k[a] == cells_[a] - 1));
       (*boundary)[i] = w;
-      system->axis.c[i] = float(2.0 * w);
+      system->axis.c.at(i) = float(2.0 * w);
     });
     system->axis.finalize();
   }

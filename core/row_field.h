@@ -1,0 +1,116 @@
+// RowField<D>: a float field on a grid whose rows (the cells along x of one
+// y (, z)) are stored once per distinct content. The coefficient fields of
+// the linear systems are uniform almost everywhere (weight 1 inside, 0
+// across a wall, one identity term), so a box keeps a handful of rows however
+// fine its grid, and an obstacle's rows are kept as they are: the same values
+// and the same kernels (they read a row at a time), a few bytes instead of
+// four a cell.
+//
+// A field is written while dense (just constructed, or after densify()), then
+// compact() keeps each distinct row once; reading works in both states.
+#pragma once
+
+#include <algorithm>
+#include <stdexcept>
+#include <cstdint>
+#include <vector>
+
+#include "core/grid.h"
+
+namespace morphoflow {
+
+template <int D>
+class RowField {
+ public:
+  RowField() = default;
+  RowField(const IVec<D>& dims, float value) : dims_(dims) {
+    nx_ = size_t(dims[0]);
+    invNx_ = 1.0 / double(nx_);
+    size_ = 1;
+    for (int a = 0; a < D; ++a) size_ *= size_t(dims[a]);
+    pool_.assign(size_, value);
+    identity();
+  }
+
+  const IVec<D>& dims() const { return dims_; }
+  int dim(int axis) const { return dims_[axis]; }
+  size_t size() const { return size_; }
+  size_t index(const IVec<D>& c) const {  // Grid's order: x fastest
+    size_t i = size_t(c[D - 1]);
+    for (int a = D - 2; a >= 0; --a) i = i * size_t(dims_[a]) + size_t(c[a]);
+    return i;
+  }
+  IVec<D> coord(size_t i) const {
+    IVec<D> c;
+    for (int a = 0; a < D; ++a) {
+      c[a] = int(i % size_t(dims_[a]));
+      i /= size_t(dims_[a]);
+    }
+    return c;
+  }
+  size_t stride(int axis) const {
+    size_t s = 1;
+    for (int a = 0; a < axis; ++a) s *= size_t(dims_[a]);
+    return s;
+  }
+
+  // Row r's nx values.
+  const float* row(size_t r) const { return pool_.data() + size_t(rowOf_[r]) * nx_; }
+  float operator[](size_t i) const {
+    if (dense_) return pool_[i];
+    size_t r = size_t(double(i) * invNx_);  // i / nx, corrected below (a division costs far more)
+    r -= r * nx_ > i;
+    r += (r + 1) * nx_ <= i;
+    return pool_[size_t(rowOf_[r]) * nx_ + (i - r * nx_)];
+  }
+  float operator()(const IVec<D>& c) const { return (*this)[index(c)]; }
+
+  // Writing: only while dense.
+  bool dense() const { return dense_; }
+  float& at(size_t i) {
+    requireDense();
+    return pool_[i];
+  }
+  float* mutableRow(size_t r) {
+    requireDense();
+    return pool_.data() + r * nx_;
+  }
+  void fill(float v) {
+    requireDense();
+    std::fill(pool_.begin(), pool_.end(), v);
+  }
+  // Keeps each distinct row once (rows compared bitwise; the first of equal
+  // rows is kept, so the result does not depend on the thread count).
+  void compact();
+  // Back to one row per row, writable.
+  void densify();
+  // v -> f(v) on every value, applied to the stored rows only.
+  template <class F>
+  void transform(F&& f) {
+    for (float& v : pool_) v = f(v);
+  }
+  // Every value, in grid order (a GPU upload's copy).
+  std::vector<float> expanded() const;
+  // Rows stored (the footprint is storedRows() * nx floats plus 4 bytes a row).
+  size_t storedRows() const { return pool_.size() / (nx_ ? nx_ : 1); }
+  size_t bytes() const { return pool_.capacity() * sizeof(float) + rowOf_.capacity() * sizeof(uint32_t); }
+
+ private:
+  void requireDense() const {
+    if (!dense_) throw std::logic_error("RowField: written after compact() (densify() it first)");
+  }
+  void identity() {
+    rowOf_.resize(nx_ ? size_ / nx_ : 0);
+    for (size_t r = 0; r < rowOf_.size(); ++r) rowOf_[r] = uint32_t(r);
+    dense_ = true;
+  }
+
+  IVec<D> dims_{};
+  size_t nx_ = 0, size_ = 0;
+  double invNx_ = 0.0;
+  std::vector<float> pool_;        // the stored rows, nx values each
+  std::vector<uint32_t> rowOf_;    // row -> its stored row
+  bool dense_ = false;
+};
+
+}  // namespace morphoflow
