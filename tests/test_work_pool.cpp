@@ -1,5 +1,6 @@
-// WorkPool: the stages' vectors circulate without new allocations, and
-// AtomicFile leaves either the whole file or nothing.
+// WorkPool: the stages' vectors circulate without new allocations;
+// AtomicFile leaves either the whole file or nothing; RowField stores a
+// field's distinct rows once.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -7,7 +8,10 @@
 
 #include <unistd.h>
 
+#include "core/laplace_system.h"
 #include "core/output_file.h"
+#include "core/parallel.h"
+#include "core/row_field.h"
 #include "core/work_pool.h"
 
 namespace morphoflow {
@@ -63,6 +67,35 @@ TEST(AtomicFile, WritesPiecesAndLeavesNothingWithoutCommit) {
   EXPECT_FALSE(fs::exists(dir / "abandoned.bin"));
   EXPECT_FALSE(fs::exists(dir / "abandoned.bin.tmp"));
   fs::remove_all(dir);
+}
+
+// A field's rows are kept once per distinct content: the values read back
+// are the dense ones, writing needs densify(), and a box's Laplacian keeps a
+// handful of rows however fine the grid, its diagonal the count of open faces.
+TEST(RowField, KeepsDistinctRowsAndReadsBackTheDenseValues) {
+  const IVec<3> dims(12, 7, 5);
+  RowField<3> f(dims, 0.0f);
+  forEachCell<3>(dims, [&](const IVec<3>& k, size_t i) { f.at(i) = float(k[0] == 0) + 2.0f * float(k[1] == 6); });
+  const std::vector<float> dense = f.expanded();
+  f.compact();
+  EXPECT_EQ(f.storedRows(), 2u);  // rows with y < 6 and rows with y = 6
+  EXPECT_EQ(f.expanded(), dense);
+  for (size_t i = 0; i < f.size(); ++i) ASSERT_EQ(f[i], dense[i]) << i;
+  EXPECT_THROW(f.at(0) = 1.0f, std::logic_error);
+  f.densify();
+  f.at(3) = 5.0f;
+  EXPECT_EQ(f[3], 5.0f);
+
+  for (int n : {16, 48}) {
+    const LaplaceSystem<3> A = makeNeumannLaplacian<3>(IVec<3>(n), {}, 1.0);
+    for (int a = 0; a < 3; ++a) EXPECT_LE(A.w[a].storedRows(), 2u) << "axis " << a;
+    EXPECT_LE(A.diag.storedRows(), 9u);
+    forEachCell<3>(A.dims, [&](const IVec<3>& k, size_t i) {
+      int open = 0;
+      for (int a = 0; a < 3; ++a) open += (k[a] > 0) + (k[a] < n - 1);
+      ASSERT_EQ(A.diag[i], float(open)) << k[0] << " " << k[1] << " " << k[2];
+    });
+  }
 }
 
 }  // namespace
