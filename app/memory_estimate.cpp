@@ -13,27 +13,27 @@ namespace morphoflow {
 namespace {
 
 // Peak bytes per cell beyond the fixed overhead, measured by `bench memory`
-// (2D 1024^2, 3D 128^3, two steps and the final checkpoint;
+// (2D 1024^2, 3D 128^3, four steps and the final checkpoint;
 // docs/performance.md "Memory"): the fluid (velocity and its advected copy,
 // pressure and viscosity systems, their warm starts, and the work vectors
 // its stages borrow in turn) and each species of a reaction-diffusion layer
 // (double state, its implicit system and warm start, a share of the solves'
 // vectors; in a coupled run also its advection scratch and feet; float
 // state for the fused explicit step).
-constexpr double kFluidBytesPerCell[2] = {181.0, 138.5};        // 2D, 3D
+constexpr double kFluidBytesPerCell[2] = {153.0, 117.5};        // 2D, 3D
 // A coupled run's fluid and species, each from two runs (the same grid for
 // both, and chemicals twice as fine: 2D 512^2 / 1024^2, 3D the shipped
 // 128^3 / 256^3 cavity) solved for the two unknowns.
-constexpr double kCoupledFluidBytesPerCell[2] = {147.0, 176.0};
-constexpr double kSpeciesBytesPerCell[2] = {30.0, 32.0};         // reaction-diffusion only
-constexpr double kCoupledSpeciesBytesPerCell[2] = {38.0, 40.0};  // carried by a fluid
+constexpr double kCoupledFluidBytesPerCell[2] = {108.0, 130.0};
+constexpr double kSpeciesBytesPerCell[2] = {26.0, 28.5};         // reaction-diffusion only
+constexpr double kCoupledSpeciesBytesPerCell[2] = {38.7, 40.2};  // carried by a fluid
 constexpr double kFusedSpeciesBytesPerCell = 16.0;               // the fused explicit step
 // A frame's OpenVDB volumes: each grid is built densely, then as a tree,
 // before the file is written, on top of the solvers' work vectors when the
 // frame follows a step (measured on the shipped 3D cavity's frames, whose
-// peak they raise by 0.85 GiB: species and density at 256^3, the velocity's
-// three components at 128^3; 16-17 bytes a voxel from 64^3 up).
-constexpr double kVdbBytesPerVoxel = 16.5;
+// peak they raise by 0.81 GiB: species and density at 256^3, the velocity's
+// three components at 128^3; 15-17 bytes a voxel from 64^3 up).
+constexpr double kVdbBytesPerVoxel = 15.5;
 constexpr double kFixedBytes = 126.0 * (1 << 20);                // the program, its libraries and thread pools
 
 double cellsOf(const std::vector<int>& res) {

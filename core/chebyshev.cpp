@@ -156,6 +156,7 @@ void Chebyshev<D>::refresh() {
       }
     }
   });
+  keepDistinctSegments(&packed_, &packedStart_);  // rows alike (a box's) share their coefficients
   // w_1 = 1, w_2 = 1 / (1 - rho^2 / 2), w_k = 1 / (1 - rho^2 w_{k-1} / 4).
   omega_.assign(2, 1.0f);
   double w = 1.0;

@@ -96,7 +96,8 @@ class Chebyshev {
   std::vector<float> zeros_;  // a row of zeros: beyond a non-periodic edge
   const float* zerosOf() const { return zeros_.data(); }
   // Per row, from packedStart_[row]: the coefficients of its cells outside
-  // the uniform span (1 / diag, then the face weights), 2D + 1 floats each.
+  // the uniform span (1 / diag, then the face weights), 2D + 1 floats each;
+  // rows with the same coefficients share them.
   std::vector<size_t> packedStart_;
   std::vector<float> packed_;
   const float* packedRow(size_t row) const { return packed_.data() + packedStart_[row]; }

@@ -227,22 +227,32 @@ void LaplaceSystem<D>::finalize() {
   // diag_i = c_i + sum over the 2D faces of w (the low faces' weights are the
   // row's own for x, the neighbour rows' for y and z; wrapped, or 0 beyond a
   // non-periodic edge: finalize zeroed those).
-  diag = RowField<D>(dims, 0.0f);
-  parallelForRows<D>(dims, [&](size_t row) {
-    RowStencil<D, double> s = rowStencil<D>(*this, zerosX_.data(), zerosX_.data(), zerosW_.data(), row);
-    const float* cr = c.row(row);
-    const float* w0 = w[0].row(row);
-    float* d = diag.mutableRow(row);
-    for (size_t i = 0; i < nx; ++i) {
-      float v = cr[i];
-      v += w0[i] + w0[i == 0 ? nx - 1 : i - 1];
-      for (int a = 1; a < D; ++a) v += w[a].row(row)[i] + s.wlo[a][i];
-      d[i] = v;
-    }
-  });
+  // Rows alike in c and their weights (a box's, whatever its size) share one
+  // computed row.
   c.compact();
   for (int a = 0; a < D; ++a) w[a].compact();
-  diag.compact();
+  auto stencil = [&](size_t row) {
+    return rowStencil<D>(*this, zerosX_.data(), zerosX_.data(), zerosW_.data(), row);
+  };
+  diag = RowField<D>::template fromSources<2 * D>(
+      dims,
+      [&](size_t row) {
+        const RowStencil<D, double> s = stencil(row);
+        std::array<const float*, 2 * D> src{c.row(row), w[0].row(row)};
+        for (int a = 1; a < D; ++a) src[size_t(2 * a)] = w[a].row(row), src[size_t(2 * a + 1)] = s.wlo[a];
+        return src;
+      },
+      [&](size_t row, float* d) {
+        const RowStencil<D, double> s = stencil(row);
+        const float* cr = c.row(row);
+        const float* w0 = w[0].row(row);
+        for (size_t i = 0; i < nx; ++i) {
+          float v = cr[i];
+          v += w0[i] + w0[i == 0 ? nx - 1 : i - 1];
+          for (int a = 1; a < D; ++a) v += w[a].row(row)[i] + s.wlo[a][i];
+          d[i] = v;
+        }
+      });
   // The longest run of interior cells per row that are uniform among
   // themselves (one weight wu > 0 on every face, one c, hence one diagonal).
   uniformSpan_.assign(rows, {});
@@ -424,6 +434,18 @@ double LaplaceSystem<D>::residual(const Vector& b, const Vector& x, Vector* r) c
       deterministicRowSum<D>(dims, [&](size_t row) {
         return defectRow<double, true>(row, b.data(), x.data(), r->data() + row * size_t(dims[0]));
       }));
+}
+
+template <int D>
+double LaplaceSystem<D>::residualInPlace(Vector* b, const Vector& x) const {
+  const size_t nx = size_t(dims[0]);
+  return std::sqrt(deterministicRowSum<D>(dims, [&](size_t row) {
+    thread_local std::vector<double> r;  // the row's residual, then over its b
+    r.resize(nx);
+    const double s = defectRow<double, true>(row, b->data(), x.data(), r.data());
+    std::copy(r.begin(), r.end(), b->data() + row * nx);
+    return s;
+  }));
 }
 
 template <int D>

@@ -55,6 +55,8 @@ struct LaplaceSystem {
   void defect(const std::vector<T>& b, const std::vector<T>& x, std::vector<T>* r) const;
   // r = b - A x; returns ||r||_2.
   double residual(const Vector& b, const Vector& x, Vector* r) const;
+  // The same with r in b's place (bitwise residual()'s values and norm).
+  double residualInPlace(Vector* b, const Vector& x) const;
   // r = b - A x on one row (r: that row's nx values); returns its ||r||^2.
   double residualRow(size_t row, const Vector& b, const Vector& x, double* r) const;
   // One red-black Gauss-Seidel sweep; `reverse` runs black first (so a

@@ -20,8 +20,11 @@ SolverResult pcg(const Op& A, const Vector& bIn, Vector* xp, Preconditioner* M, 
   PcgWorkspace local;
   PcgWorkspace& ws = workspace ? *workspace : local;
   const bool recompute = M && M->recomputesZ();  // z is then never stored
-  for (Vector* v : {&ws.r, &ws.p, &ws.q}) v->resize(n);
-  if (!recompute) ws.z.resize(n);
+  // b turns into r in place when it can be rebuilt for the final residual.
+  bool consume = false;
+  if constexpr (requires { A.residualInPlace(&ws.b, x); }) consume = ws.regenerate && &bIn == &ws.b;
+  for (Vector* v : {&ws.r, &ws.p, &ws.q})
+    if (!(consume && v == &ws.r)) v->resize(n);
   const Vector* bp = &bIn;
   if (A.singular()) {  // keep the system consistent (in place when b is ws.b)
     if (&bIn != &ws.b) ws.b = bIn;
@@ -45,8 +48,20 @@ SolverResult pcg(const Op& A, const Vector& bIn, Vector* xp, Preconditioner* M, 
   }
   const Vector& b = *bp;
   const double bnorm = unit == 1.0 ? bnorm0 : norm2(b);
-  Vector &r = ws.r, &z = ws.z, &p = ws.p, &q = ws.q;
-  double rnorm = A.residual(b, x, &r);
+  // z = M^-1 r lives in q's storage: q = A p is dead once r is updated, and
+  // z once it has gone into p (one vector less to hold).
+  Vector &r = ws.r, &p = ws.p, &q = ws.q, &z = q;
+  double rnorm;
+  if constexpr (requires { A.residualInPlace(&ws.b, x); }) {
+    if (consume) {
+      rnorm = A.residualInPlace(&ws.b, x);
+      std::swap(ws.b, ws.r);  // b's storage is r now; b is rebuilt at the end
+    } else {
+      rnorm = A.residual(b, x, &r);
+    }
+  } else {
+    rnorm = A.residual(b, x, &r);
+  }
   result.residual = rnorm / bnorm;
   if (result.residual <= opt.tolerance) {
     result.converged = true;
@@ -106,7 +121,15 @@ SolverResult pcg(const Op& A, const Vector& bIn, Vector* xp, Preconditioner* M, 
       parallelFor(n, [&](size_t i) { p[i] = z[i] + beta * p[i]; }, 4096);
   }
   // Report the true residual, not the recursively updated one.
-  result.residual = A.residual(b, x, &r) / bnorm;
+  if (consume) {  // b again, as it was solved for, in p (no longer needed)
+    ws.regenerate(&p);
+    if (A.singular()) A.removeNullSpace(&p);
+    if (unit != 1.0)
+      for (double& v : p) v *= unit;
+    result.residual = A.residual(p, x, &q) / bnorm;
+  } else {
+    result.residual = A.residual(b, x, &r) / bnorm;
+  }
   if (A.singular()) A.removeNullSpace(&x);
   if (unit != 1.0)
     for (double& v : x) v /= unit;

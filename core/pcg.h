@@ -3,6 +3,8 @@
 // Singular (pure-Neumann) systems are solved in the mean-free subspace.
 #pragma once
 
+#include <functional>
+
 #include "core/interrupter.h"
 #include "core/laplace_system.h"
 #include "core/preconditioner.h"
@@ -15,9 +17,13 @@ struct SolverOptions {
   int maxIterations = 1000;
 };
 
-// Work vectors of PCG, kept between solves to avoid reallocating them.
+// Work vectors of PCG, kept between solves to avoid reallocating them (the
+// preconditioned residual z shares q's storage). With `regenerate`, a b that
+// is the workspace's own becomes the residual (one vector less), and the
+// final true residual rebuilds b into a vector the iteration no longer needs.
 struct PcgWorkspace {
-  Vector b, r, z, p, q;
+  Vector b, r, p, q;
+  std::function<void(Vector*)> regenerate;  // writes the right-hand side into its argument
 };
 
 // Solves A x = b starting from *x. M may be null (plain CG). b may be the

@@ -1,5 +1,6 @@
 #include "core/row_field.h"
 
+#include <algorithm>
 #include <cstring>
 #include <functional>
 #include <string_view>
@@ -9,36 +10,51 @@
 
 namespace morphoflow {
 
+bool keepDistinctSegments(std::vector<float>* values, std::vector<size_t>* offset) {
+  std::vector<float>& v = *values;
+  std::vector<size_t>& off = *offset;
+  const size_t rows = off.size() - 1;
+  auto bytes = [&](size_t r) { return (off[r + 1] - off[r]) * sizeof(float); };
+  std::vector<size_t> hash(rows);
+  parallelFor(rows, [&](size_t r) {
+    hash[r] = std::hash<std::string_view>{}({reinterpret_cast<const char*>(v.data() + off[r]), bytes(r)});
+  }, 64);
+  // Serial, in order: which segment each repeats is the same for any thread count.
+  std::unordered_map<size_t, std::vector<size_t>> kept;  // hash -> segments kept
+  std::vector<size_t> to(rows + 1), keep;
+  size_t end = 0;
+  for (size_t r = 0; r < rows; ++r) {
+    std::vector<size_t>& same = kept[hash[r]];
+    auto match = std::find_if(same.begin(), same.end(), [&](size_t k) {
+      return bytes(k) == bytes(r) && std::memcmp(v.data() + off[k], v.data() + off[r], bytes(r)) == 0;
+    });
+    if (match != same.end()) {
+      to[r] = to[*match];
+      continue;
+    }
+    same.push_back(r);
+    keep.push_back(r);
+    to[r] = end;
+    end += off[r + 1] - off[r];
+  }
+  to[rows] = end;
+  if (keep.size() == rows) return false;
+  // Kept segments move down (never up), in order: in place.
+  for (size_t r : keep) std::memmove(v.data() + to[r], v.data() + off[r], bytes(r));
+  v.resize(end);
+  v.shrink_to_fit();
+  off.swap(to);
+  return true;
+}
+
 template <int D>
 void RowField<D>::compact() {
   if (!dense_) return;
   dense_ = false;
-  const size_t rows = rowOf_.size(), bytes = nx_ * sizeof(float);
-  std::vector<size_t> hash(rows);
-  parallelFor(rows, [&](size_t r) {
-    hash[r] = std::hash<std::string_view>{}({reinterpret_cast<const char*>(pool_.data() + r * nx_), bytes});
-  }, 64);
-  // Distinct rows in order of first appearance (serial: the ids, hence the
-  // layout, do not depend on the thread count).
-  std::unordered_map<size_t, std::vector<uint32_t>> byHash;
-  std::vector<size_t> first;  // stored row -> the row it copies
-  for (size_t r = 0; r < rows; ++r) {
-    std::vector<uint32_t>& ids = byHash[hash[r]];
-    const float* v = pool_.data() + r * nx_;
-    uint32_t id = uint32_t(first.size());
-    for (uint32_t k : ids)
-      if (std::memcmp(pool_.data() + first[k] * nx_, v, bytes) == 0) id = k;
-    if (id == first.size()) {
-      ids.push_back(id);
-      first.push_back(r);
-    }
-    rowOf_[r] = id;
-  }
-  if (first.size() == rows) return;  // nothing repeats: keep the rows in place
-  std::vector<float> pool(first.size() * nx_);
-  for (size_t k = 0; k < first.size(); ++k)
-    std::memcpy(pool.data() + k * nx_, pool_.data() + first[k] * nx_, bytes);
-  pool_.swap(pool);
+  std::vector<size_t> off(rowOf_.size() + 1);
+  for (size_t r = 0; r < off.size(); ++r) off[r] = r * nx_;
+  if (keepDistinctSegments(&pool_, &off))
+    for (size_t r = 0; r < rowOf_.size(); ++r) rowOf_[r] = uint32_t(off[r] / nx_);
 }
 
 template <int D>

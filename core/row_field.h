@@ -11,23 +11,28 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
+#include <map>
 #include <stdexcept>
 #include <cstdint>
 #include <vector>
 
 #include "core/grid.h"
+#include "core/parallel.h"
 
 namespace morphoflow {
+
+// Keeps each distinct segment of *values once: segment r is [offset[r],
+// offset[r + 1]); afterwards offset[r] is where its content starts in the
+// shortened *values (compared bitwise; the first of equal segments is kept,
+// independent of the thread count). Returns whether anything repeated.
+bool keepDistinctSegments(std::vector<float>* values, std::vector<size_t>* offset);
 
 template <int D>
 class RowField {
  public:
   RowField() = default;
-  RowField(const IVec<D>& dims, float value) : dims_(dims) {
-    nx_ = size_t(dims[0]);
-    invNx_ = 1.0 / double(nx_);
-    size_ = 1;
-    for (int a = 0; a < D; ++a) size_ *= size_t(dims[a]);
+  RowField(const IVec<D>& dims, float value) : RowField(dims) {
     pool_.assign(size_, value);
     identity();
   }
@@ -79,6 +84,27 @@ class RowField {
     requireDense();
     std::fill(pool_.begin(), pool_.end(), v);
   }
+  // A field whose row r, compute(r, out), depends only on the rows
+  // sources(r) of other fields (an array of K row pointers): each distinct
+  // combination of source rows is computed once, with no dense copy.
+  template <size_t K, class Sources, class Compute>
+  static RowField fromSources(const IVec<D>& dims, Sources&& sources, Compute&& compute) {
+    RowField f(dims);
+    std::map<std::array<uintptr_t, K>, uint32_t> ids;  // source rows -> stored row, in order of first use
+    std::vector<size_t> first;
+    for (size_t r = 0; r < f.rowOf_.size(); ++r) {
+      const std::array<const float*, K> src = sources(r);
+      std::array<uintptr_t, K> key;
+      for (size_t k = 0; k < K; ++k) key[k] = reinterpret_cast<uintptr_t>(src[k]);
+      const auto [it, added] = ids.emplace(key, uint32_t(first.size()));
+      if (added) first.push_back(r);
+      f.rowOf_[r] = it->second;
+    }
+    f.pool_.resize(first.size() * f.nx_);
+    parallelFor(first.size(), [&](size_t k) { compute(first[k], f.pool_.data() + k * f.nx_); });
+    f.dense_ = false;
+    return f;
+  }
   // Keeps each distinct row once (rows compared bitwise; the first of equal
   // rows is kept, so the result does not depend on the thread count).
   void compact();
@@ -96,6 +122,13 @@ class RowField {
   size_t bytes() const { return pool_.capacity() * sizeof(float) + rowOf_.capacity() * sizeof(uint32_t); }
 
  private:
+  explicit RowField(const IVec<D>& dims) : dims_(dims) {  // shaped, no rows yet
+    nx_ = size_t(dims[0]);
+    invNx_ = 1.0 / double(nx_);
+    size_ = 1;
+    for (int a = 0; a < D; ++a) size_ *= size_t(dims[a]);
+    rowOf_.resize(size_ / nx_);
+  }
   void requireDense() const {
     if (!dense_) throw std::logic_error("RowField: written after compact() (densify() it first)");
   }

@@ -391,8 +391,8 @@ void advectField(const Grid<float, D>& src, const Layout<D>& layout, const MacVe
   if (scheme == AdvectionScheme::MacCormack) {
     // phi^ = A(phi); phi~ = A^-1(phi^); phi = phi^ + (phi - phi~) / 2, limited.
     Grid<float, D>& fwd = *dst;
-    semiLagrangian<D>(src, layout, u, dt, &fwd, &lo, &hi, {&s.start, false});
-    semiLagrangian<D>(fwd, layout, u, -dt, &back, nullptr, nullptr, {&s.start, true});
+    semiLagrangian<D>(src, layout, u, dt, &fwd, &lo, &hi);
+    semiLagrangian<D>(fwd, layout, u, -dt, &back, nullptr, nullptr);
     parallelFor(src.size(), [&](size_t i) {
       float v = fwd[i] + 0.5f * (src[i] - back[i]);
       // Revert to first order where the correction leaves the stencil's range.
@@ -403,12 +403,12 @@ void advectField(const Grid<float, D>& src, const Layout<D>& layout, const MacVe
   // BFECC: phi_bar = phi + (phi - A^-1 A phi) / 2, then A(phi_bar), limited.
   Grid<float, D>& fwd = s.fwd;
   fwd.reshape(src.dims());
-  semiLagrangian<D>(src, layout, u, dt, &fwd, nullptr, nullptr, {&s.start, false});
-  semiLagrangian<D>(fwd, layout, u, -dt, &back, nullptr, nullptr, {&s.start, true});
+  semiLagrangian<D>(src, layout, u, dt, &fwd, nullptr, nullptr);
+  semiLagrangian<D>(fwd, layout, u, -dt, &back, nullptr, nullptr);
   Grid<float, D>& corrected = fwd;  // fwd is no longer needed
   parallelFor(src.size(), [&](size_t i) { corrected[i] = src[i] + 0.5f * (src[i] - back[i]); }, 4096);
-  semiLagrangian<D>(corrected, layout, u, dt, dst, nullptr, nullptr, {&s.start, true});
-  semiLagrangian<D>(src, layout, u, dt, &back, &lo, &hi, {&s.start, true});  // first-order fallback
+  semiLagrangian<D>(corrected, layout, u, dt, dst, nullptr, nullptr);
+  semiLagrangian<D>(src, layout, u, dt, &back, &lo, &hi);  // first-order fallback
   parallelFor(src.size(), [&](size_t i) {
     if ((*dst)[i] < lo[i] || (*dst)[i] > hi[i]) (*dst)[i] = back[i];
   }, 4096);

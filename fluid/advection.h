@@ -21,7 +21,6 @@ template <int D>
 struct AdvectionScratch {
   struct Set {
     Grid<float, D> lo, hi, back, fwd;  // fwd: BFECC's only (reshaped there)
-    std::array<Grid<float, D>, D> start;  // u at the samples, shared by a scheme's passes
   };
   Set set;
   // Borrows the grids' storage from a pool for one advection stage, and
@@ -35,7 +34,6 @@ struct AdvectionScratch {
   }
   Set& forShape(const IVec<D>& dims) {
     for (Grid<float, D>* g : {&set.lo, &set.hi, &set.back}) g->reshape(dims);
-    for (Grid<float, D>& g : set.start) g.reshape(dims);
     return set;
   }
 
@@ -44,7 +42,6 @@ struct AdvectionScratch {
   void each(F&& f, bool withFwd) {
     for (Grid<float, D>* g : {&set.lo, &set.hi, &set.back}) f(g->values());
     if (withFwd) f(set.fwd.values());
-    for (Grid<float, D>& g : set.start) f(g.values());
   }
 };
 

@@ -51,7 +51,6 @@ FluidSolver<D>::FluidSolver(const FluidSettings& s)
   u_ = MacVelocity<D>(cells_, h_, constraints_.periodic());
   scratch_ = u_;
   dye_ = Grid<float, D>(cells_, 0.0f);
-  dyeScratch_ = dye_;
   constraints_.apply(&u_);
 }
 
@@ -73,8 +72,11 @@ void FluidSolver<D>::step(double dt) {
   advectVelocity<D>(u_, dt, settings_.advection, &scratch_, &advectionScratch_);
   // An all-zero dye (no dye in the scene yet) advects to zero: skip the work.
   if (std::any_of(dye_.values().begin(), dye_.values().end(), [](float v) { return v != 0.0f; })) {
+    pool_.lend(&dyeScratch_.values());  // a work grid only while the dye moves
+    dyeScratch_.reshape(cells_);
     advectField<D>(dye_, cellLayout(), u_, dt, settings_.advection, &dyeScratch_, &advectionScratch_);
     std::swap(dye_, dyeScratch_);
+    pool_.give(&dyeScratch_.values());
   }
   advectionScratch_.giveBack(&pool_);
   std::swap(u_, scratch_);

@@ -82,7 +82,7 @@ void PressureProjection<D>::divergenceTimes(const MacVelocity<D>& u, double fact
 template <int D>
 SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double density, WorkPool* pool) {
   PcgWorkspace& w = workspace_;
-  const std::initializer_list<Vector*> work = {&w.b, &w.r, &w.z, &w.p, &w.q};
+  const std::initializer_list<Vector*> work = {&w.b, &w.p, &w.q};  // r: b's storage (regenerate)
   if (pool) {
     pool->lend(work);
     if (multigrid_) multigrid_->borrowFine(pool);
@@ -101,6 +101,7 @@ SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double
       ratePrev_[i] = float(rate);
     }, 4096);
   }
+  w.regenerate = [&](Vector* b) { divergenceTimes(*u, -1.0 / vc_.h, b); };
   SolverResult r;
   if (solver_ == PressureSolver::Multigrid)
     r = multigrid_->solve(workspace_.b, &phi_, options_);
@@ -109,8 +110,10 @@ SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double
                                           ? static_cast<Preconditioner*>(mic_.get())
                                           : static_cast<Preconditioner*>(multigrid_.get()),
                     options_, nullptr, &workspace_);
+  w.regenerate = nullptr;
   if (pool) {
     pool->give(work);
+    pool->give(&w.r);
     if (multigrid_) multigrid_->giveBackFine(pool);
   }
   lastDt_ = dt;

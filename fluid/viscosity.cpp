@@ -17,13 +17,14 @@ ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
   C.dims = n + unitVector<D>(a);
   if (periodic[size_t(a)]) C.dims[a] = n[a];
   C.A = LaplaceSystem<D>(C.dims, periodic, 1.0);
-  C.cBoundary = Grid<uint8_t, D>(C.dims, 0);
-  C.boundaryRhs.assign(C.A.size(), 0.0);
-  C.unknownFixed = Grid<uint8_t, D>(C.dims, 0);
+  C.cBoundary = RowField<D>(C.dims, 0.0f);
+  C.boundaryRhs = RowField<D>(C.dims, 0.0f);
   forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) {
     size_t gi = fixed.index(k);
-    C.unknownFixed[i] = fixed[gi];
-    if (fixed[gi]) return;
+    if (fixed[gi]) {
+      C.cBoundary.at(i) = -1.0f;
+      return;
+    }
     double c = 0.0, extra = 0.0;
     for (int bx = 0; bx < D; ++bx) {
       for (int dir = -1; dir <= 1; dir += 2) {
@@ -52,9 +53,11 @@ ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
         }
       }
     }
-    C.cBoundary[i] = uint8_t(c);  // whole: 2 per wall ghost, 1 per prescribed neighbour
-    C.boundaryRhs[i] = float(extra);
+    C.cBoundary.at(i) = float(c);  // whole: 2 per wall ghost, 1 per prescribed neighbour
+    C.boundaryRhs.at(i) = float(extra);
   });
+  C.cBoundary.compact();
+  C.boundaryRhs.compact();
   C.A.finalize();  // the weights compacted now; c follows at setRate
   return C;
 }
@@ -62,8 +65,8 @@ ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
 template <int D>
 void ViscousSystem<D>::setRate(double s) {
   A.scale = s;
-  A.c = RowField<D>(A.dims, 0.0f);
-  parallelFor(A.size(), [&](size_t i) { A.c.at(i) = unknownFixed[i] ? 0.0f : float(1.0 / s + double(cBoundary[i])); }, 4096);
+  A.c = cBoundary;  // its rows, mapped: no full-size field
+  A.c.transform([s](float cb) { return cb < 0.0f ? 0.0f : float(1.0 / s + double(cb)); });
   A.finalize();
 }
 
@@ -109,7 +112,7 @@ double ViscositySolver<D>::rightHandSide(const MacVelocity<D>& u, int a, double 
 template <int D>
 SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt, WorkPool* pool) {
   if (nu <= 0 || dt <= 0) return SolverResult{true, 0, 0.0};
-  const std::initializer_list<Vector*> doubles = {&b_, &x_, &pcgWork_.b, &pcgWork_.r, &pcgWork_.z, &pcgWork_.p, &pcgWork_.q};
+  const std::initializer_list<Vector*> doubles = {&b_, &x_, &pcgWork_.b, &pcgWork_.r, &pcgWork_.p, &pcgWork_.q};
   const std::initializer_list<std::vector<float>*> floats = {&chebyshevWork_.e[0], &chebyshevWork_.e[1], &chebyshevWork_.g};
   if (pool) pool->lend(doubles), pool->lend(floats);
   const SolverResult result = solveComponents(u, nu * dt / (vc_.h * vc_.h));

@@ -36,9 +36,10 @@ template <int D>
 struct ViscousSystem {
   IVec<D> dims;
   LaplaceSystem<D> A;
-  Grid<uint8_t, D> cBoundary;   // diagonal terms from walls and prescribed neighbours (whole numbers)
-  std::vector<float> boundaryRhs;  // their prescribed values, times the coupling
-  Grid<uint8_t, D> unknownFixed;  // 1 where the face is prescribed (inactive)
+  // Per unknown, rows stored once per distinct content (they differ only
+  // next to walls and prescribed faces):
+  RowField<D> cBoundary;    // diagonal terms from walls and prescribed neighbours; -1 on a prescribed face (inactive)
+  RowField<D> boundaryRhs;  // their prescribed values, times the coupling
   // A for s = nu dt / h^2: c = 1/s + boundary terms, 0 on prescribed faces.
   void setRate(double s);
 };

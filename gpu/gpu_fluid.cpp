@@ -88,7 +88,7 @@ GpuFluid<D>::GpuFluid(const FluidSettings& s, const VelocityConstraints<D>& vc) 
     v->pcg = std::make_unique<GpuPcg>(*v->A);
     v->b = GpuBuffer(v->host.A.size() * sizeof(double));
     v->x = GpuBuffer(v->host.A.size() * sizeof(double));
-    const std::vector<float>& rhs = v->host.boundaryRhs;  // the shader reads doubles
+    const std::vector<float> rhs = v->host.boundaryRhs.expanded();  // the shader reads doubles
     v->boundaryRhs = GpuBuffer::of(std::vector<double>(rhs.begin(), rhs.end()));
     viscous_[size_t(a)] = std::move(v);
   }

@@ -97,8 +97,8 @@ TEST(RunRecords, TheMemoryEstimateMatchesThePeakAndATooLargeRunIsRefused) {
   GTEST_SKIP() << "under AddressSanitizer the peak includes its shadow memory and redzones (scripts/asan)";
 #endif
   const fs::path dir = tempDir("records_memory");
-  for (const std::string& sets : {std::string(" --set grid.resolution=[64,64,64] --set rd.resolution=[64,64,64] --set time.steps=2"),
-                                  std::string(" --set grid.resolution=[48,48,48] --set rd.resolution=[96,96,96] --set time.steps=2")}) {
+  for (const std::string& sets : {std::string(" --set grid.resolution=[64,64,64] --set rd.resolution=[64,64,64] --set time.steps=4"),
+                                  std::string(" --set grid.resolution=[48,48,48] --set rd.resolution=[96,96,96] --set time.steps=4")}) {
     CommandResult r = runMorphoflow("run " + sceneFile("coupled/cavity_gray_scott_3d.toml") + sets +
                                     // a frame after each step, as a run writes them (an initial
                                     // frame alone meets no solver's work vectors)
