@@ -261,7 +261,7 @@ void checkFluidFinite(const FluidSolver<D>& fluid, const std::string& where) {
       throw NonFiniteError(fmt::format("the simulation diverged {} in the fluid step: velocity component {} is not finite",
                                        where, "xyz"[a]),
                            "use a smaller time.dt or set time.cfl, and check the forces and boundary speeds");
-  if (!finite(fluid.dye()))
+  if (fluid.hasDye() && !finite(fluid.dye()))
     throw NonFiniteError(fmt::format("the simulation diverged {} in the fluid step: the dye is not finite", where),
                          "use a smaller time.dt or set time.cfl");
 }

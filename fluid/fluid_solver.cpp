@@ -50,7 +50,6 @@ FluidSolver<D>::FluidSolver(const FluidSettings& s)
   viscosity_ = std::make_unique<ViscositySolver<D>>(constraints_, SolverOptions{s.viscosityTolerance, 500});
   u_ = MacVelocity<D>(cells_, h_, constraints_.periodic());
   scratch_ = u_;
-  dye_ = Grid<float, D>(cells_, 0.0f);
   constraints_.apply(&u_);
 }
 
@@ -64,14 +63,14 @@ void FluidSolver<D>::step(double dt) {
     t0 = t1;
   };
   // 1. forces
-  applyForces<D>(settings_, &dye_, dt, &u_);
+  applyForces<D>(settings_, dye_.empty() ? nullptr : &dye_, dt, &u_);
   constraints_.apply(&u_);
   lap(0);
   // 2. advect (velocity through itself, dye through the same field)
   advectionScratch_.borrow(&pool_, settings_.advection);
   advectVelocity<D>(u_, dt, settings_.advection, &scratch_, &advectionScratch_);
   // An all-zero dye (no dye in the scene yet) advects to zero: skip the work.
-  if (std::any_of(dye_.values().begin(), dye_.values().end(), [](float v) { return v != 0.0f; })) {
+  if (!dye_.empty() && std::any_of(dye_.values().begin(), dye_.values().end(), [](float v) { return v != 0.0f; })) {
     pool_.lend(&dyeScratch_.values());  // a work grid only while the dye moves
     dyeScratch_.reshape(cells_);
     advectField<D>(dye_, cellLayout(), u_, dt, settings_.advection, &dyeScratch_, &advectionScratch_);
@@ -105,7 +104,7 @@ void FluidSolver<D>::injectInflowDye() {
       forEachCell<D>(cells_, [&](const IVec<D>& k, size_t i) {
         if (k[a] != (high ? cells_[a] - 1 : 0) || constraints_.solid[i]) return;
         int band = int(std::floor(double(k[across]) / cells_[across] * 2 * stripes));
-        dye_[i] = band % 2 == 0 ? 1.0f : 0.0f;
+        dye()[i] = band % 2 == 0 ? 1.0f : 0.0f;
       });
     }
 }
@@ -131,7 +130,7 @@ double FluidSolver<D>::cflTimeStep(double cfl, double dtMax) const {
 template <int D>
 void FluidSolver<D>::save(StateWriter* out) const {
   for (int a = 0; a < D; ++a) out->putGrid("fluid.u" + std::to_string(a), u_[a]);
-  out->putGrid("fluid.dye", dye_);
+  if (!dye_.empty()) out->putGrid("fluid.dye", dye_);
   out->put("fluid.time", time_);
   out->put("fluid.steps", steps_);
   projection_->save(out);
@@ -141,7 +140,8 @@ void FluidSolver<D>::save(StateWriter* out) const {
 template <int D>
 void FluidSolver<D>::load(const StateReader& in) {
   for (int a = 0; a < D; ++a) in.getGrid("fluid.u" + std::to_string(a), &u_[a]);
-  in.getGrid("fluid.dye", &dye_);
+  dye_ = Grid<float, D>();
+  if (in.has("fluid.dye")) in.getGrid("fluid.dye", &dye());
   in.get("fluid.time", &time_);
   in.get("fluid.steps", &steps_);
   projection_->load(in);

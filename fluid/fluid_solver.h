@@ -43,8 +43,11 @@ class FluidSolver {
   long steps() const { return steps_; }
   const MacVelocity<D>& velocity() const { return u_; }
   MacVelocity<D>& velocity() { return u_; }
-  Grid<float, D>& dye() { return dye_; }
-  const Grid<float, D>& dye() const { return dye_; }
+  // The dye (zeros until something puts dye in: a scene without dye keeps no
+  // grid for it until asked for one).
+  Grid<float, D>& dye() { return materialisedDye(); }
+  const Grid<float, D>& dye() const { return materialisedDye(); }
+  bool hasDye() const { return !dye_.empty(); }
   const Grid<uint8_t, D>& solid() const { return constraints_.solid; }
   const VelocityConstraints<D>& constraints() const { return constraints_; }
   Grid<float, D> pressure() const { return projection_->pressure(); }
@@ -62,6 +65,10 @@ class FluidSolver {
 
  private:
   void injectInflowDye();
+  Grid<float, D>& materialisedDye() const {
+    if (dye_.empty()) dye_ = Grid<float, D>(cells_, 0.0f);
+    return dye_;
+  }
 
   FluidSettings settings_;
   IVec<D> cells_;
@@ -70,7 +77,8 @@ class FluidSolver {
   std::unique_ptr<PressureProjection<D>> projection_;
   std::unique_ptr<ViscositySolver<D>> viscosity_;
   MacVelocity<D> u_, scratch_;
-  Grid<float, D> dye_, dyeScratch_;
+  mutable Grid<float, D> dye_;  // empty: all zero
+  Grid<float, D> dyeScratch_;
   AdvectionScratch<D> advectionScratch_;
   WorkPool pool_;  // the stages' work vectors, lent to each in turn
   double time_ = 0.0;

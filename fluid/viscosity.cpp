@@ -158,12 +158,12 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
     const Grid<uint8_t, D>& fixed = vc_.fixed[a];
     const double ba = bb[size_t(a)];
     if (a > 0) rightHandSide(*u, a, s);  // b_ holds component 0's already
-    // Warm start: the increment's rate, linearly extrapolated in steps.
-    const std::vector<float> &r1 = C.rate[0], &r0 = C.rate[1];
+    // Warm start: the increment's rate, linearly extrapolated in steps
+    // (2 r1 - r0 = r1 + (r1 - r0)).
     const int history = C.history;
     x_.resize(C.A.size());
     eachUnknown<D>(C.dims, g, [&](size_t i, size_t gi) {
-      const double rate = history >= 2 ? 2.0 * double(r1[i]) - double(r0[i]) : history == 1 ? double(r1[i]) : 0.0;
+      const double rate = history >= 1 ? double(C.rate[i]) + (history >= 2 ? double(fromBfloat16(C.change[i])) : 0.0) : 0.0;
       x_[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * rate;
     });
     SolverOptions options = options_;
@@ -172,17 +172,15 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
                                        : C.chebyshev->solve(b_, &x_, options, std::sqrt(ba));
     rAll += r.residual * r.residual * ba;
     result.iterations = std::max(result.iterations, r.iterations);
-    std::swap(C.rate[0], C.rate[1]);  // the older slot takes the new rate
-    std::vector<float>& rate = C.rate[0];
-    rate.resize(C.A.size());
+    std::vector<float>& rate = C.rate;
+    rate.resize(C.A.size(), 0.0f);  // zeros before the first solve: change = the first rate, unused
+    C.change.resize(C.A.size());
     const double invS = 1.0 / s;
     eachUnknown<D>(C.dims, g, [&](size_t i, size_t gi) {
-      if (fixed[gi]) {
-        rate[i] = 0.0f;
-        return;
-      }
-      rate[i] = float((x_[i] - double(g[gi])) * invS);
-      g[gi] = float(x_[i]);
+      const float next = fixed[gi] ? 0.0f : float((x_[i] - double(g[gi])) * invS);
+      C.change[i] = toBfloat16(next - rate[i]);
+      rate[i] = next;
+      if (!fixed[gi]) g[gi] = float(x_[i]);
     });
     C.history = std::min(C.history + 1, 2);
   }
@@ -197,8 +195,10 @@ template <int D>
 void ViscositySolver<D>::save(StateWriter* out) const {
   for (int a = 0; a < D; ++a) {
     const std::string p = "viscosity." + std::to_string(a) + ".";
-    out->put(p + "history", comp_[size_t(a)].history);
-    for (int k = 0; k < comp_[size_t(a)].history; ++k) out->putVector(p + "rate" + std::to_string(k), comp_[size_t(a)].rate[size_t(k)]);
+    const Component& C = comp_[size_t(a)];
+    out->put(p + "history", C.history);
+    if (C.history >= 1) out->putVector(p + "rate", C.rate);
+    if (C.history >= 2) out->putVector(p + "change", C.change);
   }
 }
 
@@ -208,10 +208,10 @@ void ViscositySolver<D>::load(const StateReader& in) {
     Component& C = comp_[size_t(a)];
     const std::string p = "viscosity." + std::to_string(a) + ".";
     in.get(p + "history", &C.history);
-    for (int k = 0; k < C.history; ++k) {
-      C.rate[size_t(k)].resize(C.A.size());
-      in.getVector(p + "rate" + std::to_string(k), &C.rate[size_t(k)]);
-    }
+    C.rate.assign(C.A.size(), 0.0f);
+    C.change.resize(C.A.size());
+    if (C.history >= 1) in.getVector(p + "rate", &C.rate);
+    if (C.history >= 2) in.getVector(p + "change", &C.change);
   }
 }
 

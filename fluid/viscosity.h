@@ -18,6 +18,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/bfloat16.h"
 #include "core/chebyshev.h"
 #include "core/multigrid.h"
 #include "core/pcg.h"
@@ -59,10 +60,12 @@ class ViscositySolver {
 
  private:
   struct Component : ViscousSystem<D> {
-    // The last two solves' (x - u*) / s, newest first: the next warm start
-    // (a guess only, so single precision: half the memory traffic).
-    std::array<std::vector<float>, 2> rate;
-    int history = 0;            // how many of them are set
+    // The last solve's (x - u*) / s and its change from the one before: the
+    // next warm start, rate + change (a guess only: the rate in single
+    // precision, its change, a small correction, in bfloat16).
+    std::vector<float> rate;
+    std::vector<uint16_t> change;
+    int history = 0;            // how many solves they hold (0, 1, 2)
     std::unique_ptr<Chebyshev<D>> chebyshev;  // bounds the spectrum; solves while it is quick
     std::unique_ptr<Multigrid<D>> multigrid;  // present while it solves instead
   };
