@@ -24,16 +24,16 @@ constexpr double kFluidBytesPerCell[2] = {148.0, 99.0};        // 2D, 3D
 // A coupled run's fluid and species, each from two runs (the same grid for
 // both, and chemicals twice as fine: 2D 512^2 / 1024^2, 3D the shipped
 // 128^3 / 256^3 cavity) solved for the two unknowns.
-constexpr double kCoupledFluidBytesPerCell[2] = {91.0, 111.6};
+constexpr double kCoupledFluidBytesPerCell[2] = {82.0, 99.1};
 constexpr double kSpeciesBytesPerCell[2] = {26.0, 28.5};         // reaction-diffusion only
-constexpr double kCoupledSpeciesBytesPerCell[2] = {38.5, 40.2};  // carried by a fluid
+constexpr double kCoupledSpeciesBytesPerCell[2] = {31.0, 32.7};  // carried by a fluid
 constexpr double kFusedSpeciesBytesPerCell = 16.0;               // the fused explicit step
 // A frame's OpenVDB volumes: each grid is built densely, then as a tree,
 // before the file is written, on top of the solvers' work vectors when the
 // frame follows a step (measured on the shipped 3D cavity's frames, whose
-// peak they raise by 0.81 GiB: species and density at 256^3, the velocity's
-// three components at 128^3; 15-17 bytes a voxel from 64^3 up).
-constexpr double kVdbBytesPerVoxel = 15.5;
+// peak they raise by 0.64 GiB: species and density at 256^3, the velocity's
+// three components at 128^3; 12-16 bytes a voxel from 64^3 up).
+constexpr double kVdbBytesPerVoxel = 12.1;
 constexpr double kFixedBytes = 126.0 * (1 << 20);                // the program, its libraries and thread pools
 
 double cellsOf(const std::vector<int>& res) {

@@ -12,6 +12,7 @@ ARDSolver<D>::ARDSolver(RDSolver<D>* rd, ChemicalAdvector<D> advector, CouplingM
   if (!(rdTimeScale > 0)) throw std::invalid_argument("coupling: the reaction-diffusion time scale must be > 0");
   if (advector_.domain().cells != rd->cells()) throw std::invalid_argument("coupling: advection and RD grids differ");
   if (mode_ != CouplingMode::RDOnly) advector_.emptySolids(species());
+  rd_->setWorkPool(pool_.get());
 }
 
 template <int D>
@@ -27,7 +28,7 @@ void ARDSolver<D>::step(double dt, const MacVelocity<D>& u) {
   if (mode_ != CouplingMode::Passive) rd_->step(rdTimeScale_ * dt);  // eq. 6 then eq. 13
   if (mode_ == CouplingMode::ARD) advector_.emptySolids(species());  // obstacles hold no chemical
   const double t1 = traceClock();
-  if (mode_ != CouplingMode::RDOnly) advector_.advect(u, dt, species());  // eq. 19-20
+  if (mode_ != CouplingMode::RDOnly) advector_.advect(u, dt, species(), pool_.get());  // eq. 19-20
   stageSeconds_ = {t1 - t0, traceClock() - t1};
   time_ += dt;
   ++steps_;

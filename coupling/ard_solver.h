@@ -6,6 +6,7 @@
 // obstacles (seed 001 fig. 6: "the ball is not included in the RD simulation").
 #pragma once
 
+#include <memory>
 #include <array>
 #include <string>
 
@@ -47,6 +48,9 @@ class ARDSolver {
 
   RDSolver<D>* rd_;
   ChemicalAdvector<D> advector_;
+  // The advection's and the RD solves' work vectors, lent to each in turn
+  // (owned here, so the RD solver's pointer to it survives a move).
+  std::unique_ptr<WorkPool> pool_ = std::make_unique<WorkPool>();
   CouplingMode mode_;
   double rdTimeScale_;
   double time_ = 0.0;

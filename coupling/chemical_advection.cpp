@@ -196,7 +196,6 @@ ChemicalAdvector<D>::ChemicalAdvector(ChemicalDomain<D> domain, ChemicalInterpol
   size_t n = 1;
   for (int a = 0; a < D; ++a) n *= size_t(domain_.cells[a]);
   if (!domain_.solid.empty() && domain_.solid.size() != n) throw std::invalid_argument("coupling: solid mask has the wrong size");
-  for (auto& f : feet_) f.assign(n, 0.0f);
   if (!domain_.inflowValues.empty()) fromInflow_.assign(n, 0);
 }
 
@@ -211,9 +210,16 @@ void ChemicalAdvector<D>::emptySolids(const std::vector<Grid<double, D>*>& speci
 }
 
 template <int D>
-void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::vector<Grid<double, D>*>& species) {
+void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::vector<Grid<double, D>*>& species,
+                                 WorkPool* pool) {
   const ChemicalDomain<D>& d = domain_;
   const bool inflow = !d.inflowValues.empty();
+  const size_t ns = species.size();
+  if (pool)
+    for (auto& f : feet_) pool->lend(&f);
+  size_t n = 1;
+  for (int a = 0; a < D; ++a) n *= size_t(d.cells[a]);
+  for (auto& f : feet_) f.resize(n);
   // Feet once for all species (seed 001 eq. 19: x* = x - dt u), with the
   // fluid's vector kernels; periodic domains trace cell by cell.
   if (!traceCellFeet<D>(u, dt, d.cells, d.h, &feet_))
@@ -234,58 +240,72 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
       }
       fromInflow_[i] = in;
     }, 4096);
-  // Every species from one stencil per cell (one set of weights, 2^D
-  // loads per species).
-  const size_t ns = species.size();
-  while (scratch_.size() < ns) scratch_.emplace_back(d.cells);
+  // The species [s0, s1) from one stencil per cell (one set of weights,
+  // 2^D loads per species), into scratch_[s - s0].
   std::vector<double> in(ns, 0.0);
   std::vector<const double*> src(ns);
   std::vector<double*> dst(ns);
   for (size_t s = 0; s < ns; ++s) {
     in[s] = inflow ? d.inflowValues[s] : 0.0;
     src[s] = species[s]->data();
-    dst[s] = scratch_[s].data();
   }
   const bool linear = interpolation_ == ChemicalInterpolation::Linear;
-  auto cell = [&](size_t i) {
-    const double w = inflow ? fromInflow_[i] : 0.0;
-    if (w >= 1.0) {
-      for (size_t s = 0; s < ns; ++s) dst[s][i] = in[s];
-      return;
-    }
-    Vec<D> c;
-    for (int a = 0; a < D; ++a) c[a] = feet_[size_t(a)][i];
-    if (linear) {
-      size_t index[1 << D];
-      double weight[1 << D];
-      linearStencil<D>(d.cells, d.periodic, c, index, weight);
-      for (size_t s = 0; s < ns; ++s) {
-        double v = 0.0;
-        for (int k = 0; k < (1 << D); ++k) v += weight[k] * src[s][index[k]];
-        dst[s][i] = w * in[s] + (1.0 - w) * v;
-      }
-    } else {
-      for (size_t s = 0; s < ns; ++s)
-        dst[s][i] = w * in[s] + (1.0 - w) * sampleChemical<D>(*species[s], d.periodic, c, interpolation_);
-    }
-  };
-  const size_t cells = feet_[0].size();
+  const size_t cells = n;
   bool walls = true;
   for (int a = 0; a < D; ++a) walls = walls && !d.periodic[size_t(a)];
   [[maybe_unused]] const bool wide = linear && walls && cells < (size_t(1) << 31) && useAvx2();
-  [[maybe_unused]] LinearRun<D> run{d.cells, {}, inflow ? fromInflow_.data() : nullptr, in.data(), src.data(),
-                                    dst.data(), ns};
-  for (int a = 0; a < D; ++a) run.feet[size_t(a)] = feet_[size_t(a)].data();
-  constexpr size_t kRun = 1024;
-  parallelFor((cells + kRun - 1) / kRun, [&](size_t chunk) {
-    size_t i = chunk * kRun;
-    const size_t end = std::min(cells, i + kRun);
+  auto sample = [&](size_t s0, size_t s1) {
+    for (size_t s = s0; s < s1; ++s) dst[s] = scratch_[s - s0].data();
+    auto cell = [&](size_t i) {
+      const double w = inflow ? fromInflow_[i] : 0.0;
+      if (w >= 1.0) {
+        for (size_t s = s0; s < s1; ++s) dst[s][i] = in[s];
+        return;
+      }
+      Vec<D> c;
+      for (int a = 0; a < D; ++a) c[a] = feet_[size_t(a)][i];
+      if (linear) {
+        size_t index[1 << D];
+        double weight[1 << D];
+        linearStencil<D>(d.cells, d.periodic, c, index, weight);
+        for (size_t s = s0; s < s1; ++s) {
+          double v = 0.0;
+          for (int k = 0; k < (1 << D); ++k) v += weight[k] * src[s][index[k]];
+          dst[s][i] = w * in[s] + (1.0 - w) * v;
+        }
+      } else {
+        for (size_t s = s0; s < s1; ++s)
+          dst[s][i] = w * in[s] + (1.0 - w) * sampleChemical<D>(*species[s], d.periodic, c, interpolation_);
+      }
+    };
+    [[maybe_unused]] LinearRun<D> run{d.cells, {}, inflow ? fromInflow_.data() : nullptr, in.data() + s0,
+                                      src.data() + s0, dst.data() + s0, s1 - s0};
+    for (int a = 0; a < D; ++a) run.feet[size_t(a)] = feet_[size_t(a)].data();
+    constexpr size_t kRun = 1024;
+    parallelFor((cells + kRun - 1) / kRun, [&](size_t chunk) {
+      size_t i = chunk * kRun;
+      const size_t end = std::min(cells, i + kRun);
 #if MORPHOFLOW_AVX2_KERNELS
-    if (wide) i = linearRunAvx2<D>(run, i, end);
+      if (wide) i = linearRunAvx2<D>(run, i, end);
 #endif
-    for (; i < end; ++i) cell(i);
-  });
-  for (size_t s = 0; s < ns; ++s) std::swap(species[s]->values(), scratch_[s].values());
+      for (; i < end; ++i) cell(i);
+    });
+  };
+  if (!pool) {  // all species in one pass, each into its own scratch
+    while (scratch_.size() < ns) scratch_.emplace_back(d.cells);
+    sample(0, ns);
+    for (size_t s = 0; s < ns; ++s) std::swap(species[s]->values(), scratch_[s].values());
+  } else {  // one species at a time through one borrowed scratch (the same values)
+    if (scratch_.empty()) scratch_.emplace_back();
+    for (size_t s = 0; s < ns; ++s) {
+      pool->lend(&scratch_[0].values());
+      scratch_[0].reshape(d.cells);
+      sample(s, s + 1);
+      std::swap(species[s]->values(), scratch_[0].values());
+      pool->give(&scratch_[0].values());
+    }
+    for (auto& f : feet_) pool->give(&f);
+  }
   emptySolids(species);
 }
 

@@ -15,6 +15,7 @@
 #include <array>
 #include <vector>
 
+#include "core/work_pool.h"
 #include "core/grid.h"
 #include "core/mac_velocity.h"
 
@@ -40,7 +41,9 @@ class ChemicalAdvector {
 
   // species[s] <- species[s](x*) for every RD cell; deterministic for any
   // thread count (every cell is computed independently).
-  void advect(const MacVelocity<D>& u, double dt, const std::vector<Grid<double, D>*>& species);
+  // The feet and the species' scratch are borrowed from `pool` (if given)
+  // for the call.
+  void advect(const MacVelocity<D>& u, double dt, const std::vector<Grid<double, D>*>& species, WorkPool* pool = nullptr);
   // Sets the solid cells of every species to the solid values.
   void emptySolids(const std::vector<Grid<double, D>*>& species) const;
 
@@ -53,7 +56,7 @@ class ChemicalAdvector {
   // the fluid's own traces: 1e-7 of the domain, far below a cell).
   std::array<std::vector<float>, D> feet_;
   std::vector<double> fromInflow_;  // weight of the inflow value (1: the foot left through an inflow side); empty without inflow
-  std::vector<Grid<double, D>> scratch_;  // one per species
+  std::vector<Grid<double, D>> scratch_;  // one per species (one, borrowed, with a pool)
 };
 
 // Value of g at continuous grid coordinate c (cell centres at integers),

@@ -412,6 +412,9 @@ void RDSolver<D>::step(double dt) {
   const bool implicitReaction = integ == RDIntegrator::KimLin;
   const double theta = diffusionTheta(integ);
   react(dt, implicitReaction);  // Kim & Lin: updates x in place (projected per cell)
+  const std::initializer_list<Vector*> doubles = {&solveX_, &pcgWork_.b, &pcgWork_.r, &pcgWork_.p, &pcgWork_.q};
+  const std::initializer_list<std::vector<float>*> floats = {&chebyshevWork_.e[0], &chebyshevWork_.e[1], &chebyshevWork_.g};
+  if (pool_) pool_->lend(doubles), pool_->lend(floats);
   // The species are independent from here on: one after another (each
   // splits into row tasks), sharing the solvers' work vectors.
   std::vector<SolverResult> solves(size_t(n), SolverResult{true, 0, 0.0});
@@ -432,6 +435,7 @@ void RDSolver<D>::step(double dt) {
       parallelFor(cells, [&](size_t i) { x[i] += dt * R[i]; }, kChunk);
     solves[si] = solveDiffusion(s, theta * dt, &x);
   }
+  if (pool_) pool_->give(doubles), pool_->give(floats);
   for (const SolverResult& r : solves) foldWorst(&stats_.diffusion, r);
   for (int s : model_.info().clamped) {
     Grid<double, D>& g = x_[size_t(s)];

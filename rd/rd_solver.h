@@ -16,6 +16,7 @@
 #include "core/pcg.h"
 #include "core/solver_result.h"
 #include "core/state_archive.h"
+#include "core/work_pool.h"
 #include "rd/cosine_lobe.h"
 #include "rd/diffusion_tensor.h"
 #include "rd/generalized_diffusion.h"
@@ -84,6 +85,10 @@ class RDSolver {
   const Vector& dirichletFaces(int s) const { return boundaryWeights(s); }
 
   void step(double dt);
+  // Lend the diffusion solves' work vectors from `pool` for each step (and
+  // give them back after), to share them with the stages around it; null:
+  // keep them.
+  void setWorkPool(WorkPool* pool) { pool_ = pool; }
   const RDStepStats& lastStats() const { return stats_; }
   // Everything step() reads besides the settings and the scene's maps (the
   // species, time, held values, the diffusion solves' warm starts), so that
@@ -149,6 +154,7 @@ class RDSolver {
   Vector solveX_;
   ChebyshevWork chebyshevWork_;
   PcgWorkspace pcgWork_;
+  WorkPool* pool_ = nullptr;
   std::vector<std::vector<uint8_t>> fixedMasks_;
   std::vector<std::vector<double>> fixedValues_;
   std::vector<std::vector<double>> frozenValues_;
