@@ -103,8 +103,18 @@ double ViscositySolver<D>::rightHandSide(const MacVelocity<D>& u, int a, double 
   const Grid<float, D>& g = u[a];
   const Grid<uint8_t, D>& fixed = vc_.fixed[a];
   b_.resize(C.A.size());
-  eachUnknown<D>(C.dims, g, [&](size_t i, size_t gi) {
-    b_[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * double(C.boundaryRhs[i]);
+  // Row by row: the boundary terms are stored a row at a time.
+  parallelForRows<D>(C.dims, [&](size_t row) {
+    IVec<D> k(0);
+    size_t rest = row;
+    for (int b = 1; b < D; ++b) {
+      k[b] = int(rest % size_t(C.dims[b]));
+      rest /= size_t(C.dims[b]);
+    }
+    const size_t i0 = row * size_t(C.dims[0]), g0 = g.index(k);  // the row's first unknown, its face in g
+    const float* rhs = C.boundaryRhs.row(row);
+    for (size_t x = 0; x < size_t(C.dims[0]); ++x)
+      b_[i0 + x] = fixed[g0 + x] ? 0.0 : double(g[g0 + x]) + s * double(rhs[x]);
   });
   return dot(b_, b_);
 }
