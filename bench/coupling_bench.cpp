@@ -3,8 +3,9 @@
 // to 1e-6, CFL 1) and of the fluid carrying a Gray-Scott ARD layer on the
 // same grid (Kim & Lin's implicit reaction and MGPCG diffusion at ten times
 // the explicit diffusion limit, then linear semi-Lagrangian advection), with
-// the serial and tbb schedulers, all on 2 threads; the overhead ratio is
-// (fluid + ARD time) / (fluid-only time) per step, from medians.
+// the serial and tbb schedulers, on 1 and on 2 threads (the trace: the
+// 2-thread runs); the overhead ratio is (fluid + ARD time) / (fluid-only
+// time) per step, from medians.
 #include <fstream>
 #include <iostream>
 #include <optional>
@@ -25,8 +26,6 @@
 namespace morphoflow {
 
 namespace {
-
-constexpr int kThreads = 2;
 
 constexpr int kWarmup = 3;
 
@@ -68,10 +67,10 @@ CoupledTiming fluidWithARD(int n, CouplingBackend backend, double minSeconds, St
 }
 
 template <int D>
-nlohmann::json benchCase(int n, double minSeconds, StageTrace* trace) {
-  ThreadLimit limit(kThreads);
+nlohmann::json benchCase(int n, int threads, double minSeconds, StageTrace* trace) {
+  ThreadLimit limit(threads);
   const double alone = fluidOnly<D>(n, minSeconds);
-  nlohmann::json j = {{"dim", D}, {"n", n}, {"threads", kThreads}, {"fluid_only_ms", 1e3 * alone},
+  nlohmann::json j = {{"dim", D}, {"n", n}, {"threads", threads}, {"fluid_only_ms", 1e3 * alone},
                       {"fluid_only_steps_per_second", 1.0 / alone}};
   for (CouplingBackend b : {CouplingBackend::Serial, CouplingBackend::TBB}) {
     const CoupledTiming t = fluidWithARD<D>(n, b, minSeconds, trace);
@@ -99,21 +98,22 @@ bool runCouplingBench(const BenchOptions& o) {
                       "give a path in an existing, writable directory");
   }
   nlohmann::json all = nlohmann::json::array();
-  std::cout << fmt::format("{} threads; overhead = (fluid + ARD) / fluid only, target <= 1.10 at 512^2 and above\n",
-                           kThreads);
-  std::cout << fmt::format("{:>4} {:>6} {:>10} {:>10} {:>10} {:>10} {:>9} {:>9}\n", "dim", "n", "fluid/s", "serial/s",
-                           "tbb/s", "ms tbb", "ovh ser", "ovh tbb");
-  for (BenchCase c : cases) {
-    nlohmann::json j = c.dim == 2 ? benchCase<2>(c.n, o.minSeconds, trace ? &*trace : nullptr)
-                                  : benchCase<3>(c.n, o.minSeconds, trace ? &*trace : nullptr);
-    std::cout << fmt::format("{:>4} {:>6} {:>10.2f} {:>10.2f} {:>10.2f} {:>10.2f} {:>9.2f} {:>9.2f}\n", c.dim, c.n,
-                             j["fluid_only_steps_per_second"].get<double>(),
-                             j["serial"]["steps_per_second"].get<double>(), j["tbb"]["steps_per_second"].get<double>(),
-                             j["tbb"]["ms"].get<double>(), j["serial"]["overhead"].get<double>(),
-                             j["tbb"]["overhead"].get<double>())
-              << std::flush;
-    all.push_back(j);
-  }
+  std::cout << "overhead = (fluid + ARD) / fluid only, target <= 1.10 at 512^2 and above (2 threads)\n";
+  std::cout << fmt::format("{:>4} {:>6} {:>4} {:>10} {:>10} {:>10} {:>10} {:>9} {:>9}\n", "dim", "n", "thr", "fluid/s",
+                           "serial/s", "tbb/s", "ms tbb", "ovh ser", "ovh tbb");
+  for (BenchCase c : cases)
+    for (int threads : {1, 2}) {
+      StageTrace* t = trace && threads == 2 ? &*trace : nullptr;
+      nlohmann::json j =
+          c.dim == 2 ? benchCase<2>(c.n, threads, o.minSeconds, t) : benchCase<3>(c.n, threads, o.minSeconds, t);
+      std::cout << fmt::format("{:>4} {:>6} {:>4} {:>10.2f} {:>10.2f} {:>10.2f} {:>10.2f} {:>9.2f} {:>9.2f}\n", c.dim,
+                               c.n, threads, j["fluid_only_steps_per_second"].get<double>(),
+                               j["serial"]["steps_per_second"].get<double>(), j["tbb"]["steps_per_second"].get<double>(),
+                               j["tbb"]["ms"].get<double>(), j["serial"]["overhead"].get<double>(),
+                               j["tbb"]["overhead"].get<double>())
+                << std::flush;
+      all.push_back(j);
+    }
   if (!o.json.empty()) std::ofstream(o.json) << all.dump(2) << "\n";
   if (trace) {
     traceFile << trace->chromeJson();

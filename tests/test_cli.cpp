@@ -590,11 +590,14 @@ TEST(Cli, CouplingBenchWritesAChromeTrace) {
     EXPECT_TRUE(stages.count(s)) << s;
   EXPECT_EQ(groups, (std::set<std::string>{"serial 32^2", "tbb 32^2"}));
   nlohmann::json j = nlohmann::json::parse(std::ifstream(table));
-  ASSERT_EQ(j.size(), 1u);
-  for (const char* b : {"serial", "tbb"}) {
-    const double overhead = j[0][b]["overhead"].get<double>();
-    EXPECT_NEAR(overhead, j[0][b]["ms"].get<double>() / j[0]["fluid_only_ms"].get<double>(), 1e-9);
-    EXPECT_GT(overhead, 0.0);
+  ASSERT_EQ(j.size(), 2u);  // 1 and 2 threads
+  for (int k = 0; k < 2; ++k) {
+    EXPECT_EQ(j[k]["threads"].get<int>(), k + 1);
+    for (const char* b : {"serial", "tbb"}) {
+      const double overhead = j[k][b]["overhead"].get<double>();
+      EXPECT_NEAR(overhead, j[k][b]["ms"].get<double>() / j[k]["fluid_only_ms"].get<double>(), 1e-9);
+      EXPECT_GT(overhead, 0.0);
+    }
   }
   EXPECT_EQ(runMorphoflow("bench fluid --size 32 --seconds 0 --trace " + trace.string()).status, 2);
   EXPECT_EQ(runMorphoflow("bench coupling --size 32 --seconds 0 --trace " + (dir / "no" / "t.json").string()).status, 2);
