@@ -12,6 +12,30 @@
 
 namespace morphoflow {
 
+// The lattice's flat layout, x fastest (shared by Grid and RowField).
+template <int D>
+size_t latticeIndex(const IVec<D>& dims, const IVec<D>& c) {
+  size_t i = size_t(c[D - 1]);
+  for (int a = D - 2; a >= 0; --a) i = i * size_t(dims[a]) + size_t(c[a]);
+  return i;
+}
+template <int D>
+IVec<D> latticeCoord(const IVec<D>& dims, size_t i) {
+  IVec<D> c;
+  for (int a = 0; a < D; ++a) {
+    c[a] = int(i % size_t(dims[a]));
+    i /= size_t(dims[a]);
+  }
+  return c;
+}
+// Distance in the flat array between neighbours along `axis`.
+template <int D>
+size_t latticeStride(const IVec<D>& dims, int axis) {
+  size_t s = 1;
+  for (int a = 0; a < axis; ++a) s *= size_t(dims[a]);
+  return s;
+}
+
 template <typename T, int D>
 class Grid {
   static_assert(D == 2 || D == 3, "morphoflow grids are 2D or 3D");
@@ -38,24 +62,10 @@ class Grid {
   // Linear index of a cell; x fastest.
   size_t index(const IVec<D>& c) const {
     assert(contains(c));
-    size_t i = size_t(c[D - 1]);
-    for (int a = D - 2; a >= 0; --a) i = i * size_t(dims_[a]) + size_t(c[a]);
-    return i;
+    return latticeIndex<D>(dims_, c);
   }
-  IVec<D> coord(size_t i) const {
-    IVec<D> c;
-    for (int a = 0; a < D; ++a) {
-      c[a] = int(i % size_t(dims_[a]));
-      i /= size_t(dims_[a]);
-    }
-    return c;
-  }
-  // Distance in the flat array between neighbours along `axis`.
-  size_t stride(int axis) const {
-    size_t s = 1;
-    for (int a = 0; a < axis; ++a) s *= size_t(dims_[a]);
-    return s;
-  }
+  IVec<D> coord(size_t i) const { return latticeCoord<D>(dims_, i); }
+  size_t stride(int axis) const { return latticeStride<D>(dims_, axis); }
   bool contains(const IVec<D>& c) const {
     for (int a = 0; a < D; ++a)
       if (c[a] < 0 || c[a] >= dims_[a]) return false;

@@ -40,24 +40,9 @@ class RowField {
   const IVec<D>& dims() const { return dims_; }
   int dim(int axis) const { return dims_[axis]; }
   size_t size() const { return size_; }
-  size_t index(const IVec<D>& c) const {  // Grid's order: x fastest
-    size_t i = size_t(c[D - 1]);
-    for (int a = D - 2; a >= 0; --a) i = i * size_t(dims_[a]) + size_t(c[a]);
-    return i;
-  }
-  IVec<D> coord(size_t i) const {
-    IVec<D> c;
-    for (int a = 0; a < D; ++a) {
-      c[a] = int(i % size_t(dims_[a]));
-      i /= size_t(dims_[a]);
-    }
-    return c;
-  }
-  size_t stride(int axis) const {
-    size_t s = 1;
-    for (int a = 0; a < axis; ++a) s *= size_t(dims_[a]);
-    return s;
-  }
+  size_t index(const IVec<D>& c) const { return latticeIndex<D>(dims_, c); }  // Grid's order
+  IVec<D> coord(size_t i) const { return latticeCoord<D>(dims_, i); }
+  size_t stride(int axis) const { return latticeStride<D>(dims_, axis); }
 
   // Row r's nx values.
   const float* row(size_t r) const { return pool_.data() + size_t(rowOf_[r]) * nx_; }
