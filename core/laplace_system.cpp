@@ -259,7 +259,7 @@ void LaplaceSystem<D>::finalize() {
   sweepSpan_.assign(rows, {});
   parallelForRows<D>(dims, [&](size_t row) {
     if (nx < 3) return;
-    RowStencil<D, double> s = rowStencil<D>(*this, zerosX_.data(), zerosX_.data(), zerosW_.data(), row);
+    const RowStencil<D, double> s = stencil(row);
     const float* cr = c.row(row);
     const float* w0 = w[0].row(row);
     // The smoother also takes a face across a non-periodic domain edge:

@@ -51,17 +51,13 @@ SolverResult pcg(const Op& A, const Vector& bIn, Vector* xp, Preconditioner* M, 
   // z = M^-1 r lives in q's storage: q = A p is dead once r is updated, and
   // z once it has gone into p (one vector less to hold).
   Vector &r = ws.r, &p = ws.p, &q = ws.q, &z = q;
-  double rnorm;
-  if constexpr (requires { A.residualInPlace(&ws.b, x); }) {
+  double rnorm = 0.0;
+  if constexpr (requires { A.residualInPlace(&ws.b, x); })
     if (consume) {
       rnorm = A.residualInPlace(&ws.b, x);
       std::swap(ws.b, ws.r);  // b's storage is r now; b is rebuilt at the end
-    } else {
-      rnorm = A.residual(b, x, &r);
     }
-  } else {
-    rnorm = A.residual(b, x, &r);
-  }
+  if (!consume) rnorm = A.residual(b, x, &r);
   result.residual = rnorm / bnorm;
   if (result.residual <= opt.tolerance) {
     result.converged = true;

@@ -104,7 +104,6 @@ class RowField {
   std::vector<float> expanded() const;
   // Rows stored (the footprint is storedRows() * nx floats plus 4 bytes a row).
   size_t storedRows() const { return pool_.size() / (nx_ ? nx_ : 1); }
-  size_t bytes() const { return pool_.capacity() * sizeof(float) + rowOf_.capacity() * sizeof(uint32_t); }
 
  private:
   explicit RowField(const IVec<D>& dims) : dims_(dims) {  // shaped, no rows yet

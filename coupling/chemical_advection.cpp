@@ -240,46 +240,36 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
       }
       fromInflow_[i] = in;
     }, 4096);
-  // The species [s0, s1) from one stencil per cell (one set of weights,
-  // 2^D loads per species), into scratch_[s - s0].
-  std::vector<double> in(ns, 0.0);
-  std::vector<const double*> src(ns);
-  std::vector<double*> dst(ns);
-  for (size_t s = 0; s < ns; ++s) {
-    in[s] = inflow ? d.inflowValues[s] : 0.0;
-    src[s] = species[s]->data();
-  }
   const bool linear = interpolation_ == ChemicalInterpolation::Linear;
   const size_t cells = n;
   bool walls = true;
   for (int a = 0; a < D; ++a) walls = walls && !d.periodic[size_t(a)];
   [[maybe_unused]] const bool wide = linear && walls && cells < (size_t(1) << 31) && useAvx2();
-  auto sample = [&](size_t s0, size_t s1) {
-    for (size_t s = s0; s < s1; ++s) dst[s] = scratch_[s - s0].data();
+  // Species s into scratch_ (2^D loads a cell), through the feet's stencils.
+  auto sample = [&](size_t s) {
+    const double in = inflow ? d.inflowValues[s] : 0.0;
+    const double* src = species[s]->data();
+    double* dst = scratch_.data();
     auto cell = [&](size_t i) {
       const double w = inflow ? fromInflow_[i] : 0.0;
       if (w >= 1.0) {
-        for (size_t s = s0; s < s1; ++s) dst[s][i] = in[s];
+        dst[i] = in;
         return;
       }
       Vec<D> c;
       for (int a = 0; a < D; ++a) c[a] = feet_[size_t(a)][i];
+      double v = 0.0;
       if (linear) {
         size_t index[1 << D];
         double weight[1 << D];
         linearStencil<D>(d.cells, d.periodic, c, index, weight);
-        for (size_t s = s0; s < s1; ++s) {
-          double v = 0.0;
-          for (int k = 0; k < (1 << D); ++k) v += weight[k] * src[s][index[k]];
-          dst[s][i] = w * in[s] + (1.0 - w) * v;
-        }
+        for (int k = 0; k < (1 << D); ++k) v += weight[k] * src[index[k]];
       } else {
-        for (size_t s = s0; s < s1; ++s)
-          dst[s][i] = w * in[s] + (1.0 - w) * sampleChemical<D>(*species[s], d.periodic, c, interpolation_);
+        v = sampleChemical<D>(*species[s], d.periodic, c, interpolation_);
       }
+      dst[i] = w * in + (1.0 - w) * v;
     };
-    [[maybe_unused]] LinearRun<D> run{d.cells, {}, inflow ? fromInflow_.data() : nullptr, in.data() + s0,
-                                      src.data() + s0, dst.data() + s0, s1 - s0};
+    [[maybe_unused]] LinearRun<D> run{d.cells, {}, inflow ? fromInflow_.data() : nullptr, &in, &src, &dst, 1};
     for (int a = 0; a < D; ++a) run.feet[size_t(a)] = feet_[size_t(a)].data();
     constexpr size_t kRun = 1024;
     parallelFor((cells + kRun - 1) / kRun, [&](size_t chunk) {
@@ -291,21 +281,17 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
       for (; i < end; ++i) cell(i);
     });
   };
-  if (!pool) {  // all species in one pass, each into its own scratch
-    while (scratch_.size() < ns) scratch_.emplace_back(d.cells);
-    sample(0, ns);
-    for (size_t s = 0; s < ns; ++s) std::swap(species[s]->values(), scratch_[s].values());
-  } else {  // one species at a time through one borrowed scratch (the same values)
-    if (scratch_.empty()) scratch_.emplace_back();
-    for (size_t s = 0; s < ns; ++s) {
-      pool->lend(&scratch_[0].values());
-      scratch_[0].reshape(d.cells);
-      sample(s, s + 1);
-      std::swap(species[s]->values(), scratch_[0].values());
-      pool->give(&scratch_[0].values());
-    }
-    for (auto& f : feet_) pool->give(&f);
+  // One species at a time through one scratch (the species are independent):
+  // after the swap it holds the old values' storage, the next one's scratch.
+  for (size_t s = 0; s < ns; ++s) {
+    if (pool) pool->lend(&scratch_.values());
+    scratch_.reshape(d.cells);
+    sample(s);
+    std::swap(species[s]->values(), scratch_.values());
+    if (pool) pool->give(&scratch_.values());
   }
+  if (pool)
+    for (auto& f : feet_) pool->give(&f);
   emptySolids(species);
 }
 

@@ -42,7 +42,7 @@ class ChemicalAdvector {
   // species[s] <- species[s](x*) for every RD cell; deterministic for any
   // thread count (every cell is computed independently).
   // The feet and the species' scratch are borrowed from `pool` (if given)
-  // for the call.
+  // for the call; the species go through the scratch one at a time.
   void advect(const MacVelocity<D>& u, double dt, const std::vector<Grid<double, D>*>& species, WorkPool* pool = nullptr);
   // Sets the solid cells of every species to the solid values.
   void emptySolids(const std::vector<Grid<double, D>*>& species) const;
@@ -56,7 +56,7 @@ class ChemicalAdvector {
   // the fluid's own traces: 1e-7 of the domain, far below a cell).
   std::array<std::vector<float>, D> feet_;
   std::vector<double> fromInflow_;  // weight of the inflow value (1: the foot left through an inflow side); empty without inflow
-  std::vector<Grid<double, D>> scratch_;  // one per species (one, borrowed, with a pool)
+  Grid<double, D> scratch_;  // one species' advected values (borrowed, with a pool)
 };
 
 // Value of g at continuous grid coordinate c (cell centres at integers),

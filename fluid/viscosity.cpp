@@ -88,13 +88,26 @@ const MultigridOptions kViscosityCycle{3, 3, 4};
 }  // namespace
 
 // Unknown i of component a's system is face gi of its grid: the same index
-// unless a periodic axis drops the duplicate face layer.
+// unless a periodic axis drops the duplicate face layer. Row by row:
+// fn(row, i0, g0) with the row's first unknown and its face in g.
+template <int D>
+static void eachUnknownRow(const IVec<D>& dims, const Grid<float, D>& g, auto&& fn) {
+  parallelForRows<D>(dims, [&](size_t row) {
+    IVec<D> k(0);
+    size_t rest = row;
+    for (int b = 1; b < D; ++b) {
+      k[b] = int(rest % size_t(dims[b]));
+      rest /= size_t(dims[b]);
+    }
+    fn(row, row * size_t(dims[0]), g.index(k));
+  });
+}
+// fn(i, gi) for every unknown.
 template <int D>
 static void eachUnknown(const IVec<D>& dims, const Grid<float, D>& g, auto&& fn) {
-  if (dims == g.dims())
-    parallelFor(g.size(), [&](size_t i) { fn(i, i); }, 4096);
-  else
-    forEachCell<D>(dims, [&](const IVec<D>& k, size_t i) { fn(i, g.index(k)); });
+  eachUnknownRow<D>(dims, g, [&](size_t, size_t i0, size_t g0) {
+    for (size_t x = 0; x < size_t(dims[0]); ++x) fn(i0 + x, g0 + x);
+  });
 }
 
 template <int D>
@@ -104,14 +117,7 @@ double ViscositySolver<D>::rightHandSide(const MacVelocity<D>& u, int a, double 
   const Grid<uint8_t, D>& fixed = vc_.fixed[a];
   b_.resize(C.A.size());
   // Row by row: the boundary terms are stored a row at a time.
-  parallelForRows<D>(C.dims, [&](size_t row) {
-    IVec<D> k(0);
-    size_t rest = row;
-    for (int b = 1; b < D; ++b) {
-      k[b] = int(rest % size_t(C.dims[b]));
-      rest /= size_t(C.dims[b]);
-    }
-    const size_t i0 = row * size_t(C.dims[0]), g0 = g.index(k);  // the row's first unknown, its face in g
+  eachUnknownRow<D>(C.dims, g, [&](size_t row, size_t i0, size_t g0) {
     const float* rhs = C.boundaryRhs.row(row);
     for (size_t x = 0; x < size_t(C.dims[0]); ++x)
       b_[i0 + x] = fixed[g0 + x] ? 0.0 : double(g[g0 + x]) + s * double(rhs[x]);
