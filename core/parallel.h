@@ -64,9 +64,10 @@ void parallelForRows(const IVec<D>& dims, Fn&& fn) {
   parallelFor(rows, fn, rowGrain<D>(dims));
 }
 
-// Calls fn(cell, index) for every cell, in parallel over rows.
+// Calls fn(row, c) for every row, in parallel: c holds the coordinates of
+// the row's first cell (x = 0).
 template <int D, typename Fn>
-void forEachCell(const IVec<D>& dims, Fn&& fn) {
+void forEachRow(const IVec<D>& dims, Fn&& fn) {
   parallelForRows<D>(dims, [&](size_t row) {
     IVec<D> c(0);
     size_t rest = row;
@@ -74,6 +75,14 @@ void forEachCell(const IVec<D>& dims, Fn&& fn) {
       c[a] = int(rest % size_t(dims[a]));
       rest /= size_t(dims[a]);
     }
+    fn(row, c);
+  });
+}
+
+// Calls fn(cell, index) for every cell, in parallel over rows.
+template <int D, typename Fn>
+void forEachCell(const IVec<D>& dims, Fn&& fn) {
+  forEachRow<D>(dims, [&](size_t row, IVec<D> c) {
     size_t base = row * size_t(dims[0]);
     for (int x = 0; x < dims[0]; ++x) {
       c[0] = x;

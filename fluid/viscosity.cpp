@@ -92,15 +92,7 @@ const MultigridOptions kViscosityCycle{3, 3, 4};
 // fn(row, i0, g0) with the row's first unknown and its face in g.
 template <int D>
 static void eachUnknownRow(const IVec<D>& dims, const Grid<float, D>& g, auto&& fn) {
-  parallelForRows<D>(dims, [&](size_t row) {
-    IVec<D> k(0);
-    size_t rest = row;
-    for (int b = 1; b < D; ++b) {
-      k[b] = int(rest % size_t(dims[b]));
-      rest /= size_t(dims[b]);
-    }
-    fn(row, row * size_t(dims[0]), g.index(k));
-  });
+  forEachRow<D>(dims, [&](size_t row, const IVec<D>& k) { fn(row, row * size_t(dims[0]), g.index(k)); });
 }
 // fn(i, gi) for every unknown.
 template <int D>
