@@ -220,8 +220,9 @@ int main(int argc, char** argv) {
         std::cout << fmt::format("gpu: {} ({}), OpenGL {}\n", g.renderer, g.platform, g.version);
       else
         std::cout << "gpu: unavailable: " << g.reason << "\n";
-      std::cout << fmt::format("cpu: {} threads; vector kernels {} (AVX2 {}){}\n", hardwareThreads(),
-                               useAvx2() ? "8-lane AVX2" : "4-lane SSE", cpuHasAvx2() ? "present" : "absent",
+      std::cout << fmt::format("cpu: {} threads; vector kernels {} (AVX2 {}, AVX-512 {}){}\n", hardwareThreads(),
+                               useAvx512() ? "8-lane AVX2, 16-lane AVX-512" : useAvx2() ? "8-lane AVX2" : "4-lane SSE",
+                               cpuHasAvx2() ? "present" : "absent", cpuHasAvx512() ? "present" : "absent",
                                std::getenv("MORPHOFLOW_SIMD") ? " (MORPHOFLOW_SIMD set)" : "");
       return 0;
     }

@@ -5,7 +5,10 @@
 // built for AVX2) and used when the CPU has it. A wide kernel does each
 // lane's arithmetic in the scalar loop's order and without FMA, so both
 // variants give bitwise the same fields: the choice is one of speed only.
-// MORPHOFLOW_SIMD=4 in the environment keeps the four-lane kernels.
+// The 5 x 5 kernel of the fused explicit step also has a sixteen-lane
+// AVX-512 variant (its 25 weights stay in AVX-512's 32 registers), under the
+// same rule. MORPHOFLOW_SIMD=4 in the environment keeps the four-lane
+// kernels, MORPHOFLOW_SIMD=8 the eight-lane ones.
 #pragma once
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -29,5 +32,10 @@ bool useAvx2();
 // Tests compare the two variants; asking for AVX2 on a CPU without it keeps
 // the four-lane kernels.
 void setUseAvx2(bool on);
+// The same for the AVX-512 variants (AVX-512 F and VL), used only while
+// useAvx2() is too.
+bool cpuHasAvx512();
+bool useAvx512();
+void setUseAvx512(bool on);
 
 }  // namespace morphoflow

@@ -21,11 +21,13 @@ namespace {
 
 typedef float vf4x __attribute__((vector_size(16)));
 typedef float vf8x __attribute__((vector_size(32)));
+typedef float vf16x __attribute__((vector_size(64)));  // one AVX-512 register (used in avx512 targets only)
 // The same with float alignment, for unaligned loads and stores that stay
 // typed as float (a memcpy would let the compiler assume a store may change
 // the loop's constants, and reload them every iteration).
 typedef float vf4u __attribute__((vector_size(16), aligned(4)));
 typedef float vf8u __attribute__((vector_size(32), aligned(4)));
+typedef float vf16u __attribute__((vector_size(64), aligned(4)));
 
 // Float lanes for the models whose rates are plain arithmetic: every double
 // (a parameter, a constant) is rounded to float first and every operation is
@@ -51,6 +53,7 @@ template <class V> MF_INLINE FL<V> operator-(double a, FL<V> b) { return FL<V>(a
 template <class V> MF_INLINE FL<V> operator*(double a, FL<V> b) { return FL<V>(a) * b; }
 template <class V> MF_INLINE FL<V> operator/(double a, FL<V> b) { return FL<V>(a) / b; }
 
+
 // The models whose rates take float lanes (no comparisons in them).
 template <class M>
 constexpr bool kFloatLanes =
@@ -66,11 +69,13 @@ MF_INLINE NewtonLanes load(const float* p, NewtonLanes) {
 MF_INLINE FL<float> load(const float* p, FL<float>) { return FL<float>(*p); }
 MF_INLINE FL<vf4x> load(const float* p, FL<vf4x>) { return FL<vf4x>(vf4x(*reinterpret_cast<const vf4u*>(p))); }
 MF_INLINE FL<vf8x> load(const float* p, FL<vf8x>) { return FL<vf8x>(vf8x(*reinterpret_cast<const vf8u*>(p))); }
+MF_INLINE FL<vf16x> load(const float* p, FL<vf16x>) { return FL<vf16x>(vf16x(*reinterpret_cast<const vf16u*>(p))); }
 MF_INLINE void store(float* p, double v) { *p = float(v); }
 MF_INLINE void store(float* p, NewtonLanes v) { *reinterpret_cast<vf4u*>(p) = __builtin_convertvector(v, vf4x); }
 MF_INLINE void store(float* p, FL<float> v) { *p = v.v; }
 MF_INLINE void store(float* p, FL<vf4x> v) { *reinterpret_cast<vf4u*>(p) = v.v; }
 MF_INLINE void store(float* p, FL<vf8x> v) { *reinterpret_cast<vf8u*>(p) = v.v; }
+MF_INLINE void store(float* p, FL<vf16x> v) { *reinterpret_cast<vf16u*>(p) = v.v; }
 // max(v, 0) as the comparison v < 0 picks it (a NaN stays NaN).
 MF_INLINE double clampZero(double v) { return v < 0.0 ? 0.0 : v; }
 MF_INLINE NewtonLanes clampZero(NewtonLanes v) { return v < 0.0 ? NewtonLanes{} : v; }
@@ -79,6 +84,7 @@ template <class V>
 MF_INLINE FL<V> clampZero(FL<V> v) {
   return FL<V>(v.v < 0.0f ? V{} : v.v);
 }
+
 template <class L>
 constexpr int lanes() {
   if constexpr (std::is_same_v<L, double> || std::is_same_v<L, FL<float>>) return 1;
@@ -112,63 +118,132 @@ MF_INLINE void laneWeights(const RowJob<D, N>& j, L* w) {
   for (int t = 0; t < 25; ++t) w[t] = L{} + j.tw[t];  // (L{} + d: a splat for every lane type)
 }
 
-// Cells x, x + 1, ... (L's lanes at a time); at(row, dx) reads a row at x + dx.
-template <class M, int D, class L, bool K, class At>
-MF_INLINE void cellsAt(const RowJob<D, M::N>& j, int x, const L* w, At at) {
+// One 5 x 5 convolution (seed 000 eq. 37) of rows y - 2 .. y + 2: one sum
+// per kernel row, then the five together: short dependency chains (a single
+// running sum of 25 taps would wait on the add latency), in the same order at
+// every width.
+template <class L, class At>
+MF_INLINE L kernel5(const float* const* rows, const L* w, At at) {
+  L acc[5];
+#pragma GCC unroll 5
+  for (int dy = 0; dy < 5; ++dy) {
+    acc[dy] = w[5 * dy] * at(rows[dy], -2);
+#pragma GCC unroll 4
+    for (int dx = 1; dx < 5; ++dx) acc[dy] = acc[dy] + w[5 * dy + dx] * at(rows[dy], dx - 2);
+  }
+  return ((acc[0] + acc[1]) + (acc[2] + acc[3])) + acc[4];
+}
+
+// Species s's diffusion term at cells x, x + 1, ... (L's lanes at a time);
+// at(row, dx) reads a row at x + dx.
+template <int D, int N, class L, bool K, class At>
+MF_INLINE L laplacian(const RowJob<D, N>& j, int s, const L* w, At at) {
+  if (K && (j.kernel >> s & 1u)) return kernel5(j.krow[s], w, at);  // seed 000 eq. 37
+  L lap = at(j.c[s], -1) + at(j.c[s], 1);
+  for (int k = 0; k < 2 * (D - 1); ++k) lap = lap + at(j.nb[s][k], 0);
+  return lap - double(2 * D) * at(j.c[s], 0);
+}
+
+// The Euler update of cells x, x + 1, ... from their diffusion terms (seed 000 eq. 27).
+template <class M, int D, class L, class At>
+MF_INLINE void update(const RowJob<D, M::N>& j, int x, const L* lap, At at) {
   constexpr int N = M::N;
   L c[N], r[N];
   for (int s = 0; s < N; ++s) c[s] = at(j.c[s], 0);
   M::rates(c, j.p, r);  // the model's own rates (rd/models.h)
   for (int s = 0; s < N; ++s) {
-    L lap;
-    if (K && (j.kernel >> s & 1u)) {  // seed 000 eq. 37: one 5 x 5 convolution
-      // One sum per kernel row, then the five together: short dependency chains (a single running sum of
-      // 25 taps would wait on the add latency), in the same order at every width.
-      const float* const* rows = j.krow[s];
-      L acc[5];
-#pragma GCC unroll 5
-      for (int dy = 0; dy < 5; ++dy) {
-        acc[dy] = w[5 * dy] * at(rows[dy], -2);
-#pragma GCC unroll 4
-        for (int dx = 1; dx < 5; ++dx) acc[dy] = acc[dy] + w[5 * dy + dx] * at(rows[dy], dx - 2);
-      }
-      lap = ((acc[0] + acc[1]) + (acc[2] + acc[3])) + acc[4];
-    } else {
-      lap = at(j.c[s], -1) + at(j.c[s], 1);
-      for (int k = 0; k < 2 * (D - 1); ++k) lap = lap + at(j.nb[s][k], 0);
-      lap = lap - double(2 * D) * c[s];
-    }
-    L v = c[s] + j.dt * (r[s] + j.kd[s] * lap);
+    L v = c[s] + j.dt * (r[s] + j.kd[s] * lap[s]);
     if (j.clamped >> s & 1u) v = clampZero(v);  // the model's clamped species (e.g. Turing's b)
     store(j.out[s] + x, v);
   }
 }
 
-template <class M, int D, class L, bool K>
+template <class M, int D, class L, bool K, class At>
+MF_INLINE void cellsAt(const RowJob<D, M::N>& j, int x, const L* w, At at) {
+  L lap[M::N];
+  for (int s = 0; s < M::N; ++s) lap[s] = laplacian<D, M::N, L, K>(j, s, w, at);
+  update<M, D>(j, x, lap, at);
+}
+
+// Local copies of a row's job: nothing the loops store can change them, so they stay in registers.
+template <class M, int D>
+struct LocalJob {
+  RowJob<D, M::N> j;
+  double p[M::P > 0 ? M::P : 1];
+  explicit LocalJob(const RowJob<D, M::N>& job) : j(job) {
+    for (int k = 0; k < M::P; ++k) p[k] = job.p[k];
+    j.p = p;
+  }
+};
+
+template <class M, int D, class L>
 MF_INLINE int interior(const RowJob<D, M::N>& job, int x, int end) {
-  constexpr int N = M::N, n = lanes<L>();
-  // Local copies: nothing the loop stores can change them, so they stay in registers.
-  RowJob<D, N> j = job;
-  double p[M::P];
-  for (int k = 0; k < M::P; ++k) p[k] = job.p[k];
-  j.p = p;
-  L w[K ? 25 : 1];
-  if constexpr (K) laneWeights(j, w);
-  for (; x + n <= end; x += n) cellsAt<M, D, L, K>(j, x, w, [&](const float* row, int dx) { return load(row + x + dx, L()); });
+  constexpr int n = lanes<L>();
+  LocalJob<M, D> local(job);
+  const RowJob<D, M::N>& j = local.j;
+  for (; x + n <= end; x += n)
+    cellsAt<M, D, L, false>(j, x, nullptr, [&](const float* row, int dx) { return load(row + x + dx, L()); });
   return x;
+}
+
+// With the 5 x 5 kernel: a chunk of the row at a time, each species' kernel
+// over the whole chunk first (few pointers live, so none spills), then the
+// updates from the kept terms. The same operations per cell as cellsAt.
+template <class M, int D, class L>
+MF_INLINE int interiorKernel(const RowJob<D, M::N>& job, int x, int end) {
+  constexpr int N = M::N, n = lanes<L>(), kChunk = 32;  // lanes' worth of cells per chunk
+  LocalJob<M, D> local(job);
+  const RowJob<D, N>& j = local.j;
+  L w[25];
+  laneWeights<L>(j, w);
+  L lap[kChunk][N];
+  while (x + n <= end) {
+    const int count = std::min(kChunk, (end - x) / n);
+    for (int s = 0; s < N; ++s) {
+      if (!(j.kernel >> s & 1u)) {
+        for (int k = 0; k < count; ++k) {
+          const int xk = x + k * n;
+          lap[k][s] = laplacian<D, N, L, false>(j, s, w, [&](const float* row, int dx) { return load(row + xk + dx, L()); });
+        }
+        continue;
+      }
+      // Row pointers that step with the cells: each load is one pointer and a constant offset.
+      const float* rows[5];
+      for (int dy = 0; dy < 5; ++dy) rows[dy] = j.krow[s][dy] + x;
+      for (int k = 0; k < count; ++k) {
+        lap[k][s] = kernel5(rows, w, [](const float* row, int dx) { return load(row + dx, L()); });
+        for (int dy = 0; dy < 5; ++dy) rows[dy] += n;
+      }
+    }
+    for (int k = 0; k < count; ++k, x += n)
+      update<M, D>(j, x, lap[k], [&](const float* row, int dx) { return load(row + x + dx, L()); });
+  }
+  return x;
+}
+
+template <class M, int D, class L, bool K>
+MF_INLINE int interiorOf(const RowJob<D, M::N>& j, int x, int end) {
+  if constexpr (K) return interiorKernel<M, D, L>(j, x, end);
+  else return interior<M, D, L>(j, x, end);
 }
 
 // The row's cells from x on, in the widest lanes that fit (returns the first left).
 template <class M, int D, bool K>
 int interiorSse(const RowJob<D, M::N>& j, int x, int end) {
-  if constexpr (kFloatLanes<M>) return interior<M, D, FL<vf4x>, K>(j, x, end);
-  else return interior<M, D, NewtonLanes, K>(j, x, end);
+  if constexpr (kFloatLanes<M>) return interiorOf<M, D, FL<vf4x>, K>(j, x, end);
+  else return interiorOf<M, D, NewtonLanes, K>(j, x, end);
 }
 #if MORPHOFLOW_AVX2_KERNELS
 template <class M, int D, bool K>
 __attribute__((target("avx2"))) int interiorAvx2(const RowJob<D, M::N>& j, int x, int end) {
-  if constexpr (kFloatLanes<M>) x = interior<M, D, FL<vf8x>, K>(j, x, end);
-  return interior<M, D, std::conditional_t<kFloatLanes<M>, FL<vf4x>, NewtonLanes>, K>(j, x, end);
+  if constexpr (kFloatLanes<M>) x = interiorOf<M, D, FL<vf8x>, K>(j, x, end);
+  return interiorOf<M, D, std::conditional_t<kFloatLanes<M>, FL<vf4x>, NewtonLanes>, K>(j, x, end);
+}
+// The 5 x 5 kernel in sixteen lanes: its weights fit AVX-512's 32 registers.
+template <class M, int D>
+__attribute__((target("avx2,avx512f,avx512vl"))) int interiorAvx512(const RowJob<D, M::N>& j, int x, int end) {
+  if constexpr (kFloatLanes<M>) x = interiorKernel<M, D, FL<vf16x>>(j, x, end);
+  return interiorAvx2<M, D, true>(j, x, end);
 }
 #endif
 
@@ -177,7 +252,7 @@ template <class M, int D>
 void edgeCell(const RowJob<D, M::N>& j, int x) {
   using L = Scalar<M>;
   L w[25];
-  laneWeights(j, w);
+  laneWeights<L>(j, w);
   cellsAt<M, D, L, true>(j, x, w, [&](const float* row, int dx) {
     int q = x + dx;
     if (q < 0 || q >= j.nx) q = j.periodic ? (q % j.nx + j.nx) % j.nx : std::clamp(q, 0, j.nx - 1);
@@ -273,11 +348,12 @@ class Engine final : public FusedExplicitRD<D> {
   static int interiorRow(const RowJob<D, N>& j, int x, int end, [[maybe_unused]] bool wide) {
     if constexpr (kLaneRates<M>) {
 #if MORPHOFLOW_AVX2_KERNELS
+      if (wide && K && useAvx512()) x = interiorAvx512<M, D>(j, x, end);
       if (wide) x = interiorAvx2<M, D, K>(j, x, end);
 #endif
       x = interiorSse<M, D, K>(j, x, end);
     }
-    return interior<M, D, Scalar<M>, K>(j, x, end);
+    return interiorOf<M, D, Scalar<M>, K>(j, x, end);
   }
 
   double h_;

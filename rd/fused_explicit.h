@@ -2,8 +2,9 @@
 // floats (8 bytes a cell for two species, against 16 in RDSolver's doubles),
 // and each cell's Laplacian (the 5-/7-point stencil, periodic or zero-flux),
 // the model's own rates and the Euler update x' = x + dt (R(x) + d lap x)
-// (seed 000 eq. 27) computed together in double lanes, four cells at a time
-// under AVX2, from the float neighbours to the float result. Every lane does
+// (seed 000 eq. 27) computed together from the float neighbours to the float
+// result: eight float lanes under AVX2 (four double lanes for models whose
+// rates compare), sixteen under AVX-512 for the 5 x 5 kernel. Every lane does
 // the scalar code's operations in its order and without FMA, and every row
 // reads only the previous state, so the result does not depend on the
 // lanes, the rows' tiling or the thread count.

@@ -121,9 +121,10 @@ TEST(FusedExplicit, TheGeneralizedKernelMatchesRDSolversOperator) {
   RDSolver<2> rd(s, *findModel("gray-scott"));
   rd.setGeneralizedDiffusion(op, {});
   std::vector<std::vector<float>> reference;
-  for (int variant = 0; variant < 4; ++variant) {
+  for (int variant = 0; variant < 5; ++variant) {
     ThreadLimit limit(variant == 1 ? 1 : 2);
     setUseAvx2(variant != 2);
+    setUseAvx512(variant != 4);
     auto e = FusedExplicitRD<2>::create("gray-scott", IVec<2>(n, n), h, true, s.diffusion, {});
     e->setKernel(op->kernel(), {});
     if (variant == 3) e->setRowsPerTask(3);
@@ -144,4 +145,31 @@ TEST(FusedExplicit, TheGeneralizedKernelMatchesRDSolversOperator) {
     }
   }
   setUseAvx2(true);
+  setUseAvx512(true);
+}
+
+// Rows longer than the kernel's chunks (32 vectors), with a ragged end, and
+// a species on the Laplacian beside one on the kernel: the same bits with
+// AVX-512, AVX2 and SSE lanes and with one thread.
+TEST(FusedExplicit, TheGeneralizedKernelsChunksGiveTheSameBits) {
+  const IVec<2> n(16 * 33 + 11, 6);
+  const double h = 2.2;
+  GeneralizedDiffusion op(*kramersMoyalPreset("d"), n[0], n[1], h);
+  std::vector<std::vector<float>> reference;
+  for (int variant = 0; variant < 4; ++variant) {
+    ThreadLimit limit(variant == 3 ? 1 : 2);
+    setUseAvx2(variant != 2);
+    setUseAvx512(variant == 0 || variant == 3);
+    auto e = FusedExplicitRD<2>::create("gray-scott", n, h, true, {0.2 * h * h, 0.1 * h * h}, {});
+    e->setKernel(op.kernel(), {1});
+    for (int sp = 0; sp < 2; ++sp)
+      for (size_t i = 0; i < e->field(sp).size(); ++i)
+        e->field(sp)[i] = float((sp == 0 ? 0.6 : 0.2) + 0.4 * (uniform01(17, uint64_t(sp), i) - 0.5));
+    e->step(0.3, 12);
+    if (variant == 0) reference = {e->field(0), e->field(1)};
+    else
+      for (int sp = 0; sp < 2; ++sp) ASSERT_EQ(e->field(sp), reference[size_t(sp)]) << "variant " << variant;
+  }
+  setUseAvx2(true);
+  setUseAvx512(true);
 }
