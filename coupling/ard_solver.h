@@ -32,13 +32,17 @@ class ARDSolver {
   // One step over dt of fluid time reading the velocity u (seed 001 eq. 6,
   // 19, 20): react and diffuse over rdTimeScale * dt, then advect over dt.
   void step(double dt, const MacVelocity<D>& u);
+  // The step's two stages, for a caller that runs them apart (the velocity
+  // need not exist before advect): react and diffuse, then advect.
+  void reactDiffuse(double dt);
+  void advect(double dt, const MacVelocity<D>& u);
 
   RDSolver<D>& rd() { return *rd_; }
   const RDSolver<D>& rd() const { return *rd_; }
   CouplingMode mode() const { return mode_; }
   double time() const { return time_; }
   long steps() const { return steps_; }
-  // Wall seconds of the last step's two stages, run one after the other.
+  // Wall seconds of the last step's two stages.
   static constexpr int kStages = 2;
   static constexpr const char* kStageNames[kStages] = {"reaction-diffusion", "advect chemicals"};
   const std::array<double, kStages>& stageSeconds() const { return stageSeconds_; }

@@ -2,6 +2,9 @@
 
 #include <tbb/task_group.h>
 
+#include <atomic>
+#include <functional>
+
 #if defined(__SANITIZE_THREAD__)
 #include <thread>
 #endif
@@ -25,41 +28,50 @@ void recordStages(StageTrace* trace, const char* category, const char* const (&n
 
 template <int D>
 CoupledStepper<D>::CoupledStepper(FluidSolver<D>* fluid, ARDSolver<D>* ard, CouplingBackend backend)
-    : fluid_(fluid), ard_(ard), backend_(backend), velocityN_(fluid->velocity()) {}
+    : fluid_(fluid), ard_(ard), backend_(backend) {}
 
 template <int D>
 void CoupledStepper<D>::step(double dt) {
   const double t0 = traceClock();
-  // Velocity n for the ARD step, copied before the fluid writes velocity n + 1.
-  for (int a = 0; a < D; ++a) velocityN_[a].values() = fluid_->velocity()[a].values();
-  if (trace_) trace_->record("copy velocity", "coupling", t0, traceClock());
-  auto fluidStep = [&] {
+  auto fluidStep = [&](const std::function<void()>& afterAdvection) {
     const double b = traceClock();
-    fluid_->step(dt);
+    fluid_->step(dt, afterAdvection);
     fluidSeconds_ = traceClock() - b;
     recordStages(trace_, "fluid", FluidStepStats::kStageNames, fluid_->lastStats().seconds, b);
   };
-  auto ardStep = [&] {
+  // The ARD's stages, each recorded on the thread that ran it.
+  auto ardStage = [&](int k, auto&& run) {
     const double b = traceClock();
-    ard_->step(dt, velocityN_);
-    ardSeconds_ = traceClock() - b;
-    recordStages(trace_, "ard", ARDSolver<D>::kStageNames, ard_->stageSeconds(), b);
+    run();
+    if (trace_) trace_->record(ARDSolver<D>::kStageNames[k], "ard", b, traceClock());
   };
+  auto reactDiffuse = [&] { ardStage(0, [&] { ard_->reactDiffuse(dt); }); };
+  // The fluid's step keeps the velocity it advected through until the next step.
+  auto advect = [&] { ardStage(1, [&] { ard_->advect(dt, fluid_->advectedVelocity()); }); };
   if (backend_ == CouplingBackend::Serial) {
-    fluidStep();
-    ardStep();
+    fluidStep({});
+    reactDiffuse();
+    advect();
   } else {
+    // The chemicals' advection waits for two things, the reaction-diffusion
+    // stage and the fluid's advection: whichever is done second starts it.
+    std::atomic<int> done{0};
 #if defined(__SANITIZE_THREAD__)
-    std::thread fluidThread(fluidStep);  // TSan builds: a thread TSan sees (core/parallel.h)
-    ardStep();
+    auto arrive = [&] { if (done.fetch_add(1) == 1) advect(); };
+    std::thread fluidThread([&] { fluidStep(arrive); });  // TSan builds: a thread TSan sees (core/parallel.h)
+    reactDiffuse();
+    arrive();
     fluidThread.join();
 #else
     tbb::task_group group;
-    group.run(fluidStep);
-    ardStep();
+    auto arrive = [&] { if (done.fetch_add(1) == 1) group.run(advect); };
+    group.run([&] { fluidStep(arrive); });
+    reactDiffuse();
+    arrive();
     group.wait();
 #endif
   }
+  ardSeconds_ = ard_->stageSeconds()[0] + ard_->stageSeconds()[1];
   stepSeconds_ = traceClock() - t0;
 }
 

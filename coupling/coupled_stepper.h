@@ -1,10 +1,14 @@
 // CoupledStepper<D>: advances a fluid and its ARD layer together.
 //
-//   serial: fluid step n + 1, then the ARD step n reading velocity n.
-//   tbb:    the same two steps run concurrently (seed 001 sec. 7): velocity n
-//           is copied into a second buffer before the fluid overwrites it, the
-//           ARD step reads only that copy, and both steps split into TBB tasks,
-//           so RD work fills the cores while the pressure solve waits on memory.
+//   serial: fluid step n + 1, then the ARD step n: reaction-diffusion, then
+//           the chemicals advected through the velocity the fluid's step
+//           advected through (velocity n with step n + 1's forces, which the
+//           fluid keeps until its next step: no copy of it is made).
+//   tbb:    the same two steps run concurrently (seed 001 sec. 7): the ARD's
+//           reaction-diffusion beside the fluid's step from its start, its
+//           advection once the fluid's advection is done too, and both steps
+//           split into TBB tasks, so RD work fills the cores while the
+//           pressure solve waits on memory.
 //
 // Both orders compute exactly the same numbers: neither step reads what the
 // other writes, and every parallel loop has a fixed decomposition, so the
@@ -31,15 +35,14 @@ class CoupledStepper {
   double ardSeconds() const { return ardSeconds_; }
   double stepSeconds() const { return stepSeconds_; }
 
-  // Records every later step's stages (the velocity copy, the fluid's four,
-  // the ARD's two) on the thread that ran each, into `trace` (null: stop).
+  // Records every later step's stages (the fluid's four, the ARD's two) on
+  // the thread that ran each, into `trace` (null: stop).
   void setTrace(StageTrace* trace) { trace_ = trace; }
 
  private:
   FluidSolver<D>* fluid_;
   ARDSolver<D>* ard_;
   CouplingBackend backend_;
-  MacVelocity<D> velocityN_;  // the second velocity buffer: what the ARD step reads
   double fluidSeconds_ = 0, ardSeconds_ = 0, stepSeconds_ = 0;
   StageTrace* trace_ = nullptr;
 };

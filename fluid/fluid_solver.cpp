@@ -54,7 +54,7 @@ FluidSolver<D>::FluidSolver(const FluidSettings& s)
 }
 
 template <int D>
-void FluidSolver<D>::step(double dt) {
+void FluidSolver<D>::step(double dt, const std::function<void()>& afterAdvection) {
   using Clock = std::chrono::steady_clock;
   auto t0 = Clock::now();
   auto lap = [&](int stage) {
@@ -78,10 +78,11 @@ void FluidSolver<D>::step(double dt) {
     pool_.give(&dyeScratch_.values());
   }
   advectionScratch_.giveBack(&pool_);
-  std::swap(u_, scratch_);
+  std::swap(u_, scratch_);  // scratch_ keeps the velocity advected through (advectedVelocity())
   constraints_.apply(&u_);
   injectInflowDye();
   lap(1);
+  if (afterAdvection) afterAdvection();
   // 3. diffuse (implicit viscosity)
   stats_.viscosity = viscosity_->diffuse(&u_, settings_.viscosity, dt, &pool_);
   lap(2);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -31,7 +32,9 @@ class FluidSolver {
   // Throws std::invalid_argument when the settings are inconsistent.
   explicit FluidSolver(const FluidSettings& settings);
 
-  void step(double dt);
+  // afterAdvection (if given) runs once the step's advection is done, on the
+  // step's thread: from then on advectedVelocity() holds what it advected.
+  void step(double dt, const std::function<void()>& afterAdvection = {});
   // Largest dt with |u|max dt <= cfl h (dtMax when the fluid is at rest).
   double cflTimeStep(double cfl, double dtMax) const;
   double maxSpeed() const;
@@ -43,6 +46,9 @@ class FluidSolver {
   long steps() const { return steps_; }
   const MacVelocity<D>& velocity() const { return u_; }
   MacVelocity<D>& velocity() { return u_; }
+  // The velocity the last step's advection traced through (the step's start
+  // velocity with its forces applied), kept until the next step's advection.
+  const MacVelocity<D>& advectedVelocity() const { return scratch_; }
   // The dye (zeros until something puts dye in: a scene without dye keeps no
   // grid for it until asked for one).
   Grid<float, D>& dye() { return materialisedDye(); }

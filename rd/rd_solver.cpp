@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "core/bfloat16.h"
 #include "core/jacobi.h"
 #include "core/mic0.h"
 #include "core/chebyshev.h"
@@ -23,8 +24,8 @@ struct RDSolver<D>::Diffusion {
   bool useChebyshev = false;                 // it solves instead of PCG: it is the quicker
   std::unique_ptr<Preconditioner> M;
   // The last solve's x - b: the next one's warm start (a guess only, so
-  // single precision).
-  std::vector<float> increment;
+  // bfloat16: 2 bytes a cell).
+  std::vector<uint16_t> increment;
   double incrementThetaDt = 0.0;  // the theta dt it was made over
   double thetaDt = -1.0;
   long version = -1;  // tensor version it was built from
@@ -313,7 +314,7 @@ SolverResult RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
   if (df.increment.size() == b.size()) {
     const double ratio = thetaDt / df.incrementThetaDt;
     bnorm = std::sqrt(deterministicSum(b.size(), [&](size_t i) {
-      x[i] = b[i] + ratio * double(df.increment[i]);
+      x[i] = b[i] + ratio * double(fromBfloat16(df.increment[i]));
       return b[i] * b[i];
     }));
   } else {
@@ -323,7 +324,7 @@ SolverResult RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
   SolverResult r = df.useChebyshev ? df.chebyshev->solve(b, &x, o, bnorm)
                                    : solvePCG<D>(df.A, b, &x, df.M.get(), o, nullptr, &pcgWork_);
   df.increment.resize(b.size());
-  parallelFor(b.size(), [&](size_t i) { df.increment[i] = float(x[i] - b[i]); }, kChunk);
+  parallelFor(b.size(), [&](size_t i) { df.increment[i] = toBfloat16(float(x[i] - b[i])); }, kChunk);
   df.incrementThetaDt = thetaDt;
   std::swap(b, x);
   return r;
@@ -455,7 +456,7 @@ void RDSolver<D>::save(StateWriter* out) const {
     const Diffusion& df = *diffusion_[size_t(s)];
     out->putGrid(p + "x", x_[size_t(s)]);
     out->put(p + "increment_size", df.increment.size());
-    out->putVector(p + "increment", df.increment);
+    out->putVector(p + "increment_bf16", df.increment);
     out->put(p + "increment_theta_dt", df.incrementThetaDt);
     out->put(p + "frozen_size", s < int(frozenValues_.size()) ? frozenValues_[size_t(s)].size() : size_t(0));
     if (s < int(frozenValues_.size())) out->putVector(p + "frozen", frozenValues_[size_t(s)]);
@@ -473,8 +474,8 @@ void RDSolver<D>::load(const StateReader& in) {
     in.getGrid(p + "x", &x_[size_t(s)]);
     size_t n = 0;
     in.get(p + "increment_size", &n);
-    df.increment.assign(n == 0 ? 0 : cellCount_, 0.0f);
-    in.getVector(p + "increment", &df.increment);
+    df.increment.assign(n == 0 ? 0 : cellCount_, 0);
+    in.getVector(p + "increment_bf16", &df.increment);
     in.get(p + "increment_theta_dt", &df.incrementThetaDt);
     in.get(p + "frozen_size", &n);
     frozenValues_[size_t(s)].assign(n == 0 ? 0 : cellCount_, 0.0);

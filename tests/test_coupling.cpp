@@ -236,11 +236,11 @@ TEST(CoupledStepper, TraceShowsTheOverlap) {
     std::set<int> used;
     for (const auto& e : events) used.insert(e.thread);
     *threads = int(used.size());
-    EXPECT_EQ(events.size(), 12u * 7u);  // copy, 4 fluid stages, 2 ARD stages per step
+    EXPECT_EQ(events.size(), 12u * 6u);  // 4 fluid stages, 2 ARD stages per step
     int steps = 0;
-    for (size_t i = 0; i < events.size(); i += 7) {  // one step's events: copy first
+    for (size_t i = 0; i < events.size(); i += 6) {  // one step's events
       double fluid[2] = {1e300, -1e300}, ard[2] = {1e300, -1e300};
-      for (size_t k = i + 1; k < i + 7; ++k) {
+      for (size_t k = i; k < i + 6; ++k) {
         double* span = events[k].category == "fluid" ? fluid : ard;
         span[0] = std::min(span[0], events[k].begin);
         span[1] = std::max(span[1], events[k].end);
