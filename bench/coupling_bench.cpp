@@ -5,7 +5,8 @@
 // the explicit diffusion limit, then linear semi-Lagrangian advection), with
 // the serial and tbb schedulers, on 1 and on 2 threads (the trace: the
 // 2-thread runs); the overhead ratio is (fluid + ARD time) / (fluid-only
-// time) per step, from medians.
+// time) per step, from medians; the fluid-only and tbb steps' compulsory
+// traffic as a fraction of the triad's bandwidth (bench/step_traffic.h).
 #include <fstream>
 #include <iostream>
 #include <optional>
@@ -17,6 +18,7 @@
 #include "bench/bench_setups.h"
 #include "bench/bench_suites.h"
 #include "bench/bench_timing.h"
+#include "bench/step_traffic.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/stage_trace.h"
@@ -29,17 +31,29 @@ namespace {
 
 constexpr int kWarmup = 3;
 
+struct CoupledTiming {
+  double step, fluid, ard;
+  double bytes;  // mean compulsory bytes a step
+};
+
 template <int D>
-double fluidOnly(int n, double minSeconds) {
+double cellsOf(const IVec<D>& n) {
+  double c = 1.0;
+  for (int a = 0; a < D; ++a) c *= n[a];
+  return c;
+}
+
+template <int D>
+CoupledTiming fluidOnly(int n, double minSeconds) {
   FluidSolver<D> f(benchCavity<D>(n));
   const double dt = f.h();
   for (int i = 0; i < kWarmup; ++i) f.step(dt);
-  return median(timeSteps(minSeconds, [&] { f.step(dt); }, [] {}));
+  double bytes = 0.0;
+  const std::vector<double> t = timeSteps(minSeconds, [&] { f.step(dt); }, [&] {
+    bytes += fluidStepBytes<D>(cellsOf<D>(f.cells()), f.lastStats());
+  });
+  return {median(t), median(t), 0.0, bytes / double(t.size())};
 }
-
-struct CoupledTiming {
-  double step, fluid, ard;
-};
 
 template <int D>
 CoupledTiming fluidWithARD(int n, CouplingBackend backend, double minSeconds, StageTrace* trace) {
@@ -59,19 +73,24 @@ CoupledTiming fluidWithARD(int n, CouplingBackend backend, double minSeconds, St
     trace->beginGroup(fmt::format("{} {}^{}", backend == CouplingBackend::TBB ? "tbb" : "serial", n, D));
   stepper.setTrace(trace);
   std::vector<double> fluid, ardT;
+  double bytes = 0.0;
   const std::vector<double> times = timeSteps(minSeconds, [&] { stepper.step(dt); }, [&] {
     fluid.push_back(stepper.fluidSeconds());
     ardT.push_back(stepper.ardSeconds());
+    bytes += fluidStepBytes<D>(cellsOf<D>(f.cells()), f.lastStats()) +
+             ardStepBytes(D, cellsOf<D>(rd.cells()), rd.species(), rd.lastStats().diffusion.iterations);
   });
-  return {median(times), median(fluid), median(ardT)};
+  return {median(times), median(fluid), median(ardT), bytes / double(times.size())};
 }
 
 template <int D>
-nlohmann::json benchCase(int n, int threads, double minSeconds, StageTrace* trace) {
+nlohmann::json benchCase(int n, int threads, double minSeconds, StageTrace* trace, double triad) {
   ThreadLimit limit(threads);
-  const double alone = fluidOnly<D>(n, minSeconds);
+  const CoupledTiming fluid = fluidOnly<D>(n, minSeconds);
+  const double alone = fluid.step;
   nlohmann::json j = {{"dim", D}, {"n", n}, {"threads", threads}, {"fluid_only_ms", 1e3 * alone},
-                      {"fluid_only_steps_per_second", 1.0 / alone}};
+                      {"fluid_only_steps_per_second", 1.0 / alone}, {"triad_gb_per_second", triad},
+                      {"fluid_only_of_triad", fluid.bytes / alone / 1e9 / triad}};
   for (CouplingBackend b : {CouplingBackend::Serial, CouplingBackend::TBB}) {
     const CoupledTiming t = fluidWithARD<D>(n, b, minSeconds, trace);
     const std::string k = b == CouplingBackend::TBB ? "tbb" : "serial";
@@ -79,7 +98,8 @@ nlohmann::json benchCase(int n, int threads, double minSeconds, StageTrace* trac
             {"steps_per_second", 1.0 / t.step},
             {"fluid_part_ms", 1e3 * t.fluid},
             {"ard_part_ms", 1e3 * t.ard},
-            {"overhead", t.step / alone}};
+            {"overhead", t.step / alone},
+            {"of_triad", t.bytes / t.step / 1e9 / triad}};
   }
   return j;
 }
@@ -99,18 +119,22 @@ bool runCouplingBench(const BenchOptions& o) {
   }
   nlohmann::json all = nlohmann::json::array();
   std::cout << "overhead = (fluid + ARD) / fluid only, target <= 1.10 at 512^2 and above (2 threads)\n";
-  std::cout << fmt::format("{:>4} {:>6} {:>4} {:>10} {:>10} {:>10} {:>10} {:>9} {:>9}\n", "dim", "n", "thr", "fluid/s",
-                           "serial/s", "tbb/s", "ms tbb", "ovh ser", "ovh tbb");
+  double triad[3] = {0, 0, 0};
+  for (int threads : {1, 2}) triad[threads] = triadBandwidth(threads, o.minSeconds);
+  std::cout << fmt::format("triad: {:.1f} GB/s with 1 thread, {:.1f} with 2\n", triad[1], triad[2]);
+  std::cout << fmt::format("{:>4} {:>6} {:>4} {:>10} {:>10} {:>10} {:>10} {:>9} {:>9} {:>9} {:>9}\n", "dim", "n", "thr",
+                           "fluid/s", "serial/s", "tbb/s", "ms tbb", "ovh ser", "ovh tbb", "bw fluid", "bw tbb");
   for (BenchCase c : cases)
     for (int threads : {1, 2}) {
       StageTrace* t = trace && threads == 2 ? &*trace : nullptr;
-      nlohmann::json j =
-          c.dim == 2 ? benchCase<2>(c.n, threads, o.minSeconds, t) : benchCase<3>(c.n, threads, o.minSeconds, t);
-      std::cout << fmt::format("{:>4} {:>6} {:>4} {:>10.2f} {:>10.2f} {:>10.2f} {:>10.2f} {:>9.2f} {:>9.2f}\n", c.dim,
+      nlohmann::json j = c.dim == 2 ? benchCase<2>(c.n, threads, o.minSeconds, t, triad[threads])
+                                    : benchCase<3>(c.n, threads, o.minSeconds, t, triad[threads]);
+      std::cout << fmt::format("{:>4} {:>6} {:>4} {:>10.2f} {:>10.2f} {:>10.2f} {:>10.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f}\n", c.dim,
                                c.n, threads, j["fluid_only_steps_per_second"].get<double>(),
                                j["serial"]["steps_per_second"].get<double>(), j["tbb"]["steps_per_second"].get<double>(),
                                j["tbb"]["ms"].get<double>(), j["serial"]["overhead"].get<double>(),
-                               j["tbb"]["overhead"].get<double>())
+                               j["tbb"]["overhead"].get<double>(), j["fluid_only_of_triad"].get<double>(),
+                               j["tbb"]["of_triad"].get<double>())
                 << std::flush;
       all.push_back(j);
     }

@@ -1,5 +1,7 @@
 // Suite `fluid`: ms per stable-fluids step (lid-driven cavity, Re = 100,
-// MacCormack advection, MGPCG pressure to 1e-6) in 2D and 3D, 1 and 2 threads.
+// MacCormack advection, MGPCG pressure to 1e-6) in 2D and 3D, 1 and 2
+// threads, and the fraction of the triad's bandwidth the step's compulsory
+// traffic reaches (bench/step_traffic.h).
 #include <algorithm>
 #include <chrono>
 #include <fstream>
@@ -12,6 +14,7 @@
 #include "bench/bench_setups.h"
 #include "bench/bench_suites.h"
 #include "bench/bench_timing.h"
+#include "bench/step_traffic.h"
 #include "core/error.h"
 #include "core/parallel.h"
 #include "fluid/fluid_solver.h"
@@ -21,7 +24,7 @@ namespace morphoflow {
 namespace {
 
 template <int D>
-nlohmann::json benchFluid(int n, int threads, double minSeconds) {
+nlohmann::json benchFluid(int n, int threads, double minSeconds, double triad) {
   ThreadLimit limit(threads);
   FluidSolver<D> f(benchCavity<D>(n));
   const double dt = f.h();  // CFL 1 at the lid speed
@@ -29,10 +32,13 @@ nlohmann::json benchFluid(int n, int threads, double minSeconds) {
   std::vector<double> pit, vit;
   std::array<double, FluidStepStats::kStages> stage{};
   bool converged = true;
+  double cells = 1.0, bytes = 0.0;
+  for (int a = 0; a < D; ++a) cells *= f.cells()[a];
   const std::vector<double> times = timeSteps(minSeconds, [&] { f.step(dt); }, [&] {
     pit.push_back(f.lastStats().pressure.iterations);
     vit.push_back(f.lastStats().viscosity.iterations);
     converged &= f.lastStats().pressure.converged;
+    bytes += fluidStepBytes<D>(cells, f.lastStats());
     for (int k = 0; k < FluidStepStats::kStages; ++k) stage[size_t(k)] += f.lastStats().seconds[size_t(k)];
   });
   double meanIt = 0, meanVit = 0;
@@ -46,6 +52,10 @@ nlohmann::json benchFluid(int n, int threads, double minSeconds) {
                       {"pressure_iterations_mean", meanIt},
                       {"viscosity_iterations_mean", meanVit},
                       {"pressure_converged", converged}};
+  const double gbs = bytes / double(times.size()) / median(times) / 1e9;
+  j["compulsory_gb_per_second"] = gbs;
+  j["triad_gb_per_second"] = triad;
+  j["of_triad"] = gbs / triad;
   for (int k = 0; k < FluidStepStats::kStages; ++k)
     j["ms_" + std::string(FluidStepStats::kStageNames[k])] = 1e3 * stage[size_t(k)] / double(times.size());
   return j;
@@ -56,17 +66,22 @@ nlohmann::json benchFluid(int n, int threads, double minSeconds) {
 bool runFluidBench(const BenchOptions& o) {
   const std::vector<BenchCase> cases = selectBenchCases({{2, 128}, {2, 256}, {2, 512}, {2, 1024}, {3, 64}, {3, 128}}, o.size);
   nlohmann::json all = nlohmann::json::array();
-  std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9}\n", "dim", "n", "threads",
-                           "ms/step(med)", "p-iters", "v-iters", "forces", "advect", "diffuse", "project");
+  double triad[3] = {0, 0, 0};
+  for (int threads : {1, 2}) triad[threads] = triadBandwidth(threads, o.minSeconds);
+  std::cout << fmt::format("triad: {:.1f} GB/s with 1 thread, {:.1f} with 2\n", triad[1], triad[2]);
+  std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9}\n", "dim", "n", "threads",
+                           "ms/step(med)", "p-iters", "v-iters", "forces", "advect", "diffuse", "project", "of triad");
   for (BenchCase c : cases) {
     for (int threads : {1, 2}) {
-      nlohmann::json j = c.dim == 2 ? benchFluid<2>(c.n, threads, o.minSeconds) : benchFluid<3>(c.n, threads, o.minSeconds);
-      std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12.2f} {:>8.1f} {:>8.1f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f}{}\n",
+      nlohmann::json j = c.dim == 2 ? benchFluid<2>(c.n, threads, o.minSeconds, triad[threads])
+                                    : benchFluid<3>(c.n, threads, o.minSeconds, triad[threads]);
+      std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12.2f} {:>8.1f} {:>8.1f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f}{}\n",
                                c.dim, c.n, threads, j["ms_per_step_median"].get<double>(),
                                j["pressure_iterations_mean"].get<double>(),
                                j["viscosity_iterations_mean"].get<double>(), j["ms_forces"].get<double>(),
                                j["ms_advect"].get<double>(), j["ms_diffuse"].get<double>(),
-                               j["ms_project"].get<double>(), j["pressure_converged"].get<bool>() ? "" : "  (unconverged)")
+                               j["ms_project"].get<double>(), j["of_triad"].get<double>(),
+                               j["pressure_converged"].get<bool>() ? "" : "  (unconverged)")
                 << std::flush;
       all.push_back(j);
     }

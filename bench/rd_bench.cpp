@@ -16,6 +16,7 @@
 #include "bench/bench_setups.h"
 #include "bench/bench_suites.h"
 #include "bench/bench_timing.h"
+#include "bench/step_traffic.h"
 #include "core/parallel.h"
 #include "rd/fused_explicit.h"
 #include "rd/generalized_diffusion.h"
@@ -50,6 +51,8 @@ nlohmann::json benchRD(int n, bool implicit, int threads, double minSeconds) {
           {"steps", times.size()},
           {"ms_per_step_median", 1e3 * med},
           {"cell_updates_per_second", cells / med},
+          // the explicit step: two double species read and written; Kim & Lin's from its solves' steps
+          {"bytes_per_cell_update", implicit ? kimLinStepBytes(1.0, 2, diffIt / double(times.size())) : 32.0},
           {"newton_iterations_max", newtonIt},
           {"diffusion_iterations_mean", diffIt / double(times.size())}};
 }
@@ -91,8 +94,11 @@ nlohmann::json benchFused(int n, int threads, double minSeconds, bool kernel5 = 
 bool runRDBench(const BenchOptions& o) {
   const std::vector<BenchCase> cases = selectBenchCases({{2, 256}, {2, 512}, {2, 1024}, {2, 2048}, {3, 128}}, o.size);
   nlohmann::json all = nlohmann::json::array();
-  std::cout << fmt::format("{:>4} {:>6} {:>10} {:>7} {:>12} {:>14} {:>9} {:>9}\n", "dim", "n", "integrator", "threads",
-                           "ms/step(med)", "Mcell-updates/s", "newton", "pcg-its");
+  double triad[3] = {0, 0, 0};
+  for (int threads : {1, 2}) triad[threads] = triadBandwidth(threads, o.minSeconds);
+  std::cout << fmt::format("triad: {:.1f} GB/s with 1 thread, {:.1f} with 2\n", triad[1], triad[2]);
+  std::cout << fmt::format("{:>4} {:>6} {:>10} {:>7} {:>12} {:>14} {:>9} {:>9} {:>9}\n", "dim", "n", "integrator",
+                           "threads", "ms/step(med)", "Mcell-updates/s", "newton", "pcg-its", "of triad");
   for (BenchCase c : cases)
     for (int kind : {0, 1, 3, 2})  // explicit (double), fused (float), fused 5 x 5 (2D), Kim & Lin
       for (int threads : {1, 2}) {
@@ -102,10 +108,14 @@ bool runRDBench(const BenchOptions& o) {
                                                                 : benchFused<3>(c.n, threads, o.minSeconds))
                            : c.dim == 2 ? benchRD<2>(c.n, implicit, threads, o.minSeconds)
                                         : benchRD<3>(c.n, implicit, threads, o.minSeconds);
-        std::cout << fmt::format("{:>4} {:>6} {:>10} {:>7} {:>12.2f} {:>14.2f} {:>9.0f} {:>9.1f}\n", c.dim, c.n,
-                                 j["integrator"].get<std::string>(), threads, j["ms_per_step_median"].get<double>(),
+        j["triad_gb_per_second"] = triad[threads];
+        j["of_triad"] = j["cell_updates_per_second"].get<double>() * j["bytes_per_cell_update"].get<double>() / 1e9 /
+                        triad[threads];
+        std::cout << fmt::format("{:>4} {:>6} {:>10} {:>7} {:>12.2f} {:>14.2f} {:>9.0f} {:>9.1f} {:>9.2f}\n", c.dim,
+                                 c.n, j["integrator"].get<std::string>(), threads, j["ms_per_step_median"].get<double>(),
                                  1e-6 * j["cell_updates_per_second"].get<double>(),
-                                 j["newton_iterations_max"].get<double>(), j["diffusion_iterations_mean"].get<double>())
+                                 j["newton_iterations_max"].get<double>(), j["diffusion_iterations_mean"].get<double>(),
+                                 j["of_triad"].get<double>())
                   << std::flush;
         all.push_back(j);
       }

@@ -20,6 +20,7 @@
 #include "bench/bench_setups.h"
 #include "bench/bench_suites.h"
 #include "bench/bench_timing.h"
+#include "bench/step_traffic.h"
 #include "core/parallel.h"
 #include "core/chebyshev.h"
 #include "core/multigrid.h"
@@ -34,9 +35,6 @@
 
 namespace morphoflow {
 
-namespace {
-
-// GB/s of the triad with `threads` threads (median of the repeats).
 double triadBandwidth(int threads, double minSeconds) {
   ThreadLimit limit(threads);
   const size_t n = size_t(1) << 24;  // 3 x 128 MiB
@@ -47,6 +45,8 @@ double triadBandwidth(int threads, double minSeconds) {
   const std::vector<double> t = timeSteps(minSeconds, triad, [] {});
   return 24.0 * double(n) / median(t) / 1e9;
 }
+
+namespace {
 
 struct Kernel {
   std::string name;

@@ -85,6 +85,8 @@ void FluidSolver<D>::step(double dt, const std::function<void()>& afterAdvection
   if (afterAdvection) afterAdvection();
   // 3. diffuse (implicit viscosity)
   stats_.viscosity = viscosity_->diffuse(&u_, settings_.viscosity, dt, &pool_);
+  stats_.viscosityCellUpdates = viscosity_->lastCellUpdates();
+  stats_.viscosityUsedCG = viscosity_->lastUsedCG();
   lap(2);
   // 4. project
   stats_.pressure = projection_->project(&u_, dt, settings_.density, &pool_);

@@ -24,6 +24,8 @@ struct FluidStepStats {
   std::array<double, kStages> seconds{};  // wall time of each stage in this step
   SolverResult pressure;
   SolverResult viscosity;
+  double viscosityCellUpdates = 0.0;  // its solves' iterations times unknowns, over the components
+  bool viscosityUsedCG = false;       // multigrid-preconditioned CG solved (else the Chebyshev iteration)
 };
 
 template <int D>

@@ -119,7 +119,10 @@ double ViscositySolver<D>::rightHandSide(const MacVelocity<D>& u, int a, double 
 
 template <int D>
 SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt, WorkPool* pool) {
-  if (nu <= 0 || dt <= 0) return SolverResult{true, 0, 0.0};
+  if (nu <= 0 || dt <= 0) {
+    cellUpdates_ = 0.0;
+    return SolverResult{true, 0, 0.0};
+  }
   const std::initializer_list<Vector*> doubles = {&b_, &x_, &pcgWork_.b, &pcgWork_.r, &pcgWork_.p, &pcgWork_.q};
   const std::initializer_list<std::vector<float>*> floats = {&chebyshevWork_.e[0], &chebyshevWork_.e[1], &chebyshevWork_.g};
   if (pool) pool->lend(doubles), pool->lend(floats);
@@ -132,6 +135,8 @@ template <int D>
 SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
   SolverResult result;
   result.converged = true;
+  cellUpdates_ = 0.0;
+  usedCG_ = false;
   std::array<double, D> bb{};  // ||b_a||^2
   for (int a = D - 1; a >= 0; --a) {  // last: component 0, the first solved
     Component& C = comp_[size_t(a)];
@@ -180,6 +185,8 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
                                        : C.chebyshev->solve(b_, &x_, options, std::sqrt(ba));
     rAll += r.residual * r.residual * ba;
     result.iterations = std::max(result.iterations, r.iterations);
+    cellUpdates_ += double(r.iterations) * double(C.A.size());
+    usedCG_ = usedCG_ || C.multigrid != nullptr;
     std::vector<float>& rate = C.rate;
     rate.resize(C.A.size(), 0.0f);  // zeros before the first solve: change = the first rate, unused
     C.change.resize(C.A.size());

@@ -54,6 +54,11 @@ class ViscositySolver {
   // Diffuses u in place; returns the worst of the component solves. Its
   // work vectors come from `pool` (when given) and go back to it.
   SolverResult diffuse(MacVelocity<D>* u, double viscosity, double dt, WorkPool* pool = nullptr);
+  // The last diffuse's work: its solves' iterations times their unknowns,
+  // summed over the components, and whether multigrid-preconditioned CG
+  // (not the Chebyshev iteration) did any of it.
+  double lastCellUpdates() const { return cellUpdates_; }
+  bool lastUsedCG() const { return usedCG_; }
   // The warm starts of the next solve (checkpoints).
   void save(StateWriter* out) const;
   void load(const StateReader& in);
@@ -81,6 +86,8 @@ class ViscositySolver {
   ChebyshevWork chebyshevWork_;
   PcgWorkspace pcgWork_;
   double s_ = -1.0;  // nu dt / h^2 the diagonals were built for
+  double cellUpdates_ = 0.0;
+  bool usedCG_ = false;
 };
 
 }  // namespace morphoflow

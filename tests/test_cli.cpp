@@ -598,6 +598,15 @@ TEST(Cli, CouplingBenchWritesAChromeTrace) {
       EXPECT_NEAR(overhead, j[k][b]["ms"].get<double>() / j[k]["fluid_only_ms"].get<double>(), 1e-9);
       EXPECT_GT(overhead, 0.0);
     }
+    // The steps' compulsory traffic against the triad: a fluid step moves
+    // more than its velocity's 8 D bytes a cell, and the coupled step more
+    // than the fluid's alone.
+    const double triad = j[k]["triad_gb_per_second"].get<double>();
+    EXPECT_GT(triad, 0.0);
+    const double fluidGBs = j[k]["fluid_only_of_triad"].get<double>() * triad;
+    EXPECT_GT(fluidGBs * 1e9 * j[k]["fluid_only_ms"].get<double>() / 1e3, 16.0 * 32 * 32);
+    EXPECT_GT(j[k]["tbb"]["of_triad"].get<double>() * triad * j[k]["tbb"]["ms"].get<double>(),
+              fluidGBs * j[k]["fluid_only_ms"].get<double>());
   }
   EXPECT_EQ(runMorphoflow("bench fluid --size 32 --seconds 0 --trace " + trace.string()).status, 2);
   EXPECT_EQ(runMorphoflow("bench coupling --size 32 --seconds 0 --trace " + (dir / "no" / "t.json").string()).status, 2);
