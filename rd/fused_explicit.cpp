@@ -191,7 +191,7 @@ MF_INLINE int interior(const RowJob<D, M::N>& job, int x, int end) {
 // updates from the kept terms. The same operations per cell as cellsAt.
 template <class M, int D, class L>
 MF_INLINE int interiorKernel(const RowJob<D, M::N>& job, int x, int end) {
-  constexpr int N = M::N, n = lanes<L>(), kChunk = 32;  // lanes' worth of cells per chunk
+  constexpr int N = M::N, n = lanes<L>(), kChunk = 32;  // vectors of n cells per chunk
   LocalJob<M, D> local(job);
   const RowJob<D, N>& j = local.j;
   L w[25];
