@@ -37,20 +37,13 @@ struct CoupledTiming {
 };
 
 template <int D>
-double cellsOf(const IVec<D>& n) {
-  double c = 1.0;
-  for (int a = 0; a < D; ++a) c *= n[a];
-  return c;
-}
-
-template <int D>
 CoupledTiming fluidOnly(int n, double minSeconds) {
   FluidSolver<D> f(benchCavity<D>(n));
   const double dt = f.h();
   for (int i = 0; i < kWarmup; ++i) f.step(dt);
   double bytes = 0.0;
   const std::vector<double> t = timeSteps(minSeconds, [&] { f.step(dt); }, [&] {
-    bytes += fluidStepBytes<D>(cellsOf<D>(f.cells()), f.lastStats());
+    bytes += fluidStepBytes<D>(cellCount<D>(f.cells()), f.lastStats());
   });
   return {median(t), median(t), 0.0, bytes / double(t.size())};
 }
@@ -77,8 +70,8 @@ CoupledTiming fluidWithARD(int n, CouplingBackend backend, double minSeconds, St
   const std::vector<double> times = timeSteps(minSeconds, [&] { stepper.step(dt); }, [&] {
     fluid.push_back(stepper.fluidSeconds());
     ardT.push_back(stepper.ardSeconds());
-    bytes += fluidStepBytes<D>(cellsOf<D>(f.cells()), f.lastStats()) +
-             ardStepBytes(D, cellsOf<D>(rd.cells()), rd.species(), rd.lastStats().diffusion.iterations);
+    bytes += fluidStepBytes<D>(cellCount<D>(f.cells()), f.lastStats()) +
+             ardStepBytes(D, cellCount<D>(rd.cells()), rd.species(), rd.lastStats().diffusion.iterations);
   });
   return {median(times), median(fluid), median(ardT), bytes / double(times.size())};
 }
@@ -119,16 +112,14 @@ bool runCouplingBench(const BenchOptions& o) {
   }
   nlohmann::json all = nlohmann::json::array();
   std::cout << "overhead = (fluid + ARD) / fluid only, target <= 1.10 at 512^2 and above (2 threads)\n";
-  double triad[3] = {0, 0, 0};
-  for (int threads : {1, 2}) triad[threads] = triadBandwidth(threads, o.minSeconds);
-  std::cout << fmt::format("triad: {:.1f} GB/s with 1 thread, {:.1f} with 2\n", triad[1], triad[2]);
+  const std::array<double, 3> triad = suiteTriads(o.minSeconds);
   std::cout << fmt::format("{:>4} {:>6} {:>4} {:>10} {:>10} {:>10} {:>10} {:>9} {:>9} {:>9} {:>9}\n", "dim", "n", "thr",
                            "fluid/s", "serial/s", "tbb/s", "ms tbb", "ovh ser", "ovh tbb", "bw fluid", "bw tbb");
   for (BenchCase c : cases)
     for (int threads : {1, 2}) {
       StageTrace* t = trace && threads == 2 ? &*trace : nullptr;
-      nlohmann::json j = c.dim == 2 ? benchCase<2>(c.n, threads, o.minSeconds, t, triad[threads])
-                                    : benchCase<3>(c.n, threads, o.minSeconds, t, triad[threads]);
+      nlohmann::json j = c.dim == 2 ? benchCase<2>(c.n, threads, o.minSeconds, t, triad[size_t(threads)])
+                                    : benchCase<3>(c.n, threads, o.minSeconds, t, triad[size_t(threads)]);
       std::cout << fmt::format("{:>4} {:>6} {:>4} {:>10.2f} {:>10.2f} {:>10.2f} {:>10.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f}\n", c.dim,
                                c.n, threads, j["fluid_only_steps_per_second"].get<double>(),
                                j["serial"]["steps_per_second"].get<double>(), j["tbb"]["steps_per_second"].get<double>(),

@@ -32,8 +32,8 @@ nlohmann::json benchFluid(int n, int threads, double minSeconds, double triad) {
   std::vector<double> pit, vit;
   std::array<double, FluidStepStats::kStages> stage{};
   bool converged = true;
-  double cells = 1.0, bytes = 0.0;
-  for (int a = 0; a < D; ++a) cells *= f.cells()[a];
+  const double cells = cellCount<D>(f.cells());
+  double bytes = 0.0;
   const std::vector<double> times = timeSteps(minSeconds, [&] { f.step(dt); }, [&] {
     pit.push_back(f.lastStats().pressure.iterations);
     vit.push_back(f.lastStats().viscosity.iterations);
@@ -66,15 +66,13 @@ nlohmann::json benchFluid(int n, int threads, double minSeconds, double triad) {
 bool runFluidBench(const BenchOptions& o) {
   const std::vector<BenchCase> cases = selectBenchCases({{2, 128}, {2, 256}, {2, 512}, {2, 1024}, {3, 64}, {3, 128}}, o.size);
   nlohmann::json all = nlohmann::json::array();
-  double triad[3] = {0, 0, 0};
-  for (int threads : {1, 2}) triad[threads] = triadBandwidth(threads, o.minSeconds);
-  std::cout << fmt::format("triad: {:.1f} GB/s with 1 thread, {:.1f} with 2\n", triad[1], triad[2]);
+  const std::array<double, 3> triad = suiteTriads(o.minSeconds);
   std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9}\n", "dim", "n", "threads",
                            "ms/step(med)", "p-iters", "v-iters", "forces", "advect", "diffuse", "project", "of triad");
   for (BenchCase c : cases) {
     for (int threads : {1, 2}) {
-      nlohmann::json j = c.dim == 2 ? benchFluid<2>(c.n, threads, o.minSeconds, triad[threads])
-                                    : benchFluid<3>(c.n, threads, o.minSeconds, triad[threads]);
+      nlohmann::json j = c.dim == 2 ? benchFluid<2>(c.n, threads, o.minSeconds, triad[size_t(threads)])
+                                    : benchFluid<3>(c.n, threads, o.minSeconds, triad[size_t(threads)]);
       std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12.2f} {:>8.1f} {:>8.1f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f}{}\n",
                                c.dim, c.n, threads, j["ms_per_step_median"].get<double>(),
                                j["pressure_iterations_mean"].get<double>(),

@@ -94,9 +94,7 @@ nlohmann::json benchFused(int n, int threads, double minSeconds, bool kernel5 = 
 bool runRDBench(const BenchOptions& o) {
   const std::vector<BenchCase> cases = selectBenchCases({{2, 256}, {2, 512}, {2, 1024}, {2, 2048}, {3, 128}}, o.size);
   nlohmann::json all = nlohmann::json::array();
-  double triad[3] = {0, 0, 0};
-  for (int threads : {1, 2}) triad[threads] = triadBandwidth(threads, o.minSeconds);
-  std::cout << fmt::format("triad: {:.1f} GB/s with 1 thread, {:.1f} with 2\n", triad[1], triad[2]);
+  const std::array<double, 3> triad = suiteTriads(o.minSeconds);
   std::cout << fmt::format("{:>4} {:>6} {:>10} {:>7} {:>12} {:>14} {:>9} {:>9} {:>9}\n", "dim", "n", "integrator",
                            "threads", "ms/step(med)", "Mcell-updates/s", "newton", "pcg-its", "of triad");
   for (BenchCase c : cases)
@@ -108,9 +106,9 @@ bool runRDBench(const BenchOptions& o) {
                                                                 : benchFused<3>(c.n, threads, o.minSeconds))
                            : c.dim == 2 ? benchRD<2>(c.n, implicit, threads, o.minSeconds)
                                         : benchRD<3>(c.n, implicit, threads, o.minSeconds);
-        j["triad_gb_per_second"] = triad[threads];
+        j["triad_gb_per_second"] = triad[size_t(threads)];
         j["of_triad"] = j["cell_updates_per_second"].get<double>() * j["bytes_per_cell_update"].get<double>() / 1e9 /
-                        triad[threads];
+                        triad[size_t(threads)];
         std::cout << fmt::format("{:>4} {:>6} {:>10} {:>7} {:>12.2f} {:>14.2f} {:>9.0f} {:>9.1f} {:>9.2f}\n", c.dim,
                                  c.n, j["integrator"].get<std::string>(), threads, j["ms_per_step_median"].get<double>(),
                                  1e-6 * j["cell_updates_per_second"].get<double>(),

@@ -46,6 +46,13 @@ double triadBandwidth(int threads, double minSeconds) {
   return 24.0 * double(n) / median(t) / 1e9;
 }
 
+std::array<double, 3> suiteTriads(double minSeconds) {
+  std::array<double, 3> triad{};
+  for (int threads : {1, 2}) triad[size_t(threads)] = triadBandwidth(threads, minSeconds);
+  std::cout << fmt::format("triad: {:.1f} GB/s with 1 thread, {:.1f} with 2\n", triad[1], triad[2]);
+  return triad;
+}
+
 namespace {
 
 struct Kernel {

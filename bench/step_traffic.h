@@ -8,6 +8,8 @@
 // vectors more often than its kernels must reads more than it is credited.
 #pragma once
 
+#include <array>
+
 #include "fluid/fluid_solver.h"
 
 namespace morphoflow {
@@ -15,6 +17,16 @@ namespace morphoflow {
 // GB/s of STREAM's triad (a = b + s c, 3 x 128 MiB) with `threads` threads:
 // the median of repeats over at least minSeconds (roofline_bench.cpp).
 double triadBandwidth(int threads, double minSeconds);
+// The triad with 1 and 2 threads (indexed by the thread count), printed on
+// one line: what a suite's fractions divide by.
+std::array<double, 3> suiteTriads(double minSeconds);
+
+template <int D>
+double cellCount(const IVec<D>& n) {
+  double c = 1.0;
+  for (int a = 0; a < D; ++a) c *= n[a];
+  return c;
+}
 
 // A multigrid-preconditioned CG iteration a cell (double vectors): the
 // operator (read p, write q: 16), the V-cycle (read r, write z, the finest
