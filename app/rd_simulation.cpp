@@ -83,16 +83,18 @@ void RDSimulation<D>::syncHost() const {
 }
 
 template <int D>
-void RDSimulation<D>::step(double dt) {
+void RDSimulation<D>::advance(double dt, long count) {
   if (fused_) {
-    fused_->step(dt);
-    time_ += dt;
-    ++steps_;
+    fused_->step(dt, int(count));
+    for (long k = 0; k < count; ++k) time_ += dt;  // (the same sum as step by step)
+    steps_ += count;
     hostStale_ = true;
     return;
   }
-  rd_.step(dt);
-  stats_.add(rd_.lastStats());
+  for (long k = 0; k < count; ++k) {
+    rd_.step(dt);
+    stats_.add(rd_.lastStats());
+  }
 }
 
 template <int D>
@@ -130,6 +132,7 @@ template <int D>
 nlohmann::json RDSimulation<D>::resolved() const {
   nlohmann::json j = resolvedLayer<D>(scene_, rd_);
   j["explicit_step"] = fused_ ? "fused, float species (rd/fused_explicit.h)" : "RDSolver, double species";
+  if (fused_) j["steps_per_pass"] = fused_->stepsPerPass();  // temporal blocking: several where the state outgrows the caches
   return j;
 }
 

@@ -46,7 +46,9 @@ class RDSimulation : public Simulation<D> {
   using Log = std::function<void(const std::string&)>;
   RDSimulation(const Scene& scene, const Log& log);
 
-  void step(double dt) override;
+  void step(double dt) override { advance(dt, 1); }
+  void advance(double dt, long count) override;
+  long stepsTogether() const override { return fused_ ? fused_->stepsPerPass() : 1; }
   double time() const override { return fused_ ? time_ : rd_.time(); }
   long steps() const override { return fused_ ? steps_ : rd_.steps(); }
   std::vector<std::string> fieldNames() const override { return species(); }

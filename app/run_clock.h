@@ -21,6 +21,9 @@ class RunClock {
   // Whether step `step` (0-based) still runs at simulated time `time`.
   bool running(long step, double time) const { return step < steps_ && time < endTime_ - 1e-12; }
 
+  // The steps still to run from step `step` on (by the step count alone).
+  long stepsLeft(long step) const { return steps_ - step; }
+
   template <int D>
   double dt(const Simulation<D>& sim) const {
     double dt = time_.dt;

@@ -2,6 +2,7 @@
 
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <filesystem>
@@ -80,7 +81,7 @@ class Driver {
     while (clock_.running(sim_.steps(), sim_.time()) && !schedule_.pastLast(sim_.steps())) {
       if (StopSignals::received()) return stop();
       lastDt_ = clock_.dt(sim_);
-      sim_.step(lastDt_);
+      sim_.advance(lastDt_, stepsNow());
       const long f = frame();
       if (f > 0 && scene_.output.checkpointEvery > 0 && f % scene_.output.checkpointEvery == 0) saveCheckpoint();
       log_.progress(lastFrame_, sim_.steps(), stepsEstimate, sim_.time(), endTime);
@@ -102,6 +103,15 @@ class Driver {
                          wallSeconds(), j["frames_written"].get<int>(), out_.string()));
     writeLog();
     return 0;
+  }
+
+  // The steps to take at once: as many as the simulation takes faster
+  // together, up to the next step that may write a frame (frames and
+  // checkpoints fall on output.every) and the run's last; one where dt may change.
+  long stepsNow() const {
+    const long together = sim_.stepsTogether(), step = sim_.steps();
+    if (together <= 1 || scene_.hasFluid) return 1;
+    return std::max(1L, std::min({together, schedule_.every() - step % schedule_.every(), clock_.stepsLeft(step)}));
   }
 
   void fail(const std::string& exitState, const std::string& error) {

@@ -35,6 +35,13 @@ class Simulation {
 
   // Advances one step of dt.
   virtual void step(double dt) = 0;
+  // Advances `count` steps of dt, bitwise as `count` calls of step(dt).
+  virtual void advance(double dt, long count) {
+    for (long k = 0; k < count; ++k) step(dt);
+  }
+  // How many steps advance() takes faster together than one at a time (1:
+  // none; the fused explicit RD step's temporal blocking takes several).
+  virtual long stepsTogether() const { return 1; }
   // The largest dt with |u|max dt <= cfl h (dtMax when nothing moves).
   virtual double cflTimeStep(double cfl, double dtMax) const { return dtMax; }
   virtual double time() const = 0;

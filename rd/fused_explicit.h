@@ -38,8 +38,15 @@ class FusedExplicitRD {
   virtual void setKernel(const std::array<std::array<double, 5>, 5>& kernel, const std::vector<int>& species) = 0;
   // `steps` explicit steps of dt.
   virtual void step(double dt, int steps = 1) = 0;
-  // Rows per task: any value gives bitwise the same fields (tests vary it).
+  // Rows per task of a single step: any value gives bitwise the same fields (tests vary it).
   void setRowsPerTask(size_t rows) { rowsPerTask_ = rows; }
+  // Temporal blocking: `steps` steps per pass over slabs of `slices` outer
+  // slices (rows in 2D, planes in 3D) per task; 0 for the automatic choice,
+  // steps = 1 for none. Any values give bitwise the same fields.
+  void setTemporalBlocking(int steps, size_t slices) { stepsPerPass_ = steps, slicesPerTask_ = slices; }
+  // The steps one pass takes (1: no blocking): step(dt, steps) gains where
+  // `steps` is a multiple of it.
+  virtual int stepsPerPass() const = 0;
   int species() const { return int(x_.size()); }
   std::vector<float>& field(int s) { return x_[size_t(s)]; }
   const std::vector<float>& field(int s) const { return x_[size_t(s)]; }
@@ -49,6 +56,8 @@ class FusedExplicitRD {
   IVec<D> cells_;
   std::vector<std::vector<float>> x_, next_;
   size_t rowsPerTask_ = 0;  // 0: the parallel loop's own grain
+  int stepsPerPass_ = 0;     // 0: automatic
+  size_t slicesPerTask_ = 0;  // 0: automatic
 };
 
 }  // namespace morphoflow

@@ -173,3 +173,68 @@ TEST(FusedExplicit, TheGeneralizedKernelsChunksGiveTheSameBits) {
   setUseAvx2(true);
   setUseAvx512(true);
 }
+
+namespace {
+
+// The fields after `steps` steps of a layer started from the same noise,
+// with `stepsPerPass` steps per blocked pass over slabs of `slices`.
+template <int D>
+std::vector<std::vector<float>> blocked(const std::string& model, const IVec<D>& n, bool periodic, int kernelSpecies,
+                                        int stepsPerPass, size_t slices, int threads, double dt, int steps) {
+  ThreadLimit limit(threads);
+  const ModelInfo info = findModel(model)->info();
+  auto e = FusedExplicitRD<D>::create(model, n, 1.0, periodic, info.diffusion, {});
+  if constexpr (D == 2)
+    if (kernelSpecies >= 0) e->setKernel(GeneralizedDiffusion(*kramersMoyalPreset("d"), n[0], n[1], 1.0).kernel(), {kernelSpecies});
+  for (int s = 0; s < e->species(); ++s)
+    for (size_t i = 0; i < e->field(s).size(); ++i)
+      e->field(s)[i] = float(info.initial[size_t(s)] * (1.0 + 0.2 * (uniform01(19, uint64_t(s), i) - 0.5)));
+  e->setTemporalBlocking(stepsPerPass, slices);
+  e->step(dt, steps);
+  std::vector<std::vector<float>> f;
+  for (int s = 0; s < e->species(); ++s) f.push_back(e->field(s));
+  return f;
+}
+
+}  // namespace
+
+// Temporal blocking (several steps per pass over slabs of rows or planes,
+// each with its halo recomputed) gives the fields of as many single steps,
+// bitwise: for any steps per pass (a remainder included), slab height (one
+// slice, more than the grid, halos wider than the grid), thread count,
+// boundary, dimension, the 5 x 5 kernel's wider reach and a model on double lanes.
+TEST(FusedExplicit, TemporalBlockingGivesTheBitsOfSingleSteps) {
+  struct Blocking {
+    int steps;
+    size_t slices;
+    int threads;
+  };
+  const std::vector<Blocking> variants = {{2, 1, 2}, {3, 5, 1}, {8, 4, 2}, {5, 64, 2}, {23, 7, 2}, {4, 3, 1}};
+  for (bool periodic : {true, false}) {
+    const auto ref = blocked<2>("gray-scott", IVec<2>(37, 29), periodic, -1, 1, 0, 2, 0.5, 23);
+    for (const Blocking& b : variants)
+      ASSERT_EQ(blocked<2>("gray-scott", IVec<2>(37, 29), periodic, -1, b.steps, b.slices, b.threads, 0.5, 23), ref)
+          << "2D periodic " << periodic << ", " << b.steps << " steps a pass, " << b.slices << " rows a task";
+    const auto ref3 = blocked<3>("gray-scott", IVec<3>(13, 11, 9), periodic, -1, 1, 0, 2, 0.3, 10);
+    for (const Blocking& b : {Blocking{2, 1, 2}, Blocking{3, 2, 1}, Blocking{4, 4, 2}, Blocking{10, 20, 2}})
+      ASSERT_EQ(blocked<3>("gray-scott", IVec<3>(13, 11, 9), periodic, -1, b.steps, b.slices, b.threads, 0.3, 10), ref3)
+          << "3D periodic " << periodic << ", " << b.steps << " steps a pass, " << b.slices << " planes a task";
+    const auto refLateral = blocked<2>("meinhardt-lateral", IVec<2>(21, 17), periodic, -1, 1, 0, 2, 0.05, 9);
+    ASSERT_EQ(blocked<2>("meinhardt-lateral", IVec<2>(21, 17), periodic, -1, 4, 3, 2, 0.05, 9), refLateral);
+  }
+  // The kernel reaches two rows: species 1 on it, species 0 on the Laplacian.
+  const auto ref5 = blocked<2>("gray-scott", IVec<2>(45, 20), true, 1, 1, 0, 2, 0.3, 12);
+  for (const Blocking& b : {Blocking{3, 3, 2}, Blocking{4, 16, 1}, Blocking{12, 1, 2}})
+    ASSERT_EQ(blocked<2>("gray-scott", IVec<2>(45, 20), true, 1, b.steps, b.slices, b.threads, 0.3, 12), ref5)
+        << "5 x 5 kernel, " << b.steps << " steps a pass, " << b.slices << " rows a task";
+}
+
+// The automatic choice: no blocking while the state stays in cache, several
+// steps a pass beyond it (then the same bits as single steps).
+TEST(FusedExplicit, BlockingIsChosenForStatesBeyondTheCache) {
+  EXPECT_EQ(FusedExplicitRD<2>::create("gray-scott", IVec<2>(1024, 1024), 1.0, true, {0.2, 0.1}, {})->stepsPerPass(), 1);
+  EXPECT_EQ(FusedExplicitRD<3>::create("gray-scott", IVec<3>(128, 128, 128), 1.0, true, {0.2, 0.1}, {})->stepsPerPass(), 1);
+  const IVec<2> big(2048, 2048);
+  EXPECT_GT(FusedExplicitRD<2>::create("gray-scott", big, 1.0, true, {0.2, 0.1}, {})->stepsPerPass(), 1);
+  EXPECT_EQ(blocked<2>("gray-scott", big, true, -1, 0, 0, 2, 0.5, 11), blocked<2>("gray-scott", big, true, -1, 1, 0, 2, 0.5, 11));
+}
