@@ -57,9 +57,10 @@ nlohmann::json benchRD(int n, bool implicit, int threads, double minSeconds) {
           {"diffusion_iterations_mean", diffIt / double(times.size())}};
 }
 
-// The fused float step (rd/fused_explicit.h) on the same start and dt.
+// The fused float step (rd/fused_explicit.h) on the same start and dt, timed
+// over passes of its automatic steps per pass (or of one step: `single`).
 template <int D>
-nlohmann::json benchFused(int n, int threads, double minSeconds, bool kernel5 = false) {
+nlohmann::json benchFused(int n, int threads, double minSeconds, bool kernel5, bool single) {
   ThreadLimit limit(threads);
   const RDSettings st = benchGrayScott<D>(n, 1.0, RDIntegrator::ExplicitEuler);
   RDSolver<D> rd(st, *findModel("gray-scott"));
@@ -69,47 +70,63 @@ nlohmann::json benchFused(int n, int threads, double minSeconds, bool kernel5 = 
   // Seed 000's 5 x 5 kernel: Table 2 (d) on cells of 2.2 (docs/models.md), the same d per cell.
   if constexpr (D == 2)
     if (kernel5) e->setKernel(GeneralizedDiffusion(*kramersMoyalPreset("d"), n, n, 2.2).kernel(), {});
+  if (single) e->setTemporalBlocking(1, 0);
   for (int s = 0; s < 2; ++s)
     for (size_t i = 0; i < rd.field(s).size(); ++i) e->field(s)[i] = float(rd.field(s)[i]);
-  e->step(dt);
-  const std::vector<double> times = timeSteps(minSeconds, [&] { e->step(dt); }, [] {});
+  const int k = e->stepsPerPass();
+  e->step(dt, k);
+  std::vector<double> times = timeSteps(minSeconds, [&] { e->step(dt, k); }, [] {});
+  for (double& t : times) t /= k;
   const double med = median(times);
   double cells = 1;
   for (int a = 0; a < D; ++a) cells *= n;
   return {{"dim", D},
           {"n", n},
-          {"integrator", kernel5 ? "fused-5x5" : "fused"},
+          {"integrator", std::string(kernel5 ? "fused-5x5" : "fused") + (single ? "-1" : "")},
           {"threads", threads},
           {"dt", dt},
-          {"steps", times.size()},
+          {"steps", times.size() * size_t(k)},
+          {"steps_per_pass", k},
           {"ms_per_step_median", 1e3 * med},
           {"cell_updates_per_second", cells / med},
-          {"bytes_per_cell_update", 16},
+          {"bytes_per_cell_update", 16.0 / k},  // two float species read and written once a pass
           {"newton_iterations_max", 0},
           {"diffusion_iterations_mean", 0}};
+}
+
+// Whether the fused step blocks several steps at this size (the suite then
+// also times it one step a pass).
+template <int D>
+bool fusedBlocks(int n) {
+  return FusedExplicitRD<D>::create("gray-scott", IVec<D>(n), 1.0, true, {0.2, 0.1}, {})->stepsPerPass() > 1;
 }
 
 }  // namespace
 
 bool runRDBench(const BenchOptions& o) {
-  const std::vector<BenchCase> cases = selectBenchCases({{2, 256}, {2, 512}, {2, 1024}, {2, 2048}, {3, 128}}, o.size);
+  const std::vector<BenchCase> cases = selectBenchCases({{2, 256}, {2, 512}, {2, 1024}, {2, 2048}, {3, 128}, {3, 256}}, o.size);
   nlohmann::json all = nlohmann::json::array();
   const std::array<double, 3> triad = suiteTriads(o.minSeconds);
-  std::cout << fmt::format("{:>4} {:>6} {:>10} {:>7} {:>12} {:>14} {:>9} {:>9} {:>9}\n", "dim", "n", "integrator",
+  std::cout << fmt::format("{:>4} {:>6} {:>11} {:>7} {:>12} {:>14} {:>9} {:>9} {:>9}\n", "dim", "n", "integrator",
                            "threads", "ms/step(med)", "Mcell-updates/s", "newton", "pcg-its", "of triad");
+  // explicit (double), fused (float), fused 5 x 5 (2D), Kim & Lin; fused
+  // with one step a pass where the size blocks; 256^3 takes the fused rows only.
+  enum Kind { kExplicit, kFused, kFusedSingle, k5x5, k5x5Single, kKimLin };
   for (BenchCase c : cases)
-    for (int kind : {0, 1, 3, 2})  // explicit (double), fused (float), fused 5 x 5 (2D), Kim & Lin
+    for (Kind kind : {kExplicit, kFused, kFusedSingle, k5x5, k5x5Single, kKimLin})
       for (int threads : {1, 2}) {
-        const bool implicit = kind == 2;
-        if (kind == 3 && c.dim != 2) continue;
-        nlohmann::json j = kind == 1 || kind == 3 ? (c.dim == 2 ? benchFused<2>(c.n, threads, o.minSeconds, kind == 3)
-                                                                : benchFused<3>(c.n, threads, o.minSeconds))
-                           : c.dim == 2 ? benchRD<2>(c.n, implicit, threads, o.minSeconds)
-                                        : benchRD<3>(c.n, implicit, threads, o.minSeconds);
+        const bool fused = kind != kExplicit && kind != kKimLin, single = kind == kFusedSingle || kind == k5x5Single;
+        const bool kernel5 = kind == k5x5 || kind == k5x5Single;
+        if ((kernel5 && c.dim != 2) || (c.dim == 3 && c.n > 128 && !fused)) continue;
+        if (single && !(c.dim == 2 ? fusedBlocks<2>(c.n) : fusedBlocks<3>(c.n))) continue;
+        nlohmann::json j = fused ? (c.dim == 2 ? benchFused<2>(c.n, threads, o.minSeconds, kernel5, single)
+                                               : benchFused<3>(c.n, threads, o.minSeconds, false, single))
+                           : c.dim == 2 ? benchRD<2>(c.n, kind == kKimLin, threads, o.minSeconds)
+                                        : benchRD<3>(c.n, kind == kKimLin, threads, o.minSeconds);
         j["triad_gb_per_second"] = triad[size_t(threads)];
         j["of_triad"] = j["cell_updates_per_second"].get<double>() * j["bytes_per_cell_update"].get<double>() / 1e9 /
                         triad[size_t(threads)];
-        std::cout << fmt::format("{:>4} {:>6} {:>10} {:>7} {:>12.2f} {:>14.2f} {:>9.0f} {:>9.1f} {:>9.2f}\n", c.dim,
+        std::cout << fmt::format("{:>4} {:>6} {:>11} {:>7} {:>12.2f} {:>14.2f} {:>9.0f} {:>9.1f} {:>9.2f}\n", c.dim,
                                  c.n, j["integrator"].get<std::string>(), threads, j["ms_per_step_median"].get<double>(),
                                  1e-6 * j["cell_updates_per_second"].get<double>(),
                                  j["newton_iterations_max"].get<double>(), j["diffusion_iterations_mean"].get<double>(),
