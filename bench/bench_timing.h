@@ -23,6 +23,14 @@ inline std::vector<BenchCase> selectBenchCases(std::vector<BenchCase> all, int s
   return pick;
 }
 
+// The seconds one call of fn() takes.
+template <typename Fn>
+double timeOnce(Fn&& fn) {
+  auto t0 = std::chrono::steady_clock::now();
+  fn();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
 // Calls step() (after which afterStep() may read the solver's statistics)
 // until at least minSeconds have been timed and at least 5 steps, at most 200;
 // returns the step times in seconds, in the order run.
@@ -31,9 +39,7 @@ std::vector<double> timeSteps(double minSeconds, Step&& step, After&& afterStep)
   std::vector<double> times;
   double total = 0;
   while ((total < minSeconds || times.size() < 5) && times.size() < 200) {
-    auto t0 = std::chrono::steady_clock::now();
-    step();
-    double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const double t = timeOnce(step);
     times.push_back(t);
     total += t;
     afterStep();

@@ -36,6 +36,26 @@ lid_velocity = 1.0
 images = false
 )";
 
+// A Gray-Scott layer of 32^2 unit cells from a perturbed square, 20 steps,
+// a frame of v every 10 (further [output] keys may follow).
+const char* const kGrayScottScene = R"(
+[grid]
+resolution = [32, 32]
+[time]
+dt = 1.0
+steps = 20
+[rd]
+model = "gray-scott"
+diffusion = [0.2, 0.1]
+[rd.initial]
+square = 0.25
+square_values = [0.5, 0.25]
+noise = 0.01
+[output]
+every = 10
+field = "v"
+)";
+
 }  // namespace
 
 struct BadScene {
@@ -315,23 +335,7 @@ TEST(Cli, MutatedScenesNeverCrash) {
 // and reports its solvers in run.json.
 TEST(Cli, ReactionDiffusionSceneRuns) {
   auto dir = tempDir("rd");
-  fs::path p = writeScene(dir, "gs.toml", R"(
-[grid]
-resolution = [32, 32]
-[time]
-dt = 1.0
-steps = 20
-[rd]
-model = "gray-scott"
-diffusion = [0.2, 0.1]
-[rd.initial]
-square = 0.25
-square_values = [0.5, 0.25]
-noise = 0.01
-[output]
-every = 10
-field = "v"
-)");
+  fs::path p = writeScene(dir, "gs.toml", kGrayScottScene);
   CommandResult r = runMorphoflow("run " + p.string() + " --quiet --out " + (dir / "out").string());
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_TRUE(fs::exists(dir / "out" / "frames" / "000002.png"));
@@ -352,29 +356,12 @@ field = "v"
 // the one a run that writes every step (and so steps one at a time) writes.
 TEST(Cli, BlockedStepsGiveTheFramesOfSingleSteps) {
   auto dir = tempDir("rd_blocked");
-  fs::path p = writeScene(dir, "gs.toml", R"(
-[grid]
-resolution = [1536, 1536]
-[time]
-dt = 1.0
-steps = 16
-[rd]
-model = "gray-scott"
-integrator = "explicit"
-diffusion = [0.2, 0.1]
-[rd.initial]
-square = 0.25
-square_values = [0.5, 0.25]
-noise = 0.01
-[output]
-field = "v"
-images = false
-fields = true
-)");
+  fs::path p = writeScene(dir, "gs.toml", std::string(kGrayScottScene) + "images = false\nfields = true\n");
+  const std::string blocks = " --set grid.resolution=[1536,1536] --set time.steps=16 --set 'rd.integrator=\"explicit\"' ";
   std::vector<morphoflow::FieldDump> dumps;
   for (const char* run : {"--set output.every=8", "--set output.every=1 --frames 16:16"}) {
     const fs::path out = dir / (dumps.empty() ? "blocked" : "single");
-    CommandResult r = runMorphoflow("run " + p.string() + " " + run + " --quiet --out " + out.string());
+    CommandResult r = runMorphoflow("run " + p.string() + blocks + run + " --quiet --out " + out.string());
     ASSERT_EQ(r.status, 0) << r.output;
     const nlohmann::json j = nlohmann::json::parse(std::ifstream(out / "run.json"));
     EXPECT_EQ(j["steps"].get<int>(), 16);
