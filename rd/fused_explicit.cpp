@@ -317,10 +317,10 @@ class Engine final : public FusedExplicitRD<D> {
     return this->x_[size_t(s)].data() + size_t(periodic_ ? wrap(q, outer()) : q) * sliceCells();
   }
 
-  // Steps per pass: the setting, or several where the state outgrows the
-  // caches (measured on the 2-core machine of docs/performance.md: at 2048^2
-  // and 256^3 blocking gains 1.3-1.6x, while at 1024^2 and 128^3, which stay
-  // in its L3, it loses 10-20%).
+  // Steps per pass: the setting, or several where the state (x_ and next_)
+  // outgrows the L3 (measured on the 2-core machine of docs/performance.md:
+  // blocking gains 1.4-1.6x at 2048^2 and 1.1x at 256^3, and loses 10-20% at
+  // 1024^2 and 128^3, which stay in its 32 MiB L3).
   int stepsPerPass() const override {
     if (this->stepsPerPass_ > 0) return this->stepsPerPass_;
     const double stateBytes = 2.0 * N * sizeof(float) * double(sliceCells()) * outer();
