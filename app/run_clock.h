@@ -23,6 +23,8 @@ class RunClock {
 
   // The steps still to run from step `step` on (by the step count alone).
   long stepsLeft(long step) const { return steps_ - step; }
+  // Whether every step takes time.dt (a step count, no CFL limit).
+  bool fixedDt() const { return time_.steps > 0 && time_.cfl <= 0; }
 
   template <int D>
   double dt(const Simulation<D>& sim) const {

@@ -110,8 +110,8 @@ class Driver {
   // checkpoints fall on output.every) and the run's last; one where dt may change.
   long stepsNow() const {
     const long together = sim_.stepsTogether(), step = sim_.steps();
-    if (together <= 1 || scene_.hasFluid) return 1;
-    return std::max(1L, std::min({together, schedule_.every() - step % schedule_.every(), clock_.stepsLeft(step)}));
+    if (together <= 1 || !clock_.fixedDt()) return 1;
+    return std::min({together, schedule_.every() - step % schedule_.every(), clock_.stepsLeft(step)});
   }
 
   void fail(const std::string& exitState, const std::string& error) {
