@@ -98,10 +98,7 @@ GpuRDSimulation<D>::GpuRDSimulation(const Scene& scene, const std::function<void
   // The plain explicit step in single precision; everything else (every
   // integrator, maps, fixed regions, frozen species, Dirichlet walls) in double.
   const RDScene& rd = scene.rd;
-  const bool plainExplicit = rd.settings.integrator == RDIntegrator::ExplicitEuler && species_.size() == 2 &&
-                             rd.settings.boundary != RDBoundary::Dirichlet && rd.parameterMaps.empty() &&
-                             rd.perturb.empty() && rd.fixed.empty() && rd.settings.frozen.empty() && !rd.anisotropy.enabled && !rd.lobes.enabled;
-  if (!plainExplicit) {
+  if (!(rd.plainExplicit() && species_.size() == 2)) {
     host_ = std::move(init);
     layer_ = std::make_unique<GpuRDLayer<D>>(*host_);
     return;

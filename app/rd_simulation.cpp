@@ -38,12 +38,7 @@ std::vector<Grid<float, D>> speciesField(const RDSolver<D>& rd, const std::strin
   return {toFloat<D>(rd.field(int(it - names.begin())))};
 }
 
-bool fusedExplicitFits(const Scene& s) {
-  const RDScene& r = s.rd;
-  return r.settings.integrator == RDIntegrator::ExplicitEuler && r.settings.boundary != RDBoundary::Dirichlet &&
-         r.settings.frozen.empty() && r.parameterMaps.empty() && r.perturb.empty() && r.speedMaps.empty() &&
-         r.fixed.empty() && !r.strokesDeposit() && !r.anisotropy.enabled && !r.lobes.enabled;
-}
+bool fusedExplicitFits(const Scene& s) { return s.rd.plainExplicit(); }
 
 template <int D>
 RDSimulation<D>::RDSimulation(const Scene& scene, const Log& log)

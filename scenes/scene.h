@@ -158,6 +158,15 @@ struct RDScene {
       if (!s.species.empty()) return true;
     return false;
   }
+  // Whether every step is the plain explicit Euler step (rd_settings.h:
+  // x += dt (R(x) + d lap x)) with uniform parameters and nothing held, frozen,
+  // steered or walled: the one test both backends' fast explicit paths take
+  // (rd/fused_explicit.h on the CPU, gpu/gpu_explicit_rd.h on the GPU).
+  bool plainExplicit() const {
+    return settings.integrator == RDIntegrator::ExplicitEuler && settings.boundary != RDBoundary::Dirichlet &&
+           settings.frozen.empty() && parameterMaps.empty() && perturb.empty() && speedMaps.empty() && fixed.empty() &&
+           !strokesDeposit() && !anisotropy.enabled && !lobes.enabled;
+  }
   int coarseLevels = 0;              // coarse-to-fine: grids 2^L, ..., 2 times coarser first (seed 002, 000)
   long coarseSteps = 0;              // steps on each coarse grid
   bool coarseScaleDt = false;        // a grid 2^l times coarser steps 4^l dt (explicit limits scale with h^2)

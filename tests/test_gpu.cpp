@@ -359,6 +359,37 @@ TEST(Gpu, ShippedMapFixedAndMultiSpeciesScenesMatchTheCpu) {
   expectScenesAgree("gpu_map_scenes", scenes, "000002.exr", {1e-6, 0.0, false});
 }
 
+// An explicit scene whose stroke deposits chemical: the cells under the
+// stroke are held at the stroke's values on both backends (the GPU's explicit
+// step is taken only where the CPU's fast path is: RDScene::plainExplicit),
+// and the rest agrees within float rounding.
+TEST(Gpu, ExplicitSceneWithDepositingStrokeHoldsItsCells) {
+  if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
+  const fs::path dir = tempDir("gpu_explicit_deposit");
+  for (const char* backend : {"gpu", "tbb"}) {
+    CommandResult r = runMorphoflow("run " + sceneFile("rd/seeds/kim_lin_paint_deposit.toml") +
+                                    " --set rd.integrator='\"explicit\"' --set grid.resolution=[64,64] --set time.steps=40"
+                                    " --set output.every=20 --set output.fields=true --quiet --backend " + backend +
+                                    " --out " + (dir / backend).string());
+    ASSERT_EQ(r.status, 0) << backend << "\n" << r.output;
+  }
+  const morphoflow::FieldDump g = dump(dir / "gpu" / "fields" / "000002.exr"), c = dump(dir / "tbb" / "fields" / "000002.exr");
+  ASSERT_EQ(g.names, c.names);
+  size_t held = 0;
+  for (size_t i = 0; i < c.channels[0].size(); ++i) {
+    if (c.channels[0][i] != 0.5f || c.channels[1][i] != 0.25f) continue;  // (the stroke's values, exact in float)
+    ++held;
+    EXPECT_EQ(g.channels[0][i], 0.5f) << "cell " << i;
+    EXPECT_EQ(g.channels[1][i], 0.25f) << "cell " << i;
+  }
+  EXPECT_GT(held, 100u) << "the stroke covers cells";
+  for (const std::string& species : c.names) {
+    const auto [worst, size] = channelDifference(g, c, species);
+    EXPECT_LE(worst, 1e-6 * size) << species;
+  }
+  fs::remove_all(dir);
+}
+
 // The coarse-to-fine start on the GPU (its 64^2 and 128^2 levels stepped by
 // the double-precision layer: bitwise the CPU's start), then Turing's
 // explicit step in single precision with b clamped at 0 after every step, as
