@@ -16,6 +16,13 @@ namespace morphoflow {
 
 namespace {
 
+// kernels/interpolation.inc, shared with the GPU (kernels/README.md).
+#define WEIGHTS4(name, t, w) inline void name(double t, double* w)
+#define PRECISE
+#include "kernels/interpolation.inc"
+#undef WEIGHTS4
+#undef PRECISE
+
 // Sample indices and weights along one axis: linear uses 2 (from k = 1),
 // cubic 4 (k = 0..3 at i - 1 .. i + 2).
 struct AxisWeights {
@@ -36,13 +43,9 @@ AxisWeights axisWeights(double c, int n, bool periodic, ChemicalInterpolation in
   if (interp == ChemicalInterpolation::Linear) {
     a.first = 1, a.count = 2;
     a.w[1] = 1.0 - t, a.w[2] = t;
-  } else {  // Catmull-Rom
-    const double t2 = t * t, t3 = t2 * t;
+  } else {
     a.first = 0, a.count = 4;
-    a.w[0] = 0.5 * (-t3 + 2 * t2 - t);
-    a.w[1] = 0.5 * (3 * t3 - 5 * t2 + 2);
-    a.w[2] = 0.5 * (-3 * t3 + 4 * t2 + t);
-    a.w[3] = 0.5 * (t3 - t2);
+    catmullRomWeights(t, a.w);
   }
   return a;
 }

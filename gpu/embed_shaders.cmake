@@ -1,5 +1,5 @@
-# Writes OUT: every shader of SHADERS (a ;-list of paths: *.comp kernels and
-# the *.glsl code they share) as a C++ raw string,
+# Writes OUT: every shader of SHADERS (a ;-list of paths: *.comp kernels, the
+# *.glsl code they share and the kernels/ files shared with the CPU) as a C++ raw string,
 # looked up by file name through gpu/shader_source.h.
 set(body "// Generated from gpu/shaders/*.comp by gpu/embed_shaders.cmake.\n#include \"gpu/shader_source.h\"\n#include <map>\n#include <stdexcept>\nnamespace morphoflow {\nconst std::string& shaderSource(const std::string& name) {\n  static const std::map<std::string, std::string> sources = {\n")
 foreach(path ${SHADERS})

@@ -1,19 +1,20 @@
-// The reaction models of rd/models.h in GLSL, term for term, for the
-// explicit step (float, two species) and the double-precision layer (Newton
-// and the rates, every model).
+// The reaction models on the GPU: the same kernels/models/*.inc that
+// rd/models.h includes, embedded into the shaders with the GLSL side of the
+// kernels' dialect (kernels/README.md).
 #pragma once
 
 #include <string>
 
 namespace morphoflow {
 
-// #defines of NSPECIES, RATES(x, r) and JACOBIAN(x, J) (J row-major,
-// dR_s / dx_t, entries not set are 0) for the model, in single or double
-// precision (the model's parameters in p[]), or "" when it has no GPU
-// program in that precision (single: the two-species models, for the
-// explicit step; double: every model).
+// GLSL defining NSPECIES, NPARAMETERS and
+//   void modelRates(T x[NSPECIES], T p[NPARAMETERS], out T r[NSPECIES])
+//   void modelJacobian(T x[NSPECIES], T p[NPARAMETERS], out T J[NSPECIES * NSPECIES])
+// (J row-major, dR_s / dx_t) for the model, in single or double precision
+// (T), or "" for an unknown model and, in single precision (the explicit
+// step), for a model of other than two species.
 std::string gpuReaction(const std::string& model, bool doublePrecision = false);
-// The model's species, 0 for a model the GPU does not know.
+// The model's species, 0 for an unknown model.
 int gpuSpecies(const std::string& model);
 
 }  // namespace morphoflow

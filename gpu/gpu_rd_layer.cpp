@@ -17,11 +17,6 @@
 
 namespace morphoflow {
 
-namespace {
-// As rd/rd_solver.cpp: three smoothing sweeps each way.
-const MultigridOptions kDiffusionCycle{3, 3, 4};
-}  // namespace
-
 // One species' implicit system for the current theta dt, its solver, and the
 // last step's diffusive change (the warm start).
 template <int D>

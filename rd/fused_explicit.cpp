@@ -263,7 +263,7 @@ void edgeCell(const RowJob<D, M::N>& j, int x) {
 }
 
 template <class M>
-constexpr bool kLaneRates = requires(const NewtonLanes* y, const double* q, NewtonLanes* r) { M::rates(y, q, r); };
+constexpr bool kLaneRates = M::N == 2 && requires(const NewtonLanes* y, const double* q, NewtonLanes* r) { M::rates(y, q, r); };
 static_assert(!kFloatLanes<models::MeinhardtLateral>);
 
 template <int D, class M>

@@ -19,8 +19,12 @@ class ModelAdapter final : public ReactionModel {
  public:
   ModelAdapter() : info_(M::info()) {
     for (int s : info_.clamped) clampMask_ |= 1u << s;
+    kernel_.file = M::kKernel;
+    if constexpr (requires { M::kKernelBase; }) kernel_.base = M::kKernelBase;
+    if constexpr (requires { M::kKernelDefines; }) kernel_.defines = M::kKernelDefines;
   }
   const ModelInfo& info() const override { return info_; }
+  const ModelKernel& kernel() const override { return kernel_; }
   void rates(const double* x, const double* p, double* r) const override { M::rates(x, p, r); }
   void jacobian(const double* x, const double* p, double* J) const override { M::jacobian(x, p, J); }
 
@@ -58,8 +62,8 @@ class ModelAdapter final : public ReactionModel {
   }
 
  private:
-  // The models whose rates and Jacobian also take vectors of doubles.
-  static constexpr bool kBatched = requires(const NewtonLanes* y, const double* q, NewtonLanes* r) {
+  // The two-species models (their rates and Jacobian take vectors of doubles).
+  static constexpr bool kBatched = M::N == 2 && requires(const NewtonLanes* y, const double* q, NewtonLanes* r) {
     M::rates(y, q, r);
     M::jacobian(y, q, r);
   };
@@ -107,6 +111,7 @@ class ModelAdapter final : public ReactionModel {
 #endif
 
   ModelInfo info_;
+  ModelKernel kernel_;
   unsigned clampMask_ = 0;
 };
 

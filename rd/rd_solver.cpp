@@ -241,15 +241,6 @@ void RDSolver<D>::applyLaplacian(int s, const Vector& x, Vector* out) const {
   parallelFor(o.size(), [&](size_t i) { o[i] = -o[i] + k * faces[i]; }, kChunk);
 }
 
-namespace {
-// Three smoothing sweeps each way, as the fluid's viscosity: the identity
-// term makes these systems better conditioned than a Poisson problem, and a
-// third sweep costs less than the outer iteration it saves (Gray-Scott ARD
-// at 256^2 and 512^2: 4 -> 3 iterations to 1e-8, RD stage 15.5 -> 14.6 ms at
-// 512^2; docs/performance.md).
-const MultigridOptions kDiffusionCycle{3, 3, 4};
-}  // namespace
-
 // Solves (I - theta_dt d lap) x = rhs in place; the Dirichlet ghost adds
 // theta_dt d 2 g / h^2 per boundary face to the right-hand side.
 template <int D>

@@ -13,6 +13,7 @@
 #include "core/anisotropic_system.h"
 #include "core/chebyshev.h"
 #include "core/grid.h"
+#include "core/multigrid.h"
 #include "core/pcg.h"
 #include "core/solver_result.h"
 #include "core/state_archive.h"
@@ -25,6 +26,13 @@
 #include "rd/reaction_model.h"
 
 namespace morphoflow {
+
+// The diffusion solves' multigrid cycle, on both backends: three smoothing
+// sweeps each way, as the fluid's viscosity. The identity term makes these
+// systems better conditioned than a Poisson problem, and a third sweep costs
+// less than the outer iteration it saves (Gray-Scott ARD at 256^2 and 512^2:
+// 4 -> 3 iterations to 1e-8, RD stage 15.5 -> 14.6 ms at 512^2; docs/performance.md).
+inline constexpr MultigridOptions kDiffusionCycle{3, 3, 4};
 
 struct RDStepStats {
   NewtonStats newton;       // implicit reaction (Kim & Lin)

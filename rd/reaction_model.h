@@ -32,6 +32,13 @@ struct ModelInfo {
   std::vector<int> clamped;
 };
 
+// Where a model's rates and Jacobian are written (kernels/models/): the
+// file, the model file whose kernels it builds on ("" if none) and the GLSL
+// #defines it needs; what the GPU backend embeds (gpu/gpu_models.h).
+struct ModelKernel {
+  std::string file, base, defines;
+};
+
 // Per-cell parameter values: parameter k is constant[k] unless field[k] is set.
 struct ParameterValues {
   std::vector<double> constant;
@@ -62,6 +69,7 @@ class ReactionModel {
 
   virtual ~ReactionModel() = default;
   virtual const ModelInfo& info() const = 0;
+  virtual const ModelKernel& kernel() const = 0;
   int species() const { return int(info().species.size()); }
 
   // R(x; p) and its Jacobian J[s * n + t] = dR_s / dx_t for one cell.

@@ -23,6 +23,9 @@ uniform dvec2 inValue, solidValue;
 uniform bool cubic;
 
 #include "mac_sampling.glsl"
+#define WEIGHTS4(name, t, w) void name(double t, precise out double w[4])
+#define PRECISE precise
+#include "interpolation.inc"
 
 // j wrapped into [0, n) (GLSL's % is undefined for negative operands)
 int wrapIndex(int j, int n) { return j >= 0 ? j % n : (n - 1) - ((-j - 1) % n); }
@@ -42,11 +45,7 @@ void axisWeights(double x, int n, bool wrap, out int index[4], out double w[4]) 
     w[0] = 0.0lf; w[1] = 1.0lf - t; w[2] = t; w[3] = 0.0lf;
     return;
   }
-  precise double t2 = t * t, t3 = t2 * t;
-  w[0] = 0.5lf * (-t3 + 2.0lf * t2 - t);
-  w[1] = 0.5lf * (3.0lf * t3 - 5.0lf * t2 + 2.0lf);
-  w[2] = 0.5lf * (-3.0lf * t3 + 4.0lf * t2 + t);
-  w[3] = 0.5lf * (t3 - t2);
+  catmullRomWeights(t, w);
 }
 
 void main() {

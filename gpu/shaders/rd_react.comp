@@ -4,9 +4,9 @@
 // search, continuation in dt and deterministic restarts where it stalls, and
 // the complementarity solution for species that must stay >= 0: rd/newton.h,
 // step for step. MODE_RATES: r = R(x) (the explicit and semi-implicit
-// integrators). The host prepends NSPECIES, RATES(x, r) and JACOBIAN(x, J)
-// (gpu/gpu_models.h: rd/models.h in GLSL; the model's parameters in p[],
-// uniform or a parameter map's value at the cell) and GATHER_PARAMETERS.
+// integrators). The host prepends NSPECIES, modelRates and modelJacobian
+// (gpu/gpu_models.h: kernels/models/, the CPU's own; the model's parameters
+// in p[], uniform or a parameter map's value at the cell) and GATHER_PARAMETERS.
 // `precise` throughout: no fused multiply-adds, so every operation rounds as
 // the CPU's does and Newton takes the CPU's path near folds and multiple roots.
 #define N NSPECIES
@@ -21,19 +21,10 @@ uniform double uniformP[12];  // the parameters' uniform values
 uniform int mapAt[12];        // where parameter k's map starts in maps[], -1: uniform
 uniform uint clamped;         // bit s: species s stays >= 0
 
-double p[12];  // this cell's parameters (RATES and JACOBIAN read p)
+double p[NPARAMETERS];  // this cell's parameters
 
-void rates(double x[N], out double r[N]) {
-  precise double q[N];
-  RATES(x, q)
-  r = q;
-}
-void jacobian(double x[N], out double J[N * N]) {
-  precise double K[N * N];
-  for (int k = 0; k < N * N; ++k) K[k] = 0.0lf;
-  JACOBIAN(x, K)
-  J = K;
-}
+void rates(double x[N], out double r[N]) { modelRates(x, p, r); }
+void jacobian(double x[N], out double J[N * N]) { modelJacobian(x, p, J); }
 
 bool held(uint mask, int s) { return ((mask >> uint(s)) & 1u) != 0u; }
 
