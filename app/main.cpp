@@ -1,4 +1,5 @@
-// The morphoflow command line (DESIGN.md: "The command-line contract").
+// The morphoflow command line: the commands and their options over the
+// libraries of run/, batch/ and bench/ (docs/architecture.md).
 // Exit status: 0 success, 2 user error (file:line:col on stderr), 1 internal error.
 #include <malloc.h>
 #include <climits>
@@ -10,13 +11,13 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
-#include "app/batch.h"
-#include "app/gpu_simulation.h"
-#include "app/memory_estimate.h"
-#include "app/run_options.h"
+#include "batch/batch.h"
+#include "sim/gpu_simulation.h"
+#include "run/memory_estimate.h"
+#include "run/run_options.h"
 #include "app/texture_commands.h"
-#include "app/version.h"
-#include "app/memory_bench.h"
+#include "run/version.h"
+#include "run/memory_bench.h"
 #include "bench/bench_suites.h"
 #include "core/error.h"
 #include "core/number_text.h"

@@ -17,7 +17,7 @@
 #include "bench/bench_suites.h"
 #include "bench/bench_timing.h"
 #include "bench/gpu_bandwidth.h"
-#include "coupling/gpu_ard_solver.h"
+#include "gpu/gpu_ard_solver.h"
 #include "fluid/fluid_solver.h"
 #include "gpu/gpu_fluid.h"
 #include "gpu/gpu_kernels.h"

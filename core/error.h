@@ -5,6 +5,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace morphoflow {
 
@@ -37,6 +38,17 @@ class UserError : public std::runtime_error {
   }
   SourceLocation where_;
   std::string key_;
+};
+
+// A field turned NaN, infinite or too large for a float: the run stops
+// (exit 2) with the step, the stage and what to change.
+class NonFiniteError : public std::runtime_error {
+ public:
+  NonFiniteError(const std::string& message, std::string hint) : std::runtime_error(message), hint_(std::move(hint)) {}
+  const std::string& hint() const { return hint_; }
+
+ private:
+  std::string hint_;
 };
 
 }  // namespace morphoflow

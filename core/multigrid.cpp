@@ -346,7 +346,7 @@ void Multigrid<D>::cycle(int l) {
     SolverOptions o;
     o.tolerance = 1e-10;
     o.maxIterations = 20 * int(A.size()) + 50;
-    solvePCG<D>(A, coarseB_, &coarseX_, nullptr, o, nullptr, &coarseWork_);
+    solvePCG<D>(A, coarseB_, &coarseX_, nullptr, o, &coarseWork_);
     for (size_t i = 0; i < L.x.size(); ++i) L.x[i] = float(coarseX_[i]);
     return;
   }
@@ -414,8 +414,7 @@ double Multigrid<D>::applyDot(const Vector& r, double rnorm, Vector* z) {
 }
 
 template <int D>
-SolverResult Multigrid<D>::solve(const Vector& bIn, Vector* x, const SolverOptions& opt,
-                                 Interrupter* interrupter) {
+SolverResult Multigrid<D>::solve(const Vector& bIn, Vector* x, const SolverOptions& opt) {
   SolverResult result;
   Vector b = bIn;
   if (fine_.singular()) fine_.removeNullSpace(&b);
@@ -434,7 +433,6 @@ SolverResult Multigrid<D>::solve(const Vector& bIn, Vector* x, const SolverOptio
     if (fine_.singular()) fine_.removeNullSpace(x);
     ++result.iterations;
     result.residual = fine_.residual(b, *x, &r_) / bnorm;
-    if (interrupter && interrupter->progress(-1.0)) break;
   }
   result.converged = result.residual <= opt.tolerance;
   return result;

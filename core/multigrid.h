@@ -17,7 +17,6 @@
 #include <memory>
 #include <vector>
 
-#include "core/interrupter.h"
 #include "core/pcg.h"
 #include "core/preconditioner.h"
 #include "core/solver_result.h"
@@ -38,8 +37,7 @@ class Multigrid final : public Preconditioner {
 
   // Repeated V-cycles (defect correction: x += cycle(b - A x)) until the
   // relative residual meets the tolerance.
-  SolverResult solve(const Vector& b, Vector* x, const SolverOptions& options,
-                     Interrupter* interrupter = nullptr);
+  SolverResult solve(const Vector& b, Vector* x, const SolverOptions& options);
   // Preconditioner: z = one V-cycle from zero.
   void apply(const Vector& r, Vector* z) override;
   double applyDot(const Vector& r, double rnorm, Vector* z) override;

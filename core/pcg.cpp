@@ -12,7 +12,7 @@ namespace {
 // The algorithm for any symmetric operator with size/apply/residual/singular/removeNullSpace.
 template <class Op>
 SolverResult pcg(const Op& A, const Vector& bIn, Vector* xp, Preconditioner* M, const SolverOptions& opt,
-                 Interrupter* interrupter, PcgWorkspace* workspace) {
+                 PcgWorkspace* workspace) {
   Vector& x = *xp;
   const size_t n = A.size();
   x.resize(n, 0.0);
@@ -107,7 +107,6 @@ SolverResult pcg(const Op& A, const Vector& bIn, Vector* xp, Preconditioner* M, 
     result.iterations = it;
     result.residual = rnorm / bnorm;
     if (result.residual <= opt.tolerance) break;
-    if (interrupter && interrupter->progress(-1.0)) break;
     double rzNew = precondition();
     double beta = rzNew / rz;
     rz = rzNew;
@@ -137,24 +136,24 @@ SolverResult pcg(const Op& A, const Vector& bIn, Vector* xp, Preconditioner* M, 
 
 template <int D>
 SolverResult solvePCG(const LaplaceSystem<D>& A, const Vector& b, Vector* x, Preconditioner* M,
-                      const SolverOptions& options, Interrupter* interrupter, PcgWorkspace* workspace) {
-  return pcg(A, b, x, M, options, interrupter, workspace);
+                      const SolverOptions& options, PcgWorkspace* workspace) {
+  return pcg(A, b, x, M, options, workspace);
 }
 
 template <int D>
 SolverResult solvePCG(const AnisotropicSystem<D>& A, const Vector& b, Vector* x, Preconditioner* M,
-                      const SolverOptions& options, Interrupter* interrupter, PcgWorkspace* workspace) {
-  if (!A.hasCross) return pcg(A.axis, b, x, M, options, interrupter, workspace);
-  return pcg(A, b, x, M, options, interrupter, workspace);
+                      const SolverOptions& options, PcgWorkspace* workspace) {
+  if (!A.hasCross) return pcg(A.axis, b, x, M, options, workspace);
+  return pcg(A, b, x, M, options, workspace);
 }
 
 template SolverResult solvePCG<2>(const AnisotropicSystem<2>&, const Vector&, Vector*, Preconditioner*,
-                                  const SolverOptions&, Interrupter*, PcgWorkspace*);
+                                  const SolverOptions&, PcgWorkspace*);
 template SolverResult solvePCG<3>(const AnisotropicSystem<3>&, const Vector&, Vector*, Preconditioner*,
-                                  const SolverOptions&, Interrupter*, PcgWorkspace*);
+                                  const SolverOptions&, PcgWorkspace*);
 template SolverResult solvePCG<2>(const LaplaceSystem<2>&, const Vector&, Vector*, Preconditioner*,
-                                  const SolverOptions&, Interrupter*, PcgWorkspace*);
+                                  const SolverOptions&, PcgWorkspace*);
 template SolverResult solvePCG<3>(const LaplaceSystem<3>&, const Vector&, Vector*, Preconditioner*,
-                                  const SolverOptions&, Interrupter*, PcgWorkspace*);
+                                  const SolverOptions&, PcgWorkspace*);
 
 }  // namespace morphoflow

@@ -5,7 +5,6 @@
 
 #include <functional>
 
-#include "core/interrupter.h"
 #include "core/laplace_system.h"
 #include "core/preconditioner.h"
 #include "core/solver_result.h"
@@ -31,15 +30,13 @@ struct PcgWorkspace {
 // mean in place, with no copy).
 template <int D>
 SolverResult solvePCG(const LaplaceSystem<D>& A, const Vector& b, Vector* x, Preconditioner* M,
-                      const SolverOptions& options, Interrupter* interrupter = nullptr,
-                      PcgWorkspace* workspace = nullptr);
+                      const SolverOptions& options, PcgWorkspace* workspace = nullptr);
 
 template <int D>
 struct AnisotropicSystem;
 // The same for a tensor diffusion system (M typically built on A.axis).
 template <int D>
 SolverResult solvePCG(const AnisotropicSystem<D>& A, const Vector& b, Vector* x, Preconditioner* M,
-                      const SolverOptions& options, Interrupter* interrupter = nullptr,
-                      PcgWorkspace* workspace = nullptr);
+                      const SolverOptions& options, PcgWorkspace* workspace = nullptr);
 
 }  // namespace morphoflow

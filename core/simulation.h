@@ -1,4 +1,4 @@
-// Simulation<D>: what the run driver (app/run_driver.h) needs of any
+// Simulation<D>: what the run driver (run/run_driver.h) needs of any
 // simulation, fluid-only, reaction-diffusion-only or coupled, on any backend:
 // advance one step, say where it is, expose named output fields, and save and
 // restore its complete state. The driver owns everything else: the frame
@@ -12,21 +12,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/error.h"
 #include "core/grid.h"
 #include "core/state_archive.h"
 
 namespace morphoflow {
-
-// A field turned NaN, infinite or too large for a float: the run stops
-// (exit 2) with the step, the stage and what to change.
-class NonFiniteError : public std::runtime_error {
- public:
-  NonFiniteError(const std::string& message, std::string hint) : std::runtime_error(message), hint_(std::move(hint)) {}
-  const std::string& hint() const { return hint_; }
-
- private:
-  std::string hint_;
-};
 
 template <int D>
 class Simulation {

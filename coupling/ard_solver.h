@@ -15,13 +15,6 @@
 
 namespace morphoflow {
 
-enum class CouplingMode { ARD, Passive, RDOnly };
-
-// The scene's coupling.mode: "ard", "passive" or "rd-only".
-inline CouplingMode couplingMode(const std::string& mode) {
-  return mode == "passive" ? CouplingMode::Passive : mode == "rd-only" ? CouplingMode::RDOnly : CouplingMode::ARD;
-}
-
 template <int D>
 class ARDSolver {
  public:

@@ -18,10 +18,9 @@
 #include "core/work_pool.h"
 #include "core/grid.h"
 #include "core/mac_velocity.h"
+#include "coupling/coupling_choices.h"
 
 namespace morphoflow {
-
-enum class ChemicalInterpolation { Linear, Cubic };
 
 template <int D>
 struct ChemicalDomain {

@@ -109,7 +109,7 @@ SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double
     r = solvePCG<D>(A_, workspace_.b, &phi_, solver_ == PressureSolver::ICPCG
                                           ? static_cast<Preconditioner*>(mic_.get())
                                           : static_cast<Preconditioner*>(multigrid_.get()),
-                    options_, nullptr, &workspace_);
+                    options_, &workspace_);
   w.regenerate = nullptr;
   if (pool) {
     pool->give(work);

@@ -181,7 +181,7 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
     });
     SolverOptions options = options_;
     if (ba > 0.0) options.tolerance = options_.tolerance * std::sqrt(0.5 * (ba + bAll / D) / ba);
-    const SolverResult r = C.multigrid ? solvePCG<D>(C.A, b_, &x_, C.multigrid.get(), options, nullptr, &pcgWork_)
+    const SolverResult r = C.multigrid ? solvePCG<D>(C.A, b_, &x_, C.multigrid.get(), options, &pcgWork_)
                                        : C.chebyshev->solve(b_, &x_, options, std::sqrt(ba));
     rAll += r.residual * r.residual * ba;
     result.iterations = std::max(result.iterations, r.iterations);

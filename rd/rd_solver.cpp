@@ -313,7 +313,7 @@ SolverResult RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
   }
   SolverOptions o{settings_.tolerance, 2000};
   SolverResult r = df.useChebyshev ? df.chebyshev->solve(b, &x, o, bnorm)
-                                   : solvePCG<D>(df.A, b, &x, df.M.get(), o, nullptr, &pcgWork_);
+                                   : solvePCG<D>(df.A, b, &x, df.M.get(), o, &pcgWork_);
   df.increment.resize(b.size());
   parallelFor(b.size(), [&](size_t i) { df.increment[i] = toBfloat16(float(x[i] - b[i])); }, kChunk);
   df.incrementThetaDt = thetaDt;

@@ -9,6 +9,7 @@
 
 #include "core/error.h"
 #include "core/spatial_field.h"
+#include "coupling/coupling_choices.h"
 #include "fluid/fluid_settings.h"
 #include "rd/brush_strokes.h"
 #include "rd/generalized_diffusion.h"
@@ -175,8 +176,8 @@ struct RDScene {
 // [coupling]: a fluid carrying a reaction-diffusion layer (seed 001 sec. 5).
 struct CouplingScene {
   bool enabled = false;
-  std::string mode = "ard";             // ard | passive | rd-only
-  std::string interpolation = "linear"; // linear | cubic
+  CouplingMode mode = CouplingMode::ARD;
+  ChemicalInterpolation interpolation = ChemicalInterpolation::Linear;
   double rdTimeScale = 1.0;             // RD time per unit of fluid time
   std::vector<double> inflowValues;     // per species, chemical entering through inflow sides
   std::vector<double> solidValues;      // per species, inside obstacles

@@ -1,0 +1,96 @@
+#include "gpu/gpu_ard_solver.h"
+
+#include <stdexcept>
+
+#include <epoxy/gl.h>
+#include <fmt/format.h>
+
+#include "gpu/gpu_stage_timer.h"
+#include "gpu/compute_program.h"
+#include "gpu/gpu_kernels.h"
+
+namespace morphoflow {
+
+template <int D>
+GpuARDSolver<D>::GpuARDSolver(GpuRDLayer<D>* layer, const ChemicalDomain<D>& domain, ChemicalInterpolation interpolation,
+                              CouplingMode mode, double rdTimeScale, const IVec<D>& fluidCells, double fluidH)
+    : layer_(layer), domain_(domain), cubic_(interpolation == ChemicalInterpolation::Cubic), mode_(mode),
+      rdTimeScale_(rdTimeScale), fluidH_(fluidH) {
+  if (!(rdTimeScale > 0)) throw std::invalid_argument("coupling: the reaction-diffusion time scale must be > 0");
+  for (int a = 0; a < D; ++a) {
+    fluidCells_[size_t(a)] = fluidCells[a];
+    rdCells_[size_t(a)] = domain.cells[a];
+    periodic_[size_t(a)] = domain.periodic[size_t(a)] ? 1 : 0;
+  }
+  hasSolids_ = !domain.solid.empty();
+  solid_ = GpuBuffer::of(hasSolids_ ? std::vector<uint32_t>(domain.solid.begin(), domain.solid.end())
+                                    : std::vector<uint32_t>{0});
+  for (GpuBuffer& b : scratch_) b = GpuBuffer(layer->cells() * sizeof(double));
+  if (mode_ != CouplingMode::RDOnly) emptySolids();
+  timer_ = std::make_unique<GpuStageTimer>(ARDSolver<D>::kStages);
+}
+
+template <int D>
+void GpuARDSolver<D>::emptySolids() {
+  if (!hasSolids_) return;
+  const ComputeProgram& p = useKernel("chem_advect.comp", fmt::format("#define DIM {}\n#define MODE_SOLIDS", D));
+  setUniform(p, "rdCells", rdCells_);
+  auto value = [&](size_t s) { return s < domain_.solidValues.size() ? domain_.solidValues[s] : 0.0; };
+  glUniform2d(p.uniform("solidValue"), value(0), value(1));
+  layer_->field(0).bind(3);
+  layer_->field(1).bind(4);
+  solid_.bind(5);
+  dispatchFlat(layer_->cells(), 4.0 + 16.0);  // the mask, both species written
+  storageBarrier();
+}
+
+template <int D>
+void GpuARDSolver<D>::advect(double dt, const GpuFluid<D>& fluid) {
+  const ComputeProgram& p = useKernel("chem_advect.comp", fmt::format("#define DIM {}\n#define MODE_ADVECT", D));
+  setUniform(p, "cells", fluidCells_);
+  setUniform(p, "periodic", periodic_);
+  setUniform(p, "velOff", std::array<int, 3>{int(fluid.offset(0)), int(fluid.offset(1)), D == 3 ? int(fluid.offset(2)) : 0});
+  setUniform(p, "rdCells", rdCells_);
+  setUniform(p, "c", float(dt / fluidH_));
+  setUniform(p, "r", float(domain_.h / fluidH_));
+  std::array<int, 3> lo{}, hi{};
+  for (int a = 0; a < D; ++a) {
+    lo[size_t(a)] = domain_.inflow[size_t(a)][0] ? 1 : 0;
+    hi[size_t(a)] = domain_.inflow[size_t(a)][1] ? 1 : 0;
+  }
+  setUniform(p, "inflowLo", lo);
+  setUniform(p, "inflowHi", hi);
+  const bool inflow = !domain_.inflowValues.empty();
+  setUniform(p, "inflow", inflow ? 1 : 0);
+  auto in = [&](size_t s) { return inflow && s < domain_.inflowValues.size() ? domain_.inflowValues[s] : 0.0; };
+  glUniform2d(p.uniform("inValue"), in(0), in(1));
+  setUniform(p, "cubic", cubic_ ? 1 : 0);
+  fluid.velocity().bind(0);
+  layer_->field(0).bind(1);
+  layer_->field(1).bind(2);
+  scratch_[0].bind(3);
+  scratch_[1].bind(4);
+  solid_.bind(5);
+  // both species read and written, the velocity once (the fluid's grid, here per chemical cell at most)
+  dispatchFlat(layer_->cells(), 32.0 + 4.0 * D);
+  storageBarrier();
+  for (int s = 0; s < 2; ++s) std::swap(layer_->field(s), scratch_[size_t(s)]);
+  emptySolids();
+}
+
+template <int D>
+void GpuARDSolver<D>::step(double dt, const GpuFluid<D>& fluid) {
+  timer_->mark(0);
+  if (mode_ != CouplingMode::Passive) layer_->step(rdTimeScale_ * dt);  // eq. 6 then eq. 13
+  if (mode_ == CouplingMode::ARD) emptySolids();                      // obstacles hold no chemical
+  timer_->mark(1);
+  if (mode_ != CouplingMode::RDOnly) advect(dt, fluid);  // eq. 19-20
+  timer_->mark(2);
+  const std::vector<double> seconds = timer_->endStep();
+  stageSeconds_ = {seconds[0], seconds[1]};
+}
+
+template class GpuARDSolver<2>;
+template class GpuARDSolver<3>;
+
+}  // namespace morphoflow

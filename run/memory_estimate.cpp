@@ -1,0 +1,107 @@
+#include "run/memory_estimate.h"
+
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "sim/rd_simulation.h"
+#include "core/error.h"
+
+namespace morphoflow {
+
+namespace {
+
+// Peak bytes per cell beyond the fixed overhead, measured by `bench memory`
+// (2D 1024^2, 3D 128^3, four steps and the final checkpoint;
+// docs/performance.md "Memory"): the fluid (velocity and its advected copy,
+// pressure and viscosity systems, their warm starts, and the work vectors
+// its stages borrow in turn) and each species of a reaction-diffusion layer
+// (double state, its implicit system and warm start, a share of the solves'
+// vectors; in a coupled run also its advection scratch and feet; float
+// state for the fused explicit step).
+constexpr double kFluidBytesPerCell[2] = {148.0, 99.0};        // 2D, 3D
+// A coupled run's fluid and species, each from two runs (the same grid for
+// both, and chemicals twice as fine: 2D 512^2 / 1024^2, 3D the shipped
+// 128^3 / 256^3 cavity) solved for the two unknowns.
+constexpr double kCoupledFluidBytesPerCell[2] = {79.1, 84.3};
+constexpr double kSpeciesBytesPerCell[2] = {26.0, 27.3};         // reaction-diffusion only
+constexpr double kCoupledSpeciesBytesPerCell[2] = {29.4, 31.9};  // carried by a fluid
+constexpr double kFusedSpeciesBytesPerCell = 16.0;               // the fused explicit step
+// A frame's OpenVDB volumes: each grid is built densely, then as a tree,
+// before the file is written, on top of the solvers' work vectors when the
+// frame follows a step (measured on the shipped 3D cavity's frames, whose
+// peak they raise by 0.64 GiB: species and density at 256^3, the velocity's
+// three components at 128^3; 12-16 bytes a voxel from 64^3 up).
+constexpr double kVdbBytesPerVoxel = 12.1;
+constexpr double kFixedBytes = 126.0 * (1 << 20);                // the program, its libraries and thread pools
+
+double cellsOf(const std::vector<int>& res) {
+  double n = 1;
+  for (int r : res) n *= r;
+  return n;
+}
+
+uintmax_t meminfoAvailable() {
+  std::ifstream in("/proc/meminfo");
+  std::string key;
+  uintmax_t kb = 0;
+  std::string unit;
+  while (in >> key >> kb >> unit)
+    if (key == "MemAvailable:") return kb * 1024;
+  return UINTMAX_MAX;
+}
+
+uintmax_t cgroupRoom() {
+  std::ifstream max("/sys/fs/cgroup/memory.max"), cur("/sys/fs/cgroup/memory.current");
+  std::string m;
+  uintmax_t c = 0;
+  if (!(max >> m) || m == "max" || !(cur >> c)) return UINTMAX_MAX;
+  const uintmax_t limit = std::stoull(m);
+  return limit > c ? limit - c : 0;
+}
+
+}  // namespace
+
+uintmax_t estimateRunBytes(const Scene& s) {
+  const int d = s.dimension == 3 ? 1 : 0;
+  double bytes = kFixedBytes;
+  if (s.hasFluid) bytes += cellsOf(s.fluid.resolution) * (s.rd.enabled ? kCoupledFluidBytesPerCell[d] : kFluidBytesPerCell[d]);
+  if (s.output.vdb) {
+    // species and density at the layer's cells (else the fluid's); three
+    // velocity components, extra fields (and vel_mac's three, an obstacle) at the fluid's
+    const double fluidCells = s.hasFluid ? cellsOf(s.fluid.resolution) : 0.0;
+    const double layerCells = s.rd.enabled ? cellsOf(s.rd.settings.resolution) : fluidCells;
+    const double species = s.rd.enabled ? double(s.rd.initial.values.size()) : 0.0;
+    double voxels = layerCells * (species + 1.0) + fluidCells * (3.0 + double(s.output.vdbFields.size()));
+    if (s.output.vdbMacVelocity) voxels += fluidCells * 3.0;
+    if (s.hasFluid && !s.fluid.obstacles.empty()) voxels += fluidCells;
+    bytes += kVdbBytesPerVoxel * voxels;
+  }
+  if (s.rd.enabled) {
+    const double species = double(s.rd.initial.values.size());
+    const bool fused = !s.hasFluid && !s.velocity.enabled && fusedExplicitFits(s);
+    bytes += cellsOf(s.rd.settings.resolution) * species *
+             (s.hasFluid ? kCoupledSpeciesBytesPerCell[d] : fused ? kFusedSpeciesBytesPerCell : kSpeciesBytesPerCell[d]);
+  }
+  return uintmax_t(bytes);
+}
+
+uintmax_t availableBytes() { return std::min(meminfoAvailable(), cgroupRoom()); }
+
+std::string humanBytes(uintmax_t b) {
+  if (b >= (uintmax_t(1) << 30)) return fmt::format("{:.2f} GiB", double(b) / double(1 << 30));
+  if (b >= (uintmax_t(1) << 20)) return fmt::format("{:.0f} MiB", double(b) / double(1 << 20));
+  return fmt::format("{:.0f} KiB", double(b) / 1024.0);
+}
+
+void checkRunFits(const Scene& scene) {
+  const uintmax_t need = estimateRunBytes(scene), have = availableBytes();
+  if (need > have)
+    throw UserError({scene.path, 0, 0}, "grid.resolution",
+                    "this run needs about " + humanBytes(need) + " of memory, and " + humanBytes(have) +
+                        " are available",
+                    "lower grid.resolution or rd.resolution, or run it on a larger machine");
+}
+
+}  // namespace morphoflow

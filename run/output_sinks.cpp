@@ -1,0 +1,232 @@
+#include "run/output_sinks.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "run/vdb_sink.h"
+#include "core/output_file.h"
+#include "render/field_dump.h"
+#include "render/field_image.h"
+#include "render/image_io.h"
+#include "render/normal_map.h"
+#include "render/volume_preview.h"
+
+namespace morphoflow {
+
+uintmax_t fileBytes(const std::filesystem::path& file) {
+  std::error_code ec;
+  const uintmax_t n = std::filesystem::file_size(file, ec);
+  return ec ? 0 : n;
+}
+
+void addBytes(nlohmann::json* run, const std::string& kind, uintmax_t bytes) {
+  nlohmann::json& b = (*run)["bytes_written"];
+  b[kind] = (b.contains(kind) ? b[kind].get<uintmax_t>() : 0) + bytes;
+}
+
+template <int D>
+ImageSink<D>::ImageSink(const std::filesystem::path& out, const Scene& scene) : dir_(out / "frames"), scene_(scene) {
+  createOutputFolder(dir_);
+}
+
+template <int D>
+void ImageSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
+  const long frame = at.frame;
+  const OutputSettings& o = scene_.output;
+  FieldImageOptions io;
+  io.palette = o.gradient.empty() ? namedPalette(o.colormap) : Palette{o.gradient};
+  io.autoRange = o.autoRange;
+  io.symmetric = sim.symmetric(o.field);
+  io.range[0] = o.range[0];
+  io.range[1] = o.range[1];
+  io.slice = o.slice;
+  int w, h;
+  std::vector<uint8_t> rgb;
+  const bool two = o.colormap == kTwoSpeciesPalette;
+  const std::vector<std::string> sp = sim.species();
+  const Grid<float, D> shown = sim.field(two ? sp[0] : o.field).front();
+  if constexpr (D == 3) {
+    if (o.view == "volume") {
+      rgb = two ? volumeTwoToRgb(shown, sim.field(sp[1]).front(), io, o.imageSize, &w, &h)
+                : volumeToRgb(shown, io, o.imageSize, &w, &h);
+    }
+  }
+  if (rgb.empty()) {
+    rgb = two ? twoFieldsToRgb<D>(shown, sim.field(sp[1]).front(), io, &w, &h) : fieldToRgb<D>(shown, io, &w, &h);
+    rgb = upscaleToWidth(rgb, &w, &h, o.imageSize);
+  }
+  std::string err;
+  const std::filesystem::path file = dir_ / fmt::format("{:06d}.{}", frame, o.format);
+  if (!writeRgb8(file.string(), w, h, rgb, &err)) throw std::runtime_error("writing " + file.string() + ": " + err);
+  if (firstWritten_ < 0) firstWritten_ = frame;
+  ++written_;
+  bytes_ += fileBytes(file);
+}
+
+template <int D>
+void ImageSink<D>::finish() {
+  if (!scene_.output.video) return;
+  VideoRequest r;
+  r.frames = dir_;
+  r.firstFrame = int(std::max<long>(0, firstWritten_));
+  r.frameCount = written_;
+  r.fps = scene_.output.fps;
+  r.file = dir_.parent_path() / (safeFileStem(scene_.name) + ".mp4");
+  r.cancelled = cancelled;
+  video_ = encodeVideo(r);
+  videoDone_ = true;
+  videoFile_ = r.file;
+}
+
+template <int D>
+void ImageSink<D>::report(nlohmann::json* j) const {
+  (*j)["frames_written"] = written_;
+  addBytes(j, "frames", bytes_);
+  if (videoDone_ && video_.written) addBytes(j, "video", fileBytes(videoFile_));
+  if (videoDone_)
+    (*j)["video"] = {{"file", videoFile_.string()},
+                     {"written", video_.written},
+                     {"warning", video_.warning},
+                     {"ffmpeg_log", video_.log.string()}};
+}
+
+template <int D>
+nlohmann::json ImageSink<D>::state() const {
+  return {{"written", written_}, {"first_written", firstWritten_}, {"bytes", bytes_}};
+}
+
+template <int D>
+void ImageSink<D>::restore(const nlohmann::json& s) {
+  written_ = s.at("written").get<int>();
+  firstWritten_ = s.at("first_written").get<long>();
+  bytes_ = s.at("bytes").get<uintmax_t>();
+}
+
+template <int D>
+FieldDumpSink<D>::FieldDumpSink(const std::filesystem::path& out) : dir_(out / "fields") {
+  createOutputFolder(dir_);
+}
+
+template <int D>
+void FieldDumpSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
+  FieldDump d;
+  d.names = sim.dumpFieldNames();
+  for (const std::string& n : d.names) {
+    const Grid<float, D> g = sim.field(n).front();
+    if (d.resolution.empty())
+      for (int a = 0; a < D; ++a) d.resolution.push_back(g.dim(a));
+    d.channels.push_back(g.values());
+  }
+  d.time = sim.time();
+  d.step = at.step;
+  std::string err;
+  const std::filesystem::path file = dir_ / fmt::format("{:06d}.exr", at.frame);
+  if (!writeFieldDump(file.string(), d, &err)) throw std::runtime_error("writing " + file.string() + ": " + err);
+  ++written_;
+  bytes_ += fileBytes(file);
+}
+
+template <int D>
+void FieldDumpSink<D>::report(nlohmann::json* j) const {
+  (*j)["fields_written"] = written_;
+  addBytes(j, "fields", bytes_);
+}
+
+template <int D>
+nlohmann::json FieldDumpSink<D>::state() const {
+  return {{"written", written_}, {"bytes", bytes_}};
+}
+
+template <int D>
+void FieldDumpSink<D>::restore(const nlohmann::json& s) {
+  written_ = s.at("written").get<int>();
+  bytes_ = s.at("bytes").get<uintmax_t>();
+}
+
+template <int D>
+NormalMapSink<D>::NormalMapSink(const std::filesystem::path& out, const Scene& scene)
+    : normals_(out / "normals"), heights_(out / "height"), scene_(scene) {
+  createOutputFolder(normals_);
+  createOutputFolder(heights_);
+}
+
+template <int D>
+void NormalMapSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
+  if constexpr (D == 2) {
+    const OutputSettings& o = scene_.output;
+    const std::string name = o.colormap == kTwoSpeciesPalette ? sim.species()[0] : o.field;
+    Grid<float, 2> height = sim.field(name).front();
+    FieldImageOptions io;
+    io.autoRange = o.autoRange;
+    io.symmetric = sim.symmetric(name);
+    io.range[0] = o.range[0];
+    io.range[1] = o.range[1];
+    const std::array<double, 2> range = valueRange(height.data(), height.size(), io);
+    const double span = range[1] > range[0] ? range[1] - range[0] : 1.0;
+    for (float& v : height.values()) v = float(std::clamp((double(v) - range[0]) / span, 0.0, 1.0));
+    const bool periodic = scene_.rd.enabled ? scene_.rd.settings.boundary == RDBoundary::Periodic
+                                            : scene_.fluid.boundaries.sides[0].kind == BoundaryKind::Periodic;
+    const std::vector<uint8_t> rgb = normalMapRgb(height, {o.normalStrength, periodic});
+    std::string err;
+    const std::filesystem::path png = normals_ / fmt::format("{:06d}.png", at.frame);
+    if (!writeRgb8(png.string(), height.dim(0), height.dim(1), rgb, &err))
+      throw std::runtime_error("writing " + png.string() + ": " + err);
+    FieldDump d;
+    d.resolution = {height.dim(0), height.dim(1)};
+    d.names = {"height"};
+    d.channels = {height.values()};
+    d.time = sim.time();
+    d.step = at.step;
+    const std::filesystem::path exr = heights_ / fmt::format("{:06d}.exr", at.frame);
+    if (!writeFieldDump(exr.string(), d, &err)) throw std::runtime_error("writing " + exr.string() + ": " + err);
+    ++written_;
+    bytes_ += fileBytes(png) + fileBytes(exr);
+  }
+}
+
+template <int D>
+void NormalMapSink<D>::report(nlohmann::json* j) const {
+  (*j)["normal_maps_written"] = written_;
+  addBytes(j, "normal_maps", bytes_);
+}
+
+template <int D>
+nlohmann::json NormalMapSink<D>::state() const {
+  return {{"written", written_}, {"bytes", bytes_}};
+}
+
+template <int D>
+void NormalMapSink<D>::restore(const nlohmann::json& s) {
+  written_ = s.at("written").get<int>();
+  bytes_ = s.at("bytes").get<uintmax_t>();
+}
+
+template <int D>
+std::vector<std::unique_ptr<OutputSink<D>>> makeOutputSinks(const std::filesystem::path& out, const Scene& scene,
+                                                            const std::function<bool()>& cancelled) {
+  std::vector<std::unique_ptr<OutputSink<D>>> sinks;
+  if (scene.output.images) {
+    auto images = std::make_unique<ImageSink<D>>(out, scene);
+    images->cancelled = cancelled;
+    sinks.push_back(std::move(images));
+  }
+  if (scene.output.fields) sinks.push_back(std::make_unique<FieldDumpSink<D>>(out));
+  if (scene.output.vdb) sinks.push_back(std::make_unique<VdbSink<D>>(out, scene));
+  if (scene.output.normalMap) sinks.push_back(std::make_unique<NormalMapSink<D>>(out, scene));
+  return sinks;
+}
+
+template class ImageSink<2>;
+template class ImageSink<3>;
+template class FieldDumpSink<2>;
+template class FieldDumpSink<3>;
+template class NormalMapSink<2>;
+template class NormalMapSink<3>;
+template std::vector<std::unique_ptr<OutputSink<2>>> makeOutputSinks<2>(const std::filesystem::path&, const Scene&,
+                                                                         const std::function<bool()>&);
+template std::vector<std::unique_ptr<OutputSink<3>>> makeOutputSinks<3>(const std::filesystem::path&, const Scene&,
+                                                                         const std::function<bool()>&);
+
+}  // namespace morphoflow

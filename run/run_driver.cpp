@@ -1,0 +1,268 @@
+#include "run/run_driver.h"
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <optional>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "run/checkpoint.h"
+#include "run/frame_schedule.h"
+#include "run/memory_estimate.h"
+#include "run/output_sinks.h"
+#include "run/run_clock.h"
+#include "run/run_folder.h"
+#include "run/run_log.h"
+#include "run/scene_hash.h"
+#include "run/stop_signal.h"
+#include "run/version.h"
+#include "core/output_file.h"
+#include "core/parallel.h"
+
+namespace fs = std::filesystem;
+
+namespace morphoflow {
+
+namespace {
+
+// How the run is clocked: a reaction-diffusion-only scene takes whole steps
+// of time.dt (duration / dt of them); a fluid may adapt dt and clip the last.
+TimeSettings runTime(const Scene& scene) {
+  TimeSettings t = scene.time;
+  if (!scene.hasFluid) {
+    t.steps = scene.totalSteps();
+    t.cfl = 0.0;
+  }
+  return t;
+}
+
+uintmax_t peakMemoryBytes() {
+  struct rusage u {};
+  getrusage(RUSAGE_SELF, &u);
+  return uintmax_t(u.ru_maxrss) * 1024;
+}
+
+// One run of one simulation: the loop, its outputs and its records.
+template <int D>
+class Driver {
+ public:
+  Driver(Simulation<D>& sim, const Scene& scene, const RunOptions& opt, RunLog* log)
+      : sim_(sim), scene_(scene), opt_(opt), log_(*log), out_(opt.out), schedule_(scene.output.every, opt),
+        clock_(runTime(scene)), hash_(sceneHash(scene)) {}
+
+  int run() {
+    createOutputFolder(out_);
+    if (opt_.resume) resume();
+    else removeEarlierRun(out_, safeFileStem(scene_.name));
+    sinks_ = makeOutputSinks<D>(out_, scene_, [] { return StopSignals::received() != 0; });
+    if (checkpoint_) restoreSinks();
+    try {
+      return loop();
+    } catch (const NonFiniteError& e) {
+      // Every frame and checkpoint written so far stays: each was checked finite.
+      fail("diverged", e.what());
+      throw UserError({scene_.path, 0, 0}, "", e.what(), e.hint());
+    } catch (const std::exception& e) {
+      fail("failed", e.what());
+      throw;
+    }
+  }
+
+ private:
+  int loop() {
+    const long stepsEstimate = scene_.hasFluid ? scene_.totalSteps() : runTime(scene_).steps;
+    const double endTime = scene_.time.steps > 0 ? 0.0 : scene_.time.duration;
+    if (!checkpoint_) frame();
+    while (clock_.running(sim_.steps(), sim_.time()) && !schedule_.pastLast(sim_.steps())) {
+      if (StopSignals::received()) return stop();
+      lastDt_ = clock_.dt(sim_);
+      sim_.advance(lastDt_, stepsNow());
+      const long f = frame();
+      if (f > 0 && scene_.output.checkpointEvery > 0 && f % scene_.output.checkpointEvery == 0) saveCheckpoint();
+      log_.progress(lastFrame_, sim_.steps(), stepsEstimate, sim_.time(), endTime);
+    }
+    checkFinite();
+    log_.endProgress();
+    for (const auto& s : sinks_) s->finish();
+    if (StopSignals::received()) return stop();
+    for (const auto& [path, text] : sim_.measurementFiles()) {
+      createOutputFolder((out_ / path).parent_path());
+      writeFileAtomically(out_ / path, text);
+      measurementBytes_ += text.size();
+    }
+    saveCheckpoint();
+    const nlohmann::json j = record("completed");
+    if (j.contains("video") && !j["video"]["written"].get<bool>())
+      log_.warn("warning: " + j["video"]["warning"].get<std::string>());
+    log_.say(fmt::format("done: {} steps, t = {:.5g}, {:.2f} s wall, {} frames -> {}", sim_.steps(), sim_.time(),
+                         wallSeconds(), j["frames_written"].get<int>(), out_.string()));
+    writeLog();
+    return 0;
+  }
+
+  // The steps to take at once: as many as the simulation takes faster
+  // together, up to the next step that may write a frame (frames and
+  // checkpoints fall on output.every) and the run's last; one where dt may change.
+  long stepsNow() const {
+    const long together = sim_.stepsTogether(), step = sim_.steps();
+    if (together <= 1 || !clock_.fixedDt()) return 1;
+    return std::min({together, schedule_.every() - step % schedule_.every(), clock_.stepsLeft(step)});
+  }
+
+  void fail(const std::string& exitState, const std::string& error) {
+    log_.endProgress();
+    log_.keep(exitState + ": " + error);
+    record(exitState, error);
+    try {
+      writeLog();
+    } catch (const std::exception&) {  // the first error is the one to report
+    }
+  }
+
+  // The finiteness check at the current step, naming the last step found finite.
+  void checkFinite() {
+    sim_.checkFinite(checkedStep_ < 0 ? fmt::format("at step {}", sim_.steps())
+                                      : fmt::format("by step {} (finite at step {})", sim_.steps(), checkedStep_));
+    checkedStep_ = sim_.steps();
+  }
+
+  // Writes the frame of the current step, if it has one; returns its number or -1.
+  long frame() {
+    const long f = schedule_.frameAt(sim_.steps());
+    if (f < 0) return -1;
+    checkFinite();
+    for (const auto& s : sinks_) s->write(FrameInfo{f, sim_.steps(), lastDt_ > 0 ? lastDt_ : scene_.time.dt}, sim_);
+    lastFrame_ = f;
+    return f;
+  }
+
+  // SIGINT or SIGTERM: the step is done; checkpoint, say where, 128 + signal.
+  int stop() {
+    const int sig = StopSignals::received();
+    log_.endProgress();
+    const fs::path file = saveCheckpoint();
+    log_.warn(fmt::format("interrupted by {} at step {} (t = {:.5g}); checkpoint {}; continue with --resume",
+                          sig == SIGINT ? "SIGINT" : "SIGTERM", sim_.steps(), sim_.time(), file.string()));
+    record("interrupted");
+    writeLog();
+    return 128 + sig;
+  }
+
+  fs::path saveCheckpoint() {
+    nlohmann::json sinks = nlohmann::json::array();
+    for (const auto& s : sinks_) sinks.push_back(s->state());
+    const nlohmann::json header = {{"version", kVersion},      {"scene_hash", hash_},      {"scene", scene_.resolvedJson},
+                                   {"step", sim_.steps()},     {"time", sim_.time()},      {"last_frame", lastFrame_},
+                                   {"sinks", sinks},           {"log", log_.text()},       {"checkpoint_bytes", checkpointBytes_}};
+    const fs::path file = writeCheckpoint(out_, sim_.steps(), header, [this](StateWriter* w) { sim_.save(w); });
+    checkpointBytes_ += fileBytes(file);
+    return file;
+  }
+
+  void resume() {
+    Checkpoint c = latestCheckpoint(out_, [this](const std::string& line) { log_.warn(line); });
+    const nlohmann::json& h = c.header;
+    if (h.value("scene_hash", "") != hash_ && !opt_.force) {
+      std::vector<std::string> keys = changedKeys(h.value("scene", "{}"), scene_.resolvedJson);
+      throw UserError({c.file.string(), 0, 0}, "--resume",
+                      "the scene differs from the one this checkpoint was written by" +
+                          (keys.empty() ? std::string() : " (changed: " + fmt::format("{}", fmt::join(keys, ", ")) + ")"),
+                      "resume with the scene as it was, add --force to continue anyway, or run without --resume");
+    }
+    try {
+      sim_.load(StateReader(std::move(c.state)));
+    } catch (const StateError& e) {
+      throw UserError({c.file.string(), 0, 0}, "--resume", std::string("the checkpoint does not fit this scene: ") + e.what(),
+                      "run the scene without --resume to start it afresh");
+    }
+    lastFrame_ = h.value("last_frame", -1L);
+    checkpointBytes_ = h.value("checkpoint_bytes", uintmax_t(0));
+    log_.restore(h.value("log", ""));
+    log_.say(fmt::format("resumed from {} (step {}, t = {:.5g})", c.file.string(), sim_.steps(), sim_.time()));
+    resumedFrom_ = c.file.string();
+    checkpoint_ = std::move(c);
+  }
+
+  void restoreSinks() {
+    const nlohmann::json& states = checkpoint_->header.at("sinks");
+    if (states.size() != sinks_.size())
+      throw UserError({checkpoint_->file.string(), 0, 0}, "--resume", "the checkpoint was written with other outputs",
+                      "resume with the outputs as they were, or run without --resume");
+    for (size_t i = 0; i < sinks_.size(); ++i) sinks_[i]->restore(states[i]);
+  }
+
+  // run.json, with how the run ended.
+  nlohmann::json record(const std::string& exitState, const std::string& error = {}) {
+    nlohmann::json j;
+    j["version"] = kVersion;
+    j["scene_file"] = scene_.path;
+    j["scene"] = nlohmann::json::parse(scene_.resolvedJson);
+    j["settings_hash"] = hash_;
+    j["overrides"] = opt_.overrides;
+    j["resolved"] = sim_.resolved();
+    j["backend"] = opt_.backend;
+    j["threads"] = opt_.threads > 0 ? opt_.threads : hardwareThreads();
+    j["steps"] = sim_.steps();
+    j["time"] = sim_.time();
+    j["frames_written"] = 0;
+    j["fields_written"] = 0;
+    j["wall_seconds"] = wallSeconds();
+    j["exit_state"] = exitState;
+    if (!error.empty()) j["error"] = error;
+    if (!resumedFrom_.empty()) j["resumed_from"] = resumedFrom_;
+    j["peak_memory_bytes"] = peakMemoryBytes();
+    j["memory_estimate_bytes"] = estimateRunBytes(scene_);
+    j["bytes_written"] = nlohmann::json::object();
+    for (const auto& s : sinks_) s->report(&j);
+    addBytes(&j, "checkpoints", checkpointBytes_);
+    addBytes(&j, "measurements", measurementBytes_);
+    sim_.report(&j);
+    try {
+      writeFileAtomically(out_ / "run.json", j.dump(2) + "\n");
+    } catch (const std::exception&) {
+      if (exitState == "completed") throw;  // a failed run keeps its first error
+    }
+    return j;
+  }
+
+  void writeLog() { writeFileAtomically(out_ / "log.txt", log_.text()); }
+
+  double wallSeconds() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0_).count();
+  }
+
+  Simulation<D>& sim_;
+  const Scene& scene_;
+  const RunOptions& opt_;
+  RunLog& log_;
+  const fs::path out_;
+  const FrameSchedule schedule_;
+  const RunClock clock_;
+  const std::string hash_;
+  std::vector<std::unique_ptr<OutputSink<D>>> sinks_;
+  std::optional<Checkpoint> checkpoint_;
+  std::string resumedFrom_;
+  long lastFrame_ = -1;
+  long checkedStep_ = -1;
+  double lastDt_ = 0.0;
+  uintmax_t checkpointBytes_ = 0, measurementBytes_ = 0;
+  const std::chrono::steady_clock::time_point wall0_ = std::chrono::steady_clock::now();
+};
+
+}  // namespace
+
+template <int D>
+int driveRun(Simulation<D>& sim, const Scene& scene, const RunOptions& opt, RunLog* log) {
+  StopSignals signals;
+  return Driver<D>(sim, scene, opt, log).run();
+}
+
+template int driveRun<2>(Simulation<2>&, const Scene&, const RunOptions&, RunLog*);
+template int driveRun<3>(Simulation<3>&, const Scene&, const RunOptions&, RunLog*);
+
+}  // namespace morphoflow

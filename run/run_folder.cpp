@@ -1,0 +1,64 @@
+#include "run/run_folder.h"
+
+#include <fstream>
+#include <regex>
+
+#include <nlohmann/json.hpp>
+
+namespace fs = std::filesystem;
+
+namespace morphoflow {
+
+namespace {
+
+// Removes the regular files in `dir` whose names match `pattern`, then `dir`
+// itself if that left it empty.
+int removeMatching(const fs::path& dir, const std::regex& pattern) {
+  std::error_code ec;
+  if (!fs::is_directory(fs::symlink_status(dir, ec))) return 0;
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (fs::is_regular_file(e.symlink_status(ec)) && std::regex_match(name, pattern) && fs::remove(e.path(), ec)) ++n;
+  }
+  if (fs::is_empty(dir, ec)) fs::remove(dir, ec);
+  return n;
+}
+
+}  // namespace
+
+int removeEarlierRun(const fs::path& out, const std::string& videoStem) {
+  const std::string tmp = R"((\.tmp(\.[a-z]+)?|\.part)?)";
+  int n = 0;
+  n += removeMatching(out / "frames", std::regex(R"(\d{6}\.(png|exr))" + tmp));
+  n += removeMatching(out / "fields", std::regex(R"(\d{6}\.exr)" + tmp));
+  n += removeMatching(out / "vdb", std::regex(R"(.+\.\d{6}\.(vdb|nvdb))" + tmp));
+  n += removeMatching(out / "checkpoints", std::regex(R"(\d{10}\.ckpt)" + tmp));
+  n += removeMatching(out / "profiles", std::regex(R"((u_vertical|v_horizontal)_centerline\.csv)" + tmp));
+  // The earlier run's video may have had another name.
+  std::string earlierVideo;
+  try {
+    std::error_code ec;
+    std::ifstream in;
+    if (fs::is_regular_file(fs::symlink_status(out / "run.json", ec))) in.open(out / "run.json");  // never a pipe
+    if (in) {
+      const nlohmann::json j = nlohmann::json::parse(in);
+      if (j.contains("video") && j["video"].contains("file"))
+        earlierVideo = fs::path(j["video"]["file"].get<std::string>()).stem().string();
+    }
+  } catch (const std::exception&) {
+  }
+  std::string top = R"((run\.json|log\.txt|forces\.csv)" + tmp + ")";
+  for (const std::string& stem : {videoStem, earlierVideo})
+    if (!stem.empty()) top += "|" + std::regex_replace(stem, std::regex(R"([.^$|()\[\]{}*+?\\])"), R"(\$&)") +
+                              R"((\.mp4(\.part)?|\.ffmpeg\.log))";
+  std::error_code ec;
+  const std::regex topPattern(top);
+  for (const auto& e : fs::directory_iterator(out, ec)) {
+    const std::string name = e.path().filename().string();
+    if (fs::is_regular_file(e.symlink_status(ec)) && std::regex_match(name, topPattern) && fs::remove(e.path(), ec)) ++n;
+  }
+  return n;
+}
+
+}  // namespace morphoflow

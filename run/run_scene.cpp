@@ -1,0 +1,37 @@
+// `morphoflow run`: a scene file to its Simulation (sim/simulation_factory.h),
+// through the run driver.
+#include <memory>
+
+#include "core/error.h"
+#include "core/parallel.h"
+#include "run/memory_estimate.h"
+#include "run/run_driver.h"
+#include "run/run_log.h"
+#include "run/run_options.h"
+#include "scenes/scene_loader.h"
+#include "sim/simulation_factory.h"
+
+namespace morphoflow {
+
+namespace {
+
+template <int D>
+int run(const Scene& scene, const RunOptions& opt, Backend backend) {
+  RunLog log(opt.quiet, stderrIsTerminal());
+  std::unique_ptr<Simulation<D>> sim = makeSimulation<D>(
+      scene, backend, [&log](const std::string& line) { log.say(line); }, [&log](const std::string& line) { log.warn(line); });
+  return driveRun<D>(*sim, scene, opt, &log);
+}
+
+}  // namespace
+
+int runScene(const RunOptions& opt) {
+  const Backend backend = backendNamed(opt.backend);
+  Scene scene = loadScene(opt.scene, opt.overrides);
+  checkBackend(scene, backend);
+  checkRunFits(scene);
+  ThreadLimit limit(backend == Backend::Serial ? 1 : opt.threads);
+  return scene.dimension == 2 ? run<2>(scene, opt, backend) : run<3>(scene, opt, backend);
+}
+
+}  // namespace morphoflow

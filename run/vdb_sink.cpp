@@ -1,0 +1,107 @@
+#include "run/vdb_sink.h"
+
+#include <algorithm>
+
+#include <fmt/format.h>
+
+#include "run/scene_hash.h"
+#include "run/version.h"
+#include "core/output_file.h"
+
+namespace morphoflow {
+
+namespace {
+
+template <int D>
+VolumeGrid volumeGrid(const std::string& name, VolumeGrid::Kind kind, std::vector<Grid<float, D>> components,
+                      double domainWidth, int extraVoxels = 0) {
+  VolumeGrid g;
+  g.name = name;
+  g.kind = kind;
+  const IVec<D>& n = components.front().dims();
+  for (int a = 0; a < D; ++a) g.cells[size_t(a)] = n[a];
+  g.voxelSize = domainWidth / (n[0] - extraVoxels);
+  for (Grid<float, D>& c : components) g.values.push_back(c.values());
+  // A 2D velocity has no z component; a volume's vector has three.
+  if (kind == VolumeGrid::Kind::Vector || kind == VolumeGrid::Kind::Staggered)
+    while (g.values.size() < 3) g.values.emplace_back(g.values.front().size(), 0.0f);
+  return g;
+}
+
+}  // namespace
+
+template <int D>
+VdbSink<D>::VdbSink(const std::filesystem::path& out, const Scene& scene)
+    : dir_(out / "vdb"), scene_(scene), hash_(sceneHash(scene)) {
+  createOutputFolder(dir_);
+}
+
+template <int D>
+std::vector<VolumeGrid> VdbSink<D>::grids(const Simulation<D>& sim) const {
+  using K = VolumeGrid::Kind;
+  const double width = scene_.fluid.size[0];
+  const OutputSettings& o = scene_.output;
+  std::vector<VolumeGrid> g;
+  for (const std::string& s : sim.species()) g.push_back(volumeGrid<D>(s, K::Scalar, sim.field(s), width));
+  g.push_back(volumeGrid<D>("density", K::FogVolume, sim.field(o.vdbDensity), width));
+  const std::vector<std::string> names = sim.fieldNames();
+  if (std::find(names.begin(), names.end(), "velocity") != names.end())
+    g.push_back(volumeGrid<D>("vel", K::Vector, sim.field("velocity"), width));
+  // The MAC faces exactly (cells + 1 voxels per axis), for a later run to read back (docs/vfx.md).
+  if (o.vdbMacVelocity) g.push_back(volumeGrid<D>("vel_mac", K::Staggered, sim.field("velocity_mac"), width, 1));
+  for (const std::string& f : o.vdbFields) g.push_back(volumeGrid<D>(f, K::Scalar, sim.field(f), width));
+  if (sim.hasObstacles()) g.push_back(volumeGrid<D>("obstacle", K::LevelSet, sim.field("obstacle"), width));
+  return g;
+}
+
+template <int D>
+void VdbSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
+  const OutputSettings& o = scene_.output;
+  const std::vector<VolumeGrid> g = grids(sim);
+  VolumeMetadata meta;
+  meta.frame = at.frame;
+  meta.step = at.step;
+  meta.time = sim.time();
+  meta.dt = at.dt;
+  meta.scene = scene_.name;
+  meta.version = kVersion;
+  meta.settingsHash = hash_;
+  for (int a = 0; a < D; ++a) meta.domain[size_t(a)] = scene_.fluid.size[size_t(a)];
+  meta.units = "lengths in the scene's domain units (world space fills [0, domain.size]); time in its time units; "
+               "vel in domain units per time unit";
+  const VolumeOptions options{float(o.vdbTolerance), o.vdbHalf};
+  const std::string stem = fmt::format("{}.{:06d}", safeFileStem(scene_.name), at.frame);
+  const std::string vdb = encodeVdb(g, meta, options);
+  writeFileAtomically(dir_ / (stem + ".vdb"), vdb);
+  bytes_ += vdb.size();
+  if (o.nanovdb) {
+    const std::string nvdb = encodeNanoVdb(g, meta, options);
+    writeFileAtomically(dir_ / (stem + ".nvdb"), nvdb);
+    nanoBytes_ += nvdb.size();
+  }
+  ++written_;
+}
+
+template <int D>
+void VdbSink<D>::report(nlohmann::json* j) const {
+  (*j)["vdb_written"] = written_;
+  addBytes(j, "vdb", bytes_);
+  if (scene_.output.nanovdb) addBytes(j, "nanovdb", nanoBytes_);
+}
+
+template <int D>
+nlohmann::json VdbSink<D>::state() const {
+  return {{"written", written_}, {"bytes", bytes_}, {"nano_bytes", nanoBytes_}};
+}
+
+template <int D>
+void VdbSink<D>::restore(const nlohmann::json& s) {
+  written_ = s.at("written").get<int>();
+  bytes_ = s.at("bytes").get<uintmax_t>();
+  nanoBytes_ = s.at("nano_bytes").get<uintmax_t>();
+}
+
+template class VdbSink<2>;
+template class VdbSink<3>;
+
+}  // namespace morphoflow

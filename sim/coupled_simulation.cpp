@@ -1,0 +1,227 @@
+#include "sim/coupled_simulation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "sim/fluid_simulation.h"
+#include "sim/gpu_simulation.h"
+#include "gpu/gpu_ard_solver.h"
+#include "core/stage_trace.h"
+#include "sim/rd_scene_setup.h"
+#include "core/parallel.h"
+#include "rd/model_registry.h"
+
+namespace morphoflow {
+
+namespace {
+
+// The advection domain of the RD grid: the fluid's walls, inflow sides and
+// obstacles (sampled at RD cell centres).
+template <int D>
+ChemicalDomain<D> chemicalDomain(const Scene& scene, const FluidSolver<D>& fluid, const RDSolver<D>& rd) {
+  ChemicalDomain<D> d;
+  d.cells = rd.cells();
+  d.h = rd.h();
+  d.periodic = fluid.constraints().periodic();
+  for (int a = 0; a < D; ++a)
+    for (int hi = 0; hi < 2; ++hi)
+      d.inflow[size_t(a)][size_t(hi)] = scene.fluid.boundaries.side(a, hi != 0).kind == BoundaryKind::Inflow;
+  d.inflowValues = scene.coupling.inflowValues;
+  d.solidValues = scene.coupling.solidValues;
+  const Grid<uint8_t, D>& solid = fluid.solid();
+  bool any = false;
+  std::vector<uint8_t> mask(rd.field(0).size(), 0);
+  forEachCell<D>(d.cells, [&](const IVec<D>& k, size_t i) {
+    IVec<D> f;
+    for (int a = 0; a < D; ++a)
+      f[a] = std::clamp(int(std::floor((k[a] + 0.5) * d.h / fluid.h())), 0, fluid.cells()[a] - 1);
+    mask[i] = solid(f);
+  });
+  for (uint8_t m : mask) any |= m != 0;
+  if (any) d.solid = std::move(mask);
+  return d;
+}
+
+}  // namespace
+
+template <int D>
+struct CoupledSimulation<D>::Gpu {
+  GpuFluid<D> fluid;
+  GpuRDLayer<D> layer;
+  GpuARDSolver<D> ard;
+  Gpu(const Scene& scene, const FluidSolver<D>& f, const RDSolver<D>& rd, const ChemicalDomain<D>& domain)
+      : fluid(scene.fluid, f.constraints()),
+        layer(rd),
+        ard(&layer, domain, scene.coupling.interpolation,
+            scene.coupling.mode, scene.coupling.rdTimeScale, f.cells(), f.h()) {
+    fluid.upload(f.velocity(), f.dye());
+  }
+};
+
+template <int D>
+CoupledSimulation<D>::CoupledSimulation(const Scene& scene, CouplingBackend backend, Warn warn, bool gpu)
+    : scene_(scene), backend_(backend), warn_(std::move(warn)), fluid_(scene.fluid), rd_(scene.rd.settings, *findModel(scene.rd.settings.model)) {
+  checkFluidLeft<D>(scene, fluid_);
+  initialState<D>(scene, &rd_);
+  applyScene<D>(scene, &rd_);
+  const CouplingScene& C = scene.coupling;
+  const ChemicalDomain<D> domain = chemicalDomain<D>(scene, fluid_, rd_);
+  ard_ = std::make_unique<ARDSolver<D>>(
+      &rd_, ChemicalAdvector<D>(domain, C.interpolation),
+      C.mode, C.rdTimeScale);
+  stepper_ = std::make_unique<CoupledStepper<D>>(&fluid_, ard_.get(), backend);
+  if (gpu) gpu_ = std::make_unique<Gpu>(scene, fluid_, rd_, domain);  // from the state the CPU set up
+}
+
+template <int D>
+CoupledSimulation<D>::~CoupledSimulation() = default;
+
+template <int D>
+double CoupledSimulation<D>::cflTimeStep(double cfl, double dtMax) const {
+  return gpu_ ? gpu_->fluid.cflTimeStep(cfl, dtMax) : fluid_.cflTimeStep(cfl, dtMax);
+}
+
+// The ARD step reads velocity n, then the fluid writes n + 1: the CPU's
+// serial order (coupled_stepper.h), with no copy of the velocity needed.
+template <int D>
+void CoupledSimulation<D>::stepGpu(double dt) {
+  const double t0 = traceClock();
+  gpu_->ard.step(dt, gpu_->fluid);
+  gpu_->fluid.step(dt);
+  // the GPU's own time of each side (timer queries, a step late)
+  for (double s : gpu_->ard.stageSeconds()) ardSeconds_ += s;
+  for (double s : gpu_->fluid.lastStats().seconds) fluidSeconds_ += s;
+  stepSeconds_ += traceClock() - t0;
+  time_ += dt;
+  ++steps_;
+  hostStale_ = true;
+}
+
+template <int D>
+void CoupledSimulation<D>::syncHost() const {
+  if (!gpu_ || !hostStale_) return;
+  gpu_->fluid.download(&fluid_.velocity(), &fluid_.dye());
+  fluid_.adopt(time_, steps_, gpu_->fluid.phi(), gpu_->fluid.lastDt());
+  for (int s = 0; s < gpu_->layer.species(); ++s) rd_.field(s).values() = gpu_->layer.download(s);
+  hostStale_ = false;
+}
+
+template <int D>
+void CoupledSimulation<D>::step(double dt) {
+  if (gpu_) {
+    stepGpu(dt);
+  } else {
+    stepper_->step(dt);
+    fluidSeconds_ += stepper_->fluidSeconds();
+    ardSeconds_ += stepper_->ardSeconds();
+    stepSeconds_ += stepper_->stepSeconds();
+  }
+  const FluidStepStats& fs = gpu_ ? gpu_->fluid.lastStats() : fluid_.lastStats();
+  pressureIterations_ += fs.pressure.iterations;
+  diffusionIterations_ += (gpu_ ? gpu_->layer.lastStats() : rd_.lastStats()).diffusion.iterations;
+  const SolverResult& pressure = fs.pressure;
+  if (!pressure.converged && unconverged_++ == 0)
+    warn_(fmt::format("warning: step {}: pressure solve stopped at relative residual {:.2e} after {} iterations",
+                      steps(), pressure.residual, pressure.iterations));
+  // (gpu: a velocity that is not finite makes the pressure residual NaN)
+  if (gpu_ ? !std::isfinite(pressure.residual) : !std::isfinite(fluid_.maxSpeed()))
+    throw NonFiniteError(fmt::format("the simulation diverged at step {} in the fluid step: the velocity is not finite", steps()),
+                         "use a smaller time.dt or set time.cfl, and check the forces and boundary speeds");
+}
+
+template <int D>
+std::vector<std::string> CoupledSimulation<D>::fieldNames() const {
+  std::vector<std::string> names = species();
+  for (const std::string& f : fluidFieldNames()) names.push_back(f);
+  return names;
+}
+
+template <int D>
+std::vector<Grid<float, D>> CoupledSimulation<D>::field(const std::string& name) const {
+  syncHost();
+  const std::vector<std::string> sp = species();
+  if (std::find(sp.begin(), sp.end(), name) != sp.end()) return speciesField<D>(rd_, name);
+  return fluidField<D>(fluid_, name);
+}
+
+template <int D>
+void CoupledSimulation<D>::checkFinite(const std::string& when) const {
+  syncHost();
+  checkFluidFinite<D>(fluid_, when);
+  morphoflow::checkFinite<D>(rd_, when, "the advection-reaction-diffusion step (" + rdStage(rd_.settings()) + ")");
+}
+
+template <int D>
+void CoupledSimulation<D>::save(StateWriter* out) const {
+  syncHost();
+  fluid_.save(out);
+  rd_.save(out);
+  if (gpu_) {
+    gpu_->fluid.save(out);
+    gpu_->layer.save(out);
+  }
+  out->put("coupled.stats.seconds", std::array<double, 3>{fluidSeconds_, ardSeconds_, stepSeconds_});
+  out->put("coupled.stats.iterations", std::array<long, 2>{pressureIterations_, diffusionIterations_});
+  out->put("coupled.stats.unconverged", unconverged_);
+}
+
+template <int D>
+void CoupledSimulation<D>::load(const StateReader& in) {
+  fluid_.load(in);
+  rd_.load(in);
+  if (gpu_) {
+    gpu_->fluid.upload(fluid_.velocity(), fluid_.dye());
+    gpu_->fluid.load(in);
+    for (int s = 0; s < gpu_->layer.species(); ++s) gpu_->layer.upload(s, rd_.field(s).values());
+    gpu_->layer.load(in);
+    time_ = fluid_.time();
+    steps_ = fluid_.steps();
+  }
+  std::array<double, 3> s{};
+  std::array<long, 2> it{};
+  in.get("coupled.stats.seconds", &s);
+  in.get("coupled.stats.iterations", &it);
+  in.get("coupled.stats.unconverged", &unconverged_);
+  fluidSeconds_ = s[0], ardSeconds_ = s[1], stepSeconds_ = s[2];
+  pressureIterations_ = it[0], diffusionIterations_ = it[1];
+}
+
+template <int D>
+nlohmann::json CoupledSimulation<D>::resolved() const {
+  const CouplingScene& C = scene_.coupling;
+  return {{"dimension", D},
+          {"resolution", scene_.fluid.resolution},
+          {"size", scene_.fluid.size},
+          {"reynolds", scene_.reynolds},
+          {"model", rd_.model().info().name},
+          {"species", species()},
+          {"rd_resolution", scene_.rd.settings.resolution},
+          {"rd_cell_size", rd_.h()},
+          {"diffusion", rd_.diffusion()},
+          {"coupling_mode", couplingModeName(C.mode)},
+          {"interpolation", interpolationName(C.interpolation)},
+          {"rd_time_scale", C.rdTimeScale},
+          {"dt", scene_.time.dt},
+          {"cfl", scene_.time.cfl}};
+}
+
+template <int D>
+void CoupledSimulation<D>::report(nlohmann::json* j) const {
+  const double steps = double(this->steps());
+  if (gpu_) recordGlContext(j);
+  (*j)["coupling"] = {{"fluid_seconds", fluidSeconds_},
+                      {"ard_seconds", ardSeconds_},
+                      {"step_seconds", stepSeconds_},
+                      {"overlapped", !gpu_ && backend_ != CouplingBackend::Serial}};
+  (*j)["solvers"] = {{"pressure_iterations_mean", steps ? double(pressureIterations_) / steps : 0.0},
+                     {"pressure_unconverged_steps", unconverged_},
+                     {"diffusion_iterations_mean", steps ? double(diffusionIterations_) / steps : 0.0}};
+}
+
+template class CoupledSimulation<2>;
+template class CoupledSimulation<3>;
+
+}  // namespace morphoflow

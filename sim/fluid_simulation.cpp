@@ -1,0 +1,280 @@
+#include "sim/fluid_simulation.h"
+
+#include "core/error.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <fmt/format.h>
+
+#include "sim/gpu_simulation.h"
+#include "core/parallel.h"
+#include "fluid/probes.h"
+
+namespace morphoflow {
+
+template <int D>
+void initialiseDye(const Scene& scene, FluidSolver<D>* f) {
+  if (scene.dye.initial == "none") return;
+  const int n = scene.dye.stripes;
+  Grid<float, D>& dye = f->dye();
+  const IVec<D>& cells = f->cells();
+  forEachCell<D>(cells, [&](const IVec<D>& k, size_t i) {
+    int bx = int(std::floor(double(k[0]) / cells[0] * n));
+    int by = int(std::floor(double(k[1]) / cells[1] * n));
+    bool on = scene.dye.initial == "stripes" ? bx % 2 == 0 : (bx + by) % 2 == 0;
+    dye[i] = on && !f->solid()[i] ? 1.0f : 0.0f;
+  });
+}
+
+std::vector<std::string> fluidFieldNames() { return {"speed", "vorticity", "pressure", "dye", "velocity", "obstacle"}; }
+
+template <int D>
+std::vector<Grid<float, D>> fluidField(const FluidSolver<D>& f, const std::string& name) {
+  if (name == "speed") return {speedField(f)};
+  if (name == "vorticity") return {vorticityField(f)};
+  if (name == "dye") return {f.dye()};
+  if (name == "pressure") return {f.pressure()};
+  if (name == "obstacle") {
+    Grid<float, D> s(f.cells(), 0.0f);
+    for (size_t i = 0; i < s.size(); ++i) s[i] = f.solid()[i] ? 1.0f : 0.0f;
+    return {s};
+  }
+  if (name == "velocity") {
+    std::vector<Grid<float, D>> v(static_cast<size_t>(D), Grid<float, D>(f.cells(), 0.0f));
+    forEachCell<D>(f.cells(), [&](const IVec<D>& k, size_t i) {
+      const Vec<D> u = f.velocity().atCell(k);
+      for (int a = 0; a < D; ++a) v[size_t(a)][i] = float(u[a]);
+    });
+    return v;
+  }
+  if (name == "velocity_mac") {  // component a on the faces normal to a, padded to cells + 1 per axis (zeros)
+    std::vector<Grid<float, D>> v(static_cast<size_t>(D), Grid<float, D>(f.cells() + IVec<D>(1), 0.0f));
+    for (int a = 0; a < D; ++a) {
+      const Grid<float, D>& u = f.velocity()[a];
+      for (size_t i = 0; i < u.size(); ++i) v[size_t(a)](u.coord(i)) = u[i];
+    }
+    return v;
+  }
+  throw std::invalid_argument("no fluid field '" + name + "'");
+}
+
+template <int D>
+FluidSimulation<D>::FluidSimulation(const Scene& scene, Warn warn, bool gpu)
+    : scene_(scene), warn_(std::move(warn)), fluid_(scene.fluid) {
+  checkFluidLeft<D>(scene, fluid_);
+  initialiseDye<D>(scene, &fluid_);
+  if (gpu) {
+    gpu_ = std::make_unique<GpuFluid<D>>(scene.fluid, fluid_.constraints());
+    gpu_->upload(fluid_.velocity(), fluid_.dye());
+  }
+  for (int a = 0; a < D; ++a)
+    for (bool hi : {false, true})
+      if (scene.fluid.boundaries.side(a, hi).kind == BoundaryKind::Inflow) flowAxis_ = a;
+  liftAxis_ = flowAxis_ == 1 ? 0 : 1;
+}
+
+template <int D>
+void FluidSimulation<D>::syncHost() const {
+  if (!gpu_ || !hostStale_) return;
+  gpu_->download(&fluid_.velocity(), &fluid_.dye());
+  fluid_.adopt(time_, steps_, gpu_->phi(), gpu_->lastDt());
+  hostStale_ = false;
+}
+
+template <int D>
+double FluidSimulation<D>::cflTimeStep(double cfl, double dtMax) const {
+  return gpu_ ? gpu_->cflTimeStep(cfl, dtMax) : fluid_.cflTimeStep(cfl, dtMax);
+}
+
+template <int D>
+void FluidSimulation<D>::step(double dt) {
+  if (gpu_) {
+    gpu_->step(dt);
+    time_ += dt;
+    ++steps_;
+    hostStale_ = true;
+  } else {
+    fluid_.step(dt);
+  }
+  const FluidStepStats& st = gpu_ ? gpu_->lastStats() : fluid_.lastStats();
+  for (int k = 0; k < FluidStepStats::kStages; ++k) stageTotals_[size_t(k)] += st.seconds[size_t(k)];
+  pressureIterations_ += st.pressure.iterations;
+  viscosityIterations_ += st.viscosity.iterations;
+  maxPressureIterations_ = std::max(maxPressureIterations_, st.pressure.iterations);
+  maxPressureResidual_ = std::max(maxPressureResidual_, st.pressure.residual);
+  if (!st.pressure.converged && unconverged_++ == 0)
+    warn_(fmt::format("warning: step {}: pressure solve stopped at relative residual {:.2e} after {} iterations",
+                      steps(), st.pressure.residual, st.pressure.iterations));
+  // (gpu: a velocity that is not finite makes the divergence, hence the pressure residual, NaN)
+  if (gpu_ ? !std::isfinite(st.pressure.residual) : !std::isfinite(fluid_.maxSpeed()))
+    throw NonFiniteError(fmt::format("the simulation diverged at step {} in the fluid step: the velocity is not finite", steps()),
+                         "use a smaller time.dt or set time.cfl, and check the forces and boundary speeds");
+  if (scene_.probes.forces) {
+    const ProbeSettings& pr = scene_.probes;
+    const double q = 0.5 * scene_.fluid.density * pr.referenceSpeed * pr.referenceSpeed * pr.referenceArea;
+    syncHost();
+    const auto F = obstacleForce<D>(fluid_);
+    forceTime_.push_back(time());
+    drag_.push_back(F[size_t(flowAxis_)] / q);
+    lift_.push_back(F[size_t(liftAxis_)] / q);
+  }
+}
+
+template <int D>
+void FluidSimulation<D>::save(StateWriter* out) const {
+  syncHost();
+  fluid_.save(out);
+  if (gpu_) gpu_->save(out);
+  out->put("fluid.stats.stage_totals", stageTotals_);
+  out->put("fluid.stats.pressure_iterations", pressureIterations_);
+  out->put("fluid.stats.viscosity_iterations", viscosityIterations_);
+  out->put("fluid.stats.pressure_iterations_max", maxPressureIterations_);
+  out->put("fluid.stats.unconverged", unconverged_);
+  out->put("fluid.stats.pressure_residual_max", maxPressureResidual_);
+  out->putVector("fluid.probe.force_time", forceTime_);
+  out->putVector("fluid.probe.drag", drag_);
+  out->putVector("fluid.probe.lift", lift_);
+}
+
+template <int D>
+void FluidSimulation<D>::load(const StateReader& in) {
+  fluid_.load(in);
+  if (gpu_) {
+    gpu_->upload(fluid_.velocity(), fluid_.dye());
+    gpu_->load(in);
+    time_ = fluid_.time();
+    steps_ = fluid_.steps();
+  }
+  in.get("fluid.stats.stage_totals", &stageTotals_);
+  in.get("fluid.stats.pressure_iterations", &pressureIterations_);
+  in.get("fluid.stats.viscosity_iterations", &viscosityIterations_);
+  in.get("fluid.stats.pressure_iterations_max", &maxPressureIterations_);
+  in.get("fluid.stats.unconverged", &unconverged_);
+  in.get("fluid.stats.pressure_residual_max", &maxPressureResidual_);
+  const size_t n = scene_.probes.forces ? size_t(steps()) : 0;
+  forceTime_.resize(n);
+  drag_.resize(n);
+  lift_.resize(n);
+  in.getVector("fluid.probe.force_time", &forceTime_);
+  in.getVector("fluid.probe.drag", &drag_);
+  in.getVector("fluid.probe.lift", &lift_);
+}
+
+template <int D>
+nlohmann::json FluidSimulation<D>::resolved() const {
+  const ProbeSettings& pr = scene_.probes;
+  return {{"dimension", D},
+          {"resolution", scene_.fluid.resolution},
+          {"size", scene_.fluid.size},
+          {"cell_size", fluid_.h()},
+          {"viscosity", scene_.fluid.viscosity},
+          {"reynolds", scene_.reynolds},
+          {"reference_length", pr.referenceLength},
+          {"reference_speed", pr.referenceSpeed},
+          {"dt", scene_.time.dt},
+          {"cfl", scene_.time.cfl}};
+}
+
+template <int D>
+void FluidSimulation<D>::report(nlohmann::json* j) const {
+  const double steps = double(this->steps());
+  if (gpu_) {
+    recordGlContext(j);
+    (*j)["pressure_solver"] = "mgpcg";
+  }
+  nlohmann::json stages;
+  for (int k = 0; k < FluidStepStats::kStages; ++k)
+    stages[FluidStepStats::kStageNames[k]] = {{"total_seconds", stageTotals_[size_t(k)]},
+                                              {"ms_per_step", steps ? 1e3 * stageTotals_[size_t(k)] / steps : 0.0}};
+  (*j)["stages"] = stages;
+  (*j)["solvers"] = {{"pressure_iterations_mean", steps ? double(pressureIterations_) / steps : 0.0},
+                     {"pressure_iterations_max", maxPressureIterations_},
+                     {"pressure_residual_max", maxPressureResidual_},
+                     {"pressure_unconverged_steps", unconverged_},
+                     {"viscosity_iterations_mean", steps ? double(viscosityIterations_) / steps : 0.0}};
+  const ProbeSettings& pr = scene_.probes;
+  if (!pr.forces) return;
+  const double start = pr.strouhalStart >= 0 ? pr.strouhalStart : 0.5 * time();
+  const StrouhalEstimate st = estimateStrouhal(forceTime_, lift_, start, pr.referenceLength, pr.referenceSpeed);
+  double cdMean = 0;
+  int n = 0;
+  for (size_t i = 0; i < drag_.size(); ++i)
+    if (forceTime_[i] >= start) {
+      cdMean += drag_[i];
+      ++n;
+    }
+  (*j)["strouhal"] = st.periods > 0 ? nlohmann::json(st.strouhal) : nlohmann::json(nullptr);
+  (*j)["lift"] = {{"periods", st.periods},
+                  {"period_spread", st.periodSpread},
+                  {"period_strouhal", st.periodStrouhal},
+                  {"measured_from_time", start}};
+  (*j)["drag_coefficient_mean"] = n ? cdMean / n : 0.0;
+}
+
+namespace {
+
+std::string profileCsv(const Profile& p) {
+  std::string s = "coord,value\n";
+  for (size_t i = 0; i < p.coord.size(); ++i) s += fmt::format("{:.6f},{:.6f}\n", p.coord[i], p.value[i]);
+  return s;
+}
+
+}  // namespace
+
+template <int D>
+std::vector<std::pair<std::string, std::string>> FluidSimulation<D>::measurementFiles() const {
+  syncHost();
+  std::vector<std::pair<std::string, std::string>> files;
+  const ProbeSettings& pr = scene_.probes;
+  if (pr.centerlines) {
+    // Vertical centreline: u along y; horizontal centreline: v along x.
+    files.push_back({"profiles/u_vertical_centerline.csv", profileCsv(centerlineProfile<D>(fluid_, 0, 1, pr.referenceSpeed))});
+    files.push_back({"profiles/v_horizontal_centerline.csv", profileCsv(centerlineProfile<D>(fluid_, 1, 0, pr.referenceSpeed))});
+  }
+  if (pr.forces) {
+    std::string csv = "step,time,drag_coefficient,lift_coefficient\n";
+    for (size_t i = 0; i < forceTime_.size(); ++i)
+      csv += fmt::format("{},{:.6f},{:.6f},{:.6f}\n", i + 1, forceTime_[i], drag_[i], lift_[i]);
+    files.push_back({"forces.csv", csv});
+  }
+  return files;
+}
+
+template <int D>
+void checkFluidLeft(const Scene& scene, const FluidSolver<D>& fluid) {
+  for (uint8_t solid : fluid.solid().values())
+    if (!solid) return;
+  throw UserError({scene.path, 0, 0}, "obstacles", "the obstacles cover every cell: no fluid is left to simulate",
+                  "make the obstacles smaller than the domain");
+}
+
+template <int D>
+void checkFluidFinite(const FluidSolver<D>& fluid, const std::string& where) {
+  auto finite = [](const Grid<float, D>& g) {
+    for (float v : g.values())
+      if (!std::isfinite(v)) return false;
+    return true;
+  };
+  for (int a = 0; a < D; ++a)
+    if (!finite(fluid.velocity()[a]))
+      throw NonFiniteError(fmt::format("the simulation diverged {} in the fluid step: velocity component {} is not finite",
+                                       where, "xyz"[a]),
+                           "use a smaller time.dt or set time.cfl, and check the forces and boundary speeds");
+  if (fluid.hasDye() && !finite(fluid.dye()))
+    throw NonFiniteError(fmt::format("the simulation diverged {} in the fluid step: the dye is not finite", where),
+                         "use a smaller time.dt or set time.cfl");
+}
+
+template void checkFluidFinite<2>(const FluidSolver<2>&, const std::string&);
+template void checkFluidFinite<3>(const FluidSolver<3>&, const std::string&);
+template void checkFluidLeft<2>(const Scene&, const FluidSolver<2>&);
+template void checkFluidLeft<3>(const Scene&, const FluidSolver<3>&);
+template void initialiseDye<2>(const Scene&, FluidSolver<2>*);
+template void initialiseDye<3>(const Scene&, FluidSolver<3>*);
+template std::vector<Grid<float, 2>> fluidField<2>(const FluidSolver<2>&, const std::string&);
+template std::vector<Grid<float, 3>> fluidField<3>(const FluidSolver<3>&, const std::string&);
+template class FluidSimulation<2>;
+template class FluidSimulation<3>;
+
+}  // namespace morphoflow
