@@ -12,7 +12,7 @@
 #include <fmt/format.h>
 
 #include "batch/batch.h"
-#include "sim/gpu_simulation.h"
+#include "gpu/gl_context.h"
 #include "run/memory_estimate.h"
 #include "run/run_options.h"
 #include "app/texture_commands.h"

@@ -28,7 +28,7 @@ void recordStages(StageTrace* trace, const char* category, const char* const (&n
 
 template <int D>
 CoupledStepper<D>::CoupledStepper(FluidSolver<D>* fluid, ARDSolver<D>* ard, CouplingBackend backend)
-    : fluid_(fluid), ard_(ard), backend_(backend) {}
+    : fluid_(fluid), fluidStepper_(fluid), ard_(ard), backend_(backend) {}
 
 template <int D>
 void CoupledStepper<D>::step(double dt) {

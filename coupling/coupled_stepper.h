@@ -17,6 +17,7 @@
 
 #include "core/stage_trace.h"
 #include "coupling/ard_solver.h"
+#include "coupling/coupled_steps.h"
 #include "fluid/fluid_solver.h"
 
 namespace morphoflow {
@@ -24,11 +25,21 @@ namespace morphoflow {
 enum class CouplingBackend { Serial, TBB };
 
 template <int D>
-class CoupledStepper {
+class CoupledStepper final : public CoupledSteps<D> {
  public:
   CoupledStepper(FluidSolver<D>* fluid, ARDSolver<D>* ard, CouplingBackend backend);
 
-  void step(double dt);
+  void step(double dt) override;
+  const FluidStepper<D>& fluid() const override { return fluidStepper_; }
+  const RDStepStats& layerStats() const override { return ard_->rd().lastStats(); }
+  std::array<double, 3> seconds() const override { return {fluidSeconds_, ardSeconds_, stepSeconds_}; }
+  bool overlapped() const override { return backend_ != CouplingBackend::Serial; }
+  // (the hosts are the solvers stepped)
+  void toHost(FluidSolver<D>*, RDSolver<D>*) const override {}
+  void fromHost(const FluidSolver<D>&, const RDSolver<D>&) override {}
+  void save(StateWriter*) const override {}
+  void load(const StateReader&) override {}
+  void report(nlohmann::json*) const override {}
 
   // Wall seconds of the last step: the fluid's, the ARD's, and the whole step.
   double fluidSeconds() const { return fluidSeconds_; }
@@ -41,6 +52,7 @@ class CoupledStepper {
 
  private:
   FluidSolver<D>* fluid_;
+  CpuFluidStepper<D> fluidStepper_;
   ARDSolver<D>* ard_;
   CouplingBackend backend_;
   double fluidSeconds_ = 0, ardSeconds_ = 0, stepSeconds_ = 0;

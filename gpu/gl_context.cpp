@@ -155,4 +155,22 @@ void GlContext::check(const char* what) {
                              what));
 }
 
+GpuInfo gpuInfo() {
+  GpuInfo g;
+  try {
+    const GlContext& c = GlContext::instance();
+    g = {true, c.renderer(), c.version(), c.platform(), ""};
+  } catch (const std::exception& e) {
+    g.reason = e.what();
+  }
+  return g;
+}
+
+void recordGlContext(nlohmann::json* run) {
+  const GlContext& c = GlContext::instance();
+  (*run)["gl_renderer"] = c.renderer();
+  (*run)["gl_version"] = c.version();
+  (*run)["gl_platform"] = c.platform();
+}
+
 }  // namespace morphoflow

@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <string>
 
+#include <nlohmann/json.hpp>
+
 namespace morphoflow {
 
 // No usable context (no EGL, no GL 4.3): the reason, for exit 2 or a skipped test.
@@ -51,5 +53,16 @@ class GlContext {
   std::unique_ptr<Egl> egl_;
   std::string renderer_, version_, platform_;
 };
+
+// The GL renderer and version ("llvmpipe (LLVM 15.0.6, 256 bits)", "4.5 (Core Profile) Mesa 22.3.6"),
+// or the reason there is no context.
+struct GpuInfo {
+  bool available = false;
+  std::string renderer, version, platform, reason;
+};
+GpuInfo gpuInfo();
+
+// run.json: gl_renderer, gl_version, gl_platform of the context in use.
+void recordGlContext(nlohmann::json* run);
 
 }  // namespace morphoflow

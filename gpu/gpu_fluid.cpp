@@ -9,6 +9,7 @@
 #include "core/multigrid.h"
 #include "fluid/pressure_projection.h"
 #include "gpu/compute_program.h"
+#include "gpu/gl_context.h"
 #include "gpu/gpu_kernels.h"
 #include "gpu/gpu_laplace.h"
 #include "gpu/gpu_multigrid.h"
@@ -45,7 +46,7 @@ size_t GpuFluid<D>::faces(int a) const {
 }
 
 template <int D>
-GpuFluid<D>::GpuFluid(const FluidSettings& s, const VelocityConstraints<D>& vc) : settings_(s), vc_(vc), h_(vc.h) {
+GpuFluid<D>::GpuFluid(const FluidSettings& s, const VelocityConstraints<D>& vc) : settings_(s), h_(vc.h) {
   cellCount_ = 1;
   for (int a = 0; a < D; ++a) {
     cells_[size_t(a)] = vc.cells[a];
@@ -352,6 +353,27 @@ void GpuFluid<D>::step(double dt) {
   timer_->mark(4);
   const std::vector<double> seconds = timer_->endStep();
   for (int k = 0; k < FluidStepStats::kStages; ++k) stats_.seconds[size_t(k)] = seconds[size_t(k)];
+  time_ += dt;
+  ++steps_;
+}
+
+template <int D>
+void GpuFluid<D>::toHost(FluidSolver<D>* host) const {
+  download(&host->velocity(), &host->dye());
+  host->adopt(time_, steps_, phi(), lastDt_);
+}
+
+template <int D>
+void GpuFluid<D>::fromHost(const FluidSolver<D>& host) {
+  upload(host.velocity(), host.dye());
+  time_ = host.time();
+  steps_ = host.steps();
+}
+
+template <int D>
+void GpuFluid<D>::report(nlohmann::json* run) const {
+  recordGlContext(run);
+  (*run)["pressure_solver"] = "mgpcg";
 }
 
 template <int D>

@@ -5,10 +5,14 @@
 // semi-Lagrangian, MacCormack or BFECC; viscosity is implicit (diagonally
 // preconditioned CG: the identity term keeps it well conditioned); the
 // pressure is solved by MGPCG to the scene's relative tolerance. The fields
-// stay on the GPU and leave it only when asked for.
+// stay on the GPU and leave it only when asked for (toHost). What it takes
+// from the CPU is read once, at construction: the settings and the
+// assembled VelocityConstraints (fixed faces, prescribed values, solids,
+// periodic axes); nothing of the CPU solver is read while stepping.
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <memory>
 #include <vector>
 
@@ -17,6 +21,7 @@
 #include "core/state_archive.h"
 #include "fluid/fluid_settings.h"
 #include "fluid/fluid_solver.h"
+#include "fluid/fluid_stepper.h"
 #include "fluid/velocity_constraints.h"
 #include "fluid/viscosity.h"
 #include "gpu/gpu_buffer.h"
@@ -28,22 +33,25 @@ class GpuMultigrid;
 class GpuPcg;
 
 template <int D>
-class GpuFluid {
+class GpuFluid final : public FluidStepper<D> {
  public:
-  // `constraints` must outlive this.
   GpuFluid(const FluidSettings& settings, const VelocityConstraints<D>& constraints);
-  ~GpuFluid();
+  ~GpuFluid() override;
   GpuFluid(const GpuFluid&) = delete;
   GpuFluid& operator=(const GpuFluid&) = delete;
 
-  void step(double dt);
+  void step(double dt) override;
+  double time() const override { return time_; }
+  long steps() const override { return steps_; }
   // The solvers' results, and each stage's time on the GPU in the step
   // before (timer queries: timing never waits on the GPU).
-  const FluidStepStats& lastStats() const { return stats_; }
+  const FluidStepStats& lastStats() const override { return stats_; }
+  // (a velocity that is not finite makes the divergence, hence the pressure residual, NaN)
+  bool finite() const override { return std::isfinite(stats_.pressure.residual); }
   // sqrt(D) max_a max |u_a|, as FluidSolver::maxSpeed (a bound of the speed).
   double maxSpeed() const;
   // Largest dt with maxSpeed() dt <= cfl h (dtMax when the fluid is at rest), as FluidSolver's.
-  double cflTimeStep(double cfl, double dtMax) const;
+  double cflTimeStep(double cfl, double dtMax) const override;
   // Bytes of device memory a fluid of these cells allocates.
   static size_t deviceBytes(const IVec<D>& cells);
 
@@ -55,9 +63,14 @@ class GpuFluid {
   // The velocity buffer (component a at offset(a) floats) for the chemicals' advection.
   const GpuBuffer& velocity() const { return vel_; }
   size_t offset(int a) const { return off_[size_t(a)]; }
+  // The velocity, dye, clock and last projection into `host`; the velocity, dye and clock from it.
+  void toHost(FluidSolver<D>* host) const override;
+  void fromHost(const FluidSolver<D>& host) override;
   // Everything step() reads besides the settings and the fields (checkpoints).
-  void save(StateWriter* out) const;
-  void load(const StateReader& in);
+  void save(StateWriter* out) const override;
+  void load(const StateReader& in) override;
+  // run.json: the GL context and the pressure solver.
+  void report(nlohmann::json* run) const override;
 
  private:
   struct Viscous;
@@ -72,7 +85,8 @@ class GpuFluid {
   std::array<int, 3> velocityOffsets() const;  // the components' offsets in the velocity buffer (uniform velOff)
 
   FluidSettings settings_;
-  const VelocityConstraints<D>& vc_;
+  double time_ = 0.0;
+  long steps_ = 0;
   std::array<int, 3> cells_{1, 1, 1}, periodic_{};
   std::array<size_t, 3> off_{};
   size_t cellCount_ = 0, faceCount_ = 0, maxGrid_ = 0;

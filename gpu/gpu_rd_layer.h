@@ -9,7 +9,7 @@
 // species, periodic, zero-flux and Dirichlet walls, a fixed diffusion tensor
 // (seed 004 eq. 11-17), Kim & Lin's cosine lobes rebuilt from the state
 // every step (shaders/rd_lobes.comp; their systems preconditioned by the
-// diagonal); the host refuses the rest (sim/gpu_simulation.cpp).
+// diagonal); sim/steppers.cpp refuses the rest.
 #pragma once
 
 #include <array>

@@ -5,7 +5,7 @@
 
 #include <fmt/format.h>
 
-#include "sim/rd_simulation.h"
+#include "scenes/scene.h"
 #include "core/error.h"
 
 namespace morphoflow {
@@ -80,7 +80,7 @@ uintmax_t estimateRunBytes(const Scene& s) {
   }
   if (s.rd.enabled) {
     const double species = double(s.rd.initial.values.size());
-    const bool fused = !s.hasFluid && !s.velocity.enabled && fusedExplicitFits(s);
+    const bool fused = !s.hasFluid && !s.velocity.enabled && s.rd.plainExplicit();
     bytes += cellsOf(s.rd.settings.resolution) * species *
              (s.hasFluid ? kCoupledSpeciesBytesPerCell[d] : fused ? kFusedSpeciesBytesPerCell : kSpeciesBytesPerCell[d]);
   }

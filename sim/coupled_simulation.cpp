@@ -7,9 +7,7 @@
 #include <fmt/format.h>
 
 #include "sim/fluid_simulation.h"
-#include "sim/gpu_simulation.h"
-#include "gpu/gpu_ard_solver.h"
-#include "core/stage_trace.h"
+#include "sim/steppers.h"
 #include "sim/rd_scene_setup.h"
 #include "core/parallel.h"
 #include "rd/model_registry.h"
@@ -48,32 +46,19 @@ ChemicalDomain<D> chemicalDomain(const Scene& scene, const FluidSolver<D>& fluid
 }  // namespace
 
 template <int D>
-struct CoupledSimulation<D>::Gpu {
-  GpuFluid<D> fluid;
-  GpuRDLayer<D> layer;
-  GpuARDSolver<D> ard;
-  Gpu(const Scene& scene, const FluidSolver<D>& f, const RDSolver<D>& rd, const ChemicalDomain<D>& domain)
-      : fluid(scene.fluid, f.constraints()),
-        layer(rd),
-        ard(&layer, domain, scene.coupling.interpolation,
-            scene.coupling.mode, scene.coupling.rdTimeScale, f.cells(), f.h()) {
-    fluid.upload(f.velocity(), f.dye());
-  }
-};
-
-template <int D>
-CoupledSimulation<D>::CoupledSimulation(const Scene& scene, CouplingBackend backend, Warn warn, bool gpu)
-    : scene_(scene), backend_(backend), warn_(std::move(warn)), fluid_(scene.fluid), rd_(scene.rd.settings, *findModel(scene.rd.settings.model)) {
+CoupledSimulation<D>::CoupledSimulation(const Scene& scene, Backend backend, Warn warn)
+    : scene_(scene),
+      warn_(std::move(warn)),
+      fluid_(scene.fluid),
+      rd_(scene.rd.settings, *findModel(scene.rd.settings.model)),
+      host_([this] { steps_->toHost(&fluid_, &rd_); }) {
   checkFluidLeft<D>(scene, fluid_);
   initialState<D>(scene, &rd_);
   applyScene<D>(scene, &rd_);
   const CouplingScene& C = scene.coupling;
   const ChemicalDomain<D> domain = chemicalDomain<D>(scene, fluid_, rd_);
-  ard_ = std::make_unique<ARDSolver<D>>(
-      &rd_, ChemicalAdvector<D>(domain, C.interpolation),
-      C.mode, C.rdTimeScale);
-  stepper_ = std::make_unique<CoupledStepper<D>>(&fluid_, ard_.get(), backend);
-  if (gpu) gpu_ = std::make_unique<Gpu>(scene, fluid_, rd_, domain);  // from the state the CPU set up
+  ard_ = std::make_unique<ARDSolver<D>>(&rd_, ChemicalAdvector<D>(domain, C.interpolation), C.mode, C.rdTimeScale);
+  steps_ = makeCoupledSteps<D>(scene, backend, &fluid_, ard_.get(), domain);  // from the state set up here
 }
 
 template <int D>
@@ -81,53 +66,25 @@ CoupledSimulation<D>::~CoupledSimulation() = default;
 
 template <int D>
 double CoupledSimulation<D>::cflTimeStep(double cfl, double dtMax) const {
-  return gpu_ ? gpu_->fluid.cflTimeStep(cfl, dtMax) : fluid_.cflTimeStep(cfl, dtMax);
-}
-
-// The ARD step reads velocity n, then the fluid writes n + 1: the CPU's
-// serial order (coupled_stepper.h), with no copy of the velocity needed.
-template <int D>
-void CoupledSimulation<D>::stepGpu(double dt) {
-  const double t0 = traceClock();
-  gpu_->ard.step(dt, gpu_->fluid);
-  gpu_->fluid.step(dt);
-  // the GPU's own time of each side (timer queries, a step late)
-  for (double s : gpu_->ard.stageSeconds()) ardSeconds_ += s;
-  for (double s : gpu_->fluid.lastStats().seconds) fluidSeconds_ += s;
-  stepSeconds_ += traceClock() - t0;
-  time_ += dt;
-  ++steps_;
-  hostStale_ = true;
-}
-
-template <int D>
-void CoupledSimulation<D>::syncHost() const {
-  if (!gpu_ || !hostStale_) return;
-  gpu_->fluid.download(&fluid_.velocity(), &fluid_.dye());
-  fluid_.adopt(time_, steps_, gpu_->fluid.phi(), gpu_->fluid.lastDt());
-  for (int s = 0; s < gpu_->layer.species(); ++s) rd_.field(s).values() = gpu_->layer.download(s);
-  hostStale_ = false;
+  return steps_->fluid().cflTimeStep(cfl, dtMax);
 }
 
 template <int D>
 void CoupledSimulation<D>::step(double dt) {
-  if (gpu_) {
-    stepGpu(dt);
-  } else {
-    stepper_->step(dt);
-    fluidSeconds_ += stepper_->fluidSeconds();
-    ardSeconds_ += stepper_->ardSeconds();
-    stepSeconds_ += stepper_->stepSeconds();
-  }
-  const FluidStepStats& fs = gpu_ ? gpu_->fluid.lastStats() : fluid_.lastStats();
+  steps_->step(dt);
+  host_.stepped();
+  const std::array<double, 3> sec = steps_->seconds();
+  fluidSeconds_ += sec[0];
+  ardSeconds_ += sec[1];
+  stepSeconds_ += sec[2];
+  const FluidStepStats& fs = steps_->fluid().lastStats();
   pressureIterations_ += fs.pressure.iterations;
-  diffusionIterations_ += (gpu_ ? gpu_->layer.lastStats() : rd_.lastStats()).diffusion.iterations;
+  diffusionIterations_ += steps_->layerStats().diffusion.iterations;
   const SolverResult& pressure = fs.pressure;
   if (!pressure.converged && unconverged_++ == 0)
     warn_(fmt::format("warning: step {}: pressure solve stopped at relative residual {:.2e} after {} iterations",
                       steps(), pressure.residual, pressure.iterations));
-  // (gpu: a velocity that is not finite makes the pressure residual NaN)
-  if (gpu_ ? !std::isfinite(pressure.residual) : !std::isfinite(fluid_.maxSpeed()))
+  if (!steps_->fluid().finite())
     throw NonFiniteError(fmt::format("the simulation diverged at step {} in the fluid step: the velocity is not finite", steps()),
                          "use a smaller time.dt or set time.cfl, and check the forces and boundary speeds");
 }
@@ -141,7 +98,7 @@ std::vector<std::string> CoupledSimulation<D>::fieldNames() const {
 
 template <int D>
 std::vector<Grid<float, D>> CoupledSimulation<D>::field(const std::string& name) const {
-  syncHost();
+  host_.refresh();
   const std::vector<std::string> sp = species();
   if (std::find(sp.begin(), sp.end(), name) != sp.end()) return speciesField<D>(rd_, name);
   return fluidField<D>(fluid_, name);
@@ -149,20 +106,17 @@ std::vector<Grid<float, D>> CoupledSimulation<D>::field(const std::string& name)
 
 template <int D>
 void CoupledSimulation<D>::checkFinite(const std::string& when) const {
-  syncHost();
+  host_.refresh();
   checkFluidFinite<D>(fluid_, when);
   morphoflow::checkFinite<D>(rd_, when, "the advection-reaction-diffusion step (" + rdStage(rd_.settings()) + ")");
 }
 
 template <int D>
 void CoupledSimulation<D>::save(StateWriter* out) const {
-  syncHost();
+  host_.refresh();
   fluid_.save(out);
   rd_.save(out);
-  if (gpu_) {
-    gpu_->fluid.save(out);
-    gpu_->layer.save(out);
-  }
+  steps_->save(out);
   out->put("coupled.stats.seconds", std::array<double, 3>{fluidSeconds_, ardSeconds_, stepSeconds_});
   out->put("coupled.stats.iterations", std::array<long, 2>{pressureIterations_, diffusionIterations_});
   out->put("coupled.stats.unconverged", unconverged_);
@@ -172,14 +126,8 @@ template <int D>
 void CoupledSimulation<D>::load(const StateReader& in) {
   fluid_.load(in);
   rd_.load(in);
-  if (gpu_) {
-    gpu_->fluid.upload(fluid_.velocity(), fluid_.dye());
-    gpu_->fluid.load(in);
-    for (int s = 0; s < gpu_->layer.species(); ++s) gpu_->layer.upload(s, rd_.field(s).values());
-    gpu_->layer.load(in);
-    time_ = fluid_.time();
-    steps_ = fluid_.steps();
-  }
+  steps_->fromHost(fluid_, rd_);
+  steps_->load(in);
   std::array<double, 3> s{};
   std::array<long, 2> it{};
   in.get("coupled.stats.seconds", &s);
@@ -211,11 +159,11 @@ nlohmann::json CoupledSimulation<D>::resolved() const {
 template <int D>
 void CoupledSimulation<D>::report(nlohmann::json* j) const {
   const double steps = double(this->steps());
-  if (gpu_) recordGlContext(j);
+  steps_->report(j);
   (*j)["coupling"] = {{"fluid_seconds", fluidSeconds_},
                       {"ard_seconds", ardSeconds_},
                       {"step_seconds", stepSeconds_},
-                      {"overlapped", !gpu_ && backend_ != CouplingBackend::Serial}};
+                      {"overlapped", steps_->overlapped()}};
   (*j)["solvers"] = {{"pressure_iterations_mean", steps ? double(pressureIterations_) / steps : 0.0},
                      {"pressure_unconverged_steps", unconverged_},
                      {"diffusion_iterations_mean", steps ? double(diffusionIterations_) / steps : 0.0}};

@@ -1,9 +1,10 @@
 // CoupledSimulation<D>: a scene's stable fluid carrying its
 // advection-reaction-diffusion layer (seed 001 sec. 5, 7), stepped by the
-// serial or tbb-overlap scheduler (coupling/coupled_stepper.h), as a
-// Simulation: species and fluid fields, and the time each side took. On the
-// gpu backend the steps are the GPU's (GpuFluid, GpuARDSolver) and the CPU
-// solvers hold a copy of the state, refreshed when a field or checkpoint needs it.
+// CoupledSteps that sim/steppers.h chooses for the backend (the CPU's serial
+// or tbb-overlap schedule, coupling/coupled_stepper.h, or the GPU's), as a
+// Simulation: species and fluid fields, and the time each side took. The
+// FluidSolver and RDSolver hold the state outputs read, refreshed when a
+// field or checkpoint needs it (core/host_copy.h).
 #pragma once
 
 #include <memory>
@@ -13,8 +14,11 @@
 
 #include "sim/rd_simulation.h"
 #include "core/simulation.h"
-#include "coupling/coupled_stepper.h"
+#include "core/host_copy.h"
+#include "coupling/ard_solver.h"
+#include "coupling/coupled_steps.h"
 #include "scenes/scene.h"
+#include "sim/backend.h"
 
 namespace morphoflow {
 
@@ -22,13 +26,13 @@ template <int D>
 class CoupledSimulation : public Simulation<D> {
  public:
   using Warn = std::function<void(const std::string&)>;
-  CoupledSimulation(const Scene& scene, CouplingBackend backend, Warn warn, bool gpu = false);
+  CoupledSimulation(const Scene& scene, Backend backend, Warn warn);
   ~CoupledSimulation() override;
 
   void step(double dt) override;
   double cflTimeStep(double cfl, double dtMax) const override;
-  double time() const override { return gpu_ ? time_ : fluid_.time(); }
-  long steps() const override { return gpu_ ? steps_ : fluid_.steps(); }
+  double time() const override { return steps_->fluid().time(); }
+  long steps() const override { return steps_->fluid().steps(); }
   std::vector<std::string> fieldNames() const override;
   std::vector<std::string> species() const override { return rd_.model().info().species; }
   std::vector<std::string> dumpFieldNames() const override { return species(); }
@@ -42,21 +46,13 @@ class CoupledSimulation : public Simulation<D> {
   void report(nlohmann::json* run) const override;
 
  private:
-  struct Gpu;  // the GPU's fluid, layer and ARD step
-  void syncHost() const;
-  void stepGpu(double dt);
-
   const Scene& scene_;
-  CouplingBackend backend_;
   Warn warn_;
   mutable FluidSolver<D> fluid_;
   mutable RDSolver<D> rd_;
-  std::unique_ptr<Gpu> gpu_;
-  double time_ = 0.0;  // gpu: the clock of the GPU's steps
-  long steps_ = 0;
-  mutable bool hostStale_ = false;
   std::unique_ptr<ARDSolver<D>> ard_;
-  std::unique_ptr<CoupledStepper<D>> stepper_;
+  std::unique_ptr<CoupledSteps<D>> steps_;
+  HostCopy host_;
   double fluidSeconds_ = 0, ardSeconds_ = 0, stepSeconds_ = 0;
   long pressureIterations_ = 0, diffusionIterations_ = 0;
   int unconverged_ = 0;

@@ -7,7 +7,7 @@
 
 #include <fmt/format.h>
 
-#include "sim/gpu_simulation.h"
+#include "sim/steppers.h"
 #include "core/parallel.h"
 #include "fluid/probes.h"
 
@@ -60,14 +60,11 @@ std::vector<Grid<float, D>> fluidField(const FluidSolver<D>& f, const std::strin
 }
 
 template <int D>
-FluidSimulation<D>::FluidSimulation(const Scene& scene, Warn warn, bool gpu)
-    : scene_(scene), warn_(std::move(warn)), fluid_(scene.fluid) {
+FluidSimulation<D>::FluidSimulation(const Scene& scene, Backend backend, Warn warn)
+    : scene_(scene), warn_(std::move(warn)), fluid_(scene.fluid), host_([this] { stepper_->toHost(&fluid_); }) {
   checkFluidLeft<D>(scene, fluid_);
   initialiseDye<D>(scene, &fluid_);
-  if (gpu) {
-    gpu_ = std::make_unique<GpuFluid<D>>(scene.fluid, fluid_.constraints());
-    gpu_->upload(fluid_.velocity(), fluid_.dye());
-  }
+  stepper_ = makeFluidStepper<D>(backend, &fluid_);  // from the state set up here
   for (int a = 0; a < D; ++a)
     for (bool hi : {false, true})
       if (scene.fluid.boundaries.side(a, hi).kind == BoundaryKind::Inflow) flowAxis_ = a;
@@ -75,29 +72,15 @@ FluidSimulation<D>::FluidSimulation(const Scene& scene, Warn warn, bool gpu)
 }
 
 template <int D>
-void FluidSimulation<D>::syncHost() const {
-  if (!gpu_ || !hostStale_) return;
-  gpu_->download(&fluid_.velocity(), &fluid_.dye());
-  fluid_.adopt(time_, steps_, gpu_->phi(), gpu_->lastDt());
-  hostStale_ = false;
-}
-
-template <int D>
 double FluidSimulation<D>::cflTimeStep(double cfl, double dtMax) const {
-  return gpu_ ? gpu_->cflTimeStep(cfl, dtMax) : fluid_.cflTimeStep(cfl, dtMax);
+  return stepper_->cflTimeStep(cfl, dtMax);
 }
 
 template <int D>
 void FluidSimulation<D>::step(double dt) {
-  if (gpu_) {
-    gpu_->step(dt);
-    time_ += dt;
-    ++steps_;
-    hostStale_ = true;
-  } else {
-    fluid_.step(dt);
-  }
-  const FluidStepStats& st = gpu_ ? gpu_->lastStats() : fluid_.lastStats();
+  stepper_->step(dt);
+  host_.stepped();
+  const FluidStepStats& st = stepper_->lastStats();
   for (int k = 0; k < FluidStepStats::kStages; ++k) stageTotals_[size_t(k)] += st.seconds[size_t(k)];
   pressureIterations_ += st.pressure.iterations;
   viscosityIterations_ += st.viscosity.iterations;
@@ -106,14 +89,13 @@ void FluidSimulation<D>::step(double dt) {
   if (!st.pressure.converged && unconverged_++ == 0)
     warn_(fmt::format("warning: step {}: pressure solve stopped at relative residual {:.2e} after {} iterations",
                       steps(), st.pressure.residual, st.pressure.iterations));
-  // (gpu: a velocity that is not finite makes the divergence, hence the pressure residual, NaN)
-  if (gpu_ ? !std::isfinite(st.pressure.residual) : !std::isfinite(fluid_.maxSpeed()))
+  if (!stepper_->finite())
     throw NonFiniteError(fmt::format("the simulation diverged at step {} in the fluid step: the velocity is not finite", steps()),
                          "use a smaller time.dt or set time.cfl, and check the forces and boundary speeds");
   if (scene_.probes.forces) {
     const ProbeSettings& pr = scene_.probes;
     const double q = 0.5 * scene_.fluid.density * pr.referenceSpeed * pr.referenceSpeed * pr.referenceArea;
-    syncHost();
+    host_.refresh();
     const auto F = obstacleForce<D>(fluid_);
     forceTime_.push_back(time());
     drag_.push_back(F[size_t(flowAxis_)] / q);
@@ -123,9 +105,9 @@ void FluidSimulation<D>::step(double dt) {
 
 template <int D>
 void FluidSimulation<D>::save(StateWriter* out) const {
-  syncHost();
+  host_.refresh();
   fluid_.save(out);
-  if (gpu_) gpu_->save(out);
+  stepper_->save(out);
   out->put("fluid.stats.stage_totals", stageTotals_);
   out->put("fluid.stats.pressure_iterations", pressureIterations_);
   out->put("fluid.stats.viscosity_iterations", viscosityIterations_);
@@ -140,12 +122,8 @@ void FluidSimulation<D>::save(StateWriter* out) const {
 template <int D>
 void FluidSimulation<D>::load(const StateReader& in) {
   fluid_.load(in);
-  if (gpu_) {
-    gpu_->upload(fluid_.velocity(), fluid_.dye());
-    gpu_->load(in);
-    time_ = fluid_.time();
-    steps_ = fluid_.steps();
-  }
+  stepper_->fromHost(fluid_);
+  stepper_->load(in);
   in.get("fluid.stats.stage_totals", &stageTotals_);
   in.get("fluid.stats.pressure_iterations", &pressureIterations_);
   in.get("fluid.stats.viscosity_iterations", &viscosityIterations_);
@@ -179,10 +157,7 @@ nlohmann::json FluidSimulation<D>::resolved() const {
 template <int D>
 void FluidSimulation<D>::report(nlohmann::json* j) const {
   const double steps = double(this->steps());
-  if (gpu_) {
-    recordGlContext(j);
-    (*j)["pressure_solver"] = "mgpcg";
-  }
+  stepper_->report(j);
   nlohmann::json stages;
   for (int k = 0; k < FluidStepStats::kStages; ++k)
     stages[FluidStepStats::kStageNames[k]] = {{"total_seconds", stageTotals_[size_t(k)]},
@@ -224,7 +199,7 @@ std::string profileCsv(const Profile& p) {
 
 template <int D>
 std::vector<std::pair<std::string, std::string>> FluidSimulation<D>::measurementFiles() const {
-  syncHost();
+  host_.refresh();
   std::vector<std::pair<std::string, std::string>> files;
   const ProbeSettings& pr = scene_.probes;
   if (pr.centerlines) {

@@ -1,8 +1,9 @@
 // FluidSimulation<D>: a scene's stable fluid (fluid/fluid_solver.h) as a
 // Simulation, with its dye, probes (centreline profiles, obstacle forces,
-// the Strouhal number) and solver statistics. On the gpu backend the steps
-// are GpuFluid's (gpu/gpu_fluid.h) and the CPU solver only holds a copy of
-// the state, refreshed from the GPU when a field, probe or checkpoint needs it.
+// the Strouhal number) and solver statistics. The steps are its
+// FluidStepper's (sim/steppers.h chooses it for the backend); the
+// FluidSolver holds the state outputs read, refreshed when a field, probe or
+// checkpoint needs it (core/host_copy.h).
 #pragma once
 
 #include <functional>
@@ -12,9 +13,11 @@
 #include <vector>
 
 #include "core/simulation.h"
+#include "core/host_copy.h"
 #include "fluid/fluid_solver.h"
-#include "gpu/gpu_fluid.h"
+#include "fluid/fluid_stepper.h"
 #include "scenes/scene.h"
+#include "sim/backend.h"
 
 namespace morphoflow {
 
@@ -39,22 +42,22 @@ template <int D>
 class FluidSimulation : public Simulation<D> {
  public:
   using Warn = std::function<void(const std::string&)>;
-  FluidSimulation(const Scene& scene, Warn warn, bool gpu = false);
+  FluidSimulation(const Scene& scene, Backend backend, Warn warn);
 
   void step(double dt) override;
   double cflTimeStep(double cfl, double dtMax) const override;
-  double time() const override { return gpu_ ? time_ : fluid_.time(); }
-  long steps() const override { return gpu_ ? steps_ : fluid_.steps(); }
+  double time() const override { return stepper_->time(); }
+  long steps() const override { return stepper_->steps(); }
   std::vector<std::string> fieldNames() const override { return fluidFieldNames(); }
   std::vector<std::string> dumpFieldNames() const override { return {"speed", "vorticity", "pressure", "dye"}; }
   std::vector<Grid<float, D>> field(const std::string& name) const override {
-    syncHost();
+    host_.refresh();
     return fluidField<D>(fluid_, name);
   }
   bool symmetric(const std::string& name) const override { return name == "vorticity" && D == 2; }
   bool hasObstacles() const override { return !scene_.fluid.obstacles.empty(); }
   void checkFinite(const std::string& when) const override {
-    syncHost();
+    host_.refresh();
     checkFluidFinite<D>(fluid_, when);
   }
   void save(StateWriter* out) const override;
@@ -65,16 +68,11 @@ class FluidSimulation : public Simulation<D> {
   std::vector<std::pair<std::string, std::string>> measurementFiles() const override;
 
  private:
-  // gpu: the CPU copy takes the GPU's state when it is older.
-  void syncHost() const;
-
   const Scene& scene_;
   Warn warn_;
   mutable FluidSolver<D> fluid_;
-  std::unique_ptr<GpuFluid<D>> gpu_;
-  double time_ = 0.0;  // gpu: the clock of the GPU's steps
-  long steps_ = 0;
-  mutable bool hostStale_ = false;
+  std::unique_ptr<FluidStepper<D>> stepper_;
+  HostCopy host_;
   int flowAxis_ = 0, liftAxis_ = 1;
   // Statistics over the run, and the force probe's signal.
   std::array<double, FluidStepStats::kStages> stageTotals_{};

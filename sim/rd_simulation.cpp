@@ -4,31 +4,10 @@
 #include <stdexcept>
 
 #include "sim/rd_scene_setup.h"
-#include "rd/fused_explicit.h"
 #include "rd/model_registry.h"
+#include "sim/steppers.h"
 
 namespace morphoflow {
-
-void RDRunStats::add(const RDStepStats& st) {
-  newton.merge(st.newton);
-  diffusionIterations += st.diffusion.iterations;
-  diffusionMax = std::max(diffusionMax, st.diffusion.iterations);
-  unconverged += st.diffusion.converged ? 0 : 1;
-}
-
-void RDRunStats::save(StateWriter* out) const {
-  out->put("rd.stats.newton", newton);
-  out->put("rd.stats.diffusion_iterations", diffusionIterations);
-  out->put("rd.stats.diffusion_max", diffusionMax);
-  out->put("rd.stats.unconverged", unconverged);
-}
-
-void RDRunStats::load(const StateReader& in) {
-  in.get("rd.stats.newton", &newton);
-  in.get("rd.stats.diffusion_iterations", &diffusionIterations);
-  in.get("rd.stats.diffusion_max", &diffusionMax);
-  in.get("rd.stats.unconverged", &unconverged);
-}
 
 template <int D>
 std::vector<Grid<float, D>> speciesField(const RDSolver<D>& rd, const std::string& name) {
@@ -38,96 +17,52 @@ std::vector<Grid<float, D>> speciesField(const RDSolver<D>& rd, const std::strin
   return {toFloat<D>(rd.field(int(it - names.begin())))};
 }
 
-bool fusedExplicitFits(const Scene& s) { return s.rd.plainExplicit(); }
-
 template <int D>
-RDSimulation<D>::RDSimulation(const Scene& scene, const Log& log)
-    : scene_(scene), rd_(scene.rd.settings, *findModel(scene.rd.settings.model)) {
-  if (!growCoarseToFine<D>(scene, &rd_, log, &coarseReport_)) initialState<D>(scene, &rd_);
+RDSimulation<D>::RDSimulation(const Scene& scene, Backend backend, const Log& log)
+    : scene_(scene),
+      backend_(backend),
+      rd_(scene.rd.settings, *findModel(scene.rd.settings.model)),
+      host_([this] { stepper_->toHost(&rd_); }) {
+  if (!growCoarseToFine<D>(scene, &rd_, log, &coarseReport_, coarseAdvance<D>(backend))) initialState<D>(scene, &rd_);
   applyScene<D>(scene, &rd_);
-  if (fusedExplicitFits(scene)) {
-    std::vector<double> p;
-    for (size_t k = 0; k < rd_.model().info().parameters.size(); ++k) p.push_back(rd_.parameter(int(k)));
-    fused_ = FusedExplicitRD<D>::create(rd_.model().info().name, rd_.cells(), rd_.h(),
-                                        rd_.settings().boundary == RDBoundary::Periodic, rd_.diffusion(), p);
-    if (fused_ && rd_.generalizedDiffusion()) fused_->setKernel(rd_.generalizedDiffusion()->kernel(), scene.rd.generalized.species);
-    if (fused_) toFused();
-  }
-}
-
-template <int D>
-void RDSimulation<D>::toFused() {
-  for (int s = 0; s < rd_.species(); ++s) {
-    const std::vector<double>& v = rd_.field(s).values();
-    std::vector<float>& f = fused_->field(s);
-    for (size_t i = 0; i < v.size(); ++i) f[i] = float(v[i]);
-  }
-  hostStale_ = false;
-}
-
-// The float state copied into the RDSolver's fields, for frames, checks and checkpoints.
-template <int D>
-void RDSimulation<D>::syncHost() const {
-  if (!fused_ || !hostStale_) return;
-  for (int s = 0; s < rd_.species(); ++s) {
-    const std::vector<float>& f = fused_->field(s);
-    std::vector<double>& v = rd_.field(s).values();
-    for (size_t i = 0; i < v.size(); ++i) v[i] = double(f[i]);
-  }
-  hostStale_ = false;
+  stepper_ = makeLayerStepper<D>(scene, backend, &rd_);  // from the state set up here
 }
 
 template <int D>
 void RDSimulation<D>::advance(double dt, long count) {
-  if (fused_) {
-    fused_->step(dt, int(count));
-    for (long k = 0; k < count; ++k) time_ += dt;  // (the same sum as step by step)
-    steps_ += count;
-    hostStale_ = true;
-    return;
-  }
-  for (long k = 0; k < count; ++k) {
-    rd_.step(dt);
-    stats_.add(rd_.lastStats());
-  }
+  stepper_->advance(dt, count);
+  host_.stepped();
 }
 
 template <int D>
 std::vector<Grid<float, D>> RDSimulation<D>::field(const std::string& name) const {
-  syncHost();
+  host_.refresh();
   return speciesField<D>(rd_, name);
 }
 
 template <int D>
 void RDSimulation<D>::checkFinite(const std::string& when) const {
-  syncHost();
-  morphoflow::checkFinite<D>(rd_, when, rdStage(rd_.settings()));
+  host_.refresh();
+  const std::string stage = rdStage(rd_.settings());
+  morphoflow::checkFinite<D>(rd_, when, backend_ == Backend::Gpu ? "the reaction-diffusion step (gpu, " + stage + ")" : stage);
 }
 
 template <int D>
 void RDSimulation<D>::save(StateWriter* out) const {
-  syncHost();
-  rd_.save(out);
-  stats_.save(out);
-  if (fused_) out->put("rd.fused.time", time_), out->put("rd.fused.steps", steps_);
+  host_.refresh();
+  stepper_->save(out);
 }
 
 template <int D>
 void RDSimulation<D>::load(const StateReader& in) {
-  rd_.load(in);
-  stats_.load(in);
-  if (fused_) {
-    in.get("rd.fused.time", &time_);
-    in.get("rd.fused.steps", &steps_);
-    toFused();
-  }
+  stepper_->load(in);
+  host_.stepped();
 }
 
 template <int D>
 nlohmann::json RDSimulation<D>::resolved() const {
   nlohmann::json j = resolvedLayer<D>(scene_, rd_);
-  j["explicit_step"] = fused_ ? "fused, float species (rd/fused_explicit.h)" : "RDSolver, double species";
-  if (fused_) j["steps_per_pass"] = fused_->stepsPerPass();  // temporal blocking: several where the state outgrows the caches
+  stepper_->resolved(&j);
   return j;
 }
 
@@ -164,7 +99,8 @@ nlohmann::json resolvedLayer(const Scene& scene, const RDSolver<D>& rd) {
 template <int D>
 void RDSimulation<D>::report(nlohmann::json* j) const {
   (*j)["coarse_to_fine"] = coarseReport_;
-  reportRDSolvers(stats_, rd_.steps(), j);
+  if (const RDRunStats* stats = stepper_->runStats()) reportRDSolvers(*stats, stepper_->steps(), j);
+  stepper_->report(j);
 }
 
 void reportRDSolvers(const RDRunStats& stats, long rdSteps, nlohmann::json* j) {

@@ -1,6 +1,9 @@
 // RDSimulation<D>: a reaction-diffusion-only scene (no [fluid]) as a
 // Simulation: the scene's initial state (grown coarse to fine where the scene
-// asks), its maps and anisotropy, and the solvers' statistics.
+// asks), its maps and anisotropy, and the solvers' statistics. The steps are
+// its LayerStepper's (sim/steppers.h chooses it for the backend: the
+// RDSolver's own, the fused float step, or the GPU's); the RDSolver holds the
+// state outputs read, refreshed when needed (core/host_copy.h).
 #pragma once
 
 #include <functional>
@@ -9,24 +12,13 @@
 #include <vector>
 
 #include "core/simulation.h"
-#include "rd/fused_explicit.h"
+#include "core/host_copy.h"
+#include "rd/layer_stepper.h"
 #include "rd/rd_solver.h"
 #include "scenes/scene.h"
+#include "sim/backend.h"
 
 namespace morphoflow {
-
-// Whether the scene's layer takes the fused explicit step (rd/fused_explicit.h).
-bool fusedExplicitFits(const Scene& scene);
-
-// Statistics of an RD layer's steps, for run.json.
-struct RDRunStats {
-  NewtonStats newton;
-  long diffusionIterations = 0;
-  int diffusionMax = 0, unconverged = 0;
-  void add(const RDStepStats& st);
-  void save(StateWriter* out) const;
-  void load(const StateReader& in);
-};
 
 // run.json's "solvers": the Newton and diffusion statistics of `rdSteps` steps.
 void reportRDSolvers(const RDRunStats& stats, long rdSteps, nlohmann::json* run);
@@ -44,13 +36,13 @@ template <int D>
 class RDSimulation : public Simulation<D> {
  public:
   using Log = std::function<void(const std::string&)>;
-  RDSimulation(const Scene& scene, const Log& log);
+  RDSimulation(const Scene& scene, Backend backend, const Log& log);
 
   void step(double dt) override { advance(dt, 1); }
   void advance(double dt, long count) override;
-  long stepsTogether() const override { return fused_ ? fused_->stepsPerPass() : 1; }
-  double time() const override { return fused_ ? time_ : rd_.time(); }
-  long steps() const override { return fused_ ? steps_ : rd_.steps(); }
+  long stepsTogether() const override { return stepper_->stepsTogether(); }
+  double time() const override { return stepper_->time(); }
+  long steps() const override { return stepper_->steps(); }
   std::vector<std::string> fieldNames() const override { return species(); }
   std::vector<std::string> species() const override { return rd_.model().info().species; }
   std::vector<std::string> dumpFieldNames() const override { return species(); }
@@ -62,20 +54,12 @@ class RDSimulation : public Simulation<D> {
   void report(nlohmann::json* run) const override;
 
  private:
-  void toFused();
-  void syncHost() const;
-
   const Scene& scene_;
+  Backend backend_;
   mutable RDSolver<D> rd_;
-  // The explicit step of a plain layer (uniform parameters, no tensor, lobes
-  // or held cells): float species, one fused pass (rd/fused_explicit.h); the
-  // RDSolver then only builds the start and holds a copy for outputs.
-  std::unique_ptr<FusedExplicitRD<D>> fused_;
-  double time_ = 0.0;
-  long steps_ = 0;
-  mutable bool hostStale_ = false;
+  std::unique_ptr<LayerStepper<D>> stepper_;
+  HostCopy host_;
   nlohmann::json coarseReport_ = nlohmann::json::array();
-  RDRunStats stats_;
 };
 
 }  // namespace morphoflow

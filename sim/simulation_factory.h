@@ -1,5 +1,6 @@
-// The one place that chooses a scene's Simulation: from the scene and the
-// backend, and (for the GPU) whether the scene can run there at all.
+// The one place that chooses a scene's Simulation, from the scene; the
+// backend's steppers, and whether the scene runs there at all
+// (checkBackend), are sim/steppers.h's.
 #pragma once
 
 #include <functional>
@@ -8,19 +9,10 @@
 
 #include "core/simulation.h"
 #include "scenes/scene.h"
+#include "sim/backend.h"
+#include "sim/steppers.h"
 
 namespace morphoflow {
-
-// --backend: TBB tasks, one thread (the coupled step's serial schedule), or
-// OpenGL compute.
-enum class Backend { TBB, Serial, Gpu };
-// "tbb", "serial" or "gpu"; std::invalid_argument for any other name.
-Backend backendNamed(const std::string& name);
-
-// Throws UserError when the scene cannot run on the backend (the GPU: a
-// stage it has no program for, named; no OpenGL 4.3 context; too little
-// device memory). Nothing is allocated before this says yes.
-void checkBackend(const Scene& scene, Backend backend);
 
 // The scene's simulation on the backend (checkBackend said it can): say
 // takes the simulations' messages, warn their warnings.

@@ -7,6 +7,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "core/host_copy.h"
+#include "gpu/gl_context.h"
 #include "render/field_dump.h"
 #include "run/output_sinks.h"
 #include "run/run_driver.h"
@@ -34,6 +36,34 @@ std::vector<float> allFields(const Simulation<D>& sim) {
 }
 
 const std::vector<std::string> kSmallCoupled = {"grid.resolution=[32,32]", "rd.resolution=[64,64]", "output.video=false"};
+
+// A checkpoint of `sim` after `before` steps, read into a fresh simulation of
+// the scene; both then take `after` more: the fields must stay bitwise equal.
+template <int D>
+void expectResumesBitwise(const Scene& scene, Backend backend, int before, int after) {
+  auto a = makeSimulation<D>(scene, backend, quietLog, quietLog);
+  for (int k = 0; k < before; ++k) a->step(scene.time.dt);
+  std::string bytes;
+  StateWriter out([&](std::string_view frame, const void* data, size_t n) {
+    bytes.append(frame);
+    bytes.append(static_cast<const char*>(data), n);
+  });
+  a->save(&out);
+  auto b = makeSimulation<D>(scene, backend, quietLog, quietLog);
+  b->load(StateReader(std::move(bytes)));
+  EXPECT_EQ(b->steps(), a->steps());
+  EXPECT_EQ(b->time(), a->time());
+  EXPECT_EQ(allFields(*b), allFields(*a));
+  for (int k = 0; k < after; ++k) a->step(scene.time.dt), b->step(scene.time.dt);
+  EXPECT_EQ(allFields(*b), allFields(*a)) << scene.path;
+}
+
+const std::vector<std::pair<std::string, std::vector<std::string>>> kEveryKind = {
+    {"rd/turing_coarse_to_fine.toml", {"grid.resolution=[32,32]", "rd.coarse_to_fine.steps=3"}},  // the fused explicit step
+    {"rd/gray_scott_pearson.toml", {"grid.resolution=[32,32]"}},
+    {"lid_driven_cavity.toml", {"grid.resolution=[32,32]"}},
+    {"coupled/cavity_gray_scott.toml", kSmallCoupled},
+};
 
 }  // namespace
 
@@ -132,4 +162,55 @@ TEST(OutputSinks, TheSceneChoosesTheSinksAndEachReportsWhatItWrote) {
   for (const auto& [kind, bytes] : run["bytes_written"].items()) reported += bytes.get<uintmax_t>();
   EXPECT_GE(reported, fileBytes(dir / "frames/000000.png") + fileBytes(dir / "fields/000000.exr"));
   fs::remove_all(dir);
+}
+
+// A host copy is refreshed once after each step that moved the state on, and
+// never when nothing did.
+TEST(HostCopy, RefreshesOnlyAfterAStepAndOnce) {
+  int refreshes = 0;
+  HostCopy copy([&] { ++refreshes; });
+  copy.refresh();
+  EXPECT_EQ(refreshes, 0);
+  copy.stepped();
+  copy.stepped();
+  copy.refresh();
+  copy.refresh();
+  EXPECT_EQ(refreshes, 1);
+  copy.stepped();
+  copy.refresh();
+  EXPECT_EQ(refreshes, 2);
+}
+
+// Every kind of scene, on each backend's steppers, resumes from its own
+// checkpoint bitwise: the steppers' state and the hosts' together are the
+// whole state.
+TEST(Steppers, EveryKindOfSceneResumesBitwiseOnTheCpu) {
+  for (const auto& [file, sets] : kEveryKind) expectResumesBitwise<2>(loadScene(sceneFile(file), sets), Backend::TBB, 3, 3);
+}
+
+TEST(Steppers, EveryKindOfSceneResumesBitwiseOnTheGpu) {
+  if (const GpuInfo g = gpuInfo(); !g.available) GTEST_SKIP() << g.reason;
+  for (const auto& [file, sets] : kEveryKind) {
+    const Scene scene = loadScene(sceneFile(file), sets);
+    checkBackend(scene, Backend::Gpu);
+    expectResumesBitwise<2>(scene, Backend::Gpu, 3, 3);
+  }
+}
+
+// The one choice of a layer's stepper: the plain explicit step fused on the
+// CPU (float species) and in float on the GPU, every other step in double;
+// the same simulation class on both backends says which it took.
+TEST(Steppers, TheLayerStepperFollowsTheSceneAndTheBackend) {
+  const Scene plain = loadScene(sceneFile("rd/turing_coarse_to_fine.toml"), {"grid.resolution=[32,32]", "rd.coarse_to_fine.steps=3"});
+  const Scene implicit = loadScene(sceneFile("rd/gray_scott_pearson.toml"), {"grid.resolution=[32,32]"});
+  ASSERT_TRUE(plain.rd.plainExplicit());
+  ASSERT_FALSE(implicit.rd.plainExplicit());
+  auto step = [](const Scene& s, Backend b) {
+    return makeSimulation<2>(s, b, quietLog, quietLog)->resolved()["explicit_step"].get<std::string>();
+  };
+  EXPECT_EQ(step(plain, Backend::TBB).rfind("fused", 0), 0u);
+  EXPECT_EQ(step(implicit, Backend::TBB).rfind("RDSolver", 0), 0u);
+  if (const GpuInfo g = gpuInfo(); !g.available) GTEST_SKIP() << g.reason;
+  EXPECT_NE(step(plain, Backend::Gpu).find("float"), std::string::npos);
+  EXPECT_NE(step(implicit, Backend::Gpu).find("double"), std::string::npos);
 }
