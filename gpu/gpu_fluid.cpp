@@ -11,6 +11,7 @@
 #include "gpu/compute_program.h"
 #include "gpu/gl_context.h"
 #include "gpu/gpu_kernels.h"
+#include "gpu/kernel_modes.h"
 #include "gpu/gpu_laplace.h"
 #include "gpu/gpu_multigrid.h"
 #include "gpu/gpu_pcg.h"
@@ -30,7 +31,7 @@ struct GpuFluid<D>::Viscous {
 };
 
 namespace {
-std::string dimDefine(int D, const char* mode) { return fmt::format("#define DIM {}\n#define {}", D, mode); }
+std::string dimDefine(int D, FluidOp mode) { return fmt::format("#define DIM {}\n#define {}", D, define(mode)); }
 }  // namespace
 
 template <int D>
@@ -133,9 +134,9 @@ GpuFluid<D>::~GpuFluid() = default;
 
 template <int D>
 void GpuFluid<D>::applyConstraints(const GpuBuffer& vel) {
-  for (const char* mode : {"MODE_FIXED", "MODE_PERIODIC"})
+  for (FluidOp mode : {FluidOp::Fixed, FluidOp::Periodic})
     for (int a = 0; a < D; ++a) {
-      if (std::string(mode) == "MODE_PERIODIC" && !periodic_[size_t(a)]) continue;
+      if (mode == FluidOp::Periodic && !periodic_[size_t(a)]) continue;
       const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, mode));
       setUniform(p, "cells", cells_);
       setUniform(p, "axis", a);
@@ -144,7 +145,7 @@ void GpuFluid<D>::applyConstraints(const GpuBuffer& vel) {
       vel.bind(0);
       fixed_.bind(1);
       value_.bind(2);
-      dispatchFlat(faces(a), std::string(mode) == "MODE_FIXED" ? 12.0 : 0.0);  // flag, value, u; (the periodic layer: none)
+      dispatchFlat(faces(a), mode == FluidOp::Fixed ? 12.0 : 0.0);  // flag, value, u; (the periodic layer: none)
       storageBarrier();
     }
 }
@@ -155,7 +156,7 @@ void GpuFluid<D>::forces(double dt) {
     const float f = float(dt * settings_.force[size_t(a)]);
     const float b = dyeActive_ ? float(dt * settings_.buoyancy * settings_.buoyancyDirection[size_t(a)]) : 0.0f;
     if (f == 0.0f && b == 0.0f) continue;
-    const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, "MODE_FORCES"));
+    const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, FluidOp::Forces));
     setUniform(p, "cells", cells_);
     setUniform(p, "axis", a);
     setUniform(p, "n", int(faces(a)));
@@ -192,7 +193,7 @@ void GpuFluid<D>::advectField(const GpuBuffer& src, size_t srcOff, const std::ar
     dispatchFlat(n, 8.0 + 4.0 * D + (limits ? 8.0 : 0.0));  // src, dst, the velocity once (, lo, hi)
     storageBarrier();
   };
-  auto combine = [&](const char* mode, const GpuBuffer& f0, size_t f0Off, const GpuBuffer& f1, size_t f1Off,
+  auto combine = [&](FluidOp mode, const GpuBuffer& f0, size_t f0Off, const GpuBuffer& f1, size_t f1Off,
                      const GpuBuffer& f2, const GpuBuffer& f3, const GpuBuffer& f4) {
     const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, mode));
     setUniform(p, "n", int(n));
@@ -203,7 +204,7 @@ void GpuFluid<D>::advectField(const GpuBuffer& src, size_t srcOff, const std::ar
     f2.bind(5);
     f3.bind(6);
     f4.bind(11);
-    dispatchFlat(n, std::string(mode) == "MODE_MACCORMACK" ? 24.0 : std::string(mode) == "MODE_BFECC_CORRECT" ? 12.0 : 16.0);
+    dispatchFlat(n, mode == FluidOp::MacCormack ? 24.0 : mode == FluidOp::BfeccCorrect ? 12.0 : 16.0);
     storageBarrier();
   };
   switch (settings_.advection) {
@@ -214,16 +215,16 @@ void GpuFluid<D>::advectField(const GpuBuffer& src, size_t srcOff, const std::ar
       // phi^ = A(phi); phi~ = A^-1(phi^); phi = phi^ + (phi - phi~) / 2, limited
       pass(src, srcOff, dt, dst, dstOff, true);
       pass(*dst, dstOff, -dt, &back_, 0, false);
-      combine("MODE_MACCORMACK", *dst, dstOff, src, srcOff, back_, lo_, hi_);
+      combine(FluidOp::MacCormack, *dst, dstOff, src, srcOff, back_, lo_, hi_);
       break;
     case AdvectionScheme::Bfecc:
       // phi_bar = phi + (phi - A^-1 A phi) / 2, then A(phi_bar), limited
       pass(src, srcOff, dt, &fwd_, 0, false);
       pass(fwd_, 0, -dt, &back_, 0, false);
-      combine("MODE_BFECC_CORRECT", fwd_, 0, src, srcOff, back_, back_, back_);
+      combine(FluidOp::BfeccCorrect, fwd_, 0, src, srcOff, back_, back_, back_);
       pass(fwd_, 0, dt, dst, dstOff, false);
       pass(src, srcOff, dt, &back_, 0, true);  // the first-order fallback
-      combine("MODE_BFECC_LIMIT", *dst, dstOff, back_, 0, lo_, hi_, hi_);
+      combine(FluidOp::BfeccLimit, *dst, dstOff, back_, 0, lo_, hi_, hi_);
       break;
   }
 }
@@ -248,7 +249,7 @@ void GpuFluid<D>::advect(double dt) {
   for (int a = 0; a < D; ++a)
     for (bool high : {false, true}) {
       if (settings_.inflowDyeStripes <= 0 || settings_.boundaries.side(a, high).kind != BoundaryKind::Inflow) continue;
-      const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, "MODE_INFLOW_DYE"));
+      const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, FluidOp::InflowDye));
       setUniform(p, "cells", cells_);
       setUniform(p, "n", int(cellCount_));
       setUniform(p, "inflow", std::array<int, 4>{a, high ? 1 : 0, a == 0 ? 1 : 0, settings_.inflowDyeStripes});
@@ -275,7 +276,7 @@ void GpuFluid<D>::diffuse(double dt) {
     }
     std::array<int, 3> udims{1, 1, 1};
     for (int b = 0; b < D; ++b) udims[size_t(b)] = V.host.dims[b];
-    auto run = [&](const char* mode) {
+    auto run = [&](FluidOp mode) {
       const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, mode));
       setUniform(p, "cells", cells_);
       setUniform(p, "axis", a);
@@ -288,12 +289,12 @@ void GpuFluid<D>::diffuse(double dt) {
       V.b.bind(7);
       V.x.bind(8);
       V.boundaryRhs.bind(9);
-      dispatchFlat(V.host.A.size(), std::string(mode) == "MODE_VISCOUS_SETUP" ? 32.0 : 16.0);
+      dispatchFlat(V.host.A.size(), mode == FluidOp::ViscousSetup ? 32.0 : 16.0);
       storageBarrier();
     };
-    run("MODE_VISCOUS_SETUP");
+    run(FluidOp::ViscousSetup);
     const SolverResult r = V.pcg->solve(&V.b, &V.x, nullptr, {settings_.viscosityTolerance, 500});
-    run("MODE_VISCOUS_STORE");
+    run(FluidOp::ViscousStore);
     // The tolerance is that of each block; the whole system's relative residual is reported.
     const double bb = V.pcg->reduction().read()[0];
     bAll += bb;
@@ -308,7 +309,7 @@ void GpuFluid<D>::diffuse(double dt) {
 
 template <int D>
 void GpuFluid<D>::project(double dt) {
-  auto run = [&](const char* mode, int axis, size_t n) {
+  auto run = [&](FluidOp mode, int axis, size_t n) {
     const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, mode));
     setUniform(p, "cells", cells_);
     setUniform(p, "periodic", periodic_);
@@ -321,21 +322,20 @@ void GpuFluid<D>::project(double dt) {
     setUniform(p, "extrapolate", solves_ >= 2 ? 1 : 0);
     vel_.bind(0);
     fixed_.bind(1);
-    (std::string(mode) == "MODE_DIVERGENCE" ? rhs_ : phi_).bind(7);
+    (mode == FluidOp::Divergence ? rhs_ : phi_).bind(7);
     ratePrev_.bind(8);
     solid_.bind(10);
-    const std::string m = mode;
-    dispatchFlat(n, m == "MODE_DIVERGENCE" ? 8.0 * D + 12.0 : m == "MODE_WARM_START" ? 32.0 : 32.0);
+    dispatchFlat(n, mode == FluidOp::Divergence ? 8.0 * D + 12.0 : 32.0);
     storageBarrier();
   };
-  run("MODE_DIVERGENCE", 0, cellCount_);
+  run(FluidOp::Divergence, 0, cellCount_);
   // Warm start: phi / dt extrapolated from the last two projections.
-  if (solves_ >= 1 && lastDt_ > 0) run("MODE_WARM_START", 0, cellCount_);
+  if (solves_ >= 1 && lastDt_ > 0) run(FluidOp::WarmStart, 0, cellCount_);
   stats_.pressure = pressurePcg_->solve(&rhs_, &phi_, multigrid_.get(),
                                         {settings_.pressureTolerance, settings_.pressureMaxIterations});
   lastDt_ = dt;
   solves_ = dt > 0 ? std::min(solves_ + 1, 2) : 0;
-  for (int a = 0; a < D; ++a) run("MODE_GRADIENT", a, faces(a));
+  for (int a = 0; a < D; ++a) run(FluidOp::Gradient, a, faces(a));
   applyConstraints(vel_);
 }
 

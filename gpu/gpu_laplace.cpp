@@ -104,12 +104,11 @@ bool GpuLaplace::mixesColours() const {
   return false;
 }
 
-void GpuLaplace::run(const char* mode, bool single, const GpuBuffer& x, const GpuBuffer* y, const GpuBuffer* b,
+void GpuLaplace::run(LaplaceMode mode, bool single, const GpuBuffer& x, const GpuBuffer* y, const GpuBuffer* b,
                      int colour, float omega) const {
-  const std::string m = mode;
-  const bool cross = hasCross_ && !single && (m == "MODE_APPLY" || m == "MODE_RESIDUAL");
+  const bool cross = hasCross_ && !single && (mode == LaplaceMode::Apply || mode == LaplaceMode::Residual);
   const ComputeProgram& p = useKernel("laplace.comp", fmt::format("#define DIM {}\n#define REAL {}\n#define {}{}", dim_,
-                                                                  single ? "float" : "double", mode,
+                                                                  single ? "float" : "double", define(mode),
                                                                   cross ? "\n#define CROSS" : ""));
   setUniform(p, "dims", dims_);
   setUniform(p, "scale", scale_);
@@ -126,23 +125,23 @@ void GpuLaplace::run(const char* mode, bool single, const GpuBuffer& x, const Gp
   // x and y (and b), the face weights, c and the diagonal (and the mixed
   // terms); a smoothing pass touches half the cells
   const double real = single ? 4.0 : 8.0, coefficients = 4.0 * (dim_ + 2 + crossBuffers);
-  const double bytes = m == "MODE_SMOOTH" ? 0.5 * (3 * real + coefficients) : (y ? 2 : 1) * real + (b ? real : 0) + coefficients;
+  const double bytes = mode == LaplaceMode::Smooth ? 0.5 * (3 * real + coefficients) : (y ? 2 : 1) * real + (b ? real : 0) + coefficients;
   dispatchFlat(n_, bytes);
   storageBarrier();
 }
 
-void GpuLaplace::apply(const GpuBuffer& x, GpuBuffer* y) const { run("MODE_APPLY", false, x, y, nullptr, 0, 0.0f); }
+void GpuLaplace::apply(const GpuBuffer& x, GpuBuffer* y) const { run(LaplaceMode::Apply, false, x, y, nullptr, 0, 0.0f); }
 
 void GpuLaplace::residual(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* r, bool single) const {
-  run("MODE_RESIDUAL", single, x, r, &b, 0, 0.0f);
+  run(LaplaceMode::Residual, single, x, r, &b, 0, 0.0f);
 }
 
 void GpuLaplace::smooth(const GpuBuffer& b, GpuBuffer* x, int colour) const {
-  run("MODE_SMOOTH", true, *x, nullptr, &b, colour, 0.0f);
+  run(LaplaceMode::Smooth, true, *x, nullptr, &b, colour, 0.0f);
 }
 
 void GpuLaplace::jacobi(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* y, float omega) const {
-  run("MODE_JACOBI", true, x, y, &b, 0, omega);
+  run(LaplaceMode::Jacobi, true, x, y, &b, 0, omega);
 }
 
 template GpuLaplace::GpuLaplace(const LaplaceSystem<2>&);

@@ -8,6 +8,7 @@
 #include "core/anisotropic_system.h"
 #include "core/laplace_system.h"
 #include "gpu/gpu_buffer.h"
+#include "gpu/kernel_modes.h"
 
 namespace morphoflow {
 
@@ -57,7 +58,7 @@ class GpuLaplace {
   void jacobi(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* y, float omega) const;
 
  private:
-  void run(const char* mode, bool single, const GpuBuffer& x, const GpuBuffer* y, const GpuBuffer* b, int colour,
+  void run(LaplaceMode mode, bool single, const GpuBuffer& x, const GpuBuffer* y, const GpuBuffer* b, int colour,
            float omega) const;
   std::array<int, 3> dims_{1, 1, 1};
   std::array<bool, 3> periodic_{};

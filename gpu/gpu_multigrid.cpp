@@ -9,6 +9,7 @@
 #include "gpu/compute_program.h"
 #include "gpu/gl_context.h"
 #include "gpu/gpu_kernels.h"
+#include "gpu/kernel_modes.h"
 
 namespace morphoflow {
 
@@ -172,9 +173,9 @@ void GpuMultigrid::cycle(size_t l) {
   L.x.zero();
   smooth(L, false, options_.preSmooth);
   L.A->residual(L.b, L.x, &L.r, true);
-  auto transfer = [&](const char* mode, const GpuBuffer& fine, const GpuBuffer& coarse, const GpuBuffer& fineX,
+  auto transfer = [&](TransferMode mode, const GpuBuffer& fine, const GpuBuffer& coarse, const GpuBuffer& fineX,
                       const GpuBuffer& diag, size_t samples) {
-    const ComputeProgram& p = useKernel("multigrid.comp", fmt::format("#define DIM {}\n#define {}", dim, mode));
+    const ComputeProgram& p = useKernel("multigrid.comp", fmt::format("#define DIM {}\n#define {}", dim, define(mode)));
     setUniform(p, "fd", L.A->dims());
     setUniform(p, "cd", C.A->dims());
     setUniformBools(p, "periodic", L.A->periodic());
@@ -184,21 +185,21 @@ void GpuMultigrid::cycle(size_t l) {
     diag.bind(3);
     fine.bind(4);
     // restrict: the fine residual once (2^D fine cells a coarse one), b, diag; prolong: x read and written, diag
-    const bool restriction = std::string(mode) == "MODE_RESTRICT";
+    const bool restriction = mode == TransferMode::Restrict;
     dispatchFlat(samples, restriction ? 4.0 * (1 << dim) + 8.0 : 12.0);
     storageBarrier();
   };
-  transfer("MODE_RESTRICT", L.r, C.b, L.x, C.A->diag(), C.A->size());
+  transfer(TransferMode::Restrict, L.r, C.b, L.x, C.A->diag(), C.A->size());
   cycle(l + 1);
-  transfer("MODE_PROLONG", L.r, C.x, L.x, L.A->diag(), L.A->size());
+  transfer(TransferMode::Prolong, L.r, C.x, L.x, L.A->diag(), L.A->size());
   smooth(L, true, options_.postSmooth);
 }
 
 void GpuMultigrid::apply(const GpuBuffer& r, GpuBuffer* z, const GpuBuffer& scalars, int slot) {
   Level& L = levels_[0];
   const size_t n = L.A->size();
-  auto convert = [&](const char* op, const GpuBuffer& in, const GpuBuffer& out) {
-    const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + op);
+  auto convert = [&](VectorOp op, const GpuBuffer& in, const GpuBuffer& out) {
+    const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + define(op));
     setUniform(p, "n", int(n));
     setUniform(p, "slots", std::array<int, 4>{slot, 0, 0, 0});
     in.bind(0);
@@ -206,15 +207,15 @@ void GpuMultigrid::apply(const GpuBuffer& r, GpuBuffer* z, const GpuBuffer& scal
     in.bind(2);
     in.bind(3);
     L.b.bind(4);
-    if (std::string(op) == "OP_FROM_FLOAT") L.x.bind(4);
+    if (op == VectorOp::FromFloat) L.x.bind(4);
     L.A->diag().bind(5);
     scalars.bind(6);
     dispatchFlat(n, 12.0);
     storageBarrier();
   };
-  convert("OP_TO_FLOAT", r, r);
+  convert(VectorOp::ToFloat, r, r);
   cycle(0);
-  convert("OP_FROM_FLOAT", *z, *z);
+  convert(VectorOp::FromFloat, *z, *z);
 }
 
 template GpuMultigrid::GpuMultigrid(const Multigrid<2>&, const GpuLaplace&, const MultigridOptions&);

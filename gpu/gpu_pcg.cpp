@@ -19,9 +19,9 @@ GpuPcg::GpuPcg(const GpuLaplace& A)
   if (A_.singular()) sums_.activeCount(A_.diag(), A_.size(), kCount);
 }
 
-void GpuPcg::op(const char* name, const GpuBuffer& x, const GpuBuffer& y, const GpuBuffer& z, const GpuBuffer& q,
+void GpuPcg::op(VectorOp name, const GpuBuffer& x, const GpuBuffer& y, const GpuBuffer& z, const GpuBuffer& q,
                 std::array<int, 4> slots, bool first) {
-  const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + name);
+  const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + define(name));
   setUniform(p, "n", int(A_.size()));
   setUniform(p, "slots", slots);
   setUniform(p, "first", first ? 1 : 0);
@@ -32,14 +32,13 @@ void GpuPcg::op(const char* name, const GpuBuffer& x, const GpuBuffer& y, const 
   A_.diag().bind(4);  // (no float vector in these ops)
   A_.diag().bind(5);
   sums_.scalars().bind(6);
-  const std::string o = name;
-  dispatchFlat(A_.size(), o == "OP_UPDATE_XR" ? 48.0 : o == "OP_UPDATE_P" ? 24.0 : 20.0);
+  dispatchFlat(A_.size(), name == VectorOp::UpdateXR ? 48.0 : name == VectorOp::UpdateP ? 24.0 : 20.0);
   storageBarrier();
 }
 
 void GpuPcg::removeMean(GpuBuffer* x) {
   sums_.activeSum(*x, A_.diag(), A_.size(), kSum);
-  op("OP_SUB_MEAN", *x, *x, *x, *x, {kSum, kCount, 0, 0});
+  op(VectorOp::SubMean, *x, *x, *x, *x, {kSum, kCount, 0, 0});
 }
 
 SolverResult GpuPcg::solve(GpuBuffer* bp, GpuBuffer* xp, GpuMultigrid* M, const SolverOptions& options) {
@@ -62,16 +61,16 @@ SolverResult GpuPcg::solve(GpuBuffer* bp, GpuBuffer* xp, GpuMultigrid* M, const 
     if (M)
       M->apply(r_, &z_, sums_.scalars(), kRR);
     else
-      op("OP_JACOBI", r_, z_, z_, z_, {0, 0, 0, 0});
+      op(VectorOp::Jacobi, r_, z_, z_, z_, {0, 0, 0, 0});
     sums_.dot(r_, z_, n, slot);
   };
   if (result.residual > options.tolerance) {
     precondition(rz);
-    op("OP_UPDATE_P", z_, p_, p_, p_, {0, 0, 0, 0}, true);
+    op(VectorOp::UpdateP, z_, p_, p_, p_, {0, 0, 0, 0}, true);
     for (int it = 1; it <= options.maxIterations; ++it) {
       A_.apply(p_, &q_);
       sums_.dot(p_, q_, n, kPQ);
-      op("OP_UPDATE_XR", x, r_, p_, q_, {rz, kPQ, 0, 0});
+      op(VectorOp::UpdateXR, x, r_, p_, q_, {rz, kPQ, 0, 0});
       sums_.dot(r_, r_, n, kRR);
       const std::vector<double> s = sums_.read();
       result.iterations = it;
@@ -79,7 +78,7 @@ SolverResult GpuPcg::solve(GpuBuffer* bp, GpuBuffer* xp, GpuMultigrid* M, const 
       if (!(s[kPQ] > 0.0) || result.residual <= options.tolerance) break;
       const int next = rz == kRZ0 ? kRZ1 : kRZ0;
       precondition(next);
-      op("OP_UPDATE_P", z_, p_, p_, p_, {next, rz, 0, 0});
+      op(VectorOp::UpdateP, z_, p_, p_, p_, {next, rz, 0, 0});
       rz = next;
     }
   }

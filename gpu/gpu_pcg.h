@@ -8,6 +8,7 @@
 #include "core/pcg.h"
 #include "core/solver_result.h"
 #include "gpu/gpu_laplace.h"
+#include "gpu/kernel_modes.h"
 #include "gpu/gpu_reduction.h"
 
 namespace morphoflow {
@@ -24,7 +25,7 @@ class GpuPcg {
   GpuReduction& reduction() { return sums_; }
 
  private:
-  void op(const char* name, const GpuBuffer& x, const GpuBuffer& y, const GpuBuffer& z, const GpuBuffer& q,
+  void op(VectorOp name, const GpuBuffer& x, const GpuBuffer& y, const GpuBuffer& z, const GpuBuffer& q,
           std::array<int, 4> slots, bool first = false);
   void removeMean(GpuBuffer* x);
   const GpuLaplace& A_;

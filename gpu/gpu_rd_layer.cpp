@@ -100,9 +100,9 @@ size_t GpuRDLayer<D>::deviceBytes(size_t n, int species) {
 }
 
 template <int D>
-void GpuRDLayer<D>::vectorOp(const char* op, const GpuBuffer& x, GpuBuffer* y, double a, double b,
+void GpuRDLayer<D>::vectorOp(VectorOp op, const GpuBuffer& x, GpuBuffer* y, double a, double b,
                              const GpuBuffer* held) const {
-  const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + op);
+  const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + define(op));
   setUniform(p, "n", int(n_));
   setUniform(p, "ca", a);
   setUniform(p, "cb", b);
@@ -117,7 +117,7 @@ void GpuRDLayer<D>::vectorOp(const char* op, const GpuBuffer& x, GpuBuffer* y, d
 template <int D>
 void GpuRDLayer<D>::thetaStep(const GpuBuffer& rates, GpuBuffer* x, const GpuBuffer& ax, const GpuBuffer& faces, double dt,
                               double explicitD, double ghost) const {
-  const ComputeProgram& p = useKernel("vector_ops.comp", "#define OP_THETA_STEP");
+  const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + define(VectorOp::ThetaStep));
   setUniform(p, "n", int(n_));
   setUniform(p, "ca", dt);
   setUniform(p, "cb", explicitD);
@@ -185,14 +185,14 @@ SolverResult GpuRDLayer<D>::diffuse(int s, double thetaDt) {
   GpuBuffer& x = work_[size_t(s)];
   // the Dirichlet ghost adds theta dt d 2 g / h^2 per boundary face
   if (rd_.settings().boundary == RDBoundary::Dirichlet)
-    vectorOp("OP_ADD_FACES", faces_[size_t(s)], &b,
+    vectorOp(VectorOp::AddFaces, faces_[size_t(s)], &b,
              thetaDt * d / (rd_.h() * rd_.h()) * 2.0 * rd_.settings().dirichletValues[size_t(s)], 1.0);
   // warm start: b plus the last change, rescaled to this theta dt
   x.copyFrom(b, n_ * sizeof(double));
-  if (df.hasIncrement) vectorOp("OP_SCALE_ADD", df.increment, &x, thetaDt / df.incrementThetaDt, 1.0);
+  if (df.hasIncrement) vectorOp(VectorOp::ScaleAdd, df.increment, &x, thetaDt / df.incrementThetaDt, 1.0);
   const SolverResult r = df.pcg->solve(&b, &x, df.M.get(), {rd_.settings().tolerance, 2000});
   df.increment.copyFrom(x, n_ * sizeof(double));
-  vectorOp("OP_SCALE_ADD", b, &df.increment, -1.0, 1.0);
+  vectorOp(VectorOp::ScaleAdd, b, &df.increment, -1.0, 1.0);
   df.incrementThetaDt = thetaDt;
   df.hasIncrement = true;
   std::swap(x_[size_t(s)], work_[size_t(s)]);
@@ -234,7 +234,7 @@ void GpuRDLayer<D>::step(double dt) {
     stats_.diffusion.residual = std::max(stats_.diffusion.residual, r.residual);
   }
   for (int s = 0; s < species_; ++s)
-    if ((clamped_ >> s) & 1u) vectorOp("OP_CLAMP_ZERO", x_[size_t(s)], &x_[size_t(s)], 0.0, 0.0);
+    if ((clamped_ >> s) & 1u) vectorOp(VectorOp::ClampZero, x_[size_t(s)], &x_[size_t(s)], 0.0, 0.0);
   holdFixed();
   if (implicitReaction) {
     const std::vector<uint32_t> st = stats_buffer_.read<uint32_t>(2);
@@ -245,9 +245,9 @@ void GpuRDLayer<D>::step(double dt) {
 }
 
 template <int D>
-void GpuRDLayer<D>::lobeKernel(const char* mode, int species, GpuLaplace* target, GpuBuffer* faces) {
+void GpuRDLayer<D>::lobeKernel(LobeMode mode, int species, GpuLaplace* target, GpuBuffer* faces) {
   const CosineLobeSpec& spec = *rd_.cosineLobes();
-  const ComputeProgram& p = useKernel("rd_lobes.comp", fmt::format("#define DIM {}\n#define {}", D, mode));
+  const ComputeProgram& p = useKernel("rd_lobes.comp", fmt::format("#define DIM {}\n#define {}", D, define(mode)));
   std::array<int, 3> dims{1, 1, 1};
   for (int a = 0; a < D; ++a) dims[size_t(a)] = rd_.cells()[a];
   setUniform(p, "dims", dims);
@@ -284,9 +284,9 @@ bool GpuRDLayer<D>::rebuilt(int s) const {
 }
 
 template <int D>
-void GpuRDLayer<D>::tensorKernel(const char* mode, GpuLaplace* target) {
+void GpuRDLayer<D>::tensorKernel(TensorMode mode, GpuLaplace* target) {
   const DiffusionTensorSpec<D>& spec = *rd_.diffusionTensorSpec();
-  const ComputeProgram& p = useKernel("rd_tensor.comp", fmt::format("#define DIM {}\n#define {}", D, mode));
+  const ComputeProgram& p = useKernel("rd_tensor.comp", fmt::format("#define DIM {}\n#define {}", D, define(mode)));
   std::array<int, 3> dims{1, 1, 1};
   for (int a = 0; a < D; ++a) dims[size_t(a)] = rd_.cells()[a];
   setUniform(p, "dims", dims);
@@ -311,12 +311,12 @@ void GpuRDLayer<D>::tensorKernel(const char* mode, GpuLaplace* target) {
 
 template <int D>
 void GpuRDLayer<D>::buildTensor() {
-  tensorKernel("MODE_SIGMA", nullptr);
+  tensorKernel(TensorMode::Sigma, nullptr);
   for (int s = 0; s < species_; ++s) {
     if (!rd_.anisotropic(s)) continue;
     GpuLaplace* op = operator_[size_t(s)].get();
     faces_[size_t(s)].bind(9);
-    tensorKernel("MODE_FACES", op);
+    tensorKernel(TensorMode::Faces, op);
     op->recomputeDiagonal();
   }
 }
@@ -326,8 +326,8 @@ void GpuRDLayer<D>::buildLobes() {
   for (int s = 0; s < species_; ++s) {
     if (!rd_.lobed(s)) continue;
     GpuLaplace* op = operator_[size_t(s)].get();
-    lobeKernel("MODE_A", s, op, nullptr);
-    lobeKernel("MODE_FACES", s, op, &faces_[size_t(s)]);
+    lobeKernel(LobeMode::A, s, op, nullptr);
+    lobeKernel(LobeMode::Faces, s, op, &faces_[size_t(s)]);
     op->recomputeDiagonal();
   }
 }
@@ -336,8 +336,8 @@ template <int D>
 void GpuRDLayer<D>::holdFixed() {
   for (int s = 0; s < species_; ++s) {
     const size_t si = size_t(s);
-    if (isFrozen_[si]) vectorOp("OP_HOLD", frozen_[si], &x_[si], 0.0, 0.0, &allHeld_);
-    if (isFixed_[si]) vectorOp("OP_HOLD", fixedValue_[si], &x_[si], 0.0, 0.0, &fixedMask_[si]);
+    if (isFrozen_[si]) vectorOp(VectorOp::Hold, frozen_[si], &x_[si], 0.0, 0.0, &allHeld_);
+    if (isFixed_[si]) vectorOp(VectorOp::Hold, fixedValue_[si], &x_[si], 0.0, 0.0, &fixedMask_[si]);
   }
 }
 

@@ -18,6 +18,7 @@
 
 #include "core/state_archive.h"
 #include "gpu/gpu_buffer.h"
+#include "gpu/kernel_modes.h"
 #include "rd/rd_solver.h"
 
 namespace morphoflow {
@@ -54,7 +55,7 @@ class GpuRDLayer {
   struct Diffusion;
   void react(double dt, bool implicit);
   SolverResult diffuse(int s, double thetaDt);
-  void vectorOp(const char* op, const GpuBuffer& x, GpuBuffer* y, double a, double b,
+  void vectorOp(VectorOp op, const GpuBuffer& x, GpuBuffer* y, double a, double b,
                 const GpuBuffer* held = nullptr) const;
   void holdFixed();
   // x += dt R + explicitD (-A x + ghost faces) (rd_solver.cpp's explicit part, its order)
@@ -64,10 +65,10 @@ class GpuRDLayer {
   void buildLobes();
   // A shaped tensor's operator from the shape species at the step's start (seed 004 eq. 18-19).
   void buildTensor();
-  void tensorKernel(const char* mode, GpuLaplace* target);
+  void tensorKernel(TensorMode mode, GpuLaplace* target);
   bool rebuilt(int s) const;  // whether species s's operator is rebuilt every step
   // rd_lobes.comp on `species` into `target` (and the Dirichlet faces' weights).
-  void lobeKernel(const char* mode, int species, GpuLaplace* target, GpuBuffer* faces);
+  void lobeKernel(LobeMode mode, int species, GpuLaplace* target, GpuBuffer* faces);
 
   static constexpr int kMax = ReactionModel::kMaxSpecies;
   const RDSolver<D>& rd_;
