@@ -1,12 +1,15 @@
 #include "app/texture_commands.h"
 
 #include <algorithm>
+#include <memory>
 #include <filesystem>
 #include <iostream>
 #include <stdexcept>
 
+#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "app/commands.h"
 #include "core/output_file.h"
 #include "core/error.h"
 #include "render/colormap.h"
@@ -136,6 +139,52 @@ int plotCommand(const PlotOptions& o) {
   std::cout << fmt::format("{}: the propagator at |r| = {:g}, tau = {:g}; its largest value {:.4g} at {:.1f} degrees\n", o.out,
                            o.radius, o.tau, *peak, 360.0 * double(peak - p.begin()) / double(p.size()));
   return 0;
+}
+
+void addTextureCommands(CLI::App& app, Commands* commands) {
+  auto analyze = std::make_shared<AnalyzeOptions>();
+  CLI::App* analyzeCmd = app.add_subcommand("analyze", "variogram and regularity REG of an image or field dump (seed 003)");
+  analyzeCmd->add_option("file", analyze->file, "PNG/EXR image or DIR/fields/NNNNNN.exr")->required();
+  analyzeCmd->add_option("--channel", analyze->channel, "channel (species) to analyse; default the first");
+  analyzeCmd->add_option("--max-lag", analyze->maxLag, "largest spacing in cells (default: a quarter of the smaller side)")
+      ->check(CLI::Range(1, 1 << 20));
+  analyzeCmd->add_flag("--periodic", analyze->periodic, "pairs wrap around (for tiles of periodic runs)");
+  analyzeCmd->add_option("--slice", analyze->slice, "z slice of a 3D dump (default: the middle)")->check(CLI::Range(0, 1 << 20));
+  analyzeCmd->add_option("--csv", analyze->csv, "also write the variogram per lag and direction");
+  commands->add(analyzeCmd, [analyze] { return analyzeCommand(*analyze); });
+
+  auto plot = std::make_shared<PlotOptions>();
+  CLI::App* plotCmd = app.add_subcommand("plot", "plots: `plot propagator SCENE --out FILE.png` (seed 000 fig. 1)");
+  plotCmd->add_option("what", plot->what, "propagator")->required();
+  plotCmd->add_option("scene", plot->scene, "a scene with [rd.generalized]")->required();
+  plotCmd->add_option("--out", plot->out, "the image (.png)")->required();
+  plotCmd->add_option("--set", plot->overrides, "key.path=value overrides, as for run");
+  plotCmd->add_option("--tau", plot->tau, "the propagator's time")->capture_default_str();
+  plotCmd->add_option("--radius", plot->radius, "|r| of the circle plotted")->capture_default_str();
+  plotCmd->add_option("--size", plot->size, "pixels")->capture_default_str()->check(CLI::Range(64, 8192));
+  commands->add(plotCmd, [plot] { return plotCommand(*plot); });
+
+  auto texton = std::make_shared<TextonOptions>();
+  TextonWalkSettings& walk = texton->walk;
+  CLI::App* textonCmd = app.add_subcommand("texton", "random-walk texton texture (seed 003 eq. 6)");
+  textonCmd->add_option("--out", texton->out, "output image (.png or .exr)")->required();
+  textonCmd->add_option("--size", walk.width, "field width and height in cells")->capture_default_str()->check(CLI::Range(1, 16384));
+  textonCmd->add_option("--elements", walk.elements, "number of textons")->capture_default_str()->check(CLI::Range(1, 10000000));
+  textonCmd->add_option("--steps", walk.steps, "random-walk steps")->capture_default_str()->check(CLI::Range(0, 100000000));
+  textonCmd->add_option("--step-size", walk.stepSize, "cells per move")->capture_default_str()->check(CLI::Range(1, 16384));
+  textonCmd->add_option("--lifetime", walk.lifetime, "mean lifetime L in steps (0: never expire)")->capture_default_str();
+  textonCmd->add_option("-p", walk.p, "probability of moving right, given not expired")->capture_default_str();
+  textonCmd->add_option("-q", walk.q, "probability of moving left, given not expired")->capture_default_str();
+  textonCmd->add_option("--start", texton->start, "pulse | regular | uniform")
+      ->check(CLI::IsMember({"pulse", "regular", "uniform"}))
+      ->capture_default_str();
+  textonCmd->add_option("--radius", walk.radius, "texton disc radius in cells")->capture_default_str();
+  textonCmd->add_option("--seed", walk.seed, "random seed")->capture_default_str();
+  textonCmd->add_flag("--analyze", texton->analyze, "also print the texture's REG");
+  commands->add(textonCmd, [texton] {
+    texton->walk.height = texton->walk.width;
+    return textonCommand(*texton);
+  });
 }
 
 }  // namespace morphoflow

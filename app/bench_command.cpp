@@ -1,0 +1,53 @@
+// `morphoflow bench SUITE`: the benchmark suites (bench/) and the memory benchmark (run/).
+#include <memory>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "app/commands.h"
+#include "bench/bench_suites.h"
+#include "core/error.h"
+#include "core/number_text.h"
+#include "run/memory_bench.h"
+#include "run/memory_estimate.h"
+
+namespace morphoflow {
+
+namespace {
+
+struct BenchArguments {
+  std::string suite;
+  BenchOptions bench;
+};
+
+int runBench(const BenchArguments& a) {
+  const BenchOptions& bench = a.bench;
+  if (!bench.trace.empty() && a.suite != "coupling")
+    throw UserError({"--trace", 0, 0}, "", "only the coupling suite writes a trace", "drop --trace or run `bench coupling`");
+  // A --size case of n^2 cells (the suites' own sizes are known to fit) needs at most ~1 kB a cell.
+  if (const uintmax_t need = uintmax_t(bench.size) * uintmax_t(bench.size) * 1000; need > availableBytes())
+    throw UserError({"--size", 0, 0}, "", fmt::format("a {0} x {0} case needs about {1}; this machine has {2} free", bench.size,
+                                                      humanBytes(need), humanBytes(availableBytes())),
+                    "give a smaller --size");
+  if (a.suite == "memory" && bench.backend != "gpu") return runMemoryBench(bench) ? 0 : 1;
+  if (!runBenchSuite(a.suite, bench))
+    throw UserError({"bench", 0, 0}, "", "unknown suite '" + a.suite + "'", std::string("suites: ") + benchSuiteNames() + ", memory");
+  return 0;
+}
+
+}  // namespace
+
+void addBenchCommand(CLI::App& app, Commands* commands) {
+  auto a = std::make_shared<BenchArguments>();
+  BenchOptions& bench = a->bench;
+  CLI::App* cmd = app.add_subcommand("bench", "run a benchmark suite");
+  cmd->add_option("suite", a->suite, std::string("suite: ") + benchSuiteNames())->required();
+  cmd->add_option("--size", bench.size, "only grids of this many cells per axis")->check(CLI::Range(8, 16384));
+  cmd->add_option("--json", bench.json, "also write results as JSON");
+  cmd->add_option("--seconds", bench.minSeconds, "minimum timed seconds per case");
+  cmd->add_option("--backend", bench.backend, "cpu | gpu")->check(CLI::IsMember({"cpu", "gpu"}))->capture_default_str();
+  cmd->add_option("--trace", bench.trace, "coupling: write a Chrome trace-event JSON of the stages per thread");
+  commands->add(cmd, [a] { return runBench(*a); });
+}
+
+}  // namespace morphoflow
