@@ -86,7 +86,7 @@ nlohmann::json benchGpuCoupling(int n, double minSeconds, double peak) {
   domain.cells = rd.cells();
   domain.h = rd.h();
   GpuFluid<D> gf(host.settings(), host.constraints());
-  GpuRDLayer<D> layer(rd);
+  GpuRDLayer<D> layer(layerUpload(rd));
   GpuARDSolver<D> ard(&layer, domain, ChemicalInterpolation::Linear, CouplingMode::ARD, rdScale, host.cells(), host.h());
   auto step = [&] {
     ard.step(dt, gf);  // velocity n, then the fluid writes n + 1

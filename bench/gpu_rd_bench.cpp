@@ -58,7 +58,7 @@ nlohmann::json benchGpuKimLin(int n, double minSeconds) {
   RDSolver<D> rd(benchGrayScott<D>(n, 1.0, RDIntegrator::KimLin), *findModel("gray-scott"));
   pearsonStart(&rd);
   const double dt = 10.0 * 0.9 * rd.explicitDiffusionLimit();
-  GpuRDLayer<D> gpu(rd);
+  GpuRDLayer<D> gpu(layerUpload(rd));
   gpu.step(dt);  // warm-up: the programs, the diffusion systems
   double diffusionIterations = 0;
   const double traffic0 = gpuTrafficBytes();

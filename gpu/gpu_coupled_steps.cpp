@@ -9,7 +9,7 @@ template <int D>
 GpuCoupledSteps<D>::GpuCoupledSteps(const FluidSolver<D>& fluid, const RDSolver<D>& rd, const ChemicalDomain<D>& domain,
                                     ChemicalInterpolation interpolation, CouplingMode mode, double rdTimeScale)
     : fluid_(fluid.settings(), fluid.constraints()),
-      layer_(rd),
+      layer_(layerUpload(rd)),
       ard_(&layer_, domain, interpolation, mode, rdTimeScale, fluid.cells(), fluid.h()) {
   fluid_.fromHost(fluid);
 }

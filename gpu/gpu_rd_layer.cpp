@@ -32,11 +32,13 @@ struct GpuRDLayer<D>::Diffusion {
 };
 
 template <int D>
-GpuRDLayer<D>::GpuRDLayer(const RDSolver<D>& rd) : rd_(rd), species_(rd.species()), n_(rd.field(0).size()) {
-  for (size_t k = 0; k < rd.model().info().parameters.size() && k < params_.size(); ++k) params_[k] = rd.parameter(int(k));
-  for (int s : rd.model().info().clamped) clamped_ |= 1u << s;
+GpuRDLayer<D>::GpuRDLayer(const LayerUpload<D>& upload)
+    : up_(upload), species_(upload.species), n_(upload.state[0]->size()) {
+  const LayerUpload<D>& rd = up_;
+  for (size_t k = 0; k < rd.parameters.size() && k < params_.size(); ++k) params_[k] = rd.parameters[k];
+  for (int s : rd.clamped) clamped_ |= 1u << s;
   for (int s = 0; s < species_; ++s) {
-    x_[size_t(s)] = GpuBuffer::of(rd.field(s).values());
+    x_[size_t(s)] = GpuBuffer::of(*rd.state[size_t(s)]);
     rates_[size_t(s)] = GpuBuffer(n_ * sizeof(double));
     work_[size_t(s)] = GpuBuffer(n_ * sizeof(double));
     diffusion_[size_t(s)] = std::make_unique<Diffusion>();
@@ -44,12 +46,12 @@ GpuRDLayer<D>::GpuRDLayer(const RDSolver<D>& rd) : rd_(rd), species_(rd.species(
   }
   stats_buffer_ = GpuBuffer(2 * sizeof(uint32_t));
   // each species' operator (a tensor's for the anisotropic ones), for the explicit part
-  for (int s = 0; s < species_; ++s) operator_[size_t(s)] = std::make_unique<GpuLaplace>(rd.diffusionOperator(s));
+  for (int s = 0; s < species_; ++s) operator_[size_t(s)] = std::make_unique<GpuLaplace>(*rd.operators[size_t(s)]);
   // parameter maps (and perturbations), concatenated
   std::vector<double> maps;
   mapAt_.fill(-1);
-  for (size_t k = 0; k < rd.model().info().parameters.size() && k < mapAt_.size(); ++k) {
-    const std::vector<double>& f = rd.parameterField(int(k));
+  for (size_t k = 0; k < rd.parameters.size() && k < mapAt_.size(); ++k) {
+    const std::vector<double>& f = *rd.parameterMaps[k];
     if (f.empty()) continue;
     mapAt_[k] = int(maps.size());
     maps.insert(maps.end(), f.begin(), f.end());
@@ -57,15 +59,15 @@ GpuRDLayer<D>::GpuRDLayer(const RDSolver<D>& rd) : rd_(rd), species_(rd.species(
   maps_ = GpuBuffer::of(maps.empty() ? std::vector<double>{0.0} : maps);
   for (int s = 0; s < species_; ++s) {
     const size_t si = size_t(s);
-    if (si < rd.fixedMasks().size() && !rd.fixedMasks()[si].empty()) {
+    if (rd.fixedMasks[si]) {
       isFixed_[si] = true;
-      fixedMask_[si] = GpuBuffer::of(std::vector<uint32_t>(rd.fixedMasks()[si].begin(), rd.fixedMasks()[si].end()));
-      fixedValue_[si] = GpuBuffer::of(rd.fixedValues()[si]);
+      fixedMask_[si] = GpuBuffer::of(std::vector<uint32_t>(rd.fixedMasks[si]->begin(), rd.fixedMasks[si]->end()));
+      fixedValue_[si] = GpuBuffer::of(*rd.fixedValues[si]);
     }
-    if (rd.settings().boundary == RDBoundary::Dirichlet) faces_[si] = GpuBuffer::of(rd.dirichletFaces(s));
+    if (rd.dirichletFaces[si]) faces_[si] = GpuBuffer::of(*rd.dirichletFaces[si]);
   }
-  for (int s : rd.settings().frozen) isFrozen_[size_t(s)] = true;
-  if (const DiffusionTensorSpec<D>* t = rd.diffusionTensorSpec(); t && t->dynamic()) {
+  for (int s : rd.settings.frozen) isFrozen_[size_t(s)] = true;
+  if (const DiffusionTensorSpec<D>* t = rd.tensor; t && t->dynamic()) {
     std::vector<double> dir;
     for (int a = 0; a < D; ++a) dir.insert(dir.end(), t->direction[size_t(a)].begin(), t->direction[size_t(a)].end());
     direction_ = GpuBuffer::of(dir);
@@ -73,9 +75,9 @@ GpuRDLayer<D>::GpuRDLayer(const RDSolver<D>& rd) : rd_(rd), species_(rd.species(
     lambda2_ = GpuBuffer::of(t->lambda2);
     sigma_ = GpuBuffer(n_ * AnisotropicSystem<D>::kComponents * sizeof(double));
     for (int s = 0; s < species_; ++s)
-      if (rd.anisotropic(s) && !faces_[size_t(s)].id()) faces_[size_t(s)] = GpuBuffer(n_ * sizeof(double));
+      if (rd.anisotropic[size_t(s)] && !faces_[size_t(s)].id()) faces_[size_t(s)] = GpuBuffer(n_ * sizeof(double));
   }
-  if (const CosineLobeSpec* lobes = rd.cosineLobes()) {
+  if (const CosineLobeSpec* lobes = rd.lobes) {
     lobeA_ = GpuBuffer(n_ * sizeof(double));
     std::vector<double> rot(lobes->theta0.empty() ? 2 : 2 * n_);
     for (size_t i = 0; i < lobes->theta0.size(); ++i) {
@@ -84,9 +86,9 @@ GpuRDLayer<D>::GpuRDLayer(const RDSolver<D>& rd) : rd_(rd), species_(rd.species(
     }
     rot_ = GpuBuffer::of(rot);
     for (int s = 0; s < species_; ++s)
-      if (rd.lobed(s) && !faces_[size_t(s)].id()) faces_[size_t(s)] = GpuBuffer(n_ * sizeof(double));
+      if (rd.lobed[size_t(s)] && !faces_[size_t(s)].id()) faces_[size_t(s)] = GpuBuffer(n_ * sizeof(double));
   }
-  allHeld_ = GpuBuffer::of(std::vector<uint32_t>(rd.settings().frozen.empty() ? 1 : n_, 1u));
+  allHeld_ = GpuBuffer::of(std::vector<uint32_t>(rd.settings.frozen.empty() ? 1 : n_, 1u));
 }
 
 template <int D>
@@ -135,9 +137,9 @@ template <int D>
 void GpuRDLayer<D>::react(double dt, bool implicit) {
   // Each parameter by a constant index, so the compiler keeps p[] in registers.
   std::string gather = "#define GATHER_PARAMETERS";
-  for (size_t k = 0; k < rd_.model().info().parameters.size(); ++k)
+  for (size_t k = 0; k < up_.parameters.size(); ++k)
     gather += fmt::format(" p[{0}] = mapAt[{0}] < 0 ? uniformP[{0}] : maps[mapAt[{0}] + i];", k);
-  const ComputeProgram& p = useKernel("rd_react.comp", gpuReaction(rd_.settings().model, true) + gather + "\n" +
+  const ComputeProgram& p = useKernel("rd_react.comp", gpuReaction(up_.settings.model, true) + gather + "\n" +
                                                            (implicit ? "#define MODE_IMPLICIT" : "#define MODE_RATES"));
   setUniform(p, "n", int(n_));
   setUniform(p, "dt", dt);
@@ -157,26 +159,26 @@ void GpuRDLayer<D>::react(double dt, bool implicit) {
 // Solves (I - theta dt d lap) x' = x in place for species s.
 template <int D>
 SolverResult GpuRDLayer<D>::diffuse(int s, double thetaDt) {
-  const double d = rd_.diffusion()[size_t(s)];
+  const double d = up_.diffusion[size_t(s)];
   if (d == 0.0 || thetaDt == 0.0) return SolverResult{true, 0, 0.0};
   Diffusion& df = *diffusion_[size_t(s)];
   if (rebuilt(s)) {  // rebuilt every step from this step's operator: I + theta dt d A
     if (!df.A) {
-      df.A = std::make_unique<GpuLaplace>(rd_.diffusionOperator(s).shifted(thetaDt * d));
+      df.A = std::make_unique<GpuLaplace>(up_.operators[size_t(s)]->shifted(thetaDt * d));
       df.pcg = std::make_unique<GpuPcg>(*df.A);
     }
-    const double k = thetaDt * d / (rd_.h() * rd_.h());
+    const double k = thetaDt * d / (up_.h * up_.h);
     df.A->assignShifted(*operator_[size_t(s)], k);
     df.thetaDt = thetaDt;
   } else if (df.thetaDt != thetaDt) {
-    df.host = rd_.diffusionOperator(s).shifted(thetaDt * d);
+    df.host = up_.operators[size_t(s)]->shifted(thetaDt * d);
     if (df.A)
       df.A->update(df.host);
     else
       df.A = std::make_unique<GpuLaplace>(df.host);
     df.pcg = std::make_unique<GpuPcg>(*df.A);
     // multigrid once diffusion dominates the identity, the diagonal below
-    const double scale = thetaDt * d / (rd_.h() * rd_.h());
+    const double scale = thetaDt * d / (up_.h * up_.h);
     df.M = scale > 1.0 ? std::make_unique<GpuMultigrid>(Multigrid<D>(df.host.axis, kDiffusionCycle), *df.A, kDiffusionCycle)
                        : nullptr;
     df.thetaDt = thetaDt;
@@ -184,13 +186,13 @@ SolverResult GpuRDLayer<D>::diffuse(int s, double thetaDt) {
   GpuBuffer& b = x_[size_t(s)];
   GpuBuffer& x = work_[size_t(s)];
   // the Dirichlet ghost adds theta dt d 2 g / h^2 per boundary face
-  if (rd_.settings().boundary == RDBoundary::Dirichlet)
+  if (up_.settings.boundary == RDBoundary::Dirichlet)
     vectorOp(VectorOp::AddFaces, faces_[size_t(s)], &b,
-             thetaDt * d / (rd_.h() * rd_.h()) * 2.0 * rd_.settings().dirichletValues[size_t(s)], 1.0);
+             thetaDt * d / (up_.h * up_.h) * 2.0 * up_.settings.dirichletValues[size_t(s)], 1.0);
   // warm start: b plus the last change, rescaled to this theta dt
   x.copyFrom(b, n_ * sizeof(double));
   if (df.hasIncrement) vectorOp(VectorOp::ScaleAdd, df.increment, &x, thetaDt / df.incrementThetaDt, 1.0);
-  const SolverResult r = df.pcg->solve(&b, &x, df.M.get(), {rd_.settings().tolerance, 2000});
+  const SolverResult r = df.pcg->solve(&b, &x, df.M.get(), {up_.settings.tolerance, 2000});
   df.increment.copyFrom(x, n_ * sizeof(double));
   vectorOp(VectorOp::ScaleAdd, b, &df.increment, -1.0, 1.0);
   df.incrementThetaDt = thetaDt;
@@ -203,7 +205,7 @@ template <int D>
 void GpuRDLayer<D>::step(double dt) {
   stats_ = RDStepStats{};
   stats_.diffusion.converged = true;
-  const RDIntegrator integ = rd_.settings().integrator;
+  const RDIntegrator integ = up_.settings.integrator;
   const bool implicitReaction = integ == RDIntegrator::KimLin;
   const double theta = diffusionTheta(integ);
   stats_buffer_.zero();
@@ -215,16 +217,16 @@ void GpuRDLayer<D>::step(double dt) {
       }
     frozenTaken_ = true;
   }
-  if (rd_.cosineLobes()) buildLobes();  // eq. 17: a(theta) from the state at the step's start
-  if (const DiffusionTensorSpec<D>* t = rd_.diffusionTensorSpec(); t && t->dynamic()) buildTensor();  // eq. 18-19
+  if (up_.lobes) buildLobes();  // eq. 17: a(theta) from the state at the step's start
+  if (const DiffusionTensorSpec<D>* t = up_.tensor; t && t->dynamic()) buildTensor();  // eq. 18-19
   react(dt, implicitReaction);
   for (int s = 0; s < species_; ++s) {
     // the theta scheme's explicit part: x += dt R + (1 - theta) dt d lap x
-    const double explicitD = (1.0 - theta) * dt * rd_.diffusion()[size_t(s)];
+    const double explicitD = (1.0 - theta) * dt * up_.diffusion[size_t(s)];
     if (explicitD > 0) operator_[size_t(s)]->apply(x_[size_t(s)], &work_[size_t(s)]);  // A x = -lap x (less the ghosts)
     if (!implicitReaction) {
-      const bool dirichlet = rd_.settings().boundary == RDBoundary::Dirichlet;
-      const double ghost = dirichlet ? 2.0 * rd_.settings().dirichletValues[size_t(s)] / (rd_.h() * rd_.h()) : 0.0;
+      const bool dirichlet = up_.settings.boundary == RDBoundary::Dirichlet;
+      const double ghost = dirichlet ? 2.0 * up_.settings.dirichletValues[size_t(s)] / (up_.h * up_.h) : 0.0;
       thetaStep(rates_[size_t(s)], &x_[size_t(s)], work_[size_t(s)], dirichlet ? faces_[size_t(s)] : work_[size_t(s)],
                 dt, explicitD, ghost);
     }
@@ -246,13 +248,13 @@ void GpuRDLayer<D>::step(double dt) {
 
 template <int D>
 void GpuRDLayer<D>::lobeKernel(LobeMode mode, int species, GpuLaplace* target, GpuBuffer* faces) {
-  const CosineLobeSpec& spec = *rd_.cosineLobes();
+  const CosineLobeSpec& spec = *up_.lobes;
   const ComputeProgram& p = useKernel("rd_lobes.comp", fmt::format("#define DIM {}\n#define {}", D, define(mode)));
   std::array<int, 3> dims{1, 1, 1};
-  for (int a = 0; a < D; ++a) dims[size_t(a)] = rd_.cells()[a];
+  for (int a = 0; a < D; ++a) dims[size_t(a)] = up_.cells[a];
   setUniform(p, "dims", dims);
-  setUniform(p, "periodic", rd_.settings().boundary == RDBoundary::Periodic ? 1 : 0);
-  setUniform(p, "dirichlet", rd_.settings().boundary == RDBoundary::Dirichlet ? 1 : 0);
+  setUniform(p, "periodic", up_.settings.boundary == RDBoundary::Periodic ? 1 : 0);
+  setUniform(p, "dirichlet", up_.settings.boundary == RDBoundary::Dirichlet ? 1 : 0);
   setUniform(p, "witkinKass", spec.witkinKass ? 1 : 0);
   setUniform(p, "rotated", spec.theta0.empty() ? 0 : 1);
   const int lobes = int(spec.speeds.size());
@@ -279,19 +281,19 @@ void GpuRDLayer<D>::lobeKernel(LobeMode mode, int species, GpuLaplace* target, G
 
 template <int D>
 bool GpuRDLayer<D>::rebuilt(int s) const {
-  const DiffusionTensorSpec<D>* t = rd_.diffusionTensorSpec();
-  return rd_.lobed(s) || (t && t->dynamic() && rd_.anisotropic(s));
+  const DiffusionTensorSpec<D>* t = up_.tensor;
+  return up_.lobed[size_t(s)] || (t && t->dynamic() && up_.anisotropic[size_t(s)]);
 }
 
 template <int D>
 void GpuRDLayer<D>::tensorKernel(TensorMode mode, GpuLaplace* target) {
-  const DiffusionTensorSpec<D>& spec = *rd_.diffusionTensorSpec();
+  const DiffusionTensorSpec<D>& spec = *up_.tensor;
   const ComputeProgram& p = useKernel("rd_tensor.comp", fmt::format("#define DIM {}\n#define {}", D, define(mode)));
   std::array<int, 3> dims{1, 1, 1};
-  for (int a = 0; a < D; ++a) dims[size_t(a)] = rd_.cells()[a];
+  for (int a = 0; a < D; ++a) dims[size_t(a)] = up_.cells[a];
   setUniform(p, "dims", dims);
-  setUniform(p, "periodic", rd_.settings().boundary == RDBoundary::Periodic ? 1 : 0);
-  setUniform(p, "dirichlet", rd_.settings().boundary == RDBoundary::Dirichlet ? 1 : 0);
+  setUniform(p, "periodic", up_.settings.boundary == RDBoundary::Periodic ? 1 : 0);
+  setUniform(p, "dirichlet", up_.settings.boundary == RDBoundary::Dirichlet ? 1 : 0);
   setUniform(p, "shape", spec.shape);
   setUniform(p, "floorFraction", kMinPrincipalFraction);
   const int mixed = D == 3 ? 6 : 2;
@@ -313,7 +315,7 @@ template <int D>
 void GpuRDLayer<D>::buildTensor() {
   tensorKernel(TensorMode::Sigma, nullptr);
   for (int s = 0; s < species_; ++s) {
-    if (!rd_.anisotropic(s)) continue;
+    if (!up_.anisotropic[size_t(s)]) continue;
     GpuLaplace* op = operator_[size_t(s)].get();
     faces_[size_t(s)].bind(9);
     tensorKernel(TensorMode::Faces, op);
@@ -324,7 +326,7 @@ void GpuRDLayer<D>::buildTensor() {
 template <int D>
 void GpuRDLayer<D>::buildLobes() {
   for (int s = 0; s < species_; ++s) {
-    if (!rd_.lobed(s)) continue;
+    if (!up_.lobed[size_t(s)]) continue;
     GpuLaplace* op = operator_[size_t(s)].get();
     lobeKernel(LobeMode::A, s, op, nullptr);
     lobeKernel(LobeMode::Faces, s, op, &faces_[size_t(s)]);

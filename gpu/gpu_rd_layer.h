@@ -19,6 +19,7 @@
 #include "core/state_archive.h"
 #include "gpu/gpu_buffer.h"
 #include "gpu/kernel_modes.h"
+#include "rd/layer_upload.h"
 #include "rd/rd_solver.h"
 
 namespace morphoflow {
@@ -30,9 +31,9 @@ class GpuPcg;
 template <int D>
 class GpuRDLayer {
  public:
-  // The settings, model, parameters, diffusion operator and initial species
-  // of `rd` (which must outlive this).
-  explicit GpuRDLayer(const RDSolver<D>& rd);
+  // From the layer's description (rd/layer_upload.h: the settings, model,
+  // parameters, operators and initial species of an assembled RDSolver).
+  explicit GpuRDLayer(const LayerUpload<D>& upload);
   ~GpuRDLayer();
   GpuRDLayer(const GpuRDLayer&) = delete;
   GpuRDLayer& operator=(const GpuRDLayer&) = delete;
@@ -71,7 +72,7 @@ class GpuRDLayer {
   void lobeKernel(LobeMode mode, int species, GpuLaplace* target, GpuBuffer* faces);
 
   static constexpr int kMax = ReactionModel::kMaxSpecies;
-  const RDSolver<D>& rd_;
+  LayerUpload<D> up_;
   int species_ = 2;
   size_t n_ = 0;
   std::array<double, 12> params_{};

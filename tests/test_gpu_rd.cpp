@@ -35,7 +35,7 @@ double relativeDifference(RDSettings s, const ReactionModel& m, double dt, int s
       cpu.field(k)[i] = info.initial[size_t(k)] + 0.1 * (1.0 + std::abs(info.initial[size_t(k)])) * (uniform01(3, uint64_t(k), i) - 0.5);
     start[size_t(k)] = cpu.field(k).values();
   }
-  GpuRDLayer<D> gpu(cpu);
+  GpuRDLayer<D> gpu(layerUpload(cpu));
   for (int n = 0; n < steps; ++n) {
     cpu.step(dt);
     gpu.step(dt);
@@ -144,7 +144,7 @@ TEST(GpuRD, MapsFixedCellsFrozenSpeciesAndDirichletWallsMatchTheCpu) {
         cpu.setParameterField(0, F);
         cpu.setFixedCells({mask, mask}, {fixedU, fixedV});
       }
-      GpuRDLayer<2> gpu(cpu);
+      GpuRDLayer<2> gpu(layerUpload(cpu));
       const double dt = integ == RDIntegrator::ExplicitEuler ? 0.5 : 5.0;
       std::vector<double> start = cpu.field(1).values();
       for (int n = 0; n < 20; ++n) {
@@ -217,7 +217,7 @@ double tensorDifference(RDIntegrator integ, RDBoundary boundary, const IVec<D>& 
   tensor.shape = shape;  // eq. 18-19: the diffusivities follow species 1's gradient
   tensor.shapeSpecies = 1;
   cpu.setDiffusionTensor(tensor);
-  GpuRDLayer<D> gpu(cpu);
+  GpuRDLayer<D> gpu(layerUpload(cpu));
   const double dt = integ == RDIntegrator::ExplicitEuler ? 0.2 : 5.0;
   for (int n = 0; n < 10; ++n) {
     cpu.step(dt);
@@ -271,7 +271,7 @@ double lobeDifference(RDIntegrator integ, RDBoundary boundary, const IVec<D>& ce
   spec.theta0.resize(cpu.field(0).size());
   for (size_t i = 0; i < spec.theta0.size(); ++i) spec.theta0[i] = 0.3 + 0.001 * double(i % 97);
   cpu.setCosineLobes(spec);
-  GpuRDLayer<D> gpu(cpu);
+  GpuRDLayer<D> gpu(layerUpload(cpu));
   const double dt = integ == RDIntegrator::ExplicitEuler ? 0.2 : integ == RDIntegrator::CrankNicolson ? 1.0 : 5.0;
   for (int n = 0; n < 5; ++n) {
     cpu.step(dt);
