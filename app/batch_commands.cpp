@@ -14,7 +14,8 @@ namespace {
 // The options batch and sweep share.
 void addBatchOptions(CLI::App* cmd, BatchOptions* b) {
   cmd->add_option("--jobs", b->jobs, "runs at once; the machine's threads are divided between them")->check(CLI::Range(1, 256));
-  cmd->add_option("--shard", b->shard, "I/N: only every N-th run, from the I-th (0-based)");
+  cmd->add_option("--shard", b->shard, "I/N: only every N-th run, from the I-th (0-based)")
+      ->check([](const std::string& s) { return s.empty() ? std::string("expected I/N, got ''") : std::string(); });
   cmd->add_option("--set", b->sets, "override a scene key in every run: key.path=value (TOML value)")
       ->expected(1)
       ->allow_extra_args(false)

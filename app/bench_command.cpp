@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 
 #include "app/commands.h"
+#include "app/option_checks.h"
 #include "bench/bench_suites.h"
 #include "core/error.h"
 #include "core/number_text.h"
@@ -44,7 +45,7 @@ void addBenchCommand(CLI::App& app, Commands* commands) {
   cmd->add_option("suite", a->suite, std::string("suite: ") + benchSuiteNames())->required();
   cmd->add_option("--size", bench.size, "only grids of this many cells per axis")->check(CLI::Range(8, 16384));
   cmd->add_option("--json", bench.json, "also write results as JSON");
-  cmd->add_option("--seconds", bench.minSeconds, "minimum timed seconds per case");
+  cmd->add_option("--seconds", bench.minSeconds, "minimum timed seconds per case")->check(finiteIn(0.0, 3600.0));
   cmd->add_option("--backend", bench.backend, "cpu | gpu")->check(CLI::IsMember({"cpu", "gpu"}))->capture_default_str();
   cmd->add_option("--trace", bench.trace, "coupling: write a Chrome trace-event JSON of the stages per thread");
   commands->add(cmd, [a] { return runBench(*a); });

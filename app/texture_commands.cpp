@@ -10,6 +10,7 @@
 #include <fmt/format.h>
 
 #include "app/commands.h"
+#include "app/option_checks.h"
 #include "core/output_file.h"
 #include "core/error.h"
 #include "render/colormap.h"
@@ -159,8 +160,8 @@ void addTextureCommands(CLI::App& app, Commands* commands) {
   plotCmd->add_option("scene", plot->scene, "a scene with [rd.generalized]")->required();
   plotCmd->add_option("--out", plot->out, "the image (.png)")->required();
   plotCmd->add_option("--set", plot->overrides, "key.path=value overrides, as for run");
-  plotCmd->add_option("--tau", plot->tau, "the propagator's time")->capture_default_str();
-  plotCmd->add_option("--radius", plot->radius, "|r| of the circle plotted")->capture_default_str();
+  plotCmd->add_option("--tau", plot->tau, "the propagator's time")->capture_default_str()->check(finiteIn(1e-3, 1e3));
+  plotCmd->add_option("--radius", plot->radius, "|r| of the circle plotted")->capture_default_str()->check(finiteIn(1e-3, 1e3));
   plotCmd->add_option("--size", plot->size, "pixels")->capture_default_str()->check(CLI::Range(64, 8192));
   commands->add(plotCmd, [plot] { return plotCommand(*plot); });
 
@@ -172,13 +173,15 @@ void addTextureCommands(CLI::App& app, Commands* commands) {
   textonCmd->add_option("--elements", walk.elements, "number of textons")->capture_default_str()->check(CLI::Range(1, 10000000));
   textonCmd->add_option("--steps", walk.steps, "random-walk steps")->capture_default_str()->check(CLI::Range(0, 100000000));
   textonCmd->add_option("--step-size", walk.stepSize, "cells per move")->capture_default_str()->check(CLI::Range(1, 16384));
-  textonCmd->add_option("--lifetime", walk.lifetime, "mean lifetime L in steps (0: never expire)")->capture_default_str();
-  textonCmd->add_option("-p", walk.p, "probability of moving right, given not expired")->capture_default_str();
-  textonCmd->add_option("-q", walk.q, "probability of moving left, given not expired")->capture_default_str();
+  textonCmd->add_option("--lifetime", walk.lifetime, "mean lifetime L in steps (0: never expire)")
+      ->capture_default_str()
+      ->check(finiteIn(0.0, 1e9));
+  textonCmd->add_option("-p", walk.p, "probability of moving right, given not expired")->capture_default_str()->check(finiteIn(0.0, 1.0));
+  textonCmd->add_option("-q", walk.q, "probability of moving left, given not expired")->capture_default_str()->check(finiteIn(0.0, 1.0));
   textonCmd->add_option("--start", texton->start, "pulse | regular | uniform")
       ->check(CLI::IsMember({"pulse", "regular", "uniform"}))
       ->capture_default_str();
-  textonCmd->add_option("--radius", walk.radius, "texton disc radius in cells")->capture_default_str();
+  textonCmd->add_option("--radius", walk.radius, "texton disc radius in cells")->capture_default_str()->check(finiteIn(0.0, 16384.0));
   textonCmd->add_option("--seed", walk.seed, "random seed")->capture_default_str();
   textonCmd->add_flag("--analyze", texton->analyze, "also print the texture's REG");
   commands->add(textonCmd, [texton] {

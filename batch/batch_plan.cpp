@@ -1,5 +1,6 @@
 #include "batch/batch_plan.h"
 
+#include <algorithm>
 #include <filesystem>
 #include <map>
 #include <set>
@@ -96,8 +97,13 @@ BatchPlan planSweep(const std::string& scene, const std::vector<Vary>& varies, c
 
 std::pair<int, int> parseShard(const std::string& text) {
   const size_t slash = text.find('/');
-  const auto i = slash == std::string::npos ? std::nullopt : parseWhole(text.substr(0, slash));
-  const auto n = slash == std::string::npos ? std::nullopt : parseWhole(text.substr(slash + 1));
+  // digits only (no sign, no blanks) on both sides
+  auto whole = [](const std::string& t) {
+    return !t.empty() && std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; }) ? parseWhole(t)
+                                                                                                      : std::nullopt;
+  };
+  const auto i = slash == std::string::npos ? std::nullopt : whole(text.substr(0, slash));
+  const auto n = slash == std::string::npos ? std::nullopt : whole(text.substr(slash + 1));
   if (!i || !n || *n < 1 || *n > 1000000 || *i < 0 || *i >= *n)
     throw UserError({"--shard", 0, 0}, "", "expected I/N with whole numbers 0 <= I < N, got '" + text + "'",
                     "e.g. --shard $SLURM_ARRAY_TASK_ID/$SLURM_ARRAY_TASK_COUNT");

@@ -23,7 +23,10 @@ bool hasExtension(EGLDisplay d, const char* name) { return epoxy_has_egl_extensi
 // other hardware device; software devices last.
 std::vector<EGLDeviceEXT> devicesBestFirst() {
   std::vector<EGLDeviceEXT> out;
-  if (!epoxy_has_egl_extension(EGL_NO_DISPLAY, "EGL_EXT_device_enumeration")) return out;
+  if (!epoxy_has_egl_extension(EGL_NO_DISPLAY, "EGL_EXT_device_enumeration") ||
+      !epoxy_has_egl_extension(EGL_NO_DISPLAY, "EGL_EXT_device_query") ||
+      !epoxy_has_egl_extension(EGL_NO_DISPLAY, "EGL_EXT_platform_device"))
+    return out;
   EGLint n = 0;
   if (!eglQueryDevicesEXT(0, nullptr, &n) || n <= 0) return out;
   std::vector<EGLDeviceEXT> all(static_cast<size_t>(n));
@@ -106,12 +109,17 @@ GlContext& GlContext::instance() {
 
 GlContext::GlContext() : egl_(std::make_unique<Egl>()) {
   if (!epoxy_has_egl()) throw GpuUnavailable("no EGL library (libEGL.so.1) could be loaded");
+  // Without a vendor library (libglvnd found none) the platform displays'
+  // entry points are missing, and calling one would abort the process.
+  if (!epoxy_has_egl_extension(EGL_NO_DISPLAY, "EGL_EXT_platform_base"))
+    throw GpuUnavailable("the EGL library has no vendor that offers platform displays (EGL_EXT_platform_base): check "
+                         "__EGL_VENDOR_LIBRARY_FILENAMES and __EGL_VENDOR_LIBRARY_DIRS, or install libegl-mesa0");
   for (EGLDeviceEXT dev : devicesBestFirst())
     if (makeContext(eglGetPlatformDisplayEXT(EGL_PLATFORM_DEVICE_EXT, dev, nullptr), egl_.get())) {
       platform_ = "EGL device";
       break;
     }
-  if (egl_->context == EGL_NO_CONTEXT &&
+  if (egl_->context == EGL_NO_CONTEXT && epoxy_has_egl_extension(EGL_NO_DISPLAY, "EGL_MESA_platform_surfaceless") &&
       makeContext(eglGetPlatformDisplayEXT(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr), egl_.get()))
     platform_ = "Mesa surfaceless";
   if (egl_->context == EGL_NO_CONTEXT)

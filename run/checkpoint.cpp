@@ -11,6 +11,7 @@
 
 #include "core/error.h"
 #include "core/output_file.h"
+#include "run/output_kinds.h"
 
 namespace fs = std::filesystem;
 
@@ -38,7 +39,7 @@ std::vector<fs::path> checkpointsNewestFirst(const fs::path& dir) {
 
 }  // namespace
 
-fs::path checkpointDir(const fs::path& out) { return out / "checkpoints"; }
+fs::path checkpointDir(const fs::path& out) { return out / kCheckpointFiles.folder; }
 
 fs::path checkpointFile(const fs::path& out, long step) {
   return checkpointDir(out) / fmt::format("{:010d}.ckpt", step);

@@ -5,6 +5,7 @@
 
 #include <fmt/format.h>
 
+#include "run/output_kinds.h"
 #include "run/vdb_sink.h"
 #include "core/output_file.h"
 #include "render/field_dump.h"
@@ -27,7 +28,7 @@ void addBytes(nlohmann::json* run, const std::string& kind, uintmax_t bytes) {
 }
 
 template <int D>
-ImageSink<D>::ImageSink(const std::filesystem::path& out, const Scene& scene) : dir_(out / "frames"), scene_(scene) {
+ImageSink<D>::ImageSink(const std::filesystem::path& out, const Scene& scene) : dir_(out / kFrameFiles.folder), scene_(scene) {
   createOutputFolder(dir_);
 }
 
@@ -105,7 +106,7 @@ void ImageSink<D>::restore(const nlohmann::json& s) {
 }
 
 template <int D>
-FieldDumpSink<D>::FieldDumpSink(const std::filesystem::path& out) : dir_(out / "fields") {
+FieldDumpSink<D>::FieldDumpSink(const std::filesystem::path& out) : dir_(out / kFieldFiles.folder) {
   createOutputFolder(dir_);
 }
 
@@ -147,7 +148,7 @@ void FieldDumpSink<D>::restore(const nlohmann::json& s) {
 
 template <int D>
 NormalMapSink<D>::NormalMapSink(const std::filesystem::path& out, const Scene& scene)
-    : normals_(out / "normals"), heights_(out / "height"), scene_(scene) {
+    : normals_(out / kNormalMapFiles.folder), heights_(out / kHeightFiles.folder), scene_(scene) {
   createOutputFolder(normals_);
   createOutputFolder(heights_);
 }

@@ -19,7 +19,7 @@ class RunClock {
         endTime_(t.steps > 0 ? 1e300 : t.duration) {}
 
   // Whether step `step` (0-based) still runs at simulated time `time`.
-  bool running(long step, double time) const { return step < steps_ && time < endTime_ - 1e-12; }
+  bool running(long step, double time) const { return step < steps_ && time < endTime_ - TimeSettings::kEndTolerance; }
 
   // The steps still to run from step `step` on (by the step count alone).
   long stepsLeft(long step) const { return steps_ - step; }

@@ -5,6 +5,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "run/output_kinds.h"
+
 namespace fs = std::filesystem;
 
 namespace morphoflow {
@@ -30,11 +32,8 @@ int removeMatching(const fs::path& dir, const std::regex& pattern) {
 int removeEarlierRun(const fs::path& out, const std::string& videoStem) {
   const std::string tmp = R"((\.tmp(\.[a-z]+)?|\.part)?)";
   int n = 0;
-  n += removeMatching(out / "frames", std::regex(R"(\d{6}\.(png|exr))" + tmp));
-  n += removeMatching(out / "fields", std::regex(R"(\d{6}\.exr)" + tmp));
-  n += removeMatching(out / "vdb", std::regex(R"(.+\.\d{6}\.(vdb|nvdb))" + tmp));
-  n += removeMatching(out / "checkpoints", std::regex(R"(\d{10}\.ckpt)" + tmp));
-  n += removeMatching(out / "profiles", std::regex(R"((u_vertical|v_horizontal)_centerline\.csv)" + tmp));
+  for (const OutputKind& kind : kOutputKinds)
+    n += removeMatching(out / kind.folder, std::regex(std::string("(") + kind.pattern + ")" + tmp));
   // The earlier run's video may have had another name.
   std::string earlierVideo;
   try {
@@ -48,7 +47,7 @@ int removeEarlierRun(const fs::path& out, const std::string& videoStem) {
     }
   } catch (const std::exception&) {
   }
-  std::string top = R"((run\.json|log\.txt|forces\.csv)" + tmp + ")";
+  std::string top = std::string("((") + kTopLevelFiles + ")" + tmp + ")";
   for (const std::string& stem : {videoStem, earlierVideo})
     if (!stem.empty()) top += "|" + std::regex_replace(stem, std::regex(R"([.^$|()\[\]{}*+?\\])"), R"(\$&)") +
                               R"((\.mp4(\.part)?|\.ffmpeg\.log))";

@@ -1,8 +1,7 @@
 // The output folder of a run. A new run into a folder that holds an earlier
 // run's outputs removes those first (only files a run writes, by their
-// names: frames/, fields/, vdb/, checkpoints/, profiles/, run.json, log.txt,
-// forces.csv, the video), so two runs' frames never mix; anything else in
-// the folder is left alone. --resume keeps them and continues.
+// names: every kind in output_kinds.h, and the video), so two runs' files
+// never mix; anything else in the folder is left alone. --resume keeps them and continues.
 #pragma once
 
 #include <filesystem>

@@ -2,6 +2,8 @@
 // through the run driver.
 #include <memory>
 
+#include <fmt/format.h>
+
 #include "core/error.h"
 #include "core/parallel.h"
 #include "run/memory_estimate.h"
@@ -23,11 +25,24 @@ int run(const Scene& scene, const RunOptions& opt, Backend backend) {
   return driveRun<D>(*sim, scene, opt, &log);
 }
 
+// Refuses --frames A:B whose A lies beyond the run's last frame (a run
+// whose steps are known: no CFL limit), which would write nothing.
+void checkFrames(const Scene& scene, const RunOptions& opt) {
+  if (scene.time.cfl > 0 || opt.firstFrame == 0) return;
+  const long last = scene.totalSteps() / scene.output.every;
+  if (opt.firstFrame > last)
+    throw UserError({"--frames", 0, 0}, "",
+                    fmt::format("frame {} is beyond the run's last frame, {} ({} steps, a frame every {})", opt.firstFrame,
+                                last, scene.totalSteps(), scene.output.every),
+                    fmt::format("give --frames A:B with A <= {}", last));
+}
+
 }  // namespace
 
 int runScene(const RunOptions& opt) {
   const Backend backend = backendNamed(opt.backend);
   Scene scene = loadScene(opt.scene, opt.overrides);
+  checkFrames(scene, opt);
   checkBackend(scene, backend);
   checkRunFits(scene);
   ThreadLimit limit(backend == Backend::Serial ? 1 : opt.threads);

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "run/output_kinds.h"
 #include "run/scene_hash.h"
 #include "run/version.h"
 #include "core/output_file.h"
@@ -32,7 +33,7 @@ VolumeGrid volumeGrid(const std::string& name, VolumeGrid::Kind kind, std::vecto
 
 template <int D>
 VdbSink<D>::VdbSink(const std::filesystem::path& out, const Scene& scene)
-    : dir_(out / "vdb"), scene_(scene), hash_(sceneHash(scene)) {
+    : dir_(out / kVdbFiles.folder), scene_(scene), hash_(sceneHash(scene)) {
   createOutputFolder(dir_);
 }
 

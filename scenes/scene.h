@@ -22,6 +22,8 @@ struct TimeSettings {
   long steps = 0;          // exactly one of steps / duration is used
   double duration = 0.0;
   double cfl = 0.0;        // > 0: adaptive dt = min(dt, cfl h / |u|max)
+  // A run of a duration ends once it is this close to the end (run/run_clock.h).
+  static constexpr double kEndTolerance = 1e-12;
 };
 
 struct OutputSettings {

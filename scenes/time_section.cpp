@@ -20,6 +20,9 @@ void parseTime(SceneContext& c, Scene* sp) {
   s.time.duration = r.number(time, "time.", "duration", 0.0, 0, 1e9, true);
   if (!stepsNode && !durNode) s.time.steps = 100;
   s.time.cfl = r.number(time, "time.", "cfl", 0.0, 0, 1000);
+  if (durNode && s.time.duration <= TimeSettings::kEndTolerance)
+    r.fail(durNode, "time.duration", fmt::format("duration {:g} is too short for a single step", s.time.duration),
+           "give a duration of at least one step, or time.steps");
   // The work a scene asks for is bounded before any of it is done.
   if (durNode && !(s.time.duration / s.time.dt <= double(kMaxSteps)))
     r.fail(durNode, "time.duration",

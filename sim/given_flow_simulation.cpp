@@ -3,7 +3,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/format.h>
+
 #include "sim/rd_scene_setup.h"
+#include "core/error.h"
 #include "core/parallel.h"
 #include "rd/model_registry.h"
 
@@ -59,8 +62,30 @@ void GivenFlowSimulation<D>::sampleVelocity(double t) {
     throw UserError(scene_.velocity.where, scene_.velocity.key, e.path() + ": " + e.what(),
                     "every frame of the sequence must be a readable .vdb with a 'vel' grid over the scene's domain");
   }
+  checkVelocityFinite(t);
   sampled_ = true;
   applyVelocityMaps();
+}
+
+// A velocity from the user (an expression, a VDB file) is finite where it is
+// read: a NaN or an infinity would send the chemicals' back-traces anywhere.
+template <int D>
+void GivenFlowSimulation<D>::checkVelocityFinite(double t) const {
+  for (int a = 0; a < D; ++a) {
+    const Grid<float, D>& g = u_[a];
+    for (size_t i = 0; i < g.size(); ++i) {
+      if (std::isfinite(g[i])) continue;
+      const IVec<D> k = g.coord(i);
+      std::string at = "face (" + std::to_string(k[0]);
+      for (int b = 1; b < D; ++b) at += ", " + std::to_string(k[b]);
+      const bool fromFile = !scene_.velocity.vdb.empty();
+      throw UserError(scene_.velocity.where, scene_.velocity.key,
+                      fmt::format("the given velocity's {} component is {} at {}) at t = {:g}", "uvw"[a],
+                                  std::isnan(g[i]) ? "NaN" : "infinite", at, t),
+                      fromFile ? "the velocity file holds values that are not finite: write it again from a run that did not diverge"
+                               : "guard divisions and logarithms, and keep the values within float range (|v| < 3e38)");
+    }
+  }
 }
 
 // The velocity at an RD cell's centre (u_ may be on the source's own grid).

@@ -38,6 +38,7 @@ class GivenFlowSimulation : public Simulation<D> {
 
  private:
   void sampleVelocity(double t);
+  void checkVelocityFinite(double t) const;
   void applyVelocityMaps();
   Vec<D> velocityAt(const IVec<D>& cell) const;
 

@@ -50,6 +50,24 @@ TEST(Gpu, InfoNamesTheBackendsAndTheRendererOrWhyThereIsNone) {
   EXPECT_NE(r.output.find(" threads; vector kernels "), std::string::npos) << r.output;
 }
 
+// With no EGL vendor library (libglvnd pointed at none), `info` says the GPU
+// is unavailable and why, and a run that asks for it is exit 2 saying so:
+// never an abort.
+TEST(Gpu, WithoutAnEglVendorTheGpuIsUnavailableNotACrash) {
+  setenv("__EGL_VENDOR_LIBRARY_FILENAMES", "/nonexistent/vendor.json", 1);
+  const CommandResult info = runMorphoflow("info");
+  const fs::path dir = tempDir("gpu_no_vendor");
+  const CommandResult run = runMorphoflow("run " + sceneFile("rd/gray_scott_pearson.toml") +
+                                          " --set grid.resolution=[16,16] --set time.steps=2 --backend gpu --quiet --out " +
+                                          (dir / "out").string());
+  unsetenv("__EGL_VENDOR_LIBRARY_FILENAMES");
+  EXPECT_EQ(info.status, 0) << info.output;
+  EXPECT_NE(info.output.find("gpu: unavailable: "), std::string::npos) << info.output;
+  EXPECT_EQ(run.status, 2) << run.output;
+  EXPECT_NE(run.output.find("no usable GPU context"), std::string::npos) << run.output;
+  fs::remove_all(dir);
+}
+
 // Explicit Gray-Scott: float on the GPU, double on the CPU; after 200 steps
 // both species agree to 1e-5 everywhere (docs/gpu.md), and the pattern has
 // moved far beyond that from its start.
@@ -152,7 +170,9 @@ void expectScenesAgree(const std::string& folder, const std::vector<std::string>
     for (const std::string& channel : c.names) {
       const auto [worst, size] = channelDifference(g, c, channel);
       EXPECT_LE(worst, parity.relative * size + parity.absolute) << scene << " " << channel;
-      if (parity.moved) EXPECT_GT(channelDifference(c, start, channel).first, 1e-3 * size) << scene << " " << channel;
+      if (parity.moved) {
+        EXPECT_GT(channelDifference(c, start, channel).first, 1e-3 * size) << scene << " " << channel;
+      }
     }
     fs::remove_all(dir);
   }
@@ -335,10 +355,16 @@ TEST(Gpu, BenchSuitesTimeTheFluidTheLayerAndTheCoupling) {
     for (const nlohmann::json& c : j) {
       EXPECT_GT(c.contains("ms") ? c["ms"].get<double>() : c["ms_per_step_median"].get<double>(), 0.0) << c;
       EXPECT_GT(c["gb_per_second"].get<double>(), 0.0) << c;
-      if (c.contains("pressure_converged")) EXPECT_TRUE(c["pressure_converged"].get<bool>()) << c;
-      if (c.contains("ard_part_ms")) EXPECT_GT(c["ard_part_ms"].get<double>(), 0.0) << c;
+      if (c.contains("pressure_converged")) {
+        EXPECT_TRUE(c["pressure_converged"].get<bool>()) << c;
+      }
+      if (c.contains("ard_part_ms")) {
+        EXPECT_GT(c["ard_part_ms"].get<double>(), 0.0) << c;
+      }
     }
-    if (std::string(suite) == "rd") EXPECT_EQ(j.size(), 2u) << "the explicit and the Kim & Lin rows";
+    if (std::string(suite) == "rd") {
+      EXPECT_EQ(j.size(), 2u) << "the explicit and the Kim & Lin rows";
+    }
   }
   fs::remove_all(dir);
 }

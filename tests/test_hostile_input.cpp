@@ -193,6 +193,78 @@ TEST(HostileInput, ADivergingRunStopsNamingTheStepAndStageAndKeepsItsFrames) {
   fs::remove_all(dir);
 }
 
+// Every numeric option is range-checked where it is parsed: infinities, NaN,
+// values far beyond what the option can use, signs and empty tokens are exit
+// 2 naming the option, before anything runs or is written.
+TEST(HostileInput, CommandLineNumbersOutsideTheirRangeAreRefused) {
+  const fs::path dir = tempDir("hostile_ranges");
+  const std::string rd = write(dir / "rd.toml", kRdScene).string(), out = " --out " + (dir / "o").string();
+  const std::string gen = sceneFile("rd/seeds/mcgraw_fig2_turing.toml"), png = " --out " + (dir / "p.png").string();
+  std::vector<std::pair<std::string, std::string>> cases;  // the command, the option its error names
+  for (const char* v : {"inf", "nan", "1e300", "1e-300", "-1"}) {
+    cases.push_back({"plot propagator " + gen + " --tau " + v + png, "--tau"});
+    cases.push_back({"plot propagator " + gen + " --radius " + v + png, "--radius"});
+  }
+  for (const char* v : {"inf", "nan", "1e9", "-1"}) cases.push_back({std::string("bench roofline --seconds ") + v, "--seconds"});
+  for (const char* v : {"inf", "nan", "1e300", "-1"}) {
+    cases.push_back({std::string("texton --lifetime ") + v + png, "--lifetime"});
+    cases.push_back({std::string("texton --radius ") + v + png, "--radius"});
+    cases.push_back({std::string("texton -p ") + v + png, "-p"});
+  }
+  for (const char* v : {"''", "+0/2", "0/+2", "-0/2", "0/2/3"}) cases.push_back({"batch " + rd + " --shard " + v + out, "--shard"});
+  for (const auto& [args, option] : cases) {
+    CommandResult r = runMorphoflow(args);
+    EXPECT_EQ(r.status, 2) << args << "\n" << r.output;
+    EXPECT_NE(r.output.find(option), std::string::npos) << args << ": the option is not named\n" << r.output;
+  }
+  EXPECT_FALSE(fs::exists(dir / "p.png"));
+  EXPECT_FALSE(fs::exists(dir / "o"));
+  fs::remove_all(dir);
+}
+
+// A run that would do nothing says so instead of exiting 0 in silence:
+// --frames starting beyond the last frame (20 steps, a frame every 10: frames
+// 0 to 2), a duration too short for a single step. The frames it can write still run.
+TEST(HostileInput, ARunThatWouldDoNothingSaysSo) {
+  const fs::path dir = tempDir("hostile_nothing");
+  const std::string rd = write(dir / "rd.toml", kRdScene).string(), out = " --out " + (dir / "o").string();
+  CommandResult r = runMorphoflow("run " + rd + " --frames 3:5 --quiet" + out);
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("--frames"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("last frame, 2"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "o" / "frames"));
+  r = runMorphoflow("run " + rd + " --frames 2:5 --quiet" + out);
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_TRUE(fs::exists(dir / "o" / "frames" / "000002.png"));
+  std::string tiny = kRdScene;
+  tiny.replace(tiny.find("steps = 20"), 10, "duration = 1e-13");
+  r = runMorphoflow("run " + write(dir / "tiny.toml", tiny).string() + " --quiet" + out);
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("time.duration"), std::string::npos) << r.output;
+  fs::remove_all(dir);
+}
+
+// A given velocity that is not finite where it is read (an expression's
+// division by zero, a logarithm of a negative number, a value beyond float
+// range, one that blows up later in time) stops the run with exit 2 naming
+// the [velocity] key, the component, the face and the time: never a crash.
+TEST(HostileInput, AGivenVelocityThatIsNotFiniteIsRefusedWhereItIsRead) {
+  const fs::path dir = tempDir("hostile_velocity");
+  for (const auto& [u, when] : {std::pair{"1 / (x - x)", "t = 0"}, std::pair{"log(-1 - x)", "t = 0"},
+                                std::pair{"1e300", "t = 0"}, std::pair{"1 / (1 - t)", "t = 1"}}) {
+    std::string scene = kRdScene;
+    scene.replace(scene.find("dt = 1.0"), 8, "dt = 0.5");
+    scene += std::string("[velocity]\nfield = [\"") + u + "\", \"0\"]\n";
+    const std::string file = write(dir / "v.toml", scene).string();
+    const CommandResult r = runMorphoflow("run " + file + " --quiet --out " + (dir / "o").string());
+    EXPECT_EQ(r.status, 2) << u << "\n" << r.output;
+    EXPECT_NE(r.output.find(file + ":"), std::string::npos) << u << ": no location\n" << r.output;
+    EXPECT_NE(r.output.find("velocity's u component"), std::string::npos) << u << "\n" << r.output;
+    EXPECT_NE(r.output.find(when), std::string::npos) << u << "\n" << r.output;
+  }
+  fs::remove_all(dir);
+}
+
 TEST(HostileInput, CommandLineNumbersAreWholeTokens) {
   const fs::path dir = tempDir("hostile_cli");
   const std::string rd = write(dir / "rd.toml", kRdScene).string(), out = " --out " + (dir / "o").string();

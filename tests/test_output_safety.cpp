@@ -167,6 +167,30 @@ TEST(OutputSafety, ANewRunRemovesTheEarlierRunsOutputsOnly) {
   fs::remove_all(dir);
 }
 
+// Every kind of output a run writes into its folders (run/output_kinds.h):
+// a run with frames, field dumps, normal and height maps, VDB volumes and
+// checkpoints, then one that writes frames (and its final checkpoint) only:
+// the folders of the kinds it no longer writes are gone, and the frames are its own.
+TEST(OutputSafety, EveryKindOfEarlierOutputIsRemoved) {
+  const fs::path dir = tempDir("safety_every_kind");
+  const fs::path out = dir / "out";
+  ASSERT_EQ(runMorphoflow("run " + kScene + kSmall +
+                          " --set output.every=4 --set output.fields=true --set output.normal_map=true"
+                          " --set output.vdb=true --set output.checkpoint_every=1 --out " + out.string())
+                .status,
+            0);
+  for (const char* folder : {"frames", "fields", "normals", "height", "vdb", "checkpoints"})
+    ASSERT_FALSE(filesUnder(out / folder).empty()) << folder << " not written by the first run";
+  ASSERT_EQ(runMorphoflow("run " + kScene + kSmall + " --set output.every=8 --set output.checkpoint_every=0 --out " +
+                          out.string())
+                .status,
+            0);
+  for (const char* folder : {"fields", "normals", "height", "vdb"})
+    EXPECT_FALSE(fs::exists(out / folder)) << folder << " left from the first run";
+  EXPECT_EQ(filesUnder(out / "frames").size(), 6u);  // steps 0, 8, ..., 40: the second run's only
+  fs::remove_all(dir);
+}
+
 TEST(OutputSafety, SigtermStopsFfmpegAndLeavesNoPartFile) {
   const fs::path dir = tempDir("safety_ffmpeg");
   const fs::path bin = dir / "bin";
