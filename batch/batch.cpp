@@ -19,6 +19,7 @@
 #include "batch/batch_summary.h"
 #include "run/checkpoint.h"
 #include "run/child_process.h"
+#include "run/folder_lock.h"
 #include "run/scene_hash.h"
 #include "run/stop_signal.h"
 #include "core/error.h"
@@ -55,6 +56,9 @@ class BatchRunner {
   int run() {
     validate();
     createOutputFolder(dir_);
+    // one batch (or shard) at a time in a folder; its runs lock their own
+    const FolderLock lock(dir_, opt_.shard.empty() ? std::string(".morphoflow.lock")
+                                                   : ".morphoflow-shard-" + std::regex_replace(opt_.shard, std::regex("/"), "-of-") + ".lock");
     checkBatchFolder(dir_, plan_);
     StopSignals signals;
     writeSummary();

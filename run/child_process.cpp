@@ -12,6 +12,8 @@
 
 #include <fmt/format.h>
 
+#include "run/folder_lock.h"
+
 extern char** environ;
 
 namespace morphoflow {
@@ -40,7 +42,15 @@ ChildProcess::ChildProcess(const std::string& exe, const std::vector<std::string
   posix_spawnattr_setsigdefault(&attr, &defaults);
   posix_spawnattr_setsigmask(&attr, &none);
   posix_spawnattr_setflags(&attr, POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETSIGMASK);
-  const int rc = posix_spawn(&pid_, exe.c_str(), &actions, &attr, argv.data(), environ);
+  // The environment, with this process's pid for the child to stop with (run/folder_lock.h).
+  const std::string prefix = std::string(kBatchParentVariable) + "=";
+  std::vector<std::string> env{prefix + std::to_string(getpid())};
+  for (char** e = environ; *e; ++e)
+    if (std::string(*e).rfind(prefix, 0) != 0) env.emplace_back(*e);
+  std::vector<char*> envp;
+  for (std::string& e : env) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  const int rc = posix_spawn(&pid_, exe.c_str(), &actions, &attr, argv.data(), envp.data());
   posix_spawn_file_actions_destroy(&actions);
   posix_spawnattr_destroy(&attr);
   if (rc != 0) throw std::runtime_error(fmt::format("cannot start {}: {}", exe, std::strerror(rc)));

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "run/checkpoint.h"
+#include "run/folder_lock.h"
 #include "run/frame_schedule.h"
 #include "run/memory_estimate.h"
 #include "run/output_sinks.h"
@@ -57,6 +58,7 @@ class Driver {
 
   int run() {
     createOutputFolder(out_);
+    lock_.emplace(out_);  // before anything in the folder is removed or written
     if (opt_.resume) resume();
     else removeEarlierRun(out_, safeFileStem(scene_.name));
     sinks_ = makeOutputSinks<D>(out_, scene_, [] { return StopSignals::received() != 0; });
@@ -248,6 +250,7 @@ class Driver {
   std::optional<Checkpoint> checkpoint_;
   std::string resumedFrom_;
   long lastFrame_ = -1;
+  std::optional<FolderLock> lock_;
   long checkedStep_ = -1;
   double lastDt_ = 0.0;
   uintmax_t checkpointBytes_ = 0, measurementBytes_ = 0;

@@ -6,6 +6,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
+#include "run/folder_lock.h"
 #include "run/memory_estimate.h"
 #include "run/run_driver.h"
 #include "run/run_log.h"
@@ -40,6 +41,7 @@ void checkFrames(const Scene& scene, const RunOptions& opt) {
 }  // namespace
 
 int runScene(const RunOptions& opt) {
+  stopWithBatchParent();
   const Backend backend = backendNamed(opt.backend);
   Scene scene = loadScene(opt.scene, opt.overrides);
   checkFrames(scene, opt);

@@ -77,6 +77,27 @@ std::string slurp(const fs::path& p) {
 
 }  // namespace
 
+// Two processes, one folder: a second batch (here --resume) into the folder
+// of a batch still running is refused naming the holder, and the runs of a
+// batch that is killed (SIGKILL: nothing of it can clean up) stop with it,
+// checkpointing on the way out, instead of running on as orphans.
+TEST(Batch, ASecondBatchIsRefusedAndTheRunsStopWhenTheBatchIsKilled) {
+  const fs::path dir = tempDir("batch_lock"), out = dir / "out";
+  const fs::path scene = writeScene(dir, "long", 1000000, 50);
+  const pid_t batch = startMorphoflow(batchArgs({scene}, out, {"--quiet"}), dir / "batch.log");
+  pid_t child = -1;
+  ASSERT_TRUE(waitUntil([&] { return (child = childRunning(batch, scene)) > 0 && fs::exists(out / "long" / "frames"); }, 60));
+  const CommandResult second = runMorphoflow("batch " + scene.string() + " --resume --quiet --out " + out.string());
+  EXPECT_EQ(second.status, 2) << second.output;
+  EXPECT_NE(second.output.find("in use by another morphoflow run (pid " + std::to_string(batch) + ")"), std::string::npos)
+      << second.output;
+  kill(batch, SIGKILL);
+  EXPECT_EQ(waitMorphoflow(batch), 128 + SIGKILL);
+  EXPECT_TRUE(waitUntil([&] { return kill(child, 0) != 0; }, 60)) << "the run outlived its batch";
+  EXPECT_GT(countFiles(out / "long" / "checkpoints"), 0) << "the run stopped without its checkpoint";
+  fs::remove_all(dir);
+}
+
 TEST(Batch, ACrashAndAKillNineInTwoScenesNeverStopTheOthers) {
   const fs::path dir = tempDir("batch_isolation"), out = dir / "out";
   const fs::path a = writeScene(dir, "a", 40, 10), b = writeScene(dir, "b", 30, 10);

@@ -191,6 +191,28 @@ TEST(OutputSafety, EveryKindOfEarlierOutputIsRemoved) {
   fs::remove_all(dir);
 }
 
+// Two processes, one output folder: while a run writes its folder, a second
+// run into it is refused (exit 2 naming the holder's pid) and deletes
+// nothing of the first run's; once the first has ended, the folder is free.
+TEST(OutputSafety, AFolderInUseIsRefusedToASecondRun) {
+  const fs::path dir = tempDir("safety_lock");
+  const fs::path out = dir / "out";
+  const pid_t first = startMorphoflow({"run", kScene, "--set", "grid.resolution=[24,24]", "--set", "rd.resolution=[24,24]",
+                                       "--set", "time.steps=1000000", "--set", "output.every=20", "--set",
+                                       "output.video=false", "--quiet", "--out", out.string()},
+                                      dir / "log");
+  ASSERT_TRUE(waitUntil([&] { return fs::exists(out / "frames" / "000001.png"); }, 60));
+  const CommandResult second = runMorphoflow("run " + kScene + kSmall + " --out " + out.string());
+  EXPECT_EQ(second.status, 2) << second.output;
+  EXPECT_NE(second.output.find("in use by another morphoflow run (pid " + std::to_string(first) + ")"), std::string::npos)
+      << second.output;
+  EXPECT_TRUE(fs::exists(out / "frames" / "000000.png")) << "the second run deleted the first run's frames";
+  kill(first, SIGINT);
+  EXPECT_EQ(waitMorphoflow(first), 130);
+  EXPECT_EQ(runMorphoflow("run " + kScene + kSmall + " --out " + out.string()).status, 0);
+  fs::remove_all(dir);
+}
+
 TEST(OutputSafety, SigtermStopsFfmpegAndLeavesNoPartFile) {
   const fs::path dir = tempDir("safety_ffmpeg");
   const fs::path bin = dir / "bin";
