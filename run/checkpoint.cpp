@@ -11,6 +11,7 @@
 
 #include "core/error.h"
 #include "core/output_file.h"
+#include "run/memory_estimate.h"
 #include "run/output_kinds.h"
 
 namespace fs = std::filesystem;
@@ -35,6 +36,26 @@ std::vector<fs::path> checkpointsNewestFirst(const fs::path& dir) {
     if (e.path().extension() == ".ckpt") files.push_back(e.path());
   std::sort(files.rbegin(), files.rend());  // zero-padded step numbers sort by step
   return files;
+}
+
+// What the driver reads of a header: the keys it needs, of their types; a
+// header without them is unusable as a damaged file is (an empty string: it has them).
+std::string headerProblem(const nlohmann::json& h) {
+  if (!h.is_object()) return "its header is not a JSON object";
+  auto has = [&](const char* key, bool (nlohmann::json::*is)() const noexcept) { return h.contains(key) && (h[key].*is)(); };
+  for (const char* key : {"version", "scene_hash", "scene", "log"})
+    if (!has(key, &nlohmann::json::is_string)) return std::string("its header lacks the text '") + key + "'";
+  for (const char* key : {"step", "last_frame"})
+    if (!has(key, &nlohmann::json::is_number_integer)) return std::string("its header lacks the whole number '") + key + "'";
+  if (!has("checkpoint_bytes", &nlohmann::json::is_number_unsigned)) return "its header lacks the byte count 'checkpoint_bytes'";
+  if (!has("time", &nlohmann::json::is_number)) return "its header lacks the number 'time'";
+  if (!has("sinks", &nlohmann::json::is_array)) return "its header lacks the outputs' list 'sinks'";
+  for (const nlohmann::json& sink : h["sinks"]) {
+    if (!sink.is_object()) return "an output's state in its header is not an object";
+    for (const auto& [key, value] : sink.items())
+      if (!value.is_number_integer()) return "its header holds an output's '" + key + "' that is not a whole number";
+  }
+  return "";
 }
 
 }  // namespace
@@ -95,7 +116,15 @@ Checkpoint readCheckpoint(const fs::path& file) {
   if (!in) throw bad("it cannot be opened");
   const uintmax_t size = fs::file_size(file, ec);
   if (ec) throw bad("it cannot be read");
-  std::string bytes(size_t(size), '\0');
+  // (a file of a size no run writes, e.g. a sparse one, is never allocated)
+  if (const uintmax_t free = availableBytes(); size > free)
+    throw bad("it is " + humanBytes(size) + ", more than the " + humanBytes(free) + " of memory free");
+  std::string bytes;
+  try {
+    bytes.assign(size_t(size), '\0');
+  } catch (const std::bad_alloc&) {
+    throw bad("it is " + humanBytes(size) + ", more than this process can hold");
+  }
   if (!in.read(bytes.data(), std::streamsize(bytes.size()))) throw bad("it cannot be read");
   if (bytes.size() < 8 + 8 + 8 + 8 || std::memcmp(bytes.data(), kMagic, 8) != 0) throw bad("it is not a morphoflow checkpoint, or it is cut short");
   const size_t body = bytes.size() - 8;
@@ -111,6 +140,7 @@ Checkpoint readCheckpoint(const fs::path& file) {
   } catch (const std::exception& e) {
     throw bad(std::string("its header is not JSON: ") + e.what());
   }
+  if (const std::string problem = headerProblem(c.header); !problem.empty()) throw bad(problem);
   // The state stays in the bytes read (no copy of a large run's state).
   bytes.resize(body);
   bytes.erase(0, 16 + hn + 8);

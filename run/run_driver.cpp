@@ -168,7 +168,13 @@ class Driver {
 
   void resume() {
     Checkpoint c = latestCheckpoint(out_, [this](const std::string& line) { log_.warn(line); });
-    const nlohmann::json& h = c.header;
+    const nlohmann::json& h = c.header;  // (its keys and types checked by readCheckpoint)
+    // Another version's checkpoint is read section by section, each checked
+    // by name and size: one that does not fit is refused; the log says so.
+    if (h["version"] != kVersion)
+      log_.warn(fmt::format("warning: {} was written by morphoflow {}, this is {}: its state is used only if every "
+                            "section fits",
+                            c.file.string(), h["version"].get<std::string>(), kVersion));
     if (h.value("scene_hash", "") != hash_ && !opt_.force) {
       std::vector<std::string> keys = changedKeys(h.value("scene", "{}"), scene_.resolvedJson);
       throw UserError({c.file.string(), 0, 0}, "--resume",

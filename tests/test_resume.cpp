@@ -7,9 +7,12 @@
 #include <gtest/gtest.h>
 
 #include <csignal>
+#include <cstring>
+#include <functional>
 #include <fstream>
 
 #include <nlohmann/json.hpp>
+#include <xxhash.h>
 
 #include "test_support.h"
 
@@ -215,5 +218,87 @@ TEST(Resume, ADamagedCheckpointFallsBackToTheOlderOne) {
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("no checkpoint here is intact"), std::string::npos) << r.output;
   EXPECT_GT(expectSameFiles(dir / "whole", dir / "cut"), 4);
+  fs::remove_all(dir);
+}
+
+namespace {
+
+// A checkpoint file with `header` in place of its own, checksummed as the
+// program writes it (magic, header length, header, state length, state, XXH64).
+void rewriteHeader(const fs::path& file, const std::string& header) {
+  std::ifstream in(file, std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), {});
+  uint64_t hn = 0;
+  std::memcpy(&hn, bytes.data() + 8, 8);
+  std::string out = bytes.substr(0, 8);
+  const uint64_t n = header.size();
+  out.append(reinterpret_cast<const char*>(&n), 8);
+  out += header;
+  out += bytes.substr(16 + hn, bytes.size() - 8 - (16 + hn));  // the state's length and the state
+  const uint64_t digest = XXH64(out.data(), out.size(), 0);
+  out.append(reinterpret_cast<const char*>(&digest), 8);
+  std::ofstream(file, std::ios::binary | std::ios::trunc) << out;
+}
+
+}  // namespace
+
+// A checkpoint whose checksum holds but whose header lacks what a resume
+// reads (not an object, a key missing, a key of the wrong type, an output's
+// state that is not a number), and one far larger than the memory (sparse),
+// are unusable as a damaged one is: a warning naming it, and the older one
+// used. Another version's checkpoint is used by the stated rule (every state
+// section must fit), with a warning naming both versions.
+TEST(Resume, AMalformedHeaderOrAHugeFileIsUnusableAndAnotherVersionIsSaidSo) {
+  const fs::path dir = tempDir("resume_header");
+  const std::vector<std::string> run = {"run", sceneFile("rd/gray_scott_pearson.toml"), "--set", "grid.resolution=[24,24]",
+                                        "--set", "time.steps=6", "--set", "output.every=2", "--set",
+                                        "output.checkpoint_every=1", "--quiet", "--out", (dir / "out").string()};
+  ASSERT_EQ(runMorphoflow(join(run)).status, 0);
+  std::vector<fs::path> cps = checkpoints(dir / "out");
+  ASSERT_GE(cps.size(), 2u);
+  const fs::path newest = cps.back(), saved = dir / "newest.ckpt";
+  fs::copy_file(newest, saved);
+  std::ifstream in(newest, std::ios::binary);
+  std::string head(24, '\0');
+  in.read(head.data(), 16);
+  uint64_t hn = 0;
+  std::memcpy(&hn, head.data() + 8, 8);
+  head.resize(hn);
+  in.read(head.data(), std::streamsize(hn));
+  const nlohmann::json header = nlohmann::json::parse(head);
+  std::vector<std::string> resume = run;
+  resume.push_back("--resume");
+  auto withHeader = [&](const std::function<void(nlohmann::json*)>& change) {
+    nlohmann::json h = header;
+    change(&h);
+    fs::copy_file(saved, newest, fs::copy_options::overwrite_existing);
+    rewriteHeader(newest, h.dump());
+    return runMorphoflow(join(resume));
+  };
+  const std::vector<std::pair<std::string, std::function<void(nlohmann::json*)>>> malformed = {
+      {"not an object", [](nlohmann::json* h) { *h = nlohmann::json::array({1, 2}); }},
+      {"no sinks", [](nlohmann::json* h) { h->erase("sinks"); }},
+      {"step a string", [](nlohmann::json* h) { (*h)["step"] = "x"; }},
+      {"scene a number", [](nlohmann::json* h) { (*h)["scene"] = 3; }},
+      {"sink state a string", [](nlohmann::json* h) { (*h)["sinks"][0]["written"] = "many"; }},
+  };
+  for (const auto& [what, change] : malformed) {
+    const CommandResult r = withHeader(change);
+    EXPECT_EQ(r.status, 0) << what << "\n" << r.output;
+    EXPECT_NE(r.output.find(newest.string()), std::string::npos) << what << "\n" << r.output;
+    EXPECT_NE(r.output.find("the checkpoint is unusable: "), std::string::npos) << what << "\n" << r.output;
+  }
+  fs::copy_file(saved, newest, fs::copy_options::overwrite_existing);
+  std::error_code ec;  // a sparse file far beyond any machine's memory (ext4 allows up to 16 TiB)
+  for (int e = 43; e >= 40 && (fs::resize_file(newest, uintmax_t(1) << e, ec), ec); --e) {
+  }
+  ASSERT_FALSE(ec) << ec.message();
+  CommandResult r = runMorphoflow(join(resume));
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("more than the"), std::string::npos) << r.output;
+  r = withHeader([](nlohmann::json* h) { (*h)["version"] = "0.0.1-other"; });
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("written by morphoflow 0.0.1-other"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("unusable"), std::string::npos) << r.output;
   fs::remove_all(dir);
 }
