@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "core/error.h"
 #include "core/parallel.h"
 #include "core/simulation.h"
 #include "core/spatial_field.h"
@@ -73,11 +74,31 @@ void applyScene(const Scene& scene, RDSolver<D>* rd) {
   for (size_t k = 0; k < params.size(); ++k)
     if (!params[k].empty()) rd->setParameterField(int(k), std::move(params[k]));
   // Brush strokes, their direction extended to every cell (Kim & Lin sec. 6).
+  // Each stroke must cover a cell; the direction is painted only where it steers something.
+  const bool periodic = rd->settings().boundary == RDBoundary::Periodic;
+  for (const RDStroke& s : scene.rd.strokes) {
+    try {
+      strokeCoverage<D>(s.stroke, n, rd->settings().size, periodic);
+    } catch (const std::invalid_argument&) {
+      throw UserError(s.where, s.key, "the stroke covers no cell of the grid",
+                      s.stroke.isImage() ? "an image stroke covers the cells brighter than its range's middle: this image has none"
+                                         : "give points inside the domain, or a wider stroke");
+    }
+  }
+  const bool steers = (scene.rd.anisotropy.enabled && scene.rd.anisotropy.thetaFromStrokes) ||
+                      (scene.rd.lobes.enabled && scene.rd.lobes.theta0FromStrokes);
   PaintedStrokes<D> painted;
-  if (!scene.rd.strokes.empty()) {
+  if (steers) {
     std::vector<BrushStroke> strokes;
     for (const RDStroke& s : scene.rd.strokes) strokes.push_back(s.stroke);
-    painted = paintStrokes<D>(strokes, n, rd->settings().size, rd->settings().boundary == RDBoundary::Periodic);
+    try {
+      painted = paintStrokes<D>(strokes, n, rd->settings().size, periodic);
+    } catch (const std::invalid_argument&) {  // every stroke an image without edges
+      const RDStroke& first = scene.rd.strokes.front();
+      throw UserError(first.where, first.key, "the strokes give no direction: an image stroke's direction comes from its edges, "
+                                              "and these images are uniform where they cover",
+                      "add a polyline stroke, use an image with edges, or give the direction another way");
+    }
   }
   // Inhomogeneous anisotropic diffusion (seed 004 eq. 11-19).
   if (const RDAnisotropy& an = scene.rd.anisotropy; an.enabled) {
@@ -148,8 +169,7 @@ void applyScene(const Scene& scene, RDSolver<D>* rd) {
   }
   for (const RDStroke& s : scene.rd.strokes) {
     if (s.species.empty()) continue;
-    const std::vector<uint8_t> under =
-        strokeCoverage<D>(s.stroke, n, rd->settings().size, rd->settings().boundary == RDBoundary::Periodic);
+    const std::vector<uint8_t> under = strokeCoverage<D>(s.stroke, n, rd->settings().size, periodic);
     hold(s.species, s.values, [&](size_t i) { return under[i] != 0; });
   }
   if (!scene.rd.fixed.empty() || scene.rd.strokesDeposit())

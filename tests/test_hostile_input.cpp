@@ -265,6 +265,25 @@ TEST(HostileInput, AGivenVelocityThatIsNotFiniteIsRefusedWhereItIsRead) {
   fs::remove_all(dir);
 }
 
+// A stroke from a uniform image has cells under it but no edges, so no
+// direction: it deposits (no direction needed), and where a direction is
+// needed (lobes along the strokes) the run is exit 2 naming the stroke.
+TEST(HostileInput, AStrokeFromAUniformImageDepositsButGivesNoDirection) {
+  const fs::path dir = tempDir("hostile_uniform_stroke");
+  std::ofstream(dir / "bright.pgm", std::ios::binary) << "P5 16 16 255\n" << std::string(256, char(255));
+  const std::string base = std::string(kRdScene) + "[[rd.strokes]]\nimage = \"bright.pgm\"\n";
+  CommandResult r = runMorphoflow("run " + write(dir / "deposit.toml", base + "species = [\"v\"]\nvalues = [0.5]\n").string() +
+                                  " --quiet --out " + (dir / "a").string());
+  EXPECT_EQ(r.status, 0) << r.output;
+  const std::string lobes = write(dir / "lobes.toml", base + "[rd.cosine_lobes]\nspeeds = [1]\ntheta0 = \"strokes\"\n").string();
+  r = runMorphoflow("run " + lobes + " --quiet --out " + (dir / "b").string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find(lobes + ":"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("the strokes give no direction"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "b" / "frames"));
+  fs::remove_all(dir);
+}
+
 TEST(HostileInput, CommandLineNumbersAreWholeTokens) {
   const fs::path dir = tempDir("hostile_cli");
   const std::string rd = write(dir / "rd.toml", kRdScene).string(), out = " --out " + (dir / "o").string();
