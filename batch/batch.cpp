@@ -112,7 +112,7 @@ class BatchRunner {
   }
 
   // --resume: a run completed with the same settings is skipped; one with
-  // checkpoints continues from them.
+  // checkpoints and the same settings continues from them; any other runs afresh.
   bool skipOrResume(size_t i) {
     RunRecord& r = records_[i];
     const fs::path folder = dir_ / r.run.folder;
@@ -126,7 +126,9 @@ class BatchRunner {
       r.wallSeconds = prev.value("wall_seconds", 0.0);
       return true;
     }
-    prepared_[i].resume = hasCheckpoint(folder);
+    // A run whose settings changed since (an edited scene, another --set) runs afresh.
+    const bool sameSettings = !prev.is_object() || prev.value("settings_hash", "") == prepared_[i].hash;
+    prepared_[i].resume = sameSettings && hasCheckpoint(folder);
     return false;
   }
 

@@ -170,6 +170,25 @@ TEST(Batch, SetAppliesToEveryRunAndJobsDivideTheThreads) {
   }
 }
 
+// --resume with a changed --set (docs/batch.md): a run completed with other
+// settings runs again, afresh, to the new settings; with the same ones it is skipped.
+TEST(Batch, ResumeWithAChangedSetRunsTheSceneAgain) {
+  const fs::path dir = tempDir("batch_resume_set"), out = dir / "out";
+  const fs::path scene = writeScene(dir, "gs", 40, 10);
+  const std::string base = "batch " + scene.string() + " --quiet --out " + out.string();
+  ASSERT_EQ(runMorphoflow(base + " --set time.steps=20").status, 0);
+  CommandResult r = runMorphoflow(base + " --set time.steps=40 --resume");
+  EXPECT_EQ(r.status, 0) << r.output;
+  const nlohmann::json run = readJson(out / "gs" / "run.json");
+  EXPECT_EQ(run["exit_state"], "completed");
+  EXPECT_EQ(run["steps"], 40);
+  EXPECT_EQ(runNamed(readJson(out / "batch.json"), "gs")["status"], "completed");
+  r = runMorphoflow(base + " --set time.steps=40 --resume");
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(runNamed(readJson(out / "batch.json"), "gs")["status"], "skipped");
+  fs::remove_all(dir);
+}
+
 TEST(Batch, SigintCheckpointsTheRunningScenesAndResumeFinishesOnlyWhatIsLeft) {
   const fs::path dir = tempDir("batch_resume"), out = dir / "out";
   const fs::path quick = writeScene(dir, "quick", 20, 10), slow = writeScene(dir, "slow", 30000, 1000, "checkpoint_every = 1\n");
