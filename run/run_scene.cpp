@@ -1,5 +1,7 @@
 // `morphoflow run`: a scene file to its Simulation (sim/simulation_factory.h),
 // through the run driver.
+#include <algorithm>
+#include <filesystem>
 #include <memory>
 
 #include <fmt/format.h>
@@ -38,6 +40,25 @@ void checkFrames(const Scene& scene, const RunOptions& opt) {
                     fmt::format("give --frames A:B with A <= {}", last));
 }
 
+// Refuses a scene that reads a file inside the output folder: the run would
+// delete it (an earlier run's outputs go first) or write over it.
+void checkInputsOutside(const Scene& scene, const std::string& out) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::path folder = fs::weakly_canonical(fs::absolute(out), ec);
+  if (ec) return;
+  for (const SceneInput& in : scene.inputs) {
+    const fs::path file = fs::weakly_canonical(fs::absolute(in.path), ec);
+    if (ec) continue;
+    const auto [f, o] = std::mismatch(file.begin(), file.end(), folder.begin(), folder.end());
+    if (o == folder.end())
+      throw UserError(in.where, in.key,
+                      "the scene reads " + in.path + ", which lies inside the output folder " + out +
+                          ": the run would delete or overwrite it",
+                      "move the file out of the output folder, or give another --out");
+  }
+}
+
 }  // namespace
 
 int runScene(const RunOptions& opt) {
@@ -45,6 +66,7 @@ int runScene(const RunOptions& opt) {
   const Backend backend = backendNamed(opt.backend);
   Scene scene = loadScene(opt.scene, opt.overrides);
   checkFrames(scene, opt);
+  checkInputsOutside(scene, opt.out);
   checkBackend(scene, backend);
   checkRunFits(scene);
   ThreadLimit limit(backend == Backend::Serial ? 1 : opt.threads);

@@ -57,6 +57,7 @@ void parseObstacles(SceneContext& c, Scene* sp) {
         GrayImage img;
         std::string err;
         if (!readGrayImage(fp.string(), &img, &err)) r.fail(fn, p + key, "cannot read the image: " + err);
+        r.noteInput(fp, fn, p + key);
         spec.fieldWidth = img.width;
         spec.fieldHeight = img.height;
         spec.field = std::move(img.pixels);

@@ -198,8 +198,16 @@ struct VelocityScene {
   std::string key;
 };
 
+// A file a scene reads besides itself (an image, a frame of a velocity sequence).
+struct SceneInput {
+  std::string path;
+  SourceLocation where;
+  std::string key;
+};
+
 struct Scene {
   std::string path;                // the file it came from
+  std::vector<SceneInput> inputs;  // the files it reads
   std::string name;
   int dimension = 2;
   uint64_t seed = 1;

@@ -106,6 +106,7 @@ Scene parseScene(const std::string& text, const std::string& path, const std::ve
   parseCoupling(c, &s);
   parseOutput(c, &s);
   checkBackTraces(c, s);
+  s.inputs = r.inputs();
 
   r.checkUnknown(root, "");
 

@@ -166,6 +166,7 @@ class Reader {
     GrayImage g;
     std::string err;
     if (!readGrayImage(fp.string(), &g, &err)) fail(img, full + ".image", "cannot read the image: " + err);
+    noteInput(fp, img, full + ".image");
     f.field.imageWidth = g.width;
     f.field.imageHeight = g.height;
     f.field.image = std::move(g.pixels);
@@ -178,11 +179,18 @@ class Reader {
   const std::string& file() const { return file_; }
   toml::table& root() { return root_; }
 
+  // A file the scene reads (an image, a velocity volume), and the key that names it.
+  void noteInput(const std::filesystem::path& path, const toml::node* n, const std::string& key) {
+    inputs_.push_back({path.string(), where(n, key), key});
+  }
+  const std::vector<SceneInput>& inputs() const { return inputs_; }
+
  private:
   std::string file_;
   toml::table& root_;
   std::map<std::string, SourceLocation> overrideLocs_;
   std::map<const toml::table*, std::set<std::string>> known_;
+  std::vector<SceneInput> inputs_;
 };
 
 // An array of species names of `model` (one of `species`), as indices.

@@ -83,6 +83,7 @@ void parseVelocity(SceneContext& c, Scene* sp) {
     V.vdb = fp.string();
     try {
       const std::vector<VelocityFrame> frames = findVelocityFrames(V.vdb, V.frameTime);
+      for (const VelocityFrame& f : frames) r.noteInput(f.path, vn, p + "vdb");
       if (c.D == 2) checkFirstFrame<2>(frames, s);
       else checkFirstFrame<3>(frames, s);
     } catch (const VelocityFileError& e) {

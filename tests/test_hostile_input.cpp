@@ -284,6 +284,28 @@ TEST(HostileInput, AStrokeFromAUniformImageDepositsButGivesNoDirection) {
   fs::remove_all(dir);
 }
 
+// A run never destroys its inputs: a scene that reads a file inside --out
+// (here a map taken from an earlier run's frame) is refused naming the key
+// before anything is deleted; the same scene into another folder runs.
+TEST(HostileInput, ASceneThatReadsFromItsOutputFolderIsRefused) {
+  const fs::path dir = tempDir("hostile_inputs_inside");
+  const fs::path out = dir / "o";
+  ASSERT_EQ(runMorphoflow("run " + write(dir / "rd.toml", kRdScene).string() + " --quiet --out " + out.string()).status, 0);
+  ASSERT_TRUE(fs::exists(out / "frames" / "000000.png"));
+  const std::string mapped = write(dir / "mapped.toml", std::string(kRdScene) + "[rd.maps]\nF = { image = \"" +
+                                                            (out / "frames" / "000000.png").string() +
+                                                            "\", range = [0.03, 0.05] }\n")
+                                 .string();
+  CommandResult r = runMorphoflow("run " + mapped + " --quiet --out " + out.string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("rd.maps.F.image"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("inside the output folder"), std::string::npos) << r.output;
+  EXPECT_TRUE(fs::exists(out / "frames" / "000000.png")) << "the input was deleted";
+  r = runMorphoflow("run " + mapped + " --quiet --out " + (dir / "elsewhere").string());
+  EXPECT_EQ(r.status, 0) << r.output;
+  fs::remove_all(dir);
+}
+
 TEST(HostileInput, CommandLineNumbersAreWholeTokens) {
   const fs::path dir = tempDir("hostile_cli");
   const std::string rd = write(dir / "rd.toml", kRdScene).string(), out = " --out " + (dir / "o").string();
