@@ -9,6 +9,7 @@
 #include "bench/bench_suites.h"
 #include "core/error.h"
 #include "core/number_text.h"
+#include "core/output_file.h"
 #include "run/memory_bench.h"
 #include "run/memory_estimate.h"
 
@@ -30,6 +31,9 @@ int runBench(const BenchArguments& a) {
     throw UserError({"--size", 0, 0}, "", fmt::format("a {0} x {0} case needs about {1}; this machine has {2} free", bench.size,
                                                       humanBytes(need), humanBytes(availableBytes())),
                     "give a smaller --size");
+  // the files it will write, checked before the long work
+  if (!bench.json.empty()) checkOutputFile(bench.json, "--json");
+  if (!bench.trace.empty()) checkOutputFile(bench.trace, "--trace");
   if (a.suite == "memory" && bench.backend != "gpu") return runMemoryBench(bench) ? 0 : 1;
   if (!runBenchSuite(a.suite, bench))
     throw UserError({"bench", 0, 0}, "", "unknown suite '" + a.suite + "'", std::string("suites: ") + benchSuiteNames() + ", memory");

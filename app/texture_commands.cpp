@@ -36,6 +36,7 @@ void printReg(const std::string& what, const Variogram& v) {
 }  // namespace
 
 int analyzeCommand(const AnalyzeOptions& o) {
+  if (!o.csv.empty()) checkOutputFile(o.csv, "--csv");
   FieldDump d;
   std::string err;
   if (!readFieldDump(o.file, &d, &err)) throw UserError({o.file, 0, 0}, "", "cannot read: " + err, "give a PNG/EXR image or a fields/NNNNNN.exr dump");
@@ -81,6 +82,7 @@ int analyzeCommand(const AnalyzeOptions& o) {
 }
 
 int textonCommand(TextonOptions o) {
+  checkOutputFile(o.out, "--out");
   TextonWalkSettings& s = o.walk;
   s.start = o.start == "regular" ? TextonStart::Regular : o.start == "uniform" ? TextonStart::Uniform : TextonStart::Pulse;
   try {
@@ -112,7 +114,7 @@ int textonCommand(TextonOptions o) {
     const std::vector<uint8_t> rgb = fieldToRgb<2>(g, io, &w, &h);
     ok = writeRgb8(o.out, s.width, s.height, rgb, &err);
   }
-  if (!ok) throw std::runtime_error("writing " + o.out + ": " + err);
+  if (!ok) throw UserError({o.out, 0, 0}, "--out", "cannot write the texture: " + err);
   std::cout << fmt::format("{}: {} of {} textons after {} steps of {} cells\n", o.out, at.size(), s.elements, s.steps,
                            s.stepSize);
   if (o.analyze) printReg("variogram", variogram(img, s.width, s.height));
@@ -120,6 +122,7 @@ int textonCommand(TextonOptions o) {
 }
 
 int plotCommand(const PlotOptions& o) {
+  checkOutputFile(o.out, "--out");
   if (o.what != "propagator")
     throw UserError({"plot", 0, 0}, "", "unknown plot '" + o.what + "'", "plots: propagator");
   const Scene scene = loadScene(o.scene, o.overrides);

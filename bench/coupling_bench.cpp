@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "core/output_file.h"
 #include "bench/bench_setups.h"
 #include "bench/bench_suites.h"
 #include "bench/bench_timing.h"
@@ -102,14 +103,7 @@ nlohmann::json benchCase(int n, int threads, double minSeconds, StageTrace* trac
 bool runCouplingBench(const BenchOptions& o) {
   const std::vector<BenchCase> cases = selectBenchCases({{2, 128}, {2, 256}, {2, 512}, {2, 1024}, {3, 64}, {3, 128}}, o.size);
   std::optional<StageTrace> trace;
-  std::ofstream traceFile;
-  if (!o.trace.empty()) {
-    trace.emplace();
-    traceFile.open(o.trace);  // before the long run: a bad path fails at once
-    if (!traceFile)
-      throw UserError({"--trace", 0, 0}, "", "cannot write the trace to '" + o.trace + "'",
-                      "give a path in an existing, writable directory");
-  }
+  if (!o.trace.empty()) trace.emplace();
   nlohmann::json all = nlohmann::json::array();
   std::cout << "overhead = (fluid + ARD) / fluid only, target <= 1.10 at 512^2 and above (2 threads)\n";
   const std::array<double, 3> triad = suiteTriads(o.minSeconds);
@@ -129,11 +123,9 @@ bool runCouplingBench(const BenchOptions& o) {
                 << std::flush;
       all.push_back(j);
     }
-  if (!o.json.empty()) std::ofstream(o.json) << all.dump(2) << "\n";
+  if (!o.json.empty()) writeFileAtomically(o.json, all.dump(2) + "\n");
   if (trace) {
-    traceFile << trace->chromeJson();
-    traceFile.close();
-    if (!traceFile) throw std::runtime_error("writing the trace to " + o.trace + " failed");
+    writeFileAtomically(o.trace, trace->chromeJson());
     std::cout << fmt::format("trace: {} stages -> {} (open in ui.perfetto.dev or chrome://tracing)\n", trace->events().size(),
                              o.trace);
   }

@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "core/output_file.h"
 #include "bench/bench_setups.h"
 #include "bench/bench_suites.h"
 #include "bench/bench_timing.h"
@@ -84,7 +85,7 @@ bool runFluidBench(const BenchOptions& o) {
       all.push_back(j);
     }
   }
-  if (!o.json.empty()) std::ofstream(o.json) << all.dump(2) << "\n";
+  if (!o.json.empty()) writeFileAtomically(o.json, all.dump(2) + "\n");
   return true;
 }
 

@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "core/output_file.h"
 #include "bench/bench_setups.h"
 #include "bench/bench_suites.h"
 #include "bench/bench_timing.h"
@@ -123,7 +124,7 @@ bool runGpuFluidBench(const BenchOptions& o) {
               << std::flush;
     all.push_back(j);
   }
-  if (!o.json.empty()) std::ofstream(o.json) << all.dump(2) << "\n";
+  if (!o.json.empty()) writeFileAtomically(o.json, all.dump(2) + "\n");
   return true;
 }
 
@@ -143,7 +144,7 @@ bool runGpuCouplingBench(const BenchOptions& o) {
               << std::flush;
     all.push_back(j);
   }
-  if (!o.json.empty()) std::ofstream(o.json) << all.dump(2) << "\n";
+  if (!o.json.empty()) writeFileAtomically(o.json, all.dump(2) + "\n");
   return true;
 }
 

@@ -17,6 +17,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "core/output_file.h"
 #include "bench/bench_setups.h"
 #include "bench/bench_suites.h"
 #include "bench/bench_timing.h"
@@ -188,7 +189,7 @@ bool runRooflineBench(const BenchOptions& o) {
                                   {"gb_per_second", gbs}, {"fraction_of_triad", gbs / bw[threads]}});
       }
   }
-  if (!o.json.empty()) std::ofstream(o.json) << all.dump(2) << "\n";
+  if (!o.json.empty()) writeFileAtomically(o.json, all.dump(2) + "\n");
   return true;
 }
 

@@ -115,6 +115,14 @@ void createOutputFolder(const fs::path& dir) {
   if (::access(dir.c_str(), W_OK | X_OK) != 0) fail(dir, "cannot write into the folder", errno);
 }
 
+void checkOutputFile(const fs::path& file, const std::string& option) {
+  if (file.empty() || file.filename().empty() || file.filename() == "." || file.filename() == "..")
+    throw OutputError(file, "is not a file name", "give " + option + " a file path");
+  const fs::path parent = file.parent_path().empty() ? fs::path(".") : file.parent_path();
+  createOutputFolder(parent);
+  checkReplaceable(file);
+}
+
 std::string safeFileStem(const std::string& name) {
   std::string s;
   for (char ch : name) {

@@ -48,6 +48,11 @@ void checkReplaceable(const std::filesystem::path& path);
 // file, under /proc, /sys or /dev, or cannot be created or written.
 void createOutputFolder(const std::filesystem::path& dir);
 
+// Before a command that writes one file at `file` does its work: the folder
+// it goes in is a checked output folder (createOutputFolder), and the path
+// is empty or a regular file (checkReplaceable); the option named in errors.
+void checkOutputFile(const std::filesystem::path& file, const std::string& option);
+
 // A scene's name made safe as a file stem: letters, digits, '-', '_' and
 // '.' (no leading dot); anything else becomes '_'. Never empty, never a path.
 std::string safeFileStem(const std::string& name);

@@ -226,7 +226,16 @@ bool readVdbVelocity(const std::string& path, VelocityVolume* out, std::string* 
     if (!box.empty()) {
       const openvdb::Coord d = box.dim();
       for (int a = 0; a < 3; ++a) v.origin[size_t(a)] = box.min()[a], v.cells[size_t(a)] = d[a];
-      const size_t n = size_t(d[0]) * size_t(d[1]) * size_t(d[2]);
+      const double cells = double(d[0]) * double(d[1]) * double(d[2]);
+      // The box of the active voxels is read densely: bounded before anything is allocated.
+      if (cells > double(kMaxVelocityCells)) {
+        *error = "the velocity's active voxels span " + std::to_string(d[0]) + " x " + std::to_string(d[1]) + " x " +
+                 std::to_string(d[2]) + " cells (" + std::to_string(grid->activeVoxelCount()) +
+                 " of them active), more than the " + std::to_string(kMaxVelocityCells >> 20) +
+                 " Mi cells a velocity volume may span";
+        return false;
+      }
+      const size_t n = size_t(cells);
       std::vector<openvdb::Vec3s> dense(n);
       openvdb::tools::Dense<openvdb::Vec3s, openvdb::tools::LayoutXYZ> dst(box, dense.data());
       openvdb::tools::copyToDense(*grid, dst);

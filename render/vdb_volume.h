@@ -63,8 +63,11 @@ struct VelocityVolume {
   std::array<double, 3> domain{};        // the writer's domain_size metadata
 };
 
+// The box of a velocity volume's active voxels may span at most this many
+// cells (512^3: it is read densely, 24 bytes a cell).
+constexpr long kMaxVelocityCells = 1L << 27;
 // False and a message (what is missing, or what OpenVDB said) when the file
-// cannot be read or has no velocity grid.
+// cannot be read, has no velocity grid, or spans more than kMaxVelocityCells.
 bool readVdbVelocity(const std::string& path, VelocityVolume* out, std::string* error);
 // The file's `time` metadata (*has false when it has none), without reading its grids.
 bool readVdbTime(const std::string& path, double* time, bool* has, std::string* error);

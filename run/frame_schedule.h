@@ -1,5 +1,5 @@
 // Which steps write a frame: every output.every steps (frame 0 is the
-// initial state), within --frames A:B; the run stops after frame B.
+// initial state), within --frames A:B; the run stops at frame B.
 #pragma once
 
 #include "run/run_options.h"
@@ -18,8 +18,9 @@ class FrameSchedule {
     if (frame < first_ || (last_ >= 0 && frame > last_)) return -1;
     return frame;
   }
-  // Whether the run is done before step `step` + 1: it is past --frames' B.
-  bool pastLast(long step) const { return last_ >= 0 && step >= long(last_ + 1) * every_; }
+  // Whether the run is done at step `step`: --frames' B is written. (It
+  // stops there, so its final checkpoint is at B's step and a resume writes B + 1.)
+  bool pastLast(long step) const { return last_ >= 0 && step >= long(last_) * every_; }
   int every() const { return every_; }
 
  private:

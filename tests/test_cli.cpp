@@ -644,7 +644,9 @@ TEST(Cli, CouplingBenchWritesAChromeTrace) {
               fluidGBs * j[k]["fluid_only_ms"].get<double>());
   }
   EXPECT_EQ(runMorphoflow("bench fluid --size 32 --seconds 0 --trace " + trace.string()).status, 2);
-  EXPECT_EQ(runMorphoflow("bench coupling --size 32 --seconds 0 --trace " + (dir / "no" / "t.json").string()).status, 2);
+  // A trace into a folder that is a file is refused before the benchmark runs.
+  std::ofstream(dir / "file") << "x";
+  EXPECT_EQ(runMorphoflow("bench coupling --size 32 --seconds 0 --trace " + (dir / "file" / "t.json").string()).status, 2);
   fs::remove_all(dir);
 }
 

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 
 #include <nlohmann/json.hpp>
@@ -171,6 +172,30 @@ TEST(GivenVelocity, VolumesThatCannotServeAreRefusedWithTheirPath) {
   r = runMorphoflow("validate " + none.string());
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("cannot list the folder"), std::string::npos) << r.output;
+  fs::remove_all(dir);
+}
+
+// A velocity volume whose active voxels span a huge box (two voxels far
+// apart: a file of a few KB) is refused by its size before it is read
+// densely, for validate and run alike, and quickly. (Written with Debian's
+// pyopenvdb, as a foreign tool would.)
+TEST(GivenVelocity, AVolumeSpanningAHugeBoxIsRefusedBeforeItIsRead) {
+  const fs::path dir = tempDir("vdb_huge");
+  const std::string py = "import pyopenvdb as vdb\ng = vdb.Vec3SGrid()\ng.name = 'vel'\na = g.getAccessor()\n"
+                         "a.setValueOn((0, 0, 0), (1, 0, 0))\na.setValueOn((4000, 4000, 4000), (1, 0, 0))\n"
+                         "vdb.write('" + (dir / "far.0000.vdb").string() + "', grids=[g])\n";
+  std::ofstream(dir / "write.py") << py;
+  if (std::system(("/usr/bin/python3 " + (dir / "write.py").string() + " 2>/dev/null").c_str()) != 0)
+    GTEST_SKIP() << "no pyopenvdb";
+  ASSERT_LT(fs::file_size(dir / "far.0000.vdb"), 100000u);
+  const fs::path scene = write(dir / "far.toml", "[grid]\nresolution = [16, 16]\n[rd]\nmodel = \"gray-scott\"\n[velocity]\n"
+                                                 "vdb = \"far.####.vdb\"\nframe_time = 1.0\n");
+  for (const std::string& cmd : {"validate " + scene.string(), "run " + scene.string() + " --quiet --out " + (dir / "o").string()}) {
+    const CommandResult r = runMorphoflow(cmd);
+    EXPECT_EQ(r.status, 2) << cmd << "\n" << r.output;
+    EXPECT_NE(r.output.find("far.0000.vdb"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("Mi cells a velocity volume may span"), std::string::npos) << r.output;
+  }
   fs::remove_all(dir);
 }
 

@@ -306,6 +306,64 @@ TEST(HostileInput, ASceneThatReadsFromItsOutputFolderIsRefused) {
   fs::remove_all(dir);
 }
 
+// Every file a command writes goes through the checked output path: for
+// bench --json, plot --out, texton --out and analyze --csv, a folder, a FIFO
+// (never opened: no hang) and a path under /dev are exit 2 naming the path
+// before any work; so is a symlink (never written through); a missing
+// folder is created.
+TEST(HostileInput, EveryWriterRefusesFoldersPipesAndDevices) {
+  const fs::path dir = tempDir("hostile_writers");
+  const std::string gen = sceneFile("rd/seeds/mcgraw_fig2_turing.toml");
+  const fs::path folder = dir / "folder", fifo = dir / "fifo";
+  fs::create_directories(folder);
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0644), 0);
+  const std::string png = (dir / "t.png").string();
+  ASSERT_EQ(runMorphoflow("texton --size 32 --elements 4 --steps 4 --out " + png).status, 0);
+  auto commands = [&](const std::string& target) {
+    return std::vector<std::string>{"bench roofline --json " + target, "plot propagator " + gen + " --size 64 --out " + target,
+                                    "texton --size 32 --elements 4 --steps 4 --out " + target,
+                                    "analyze " + png + " --csv " + target};
+  };
+  for (const std::string& target : {folder.string(), fifo.string(), std::string("/dev/morphoflow_test_file")})
+    for (const std::string& cmd : commands(target)) {
+      const CommandResult r = runMorphoflow(cmd);
+      EXPECT_EQ(r.status, 2) << cmd << "\n" << r.output;
+      EXPECT_NE(r.output.find(target.rfind("/dev/", 0) == 0 ? std::string("/dev") : target), std::string::npos) << cmd << "\n"
+                                                                                                             << r.output;
+    }
+  EXPECT_FALSE(fs::exists("/dev/morphoflow_test_file"));
+  struct stat st;
+  ASSERT_EQ(lstat(fifo.c_str(), &st), 0);
+  EXPECT_TRUE(S_ISFIFO(st.st_mode));
+  // A symlink at the path is refused as any other non-file is: never written through.
+  std::ofstream(dir / "target.txt") << "mine";
+  fs::create_symlink(dir / "target.txt", dir / "link.png");
+  EXPECT_EQ(runMorphoflow("texton --size 32 --elements 4 --steps 4 --out " + (dir / "link.png").string()).status, 2);
+  EXPECT_TRUE(fs::is_symlink(dir / "link.png"));
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(std::ifstream(dir / "target.txt").rdbuf()), {}), "mine");
+  // A missing folder is created.
+  EXPECT_EQ(runMorphoflow("plot propagator " + gen + " --size 64 --out " + (dir / "new" / "p.png").string()).status, 0);
+  EXPECT_TRUE(fs::is_regular_file(dir / "new" / "p.png"));
+  fs::remove_all(dir);
+}
+
+// A run limited by --frames and then resumed without the limit writes every
+// later frame, bitwise the frames of a run that was never limited.
+TEST(HostileInput, ARunLimitedByFramesResumesWithTheNextFrame) {
+  const fs::path dir = tempDir("hostile_frames_resume");
+  const std::string rd = write(dir / "rd.toml", kRdScene).string() + " --set time.steps=50 --quiet --out ";
+  ASSERT_EQ(runMorphoflow("run " + rd + (dir / "whole").string()).status, 0);
+  ASSERT_EQ(runMorphoflow("run " + rd + (dir / "cut").string() + " --frames 0:2").status, 0);
+  EXPECT_FALSE(fs::exists(dir / "cut" / "frames" / "000003.png"));
+  ASSERT_EQ(runMorphoflow("run " + rd + (dir / "cut").string() + " --resume").status, 0);
+  auto bytes = [](const fs::path& p) { return std::string(std::istreambuf_iterator<char>(std::ifstream(p, std::ios::binary).rdbuf()), {}); };
+  for (const char* f : {"000000.png", "000002.png", "000003.png", "000004.png", "000005.png"}) {
+    ASSERT_TRUE(fs::exists(dir / "cut" / "frames" / f)) << f << " lost";
+    EXPECT_EQ(bytes(dir / "cut" / "frames" / f), bytes(dir / "whole" / "frames" / f)) << f;
+  }
+  fs::remove_all(dir);
+}
+
 TEST(HostileInput, CommandLineNumbersAreWholeTokens) {
   const fs::path dir = tempDir("hostile_cli");
   const std::string rd = write(dir / "rd.toml", kRdScene).string(), out = " --out " + (dir / "o").string();
