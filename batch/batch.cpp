@@ -23,6 +23,7 @@
 #include "run/scene_hash.h"
 #include "run/stop_signal.h"
 #include "core/error.h"
+#include "core/number_text.h"
 #include "core/output_file.h"
 #include "core/parallel.h"
 #include "scenes/scene_loader.h"
@@ -227,16 +228,21 @@ std::map<int, nlohmann::json> readShardSummaries(const std::string& dirText) {
     std::smatch m;
     const std::string name = e.path().filename().string();
     if (!std::regex_match(name, m, shardFile)) continue;
+    std::error_code fec;
+    if (!fs::is_regular_file(fs::symlink_status(e.path(), fec)))
+      throw UserError({e.path().string(), 0, 0}, "", "not a batch summary: it is not a regular file", "remove it");
     const nlohmann::json j = readJsonFile(e.path());
-    if (!j.is_object() || !j.contains("runs"))
-      throw UserError({e.path().string(), 0, 0}, "", "not a batch summary", "remove it, or run that shard again");
-    const int i = std::stoi(m[1]), n = std::stoi(m[2]);
-    if (i >= n) throw UserError({e.path().string(), 0, 0}, "", "not a shard's summary (I must be below N)", "remove it");
-    if (count && (n != count || j.value("batch_id", "") != shards.begin()->second.value("batch_id", "")))
+    if (const std::string problem = summaryProblem(j, fs::path(dirText)); !problem.empty())
+      throw UserError({e.path().string(), 0, 0}, "", "not a batch summary: " + problem, "remove it, or run that shard again");
+    const auto i = parseWhole(m[1]), n = parseWhole(m[2]);
+    if (!i || !n || *n > 1000000 || *i >= *n)
+      throw UserError({e.path().string(), 0, 0}, "", "not a shard's summary (I/N with I below N <= 1000000)", "remove it");
+    if (count && (*n != count || j["batch_id"] != shards.begin()->second["batch_id"] ||
+                  j["planned_runs"] != shards.begin()->second["planned_runs"]))
       throw UserError({e.path().string(), 0, 0}, "", "the shard summaries are from different batches",
                       "gather each batch's folder on its own");
-    count = n;
-    shards[i] = j;
+    count = int(*n);
+    shards[int(*i)] = j;
   }
   if (ec || shards.empty())
     throw UserError({dirText, 0, 0}, "", "no shard summaries (batch.shard-I-of-N.json) here",
@@ -256,6 +262,14 @@ std::vector<RunRecord> interleaveShards(const std::map<int, nlohmann::json>& sha
   std::vector<std::vector<RunRecord>> parts;
   size_t total = 0;
   for (const auto& [i, j] : shards) total += parts.emplace_back(recordsFromJson(j)).size();
+  // Shard i of N holds the planned runs i, i + N, ...: every one of them, no more.
+  const size_t planned = shards.begin()->second["planned_runs"].get<size_t>();
+  for (const auto& [i, j] : shards)
+    if (j["runs"].size() != (planned + count - 1 - size_t(i)) / count)
+      throw UserError({dirText, 0, 0}, "",
+                      fmt::format("shard {} of {} lists {} runs, where the plan of {} runs gives it {}", i, count, j["runs"].size(),
+                                  planned, (planned + count - 1 - size_t(i)) / count),
+                      "run that shard again");
   std::vector<RunRecord> records;
   for (size_t k = 0; k < total; ++k) {
     const auto& part = parts[k % count];

@@ -121,6 +121,55 @@ nlohmann::json summaryJson(const BatchPlan& plan, const std::vector<RunRecord>& 
           {"exit_status", batchExitStatus(records)}, {"runs", runs}};
 }
 
+namespace {
+
+// A path a summary names: relative, no "..", and (when `file`) a regular file inside the folder.
+bool insideFolder(const std::string& path, const fs::path& batchDir, bool file) {
+  const fs::path p(path);
+  if (path.empty() || p.is_absolute()) return false;
+  for (const fs::path& part : p)
+    if (part == "..") return false;
+  std::error_code ec;
+  return !file || fs::is_regular_file(fs::symlink_status(batchDir / p, ec));
+}
+
+}  // namespace
+
+std::string summaryProblem(const nlohmann::json& j, const fs::path& batchDir) {
+  using json = nlohmann::json;
+  if (!j.is_object()) return "it is not a JSON object";
+  auto is = [](const json& o, const char* key, bool (json::*test)() const noexcept) { return o.contains(key) && (o[key].*test)(); };
+  if (!is(j, "runs", &json::is_array)) return "it has no list of runs";
+  if (!is(j, "planned_runs", &json::is_number_unsigned)) return "it has no planned_runs count";
+  if (!is(j, "kind", &json::is_string) || !is(j, "batch_id", &json::is_string)) return "it lacks its kind or batch_id";
+  if (j.contains("keys") && !(j["keys"].is_array() && std::all_of(j["keys"].begin(), j["keys"].end(), [](const json& k) { return k.is_string(); })))
+    return "its keys are not a list of names";
+  for (size_t k = 0; k < j["runs"].size(); ++k) {
+    const json& r = j["runs"][k];
+    const std::string at = "run " + std::to_string(k) + " ";
+    if (!r.is_object()) return at + "is not an object";
+    for (const char* key : {"scene", "folder", "status", "last_frame"})
+      if (!is(r, key, &json::is_string)) return at + "lacks the text '" + key + "'";
+    for (const char* key : {"steps", "frames", "bytes_written"})
+      if (!is(r, key, &json::is_number_unsigned)) return at + "lacks the count '" + key + "' (a whole number >= 0)";
+    if (!is(r, "exit_code", &json::is_number_integer)) return at + "lacks its exit_code";
+    if (!is(r, "wall_seconds", &json::is_number) || r["wall_seconds"].get<double>() < 0) return at + "lacks its wall_seconds";
+    if (!is(r, "resumed", &json::is_boolean)) return at + "lacks 'resumed'";
+    if (!is(r, "overrides", &json::is_array)) return at + "lacks its overrides";
+    for (const json& o : r["overrides"])
+      if (!o.is_string()) return at + "has an override that is not text";
+    if (r.contains("values"))
+      for (const auto& [key, v] : r["values"].items())
+        if (!v.is_string()) return at + "has a value of '" + key + "' that is not text";
+    if (r.contains("error") && !r["error"].is_string()) return at + "has an error that is not text";
+    if (!insideFolder(r["folder"].get<std::string>(), batchDir, false)) return at + "names a folder outside the batch folder";
+    const std::string last = r["last_frame"].get<std::string>();
+    if (!last.empty() && !insideFolder(last, batchDir, true))
+      return at + "names a last frame (" + last + ") that is not a file inside the batch folder";
+  }
+  return "";
+}
+
 std::vector<RunRecord> recordsFromJson(const nlohmann::json& summary) {
   std::vector<RunRecord> out;
   const std::vector<std::string> keys = summary.value("keys", std::vector<std::string>{});

@@ -43,6 +43,10 @@ void recordExit(const std::filesystem::path& batchDir, RunRecord* r);
 
 nlohmann::json summaryJson(const BatchPlan& plan, const std::vector<RunRecord>& records, const std::string& shard);
 std::vector<RunRecord> recordsFromJson(const nlohmann::json& summary);
+// What is wrong with a summary read back (its schema: every key gather reads,
+// of its type; every path it names relative, inside `batchDir` and a regular
+// file there), or "" when nothing is.
+std::string summaryProblem(const nlohmann::json& summary, const std::filesystem::path& batchDir);
 void printSummary(std::ostream& out, const std::vector<RunRecord>& records, const std::filesystem::path& batchDir);
 
 // The summary file of a shard ("I/N"), or batch.json when not sharded.

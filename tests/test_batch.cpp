@@ -4,6 +4,8 @@
 // every run, --keep-going, --resume, SIGINT, shards, the sweep's folders,
 // sweep.csv and contact sheet, and the bad options.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
+#include <functional>
 
 #include <csignal>
 #include <fstream>
@@ -265,6 +267,55 @@ TEST(Batch, BadOptionsAreUserErrors) {
     EXPECT_EQ(r.status, 2) << args << "\n" << r.output;
     EXPECT_FALSE(r.output.empty()) << args;  // what was wrong
   }
+}
+
+// gather trusts nothing it reads: a shard summary with a key of the wrong
+// type or missing, a last frame outside the batch folder (it would be read
+// into the contact sheet) or not a file, a run list shorter than the plan,
+// a huge N in a file name, a FIFO named as a summary: each is exit 2 naming
+// the file (never a crash, a hang or a silent summary), and the intact
+// shards gather again.
+TEST(Batch, GatherRefusesSummariesThatDoNotHold) {
+  const fs::path dir = tempDir("batch_gather_hostile"), out = dir / "out";
+  std::string list;
+  for (const char* n : {"g0", "g1", "g2"}) list += writeScene(dir, n, 10, 10).string() + " ";
+  for (const char* shard : {"0/2", "1/2"})
+    ASSERT_EQ(runMorphoflow("batch " + list + "--shard " + shard + " --quiet --out " + out.string()).status, 0);
+  const fs::path file = out / "batch.shard-0-of-2.json";
+  ASSERT_TRUE(fs::exists(file));
+  const nlohmann::json good = readJson(file);
+  ASSERT_EQ(runMorphoflow("gather " + out.string()).status, 0);
+  const std::vector<std::pair<std::string, std::function<void(nlohmann::json*)>>> bad = {
+      {"steps a string", [](nlohmann::json* j) { (*j)["runs"][0]["steps"] = "x"; }},
+      {"no last_frame", [](nlohmann::json* j) { (*j)["runs"][0].erase("last_frame"); }},
+      {"negative bytes", [](nlohmann::json* j) { (*j)["runs"][0]["bytes_written"] = -5; }},
+      {"last frame outside", [](nlohmann::json* j) { (*j)["runs"][0]["last_frame"] = "/etc/passwd"; }},
+      {"last frame up", [](nlohmann::json* j) { (*j)["runs"][0]["last_frame"] = "../../x.png"; }},
+      {"last frame missing", [](nlohmann::json* j) { (*j)["runs"][0]["last_frame"] = "g0/frames/999999.png"; }},
+      {"a run short", [](nlohmann::json* j) { (*j)["runs"].erase(1); }},
+      {"runs not a list", [](nlohmann::json* j) { (*j)["runs"] = 3; }},
+  };
+  for (const auto& [what, change] : bad) {
+    nlohmann::json j = good;
+    change(&j);
+    std::ofstream(file, std::ios::trunc) << j.dump();
+    const CommandResult r = runMorphoflow("gather " + out.string());
+    EXPECT_EQ(r.status, 2) << what << "\n" << r.output;
+    EXPECT_NE(r.output.find(what == "a run short" ? out.string() : file.string()), std::string::npos) << what << "\n" << r.output;
+  }
+  std::ofstream(file, std::ios::trunc) << good.dump();
+  const fs::path huge = out / "batch.shard-1-of-99999999999999999999.json", fifo = out / "batch.shard-3-of-4.json";
+  std::ofstream(huge) << good.dump();
+  CommandResult r = runMorphoflow("gather " + out.string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  fs::remove(huge);
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0644), 0);
+  r = runMorphoflow("gather " + out.string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find(fifo.string()), std::string::npos) << r.output;
+  fs::remove(fifo);
+  EXPECT_EQ(runMorphoflow("gather " + out.string()).status, 0);
+  fs::remove_all(dir);
 }
 
 TEST(Batch, ShardsSplitTheScenesAndGatherMergesTheirSummaries) {
