@@ -110,6 +110,18 @@ Scene parseScene(const std::string& text, const std::string& path, const std::ve
 
   r.checkUnknown(root, "");
 
+  // The files it reads, by size and modification time: a changed input
+  // changes the settings hash (a batch --resume runs the scene again).
+  if (!s.inputs.empty()) {
+    toml::table stamps;
+    for (const SceneInput& in : s.inputs) {
+      std::error_code ec;
+      const auto size = std::filesystem::file_size(in.path, ec);
+      const auto time = std::filesystem::last_write_time(in.path, ec).time_since_epoch().count();
+      stamps.insert_or_assign(in.path, fmt::format("{} bytes, modified {}", ec ? 0 : size, ec ? 0 : time));
+    }
+    root.insert_or_assign("inputs", std::move(stamps));
+  }
   // The scene as resolved, for run.json.
   std::ostringstream json;
   json << toml::json_formatter{root};

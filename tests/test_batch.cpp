@@ -191,6 +191,23 @@ TEST(Batch, ResumeWithAChangedSetRunsTheSceneAgain) {
   fs::remove_all(dir);
 }
 
+// --resume notices a changed input file (a map's image rewritten): the run
+// is done again, not skipped as completed; unchanged, it is skipped.
+TEST(Batch, ResumeRunsASceneAgainWhenAnInputFileChanged) {
+  const fs::path dir = tempDir("batch_resume_input"), out = dir / "out";
+  auto image = [&](int grey) { std::ofstream(dir / "m.pgm", std::ios::binary) << "P5 8 8 255\n" << std::string(64 + grey % 2, char(grey)); };
+  image(100);
+  const fs::path scene = writeScene(dir, "mapped", 20, 10, "[rd.maps]\nF = { image = \"m.pgm\", range = [0.03, 0.05] }\n");
+  const std::string cmd = "batch " + scene.string() + " --quiet --out " + out.string();
+  ASSERT_EQ(runMorphoflow(cmd).status, 0);
+  ASSERT_EQ(runMorphoflow(cmd + " --resume").status, 0);
+  EXPECT_EQ(runNamed(readJson(out / "batch.json"), "mapped")["status"], "skipped");
+  image(201);  // other pixels, another size
+  ASSERT_EQ(runMorphoflow(cmd + " --resume").status, 0);
+  EXPECT_EQ(runNamed(readJson(out / "batch.json"), "mapped")["status"], "completed");
+  fs::remove_all(dir);
+}
+
 TEST(Batch, SigintCheckpointsTheRunningScenesAndResumeFinishesOnlyWhatIsLeft) {
   const fs::path dir = tempDir("batch_resume"), out = dir / "out";
   const fs::path quick = writeScene(dir, "quick", 20, 10), slow = writeScene(dir, "slow", 30000, 1000, "checkpoint_every = 1\n");
