@@ -34,6 +34,9 @@ namespace morphoflow {
 
 namespace {
 
+// A warning is shown even with --quiet.
+void warnLine(const std::string& line) { std::cerr << line << "\n"; }
+
 // What a run needs besides its plan: validated? resumable? already done?
 struct Prepared {
   std::string hash;  // the scene's settings hash; empty when invalid
@@ -72,7 +75,7 @@ class BatchRunner {
       if (r.status == "pending") r.status = "not started";
     writeSummary();
     printSummary(std::cout, records_, dir_);
-    if (plan_.kind == "sweep" && opt_.shard.empty() && !sig) writeSweepOutputs(dir_, plan_.keys, records_);
+    if (plan_.kind == "sweep" && opt_.shard.empty() && !sig) writeSweepOutputs(dir_, plan_.keys, records_, warnLine);
     if (sig) say(fmt::format("stopped by {}; continue with --resume", sig == SIGINT ? "SIGINT" : "SIGTERM"));
     return sig ? 128 + sig : batchExitStatus(records_);
   }
@@ -237,8 +240,9 @@ std::map<int, nlohmann::json> readShardSummaries(const std::string& dirText) {
     const auto i = parseWhole(m[1]), n = parseWhole(m[2]);
     if (!i || !n || *n > 1000000 || *i >= *n)
       throw UserError({e.path().string(), 0, 0}, "", "not a shard's summary (I/N with I below N <= 1000000)", "remove it");
-    if (count && (*n != count || j["batch_id"] != shards.begin()->second["batch_id"] ||
-                  j["planned_runs"] != shards.begin()->second["planned_runs"]))
+    const nlohmann::json& other = shards.empty() ? j : shards.begin()->second;
+    if (count && (*n != count || j["batch_id"] != other["batch_id"] || j["planned_runs"] != other["planned_runs"] ||
+                  j["kind"] != other["kind"] || j.value("keys", nlohmann::json::array()) != other.value("keys", nlohmann::json::array())))
       throw UserError({e.path().string(), 0, 0}, "", "the shard summaries are from different batches",
                       "gather each batch's folder on its own");
     count = int(*n);
@@ -296,7 +300,7 @@ int gatherBatch(const std::string& dirText) {
   merged["shards"] = shards.size();
   writeFileAtomically(dir / "batch.json", merged.dump(2) + "\n");
   printSummary(std::cout, records, dir);
-  if (plan.kind == "sweep") writeSweepOutputs(dir, plan.keys, records);
+  if (plan.kind == "sweep") writeSweepOutputs(dir, plan.keys, records, warnLine);
   return batchExitStatus(records);
 }
 

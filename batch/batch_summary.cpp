@@ -1,5 +1,6 @@
 #include "batch/batch_summary.h"
 
+#include <algorithm>
 #include <csignal>
 #include <fstream>
 #include <map>
@@ -124,13 +125,19 @@ nlohmann::json summaryJson(const BatchPlan& plan, const std::vector<RunRecord>& 
 namespace {
 
 // A path a summary names: relative, no "..", and (when `file`) a regular file inside the folder.
+// A folder linked out of the batch folder is outside it too.
 bool insideFolder(const std::string& path, const fs::path& batchDir, bool file) {
   const fs::path p(path);
   if (path.empty() || p.is_absolute()) return false;
   for (const fs::path& part : p)
     if (part == "..") return false;
+  if (!file) return true;
   std::error_code ec;
-  return !file || fs::is_regular_file(fs::symlink_status(batchDir / p, ec));
+  if (!fs::is_regular_file(fs::symlink_status(batchDir / p, ec))) return false;
+  const fs::path root = fs::canonical(batchDir, ec), at = fs::canonical(batchDir / p, ec);
+  if (ec) return false;
+  const auto [end, _] = std::mismatch(root.begin(), root.end(), at.begin(), at.end());
+  return end == root.end();
 }
 
 }  // namespace
@@ -142,8 +149,10 @@ std::string summaryProblem(const nlohmann::json& j, const fs::path& batchDir) {
   if (!is(j, "runs", &json::is_array)) return "it has no list of runs";
   if (!is(j, "planned_runs", &json::is_number_unsigned)) return "it has no planned_runs count";
   if (!is(j, "kind", &json::is_string) || !is(j, "batch_id", &json::is_string)) return "it lacks its kind or batch_id";
+  if (j["kind"] != "batch" && j["kind"] != "sweep") return "its kind is neither batch nor sweep";
   if (j.contains("keys") && !(j["keys"].is_array() && std::all_of(j["keys"].begin(), j["keys"].end(), [](const json& k) { return k.is_string(); })))
     return "its keys are not a list of names";
+  if (j["kind"] == "sweep" && (!j.contains("keys") || j["keys"].empty())) return "it is a sweep's without the keys it varies";
   for (size_t k = 0; k < j["runs"].size(); ++k) {
     const json& r = j["runs"][k];
     const std::string at = "run " + std::to_string(k) + " ";
@@ -158,6 +167,7 @@ std::string summaryProblem(const nlohmann::json& j, const fs::path& batchDir) {
     if (!is(r, "overrides", &json::is_array)) return at + "lacks its overrides";
     for (const json& o : r["overrides"])
       if (!o.is_string()) return at + "has an override that is not text";
+    if (r.contains("values") && !r["values"].is_object()) return at + "has values that are not a table";
     if (r.contains("values"))
       for (const auto& [key, v] : r["values"].items())
         if (!v.is_string()) return at + "has a value of '" + key + "' that is not text";
@@ -231,7 +241,8 @@ void checkBatchFolder(const fs::path& dir, const BatchPlan& plan) {
   }
 }
 
-void writeSweepOutputs(const fs::path& dir, const std::vector<std::string>& keys, const std::vector<RunRecord>& records) {
+void writeSweepOutputs(const fs::path& dir, const std::vector<std::string>& keys, const std::vector<RunRecord>& records,
+                       const std::function<void(const std::string&)>& warn) {
   std::string csv;
   for (const std::string& k : keys) csv += csvField(k) + ",";
   csv += "status,exit_code,wall_seconds,last_frame\n";
@@ -259,7 +270,15 @@ void writeSweepOutputs(const fs::path& dir, const std::vector<std::string>& keys
       sheet.images[at[i].first * sheet.columns.size() + at[i].second] = (dir / records[i].lastFrame).string();
   sheet.title = "columns: " + keys[0] + (keys.size() > 1 ? "    rows: " + keys[1] : "");
   for (size_t k = 2; k < keys.size(); ++k) sheet.title += ", " + keys[k];
-  writeContactSheet((dir / "contact_sheet.png").string(), sheet);
+  // Cells shrink so that the sheet stays within about 4096 pixels a side.
+  const size_t most = std::max(sheet.columns.size(), sheet.rows.size());
+  if (most > kMaxSheetCells) {
+    warn(fmt::format("warning: no contact sheet: {} values a side, more than the {} one sheet shows", most, kMaxSheetCells));
+    return;
+  }
+  sheet.cellWidth = int(std::clamp<size_t>(4096 / most, 16, 160));
+  for (const std::string& frame : writeContactSheet((dir / "contact_sheet.png").string(), sheet))
+    warn("warning: the contact sheet shows a grey cell for " + frame);
 }
 
 }  // namespace morphoflow

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <ostream>
 #include <string>
 #include <vector>
@@ -53,8 +54,11 @@ void printSummary(std::ostream& out, const std::vector<RunRecord>& records, cons
 std::filesystem::path summaryPath(const std::filesystem::path& dir, const std::string& shard);
 // Refuses (UserError) a folder that holds the summary of another batch.
 void checkBatchFolder(const std::filesystem::path& dir, const BatchPlan& plan);
-// sweep.csv and contact_sheet.png from a complete sweep's records.
+// sweep.csv and contact_sheet.png from a complete sweep's records (at most
+// kMaxSheetCells values a side on the sheet); a frame the sheet cannot show,
+// or a sheet too large to draw, is reported through `warn`.
+constexpr size_t kMaxSheetCells = 256;
 void writeSweepOutputs(const std::filesystem::path& dir, const std::vector<std::string>& keys,
-                       const std::vector<RunRecord>& records);
+                       const std::vector<RunRecord>& records, const std::function<void(const std::string&)>& warn);
 
 }  // namespace morphoflow

@@ -175,11 +175,11 @@ struct RowVelocity {
       t[a][0] = d - float(shift);
       begin = std::max(begin, -shift);  // g = x + d >= 0
       end = std::min(end, ax.n - 1 - shift);  // floor(g) <= n - 2
-      size_t offset = size_t(ptrdiff_t(shift));
+      ptrdiff_t offset = shift;  // (may be -1: base[a] + x is in range for x >= begin)
       for (int b = 1; b < D; ++b) {
         const AxisTap tb = (b == a ? vel.face[b] : vel.centre[b]).at(p[b]);
         t[a][b] = tb.t;
-        offset += size_t(tb.lo) * vel.stride[a][b];
+        offset += ptrdiff_t(tb.lo) * ptrdiff_t(vel.stride[a][b]);
       }
       base[a] = vel.data[a] + offset;
       s1[a] = vel.stride[a][1];

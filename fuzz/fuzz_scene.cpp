@@ -11,6 +11,8 @@
 #include "scenes/scene_loader.h"
 #include "scenes/vary.h"
 
+extern "C" int LLVMFuzzerInitialize(int*, char***) { return 0; }
+
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string input(reinterpret_cast<const char*>(data), size);
   std::string text = input;

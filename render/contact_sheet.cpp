@@ -7,6 +7,7 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 
+#include "core/output_file.h"
 #include "render/image_file.h"
 
 namespace morphoflow {
@@ -16,12 +17,12 @@ namespace {
 constexpr int kPad = 6, kLabel = 22, kFontSize = 14;
 const char* const kFont = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 
-// A frame as RGB, scaled to `width` pixels across.
-OIIO::ImageBuf scaledFrame(const std::string& path, int width) {
+// A frame as RGB, scaled to `width` pixels across (and at most 4 widths
+// down); an uninitialised buffer and *error when it cannot be read.
+OIIO::ImageBuf scaledFrame(const std::string& path, int width, std::string* error) {
   OIIO::ImageSpec spec;
   std::vector<float> px;
-  std::string error;
-  if (!readImageFloat(path, &spec, &px, &error)) throw std::runtime_error("contact sheet: " + error);
+  if (!readImageFloat(path, &spec, &px, error)) return {};
   OIIO::ImageSpec rgbSpec(spec.width, spec.height, 3, OIIO::TypeDesc::FLOAT);
   OIIO::ImageBuf rgb(rgbSpec);
   for (int y = 0; y < spec.height; ++y)
@@ -30,8 +31,9 @@ OIIO::ImageBuf scaledFrame(const std::string& path, int width) {
       const float c[3] = {p[0], p[spec.nchannels >= 3 ? 1 : 0], p[spec.nchannels >= 3 ? 2 : 0]};
       rgb.setpixel(x, y, c, 3);
     }
-  const int height = std::max(1, int(double(width) * spec.height / spec.width + 0.5));
-  return OIIO::ImageBufAlgo::resize(rgb, "", 0.0f, OIIO::ROI(0, width, 0, height, 0, 1, 0, 3));
+  const double scale = std::min(double(width) / spec.width, 4.0 * width / spec.height);
+  const int w = std::max(1, int(scale * spec.width + 0.5)), h = std::max(1, int(scale * spec.height + 0.5));
+  return OIIO::ImageBufAlgo::resize(rgb, "", 0.0f, OIIO::ROI(0, w, 0, h, 0, 1, 0, 3));
 }
 
 void label(OIIO::ImageBuf* sheet, int x, int y, const std::string& text) {
@@ -42,15 +44,18 @@ void label(OIIO::ImageBuf* sheet, int x, int y, const std::string& text) {
 
 }  // namespace
 
-void writeContactSheet(const std::string& path, const ContactSheet& s) {
+std::vector<std::string> writeContactSheet(const std::string& path, const ContactSheet& s) {
   const size_t nc = s.columns.size(), nr = s.rows.size();
-  if (nc == 0 || nr == 0 || s.images.size() != nc * nr) throw std::runtime_error("contact sheet: no cells");
+  if (nc == 0 || nr == 0 || s.images.size() != nc * nr) throw std::logic_error("contact sheet: no cells");
   std::vector<OIIO::ImageBuf> frames(s.images.size());
+  std::vector<std::string> unread;
   int cellH = 0;
   for (size_t i = 0; i < s.images.size(); ++i)
     if (!s.images[i].empty()) {
-      frames[i] = scaledFrame(s.images[i], s.cellWidth);
-      cellH = std::max(cellH, frames[i].spec().height);
+      std::string error;
+      frames[i] = scaledFrame(s.images[i], s.cellWidth, &error);
+      if (!frames[i].initialized()) unread.push_back(s.images[i] + ": " + error);
+      else cellH = std::max(cellH, frames[i].spec().height);
     }
   if (cellH == 0) cellH = s.cellWidth;
   int rowLabelW = 0;
@@ -77,7 +82,8 @@ void writeContactSheet(const std::string& path, const ContactSheet& s) {
   std::string error;
   if (!writeImageAtomically(path, OIIO::ImageSpec(width, height, 3, OIIO::TypeDesc::UINT8), OIIO::TypeDesc::UINT8,
                             rgb.data(), &error))
-    throw std::runtime_error("contact sheet: " + error);
+    throw OutputError(path, "the contact sheet cannot be written: " + error);
+  return unread;
 }
 
 }  // namespace morphoflow

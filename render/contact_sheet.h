@@ -16,8 +16,9 @@ struct ContactSheet {
   int cellWidth = 160;                // pixels per cell; each frame is scaled to it
 };
 
-// Writes the sheet as a PNG (atomically). Throws std::runtime_error when a
-// frame cannot be read or the sheet written.
-void writeContactSheet(const std::string& path, const ContactSheet& sheet);
+// Writes the sheet as a PNG (atomically). A frame that cannot be read is a
+// grey cell, as a missing one is; each such frame ("PATH: why") is returned.
+// Throws OutputError when the sheet cannot be written.
+std::vector<std::string> writeContactSheet(const std::string& path, const ContactSheet& sheet);
 
 }  // namespace morphoflow

@@ -2,6 +2,7 @@
 
 #include <cstring>
 #include <mutex>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -14,6 +15,8 @@
 #include <nanovdb/util/IO.h>
 #include <nanovdb/util/OpenToNanoVDB.h>
 #include <xxhash.h>
+
+#include "render/allocation_limit.h"
 
 namespace morphoflow {
 
@@ -171,9 +174,19 @@ std::string encodeNanoVdb(const std::vector<VolumeGrid>& grids, const VolumeMeta
   return os.str();
 }
 
+namespace {
+
+// No buffer of a valid volume's reading is near this: a leaf holds 512 voxels.
+constexpr size_t kMaxReaderAllocation = size_t(64) << 20;
+constexpr const char* kClaimsTooMuch =
+    "the file is damaged: a length stored in it asks for more than 64 MiB at once (a valid volume never does)";
+
+}  // namespace
+
 bool readVdbTime(const std::string& path, double* time, bool* has, std::string* error) {
   initialiseOnce();
   try {
+    AllocationLimit limit(kMaxReaderAllocation);
     openvdb::io::File file(path);
     file.open(/*delayLoad=*/true);
     openvdb::MetaMap::Ptr meta = file.getMetadata();
@@ -181,6 +194,9 @@ bool readVdbTime(const std::string& path, double* time, bool* has, std::string* 
     *has = false;
     if (auto m = meta->getMetadata<openvdb::DoubleMetadata>("time")) *has = true, *time = m->value();
     return true;
+  } catch (const std::bad_alloc&) {
+    *error = kClaimsTooMuch;
+    return false;
   } catch (const std::exception& e) {
     *error = e.what();
     return false;
@@ -190,6 +206,7 @@ bool readVdbTime(const std::string& path, double* time, bool* has, std::string* 
 bool readVdbVelocity(const std::string& path, VelocityVolume* out, std::string* error) {
   initialiseOnce();
   try {
+    std::optional<AllocationLimit> limit(std::in_place, kMaxReaderAllocation);  // (while OpenVDB reads)
     openvdb::io::File file(path);
     file.open(/*delayLoad=*/false);
     const bool mac = file.hasGrid("vel_mac");
@@ -202,6 +219,7 @@ bool readVdbVelocity(const std::string& path, VelocityVolume* out, std::string* 
     openvdb::MetaMap::Ptr meta = file.getMetadata();
     openvdb::GridBase::Ptr base = file.readGrid(mac ? "vel_mac" : "vel");
     file.close();
+    limit.reset();
     auto grid = openvdb::gridPtrCast<openvdb::Vec3SGrid>(base);
     if (!grid) {
       *error = "the grid '" + base->getName() + "' is not a Vec3 float grid (it is " + base->valueType() + ")";
@@ -246,6 +264,9 @@ bool readVdbVelocity(const std::string& path, VelocityVolume* out, std::string* 
     }
     *out = std::move(v);
     return true;
+  } catch (const std::bad_alloc&) {
+    *error = kClaimsTooMuch;
+    return false;
   } catch (const std::exception& e) {
     *error = e.what();
     return false;

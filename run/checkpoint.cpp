@@ -47,6 +47,7 @@ std::string headerProblem(const nlohmann::json& h) {
     if (!has(key, &nlohmann::json::is_string)) return std::string("its header lacks the text '") + key + "'";
   for (const char* key : {"step", "last_frame"})
     if (!has(key, &nlohmann::json::is_number_integer)) return std::string("its header lacks the whole number '") + key + "'";
+  if (h["step"].get<long>() < 0 || h["last_frame"].get<long>() < -1) return "its header holds a negative step or frame";
   if (!has("checkpoint_bytes", &nlohmann::json::is_number_unsigned)) return "its header lacks the byte count 'checkpoint_bytes'";
   if (!has("time", &nlohmann::json::is_number)) return "its header lacks the number 'time'";
   if (!has("sinks", &nlohmann::json::is_array)) return "its header lacks the outputs' list 'sinks'";

@@ -16,6 +16,18 @@
 
 namespace morphoflow {
 
+std::filesystem::path endFile(const std::filesystem::path& dir, const std::string& extension, bool last) {
+  std::filesystem::path found;
+  std::error_code ec;
+  for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.size() <= extension.size() || name.compare(name.size() - extension.size(), extension.size(), extension) != 0)
+      continue;
+    if (found.empty() || (last ? e.path() > found : e.path() < found)) found = e.path();
+  }
+  return found;
+}
+
 uintmax_t fileBytes(const std::filesystem::path& file) {
   std::error_code ec;
   const uintmax_t n = std::filesystem::file_size(file, ec);
@@ -91,6 +103,17 @@ void ImageSink<D>::report(nlohmann::json* j) const {
                      {"written", video_.written},
                      {"warning", video_.warning},
                      {"ffmpeg_log", video_.log.string()}};
+}
+
+template <int D>
+std::vector<std::string> ImageSink<D>::whereToLook() const {
+  std::vector<std::string> lines;
+  if (videoDone_ && video_.written)
+    lines.push_back(fmt::format("animation: {} (play it with `ffplay -loop 0 {}` or any video player)", videoFile_.string(),
+                                videoFile_.string()));
+  if (const std::filesystem::path newest = endFile(dir_, "." + scene_.output.format, true); !newest.empty())
+    lines.push_back(fmt::format("newest frame: {} (of {} in {}/)", newest.string(), written_, dir_.string()));
+  return lines;
 }
 
 template <int D>

@@ -38,6 +38,8 @@ class OutputSink {
   // What it must remember across a checkpoint (counts, the first frame).
   virtual nlohmann::json state() const = 0;
   virtual void restore(const nlohmann::json& state) = 0;
+  // Lines said at the end of a run: what it wrote and how to look at it.
+  virtual std::vector<std::string> whereToLook() const { return {}; }
 };
 
 // The scene's field through its palette (or two species in red and green).
@@ -50,6 +52,7 @@ class ImageSink : public OutputSink<D> {
   void report(nlohmann::json* run) const override;
   nlohmann::json state() const override;
   void restore(const nlohmann::json& state) override;
+  std::vector<std::string> whereToLook() const override;
   // Polled while the video is encoded: true stops it.
   std::function<bool()> cancelled;
 
@@ -104,6 +107,8 @@ template <int D>
 std::vector<std::unique_ptr<OutputSink<D>>> makeOutputSinks(const std::filesystem::path& out, const Scene& scene,
                                                             const std::function<bool()>& cancelled);
 
+// The first or the last file in `dir` whose name ends in `extension` (by name: frames are zero-padded), or "".
+std::filesystem::path endFile(const std::filesystem::path& dir, const std::string& extension, bool last);
 // The bytes of a file just written (0 when it is not there).
 uintmax_t fileBytes(const std::filesystem::path& file);
 // Adds `bytes` to run["bytes_written"][kind].

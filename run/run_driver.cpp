@@ -103,6 +103,8 @@ class Driver {
       log_.warn("warning: " + j["video"]["warning"].get<std::string>());
     log_.say(fmt::format("done: {} steps, t = {:.5g}, {:.2f} s wall, {} frames -> {}", sim_.steps(), sim_.time(),
                          wallSeconds(), j["frames_written"].get<int>(), out_.string()));
+    for (const auto& s : sinks_)
+      for (const std::string& line : s->whereToLook()) log_.say(line);
     writeLog();
     return 0;
   }

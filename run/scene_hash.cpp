@@ -25,9 +25,12 @@ void flatten(const nlohmann::json& j, const std::string& prefix, std::map<std::s
 }  // namespace
 
 std::vector<std::string> changedKeys(const std::string& a, const std::string& b) {
+  // (a checkpoint's header may hold anything: no keys are named unless both are tables)
+  const nlohmann::json ja = nlohmann::json::parse(a, nullptr, false), jb = nlohmann::json::parse(b, nullptr, false);
+  if (!ja.is_object() || !jb.is_object()) return {};
   std::map<std::string, std::string> fa, fb;
-  flatten(nlohmann::json::parse(a), "", &fa);
-  flatten(nlohmann::json::parse(b), "", &fb);
+  flatten(ja, "", &fa);
+  flatten(jb, "", &fb);
   std::vector<std::string> keys;
   for (const auto& [k, v] : fa)
     if (!fb.count(k) || fb[k] != v) keys.push_back(k);

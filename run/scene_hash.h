@@ -14,7 +14,8 @@ namespace morphoflow {
 std::string sceneHash(const Scene& scene);
 std::string hashHex(const void* data, size_t bytes);
 // The keys (dotted paths) whose values differ between two resolved scenes
-// (JSON text), for "resuming with a changed scene".
+// (JSON text), for "resuming with a changed scene"; none when either is not
+// a JSON table.
 std::vector<std::string> changedKeys(const std::string& jsonA, const std::string& jsonB);
 
 }  // namespace morphoflow

@@ -95,6 +95,17 @@ nlohmann::json VdbSink<D>::state() const {
   return {{"written", written_}, {"bytes", bytes_}, {"nano_bytes", nanoBytes_}};
 }
 
+// Blender loads a numbered sequence as one animated volume from its first file.
+template <int D>
+std::vector<std::string> VdbSink<D>::whereToLook() const {
+  const std::filesystem::path first = endFile(dir_, ".vdb", false);
+  if (first.empty()) return {};
+  const std::string sequence = (dir_ / (safeFileStem(scene_.name) + ".######.vdb")).string();
+  return {fmt::format("volumes: {} (Blender: File > Import > OpenVDB, choose {}; or run `blender --python-expr "
+                      "\"import bpy; bpy.ops.object.volume_import(filepath='{}')\"`)",
+                      sequence, first.filename().string(), first.string())};
+}
+
 template <int D>
 void VdbSink<D>::restore(const nlohmann::json& s) {
   written_ = s.at("written").get<int>();

@@ -22,6 +22,7 @@ class VdbSink : public OutputSink<D> {
   void report(nlohmann::json* run) const override;
   nlohmann::json state() const override;
   void restore(const nlohmann::json& state) override;
+  std::vector<std::string> whereToLook() const override;
 
  private:
   // The grids of the simulation's current state.

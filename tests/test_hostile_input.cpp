@@ -6,9 +6,14 @@
 
 #include <chrono>
 #include <fstream>
+#include <thread>
 
 #include <nlohmann/json.hpp>
 
+#include "render/allocation_limit.h"
+#include "render/contact_sheet.h"
+#include "render/image_io.h"
+#include "render/vdb_volume.h"
 #include "test_support.h"
 
 using namespace morphoflow::testing;
@@ -374,5 +379,54 @@ TEST(HostileInput, CommandLineNumbersAreWholeTokens) {
     CommandResult r = runMorphoflow(args);
     EXPECT_EQ(r.status, 2) << args << "\n" << r.output;
   }
+  fs::remove_all(dir);
+}
+
+// Inside an AllocationLimit, on its thread, one request above the bound is
+// bad_alloc at once; below it, after the scope and on other threads, nothing changes.
+TEST(HostileInput, AnAllocationLimitRefusesOneRequestAboveItsBoundOnlyInItsScope) {
+  // (a direct call: a new-expression whose result is unused may be elided)
+  auto allocate = [](size_t bytes) { ::operator delete(::operator new(bytes)); };
+  {
+    morphoflow::AllocationLimit limit(1 << 20);
+    EXPECT_THROW(allocate(size_t(2) << 20), std::bad_alloc);
+    EXPECT_NO_THROW(allocate(size_t(1) << 19));
+    std::thread other([&] { EXPECT_NO_THROW(allocate(size_t(4) << 20)); });
+    other.join();
+  }
+  EXPECT_NO_THROW(allocate(size_t(4) << 20));
+}
+
+// Volumes whose stored lengths claim gigabytes (a Blosc block, a metadata
+// string: cases the fuzzer found) are refused as damaged without reading
+// them into memory.
+TEST(HostileInput, AVolumeWhoseLengthsClaimGigabytesIsRefusedAsDamaged) {
+  for (const char* name : {"blosc_size_beyond_memory", "metadata_of_gigabytes", "metadata_copied"}) {
+    const std::string file = std::string(MORPHOFLOW_SOURCE_DIR) + "/fuzz/regressions/vdb_velocity/" + name;
+    morphoflow::VelocityVolume v;
+    std::string error;
+    EXPECT_FALSE(morphoflow::readVdbVelocity(file, &v, &error)) << name;
+    EXPECT_FALSE(error.empty()) << name;
+  }
+}
+
+// A sweep's contact sheet shows a frame that cannot be read as a grey cell
+// and names it; the sheet is still written.
+TEST(HostileInput, AContactSheetShowsADamagedFrameGreyAndNamesIt) {
+  const fs::path dir = tempDir("sheet_damaged_frame");
+  std::string error;
+  const std::string good = (dir / "good.png").string(), bad = (dir / "bad.png").string();
+  ASSERT_TRUE(morphoflow::writeRgb8(good, 8, 8, std::vector<uint8_t>(192, 100), &error)) << error;
+  ASSERT_TRUE(morphoflow::writeRgb8(bad, 8, 8, std::vector<uint8_t>(192, 200), &error)) << error;
+  fs::resize_file(bad, fs::file_size(bad) / 2);
+  morphoflow::ContactSheet sheet;
+  sheet.columns = {"a", "b"};
+  sheet.rows = {""};
+  sheet.images = {good, bad};
+  const std::vector<std::string> unread = morphoflow::writeContactSheet((dir / "sheet.png").string(), sheet);
+  ASSERT_EQ(unread.size(), 1u);
+  EXPECT_EQ(unread[0].rfind(bad, 0), 0u) << unread[0];
+  morphoflow::GrayImage back;
+  EXPECT_TRUE(morphoflow::readGrayImage((dir / "sheet.png").string(), &back, &error)) << error;
   fs::remove_all(dir);
 }

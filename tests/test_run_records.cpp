@@ -119,3 +119,30 @@ TEST(RunRecords, TheMemoryEstimateMatchesThePeakAndATooLargeRunIsRefused) {
   EXPECT_FALSE(fs::exists(dir / "big" / "run.json"));
   fs::remove_all(dir);
 }
+
+// A run ends by naming what to open: a 3D run its VDB sequence and the line
+// that loads it in Blender (whose file exists), a 2D run its animation and
+// its newest frame.
+TEST(RunRecords, ARunEndsByNamingWhatToOpenAndHow) {
+  const fs::path dir = tempDir("where_to_look");
+  const CommandResult vol = runMorphoflow("run " + sceneFile("lid_driven_cavity_3d.toml") +
+                                          " --set grid.resolution=[8,8,8] --set time.duration=0.05 --set output.vdb=true"
+                                          " --set output.video=false --out " + (dir / "3d").string());
+  ASSERT_EQ(vol.status, 0) << vol.output;
+  const fs::path first = dir / "3d" / "vdb" / "lid_driven_cavity_3d.000000.vdb";
+  ASSERT_TRUE(fs::exists(first));
+  EXPECT_NE(vol.output.find("volumes: " + (dir / "3d" / "vdb" / "lid_driven_cavity_3d.######.vdb").string()),
+            std::string::npos) << vol.output;
+  EXPECT_NE(vol.output.find("bpy.ops.object.volume_import(filepath='" + first.string() + "')"), std::string::npos)
+      << vol.output;
+  const CommandResult flat = runMorphoflow("run " + sceneFile("rd/gray_scott_pearson.toml") +
+                                           " --set grid.resolution=[32,32] --set time.steps=20 --set output.every=10 --set output.video=true"
+                                           " --out " + (dir / "2d").string());
+  ASSERT_EQ(flat.status, 0) << flat.output;
+  EXPECT_NE(flat.output.find("newest frame: " + (dir / "2d" / "frames" / "000002.png").string()), std::string::npos)
+      << flat.output;
+  ASSERT_TRUE(fs::exists(dir / "2d" / "gray_scott_pearson.mp4")) << "ffmpeg is one of scripts/setup's packages";
+  EXPECT_NE(flat.output.find("animation: " + (dir / "2d" / "gray_scott_pearson.mp4").string()), std::string::npos)
+      << flat.output;
+  fs::remove_all(dir);
+}

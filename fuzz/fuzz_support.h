@@ -1,0 +1,71 @@
+// What the libFuzzer targets share: a scratch folder of their own per
+// process, the rule that a UserError (or a NonFiniteError: a diverged run)
+// is the right answer to bad input and anything else is a bug, and seeds
+// written by the target itself (MORPHOFLOW_FUZZ_SEEDS=DIR), so that the
+// corpus starts from files of the format this build writes.
+#pragma once
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <string_view>
+
+#include "core/error.h"
+
+namespace morphoflow::fuzz {
+
+// TMPDIR/morphoflow-fuzz-PID/NAME, emptied (all of it removed at exit).
+inline std::filesystem::path freshScratch(const std::string& name) {
+  static const std::filesystem::path root = [] {
+    std::atexit([] {
+      std::error_code ec;
+      std::filesystem::remove_all(std::filesystem::temp_directory_path() / ("morphoflow-fuzz-" + std::to_string(getpid())), ec);
+    });
+    return std::filesystem::temp_directory_path() / ("morphoflow-fuzz-" + std::to_string(getpid()));
+  }();
+  const std::filesystem::path dir = root / name;
+  std::error_code ec;
+  std::filesystem::remove_all(dir, ec);
+  std::filesystem::create_directories(dir);
+  return dir;
+}
+
+inline void writeBytes(const std::filesystem::path& file, std::string_view bytes) {
+  std::filesystem::create_directories(file.parent_path());
+  std::ofstream(file, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
+}
+
+// Runs f; a UserError or NonFiniteError is fine (said on stderr with
+// MORPHOFLOW_FUZZ_VERBOSE=1, to see how deep an input went), any other
+// exception aborts.
+template <class F>
+void expectUserErrorsOnly(F&& f) {
+  static const bool verbose = std::getenv("MORPHOFLOW_FUZZ_VERBOSE") != nullptr;
+  try {
+    f();
+    if (verbose) std::fprintf(stderr, "answered without an error\n");
+  } catch (const UserError& e) {
+    if (verbose) std::fprintf(stderr, "UserError: %s\n", e.what());
+  } catch (const NonFiniteError& e) {
+    if (verbose) std::fprintf(stderr, "NonFiniteError: %s\n", e.what());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "not a UserError: %s\n", e.what());
+    std::abort();
+  }
+}
+
+// Calls write(dir) when MORPHOFLOW_FUZZ_SEEDS names a folder, then exits.
+template <class F>
+void writeSeedsIfAsked(F&& write) {
+  const char* dir = std::getenv("MORPHOFLOW_FUZZ_SEEDS");
+  if (!dir || !*dir) return;
+  std::filesystem::create_directories(dir);
+  write(std::filesystem::path(dir));
+  std::exit(0);
+}
+
+}  // namespace morphoflow::fuzz
