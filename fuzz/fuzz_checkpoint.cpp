@@ -8,8 +8,6 @@
 // fuzzer reaches past the checksum.
 #include <cstdint>
 #include <cstring>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -75,13 +73,6 @@ std::string frame(std::string_view header, std::string_view state) {
   return file;
 }
 
-std::string readAll(const fs::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
 // Each scene run to its end with a checkpoint every frame; the one at step 6,
 // both framed and whole.
 void writeSeeds(const fs::path& dir) {
@@ -98,7 +89,7 @@ void writeSeeds(const fs::path& dir) {
     fuzz::writeBytes(dir / ("framed-" + std::to_string(which)), std::string(1, char(which)) + c.header.dump() +
                                                                      std::string(kStateMark) + c.state);
     fuzz::writeBytes(dir / ("whole-" + std::to_string(which)),
-                     std::string(1, char(which | 4)) + readAll(checkpointFile(out, kResumeStep)));
+                     std::string(1, char(which | 4)) + fuzz::readBytes(checkpointFile(out, kResumeStep)));
   }
 }
 

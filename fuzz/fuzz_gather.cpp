@@ -74,10 +74,7 @@ void writeSeeds(const fs::path& dir) {
       std::string error;
       fs::create_directories((scratch / r.lastFrame).parent_path());
       writeRgb8((scratch / r.lastFrame).string(), 4, 4, std::vector<uint8_t>(48, uint8_t(40 * i)), &error);
-      std::ifstream in(scratch / r.lastFrame, std::ios::binary);
-      std::ostringstream png;
-      png << in.rdbuf();
-      input += std::string(kFileMark) + r.lastFrame + "\n" + png.str() + "\n";
+      input += std::string(kFileMark) + r.lastFrame + "\n" + fuzz::readBytes(scratch / r.lastFrame) + "\n";
       plan.runs.push_back(r.run);
       records.push_back(r);
     }
