@@ -32,7 +32,7 @@ struct AxisSamples {
   AxisSamples(int samples, int cells, bool wrap, float off) : n(samples), period(cells), periodic(wrap), offset(off) {}
 
   AxisTap at(float p) const {
-    float g = p - offset;
+    float g = float(boundedCoordinate(p - offset));
     if (!periodic) {
       g = std::clamp(g, 0.0f, float(n - 1));
       int i = std::min(int(g), std::max(n - 2, 0));

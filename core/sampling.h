@@ -39,9 +39,19 @@ struct Layout {
   Vec<D> toWorld(const IVec<D>& k) const { return (Vec<D>(k) + offset) * h; }
 };
 
+// A grid coordinate every sampler can index with: NaN (the trace through a
+// diverged velocity) becomes 0 and magnitudes beyond 2^30 cells are capped,
+// so the conversions to int stay defined; coordinates in range pass as they are.
+inline double boundedCoordinate(double g) {
+  constexpr double kMax = double(1 << 30);
+  if (g >= -kMax && g <= kMax) return g;
+  return g > 0.0 ? kMax : (g < 0.0 ? -kMax : 0.0);
+}
+
 namespace detail {
 // Lower sample index and weight of the upper one along one axis.
 inline void axisStencil(double g, int n, bool periodic, int period, int* i0, int* i1, double* t) {
+  g = boundedCoordinate(g);
   if (periodic) {
     double f = std::floor(g);
     *t = g - f;

@@ -3,6 +3,7 @@
 // back and checks that each one is there with the size the reader expects.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <functional>
@@ -60,24 +61,39 @@ class StateReader {
   StateReader(const StateReader&) = delete;  // sections_ points into all_
   StateReader& operator=(const StateReader&) = delete;
   std::string_view bytes(const std::string& name, size_t expected) const;
+  // Floating-point values are checked finite as they are read: a state
+  // holding NaN or infinity was not written by a run (runs stop at the
+  // first non-finite field) and is refused with a StateError.
   template <class T>
   void get(const std::string& name, T* value) const {
     std::memcpy(value, bytes(name, sizeof(T)).data(), sizeof(T));
+    checkFinite(name, value, 1);
   }
   // Fills v, whose size is already the expected one.
   template <class T>
   void getVector(const std::string& name, std::vector<T>* v) const {
     const std::string_view b = bytes(name, v->size() * sizeof(T));
     if (!b.empty()) std::memcpy(v->data(), b.data(), b.size());
+    checkFinite(name, v->data(), v->size());
   }
   template <class T, int D>
   void getGrid(const std::string& name, Grid<T, D>* g) const {
     const std::string_view b = bytes(name, g->size() * sizeof(T));
     if (!b.empty()) std::memcpy(g->data(), b.data(), b.size());
+    checkFinite(name, g->data(), g->size());
   }
   bool has(const std::string& name) const { return sections_.count(name) != 0; }
 
  private:
+  template <class T>
+  static void checkFinite(const std::string& name, const T* v, size_t n) {
+    if constexpr (std::is_floating_point_v<T>) {
+      for (size_t i = 0; i < n; ++i)
+        if (!std::isfinite(v[i]))
+          throw StateError("section '" + name + "' holds a non-finite value at index " + std::to_string(i));
+    }
+  }
+
   std::string all_;
   std::map<std::string, std::string_view> sections_;
 };

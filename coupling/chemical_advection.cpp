@@ -5,6 +5,7 @@
 #include <stdexcept>
 
 #include "core/parallel.h"
+#include "core/sampling.h"
 #include "core/simd_dispatch.h"
 #include "fluid/advection.h"
 
@@ -33,6 +34,7 @@ struct AxisWeights {
 
 AxisWeights axisWeights(double c, int n, bool periodic, ChemicalInterpolation interp) {
   AxisWeights a{};
+  c = boundedCoordinate(c);
   if (!periodic) c = std::clamp(c, 0.0, double(n - 1));
   const double f = std::floor(c), t = c - f;
   const int i = int(f);
@@ -57,6 +59,7 @@ struct LinearAxis {
   double wlo, whi;
 };
 inline LinearAxis linearAxis(double c, int n, bool periodic) {
+  c = boundedCoordinate(c);
   if (!periodic) c = std::clamp(c, 0.0, double(n - 1));
   const double f = std::floor(c), t = c - f;
   const int i = int(f);
@@ -124,7 +127,7 @@ __attribute__((target("avx2"))) size_t linearRunAvx2(const LinearRun<D>& r, size
       const __m256d top = _mm256_set1_pd(double(r.dims[a] - 1)), zero = _mm256_setzero_pd();
       __m256d c = _mm256_cvtps_pd(_mm_loadu_ps(r.feet[size_t(a)] + i));
       c = _mm256_blendv_pd(c, top, _mm256_cmp_pd(top, c, _CMP_LT_OQ));
-      c = _mm256_blendv_pd(c, zero, _mm256_cmp_pd(c, zero, _CMP_LT_OQ));
+      c = _mm256_max_pd(c, zero);  // (a NaN foot becomes 0, as boundedCoordinate does)
       const __m256d f = _mm256_floor_pd(c), t = _mm256_sub_pd(c, f);
       lo[a] = _mm256_cvttpd_epi32(f);
       hi[a] = _mm_min_epi32(_mm_add_epi32(lo[a], _mm_set1_epi32(1)), _mm_set1_epi32(r.dims[a] - 1));

@@ -467,6 +467,9 @@ void RDSolver<D>::load(const StateReader& in) {
     in.get(p + "increment_size", &n);
     df.increment.assign(n == 0 ? 0 : cellCount_, 0);
     in.getVector(p + "increment_bf16", &df.increment);
+    for (uint16_t h : df.increment)
+      if (!std::isfinite(fromBfloat16(h)))
+        throw StateError("section '" + p + "increment_bf16' holds a non-finite value");
     in.get(p + "increment_theta_dt", &df.incrementThetaDt);
     in.get(p + "frozen_size", &n);
     frozenValues_[size_t(s)].assign(n == 0 ? 0 : cellCount_, 0.0);

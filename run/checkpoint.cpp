@@ -53,8 +53,12 @@ std::string headerProblem(const nlohmann::json& h) {
   if (!has("sinks", &nlohmann::json::is_array)) return "its header lacks the outputs' list 'sinks'";
   for (const nlohmann::json& sink : h["sinks"]) {
     if (!sink.is_object()) return "an output's state in its header is not an object";
-    for (const auto& [key, value] : sink.items())
+    for (const char* key : {"written", "bytes"})
+      if (!sink.contains(key)) return std::string("an output's state in its header lacks '") + key + "'";
+    for (const auto& [key, value] : sink.items()) {
       if (!value.is_number_integer()) return "its header holds an output's '" + key + "' that is not a whole number";
+      if (value.get<long long>() < -1) return "its header holds an output's '" + key + "' that is negative";
+    }
   }
   return "";
 }

@@ -123,9 +123,9 @@ nlohmann::json ImageSink<D>::state() const {
 
 template <int D>
 void ImageSink<D>::restore(const nlohmann::json& s) {
-  written_ = s.at("written").get<int>();
-  firstWritten_ = s.at("first_written").get<long>();
-  bytes_ = s.at("bytes").get<uintmax_t>();
+  written_ = stateCount<int>(s, "written");
+  firstWritten_ = stateCount<long>(s, "first_written", -1);
+  bytes_ = stateCount<uintmax_t>(s, "bytes");
 }
 
 template <int D>
@@ -165,8 +165,8 @@ nlohmann::json FieldDumpSink<D>::state() const {
 
 template <int D>
 void FieldDumpSink<D>::restore(const nlohmann::json& s) {
-  written_ = s.at("written").get<int>();
-  bytes_ = s.at("bytes").get<uintmax_t>();
+  written_ = stateCount<int>(s, "written");
+  bytes_ = stateCount<uintmax_t>(s, "bytes");
 }
 
 template <int D>
@@ -223,8 +223,8 @@ nlohmann::json NormalMapSink<D>::state() const {
 
 template <int D>
 void NormalMapSink<D>::restore(const nlohmann::json& s) {
-  written_ = s.at("written").get<int>();
-  bytes_ = s.at("bytes").get<uintmax_t>();
+  written_ = stateCount<int>(s, "written");
+  bytes_ = stateCount<uintmax_t>(s, "bytes");
 }
 
 template <int D>

@@ -8,6 +8,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <limits>
+#include <stdexcept>
 #include <memory>
 #include <string>
 #include <vector>
@@ -113,5 +115,22 @@ std::filesystem::path endFile(const std::filesystem::path& dir, const std::strin
 uintmax_t fileBytes(const std::filesystem::path& file);
 // Adds `bytes` to run["bytes_written"][kind].
 void addBytes(nlohmann::json* run, const std::string& kind, uintmax_t bytes);
+// A count kept in a sink's checkpoint state: an integer at least `lowest`
+// that fits T, else std::invalid_argument naming the key.
+template <class T>
+T stateCount(const nlohmann::json& state, const char* key, long long lowest = 0) {
+  const nlohmann::json& v = state.at(key);
+  if (!v.is_number_integer()) throw std::invalid_argument(std::string("'") + key + "' is not an integer");
+  const auto outOfRange = [key] { return std::invalid_argument(std::string("'") + key + "' is out of range"); };
+  if (v.is_number_unsigned()) {
+    const unsigned long long u = v.get<unsigned long long>();
+    if (u > static_cast<unsigned long long>(std::numeric_limits<T>::max())) throw outOfRange();
+    return T(u);
+  }
+  const long long n = v.get<long long>();
+  if (n < lowest || (n > 0 && static_cast<unsigned long long>(n) > static_cast<unsigned long long>(std::numeric_limits<T>::max())))
+    throw outOfRange();
+  return T(n);
+}
 
 }  // namespace morphoflow

@@ -203,7 +203,17 @@ class Driver {
     if (states.size() != sinks_.size())
       throw UserError({checkpoint_->file.string(), 0, 0}, "--resume", "the checkpoint was written with other outputs",
                       "resume with the outputs as they were, or run without --resume");
-    for (size_t i = 0; i < sinks_.size(); ++i) sinks_[i]->restore(states[i]);
+    // A checksum-valid header whose outputs' state lacks a key or holds a
+    // wrong type or a negative count is refused as damaged, naming it.
+    for (size_t i = 0; i < sinks_.size(); ++i) {
+      try {
+        sinks_[i]->restore(states[i]);
+      } catch (const std::exception& e) {  // json's errors and stateCount's
+        throw UserError({checkpoint_->file.string(), 0, 0}, "--resume",
+                        fmt::format("the checkpoint's state of output {} is damaged ({})", i + 1, e.what()),
+                        "run the scene without --resume to start it afresh");
+      }
+    }
   }
 
   // run.json, with how the run ended.

@@ -108,9 +108,9 @@ std::vector<std::string> VdbSink<D>::whereToLook() const {
 
 template <int D>
 void VdbSink<D>::restore(const nlohmann::json& s) {
-  written_ = s.at("written").get<int>();
-  bytes_ = s.at("bytes").get<uintmax_t>();
-  nanoBytes_ = s.at("nano_bytes").get<uintmax_t>();
+  written_ = stateCount<int>(s, "written");
+  bytes_ = stateCount<uintmax_t>(s, "bytes");
+  nanoBytes_ = stateCount<uintmax_t>(s, "nano_bytes");
 }
 
 template class VdbSink<2>;

@@ -296,3 +296,31 @@ TEST(ChemicalAdvection, WideSamplerIsTheScalarLoopBitwise) {
   expectWideSamplerIsScalar<2>(IVec<2>(37, 29));
   expectWideSamplerIsScalar<3>(IVec<3>(13, 11, 9));
 }
+
+// A velocity near float's limit (a run diverging within a step, or a resumed
+// state holding one) sends the back-traces to infinity or NaN: every
+// sampler keeps its indices inside the grid (boundedCoordinate), so the
+// step ends with values from the grid, never a read outside it.
+TEST(ChemicalAdvection, AVelocityNearFloatsLimitSamplesInsideTheGrid) {
+  const int n = 16;
+  for (bool periodic : {false, true})
+    for (ChemicalInterpolation interp : {ChemicalInterpolation::Linear, ChemicalInterpolation::Cubic}) {
+      MacVelocity<2> u(IVec<2>(n, n), 1.0 / n, {periodic, periodic});
+      u[0].fill(3e38f);
+      u[1].fill(-3e38f);
+      for (int j = 0; j < n; j += 3) u[0](IVec<2>(5, j)) = -3e38f;  // opposite signs meet: inf - inf
+      ChemicalDomain<2> d;
+      d.cells = IVec<2>(n, n);
+      d.h = 1.0 / n;
+      d.periodic = {periodic, periodic};
+      ChemicalAdvector<2> adv(d, interp);
+      Grid<double, 2> g(d.cells);
+      for (size_t i = 0; i < g.size(); ++i) g[i] = 0.25 + 0.5 * double(i % 7) / 6.0;
+      for (int s = 0; s < 3; ++s) adv.advect(u, 1.0, {&g});
+      for (double v : g.values()) {
+        ASSERT_TRUE(std::isfinite(v)) << "periodic " << periodic;
+        EXPECT_GE(v, 0.25 - 1e-12);
+        EXPECT_LE(v, 0.75 + 1e-12);
+      }
+    }
+}

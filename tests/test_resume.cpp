@@ -223,21 +223,29 @@ TEST(Resume, ADamagedCheckpointFallsBackToTheOlderOne) {
 
 namespace {
 
-// A checkpoint file with `header` in place of its own, checksummed as the
-// program writes it (magic, header length, header, state length, state, XXH64).
-void rewriteHeader(const fs::path& file, const std::string& header) {
-  std::ifstream in(file, std::ios::binary);
-  const std::string bytes((std::istreambuf_iterator<char>(in)), {});
-  uint64_t hn = 0;
-  std::memcpy(&hn, bytes.data() + 8, 8);
-  std::string out = bytes.substr(0, 8);
-  const uint64_t n = header.size();
-  out.append(reinterpret_cast<const char*>(&n), 8);
-  out += header;
-  out += bytes.substr(16 + hn, bytes.size() - 8 - (16 + hn));  // the state's length and the state
+// A checkpoint file with its header and state changed by `edit`, checksummed
+// as the program writes it (magic, header length, header, state length,
+// state, XXH64).
+void rewriteCheckpoint(const fs::path& file, const std::function<void(std::string* header, std::string* state)>& edit) {
+  const std::string in = bytes(file);
+  uint64_t hn = 0, sn = 0;
+  std::memcpy(&hn, in.data() + 8, 8);
+  std::memcpy(&sn, in.data() + 16 + hn, 8);
+  std::string header = in.substr(16, hn), state = in.substr(24 + hn, sn);
+  edit(&header, &state);
+  std::string out = in.substr(0, 8);
+  for (const std::string* part : {&header, &state}) {
+    const uint64_t n = part->size();
+    out.append(reinterpret_cast<const char*>(&n), 8);
+    out += *part;
+  }
   const uint64_t digest = XXH64(out.data(), out.size(), 0);
   out.append(reinterpret_cast<const char*>(&digest), 8);
   std::ofstream(file, std::ios::binary | std::ios::trunc) << out;
+}
+
+void rewriteHeader(const fs::path& file, const std::string& header) {
+  rewriteCheckpoint(file, [&](std::string* h, std::string*) { *h = header; });
 }
 
 }  // namespace
@@ -281,6 +289,8 @@ TEST(Resume, AMalformedHeaderOrAHugeFileIsUnusableAndAnotherVersionIsSaidSo) {
       {"step a string", [](nlohmann::json* h) { (*h)["step"] = "x"; }},
       {"scene a number", [](nlohmann::json* h) { (*h)["scene"] = 3; }},
       {"sink state a string", [](nlohmann::json* h) { (*h)["sinks"][0]["written"] = "many"; }},
+      {"sink state without its count", [](nlohmann::json* h) { (*h)["sinks"][0].erase("written"); }},
+      {"sink state negative", [](nlohmann::json* h) { (*h)["sinks"][0]["bytes"] = -7; }},
   };
   for (const auto& [what, change] : malformed) {
     const CommandResult r = withHeader(change);
@@ -300,5 +310,53 @@ TEST(Resume, AMalformedHeaderOrAHugeFileIsUnusableAndAnotherVersionIsSaidSo) {
   EXPECT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("written by morphoflow 0.0.1-other"), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("unusable"), std::string::npos) << r.output;
+  fs::remove_all(dir);
+}
+
+// A checkpoint whose checksum holds but whose state holds NaN or infinity
+// (in a species, in a double scalar such as the time), and one whose image
+// output's state lacks the first frame it wrote, are refused with exit 2
+// naming the file and the section or output: never a crash or a NaN run.
+TEST(Resume, AStateHoldingNaNOrAnOutputStateLackingAKeyIsRefusedNamingIt) {
+  const fs::path dir = tempDir("resume_state");
+  const std::vector<std::string> run = {"run", sceneFile("rd/gray_scott_pearson.toml"), "--set", "grid.resolution=[24,24]",
+                                        "--set", "time.steps=4", "--set", "output.every=2", "--set",
+                                        "output.checkpoint_every=1", "--quiet", "--out", (dir / "out").string()};
+  ASSERT_EQ(runMorphoflow(join(run)).status, 0);
+  std::vector<fs::path> cps = checkpoints(dir / "out");
+  ASSERT_FALSE(cps.empty());
+  const fs::path newest = cps.back(), saved = dir / "newest.ckpt";
+  fs::copy_file(newest, saved);
+  std::vector<std::string> resume = run;
+  resume.push_back("--resume");
+  // The value at the start of a section's data: its frame is the name's
+  // length (4 bytes), the name and the data's length (8 bytes).
+  auto poison = [&](const std::string& section, double value) {
+    fs::copy_file(saved, newest, fs::copy_options::overwrite_existing);
+    rewriteCheckpoint(newest, [&](std::string*, std::string* state) {
+      const size_t at = state->find(section);
+      ASSERT_NE(at, std::string::npos) << section;
+      std::memcpy(state->data() + at + section.size() + 8, &value, sizeof(double));
+    });
+    return runMorphoflow(join(resume));
+  };
+  for (const auto& [section, value] : std::vector<std::pair<std::string, double>>{
+           {"rd.0.x", std::nan("")}, {"rd.1.x", -INFINITY}, {"rd.time", INFINITY}}) {
+    const CommandResult r = poison(section, value);
+    EXPECT_EQ(r.status, 2) << section << "\n" << r.output;
+    EXPECT_NE(r.output.find(newest.string()), std::string::npos) << section << "\n" << r.output;
+    EXPECT_NE(r.output.find("section '" + section + "' holds a non-finite value"), std::string::npos) << r.output;
+  }
+  fs::copy_file(saved, newest, fs::copy_options::overwrite_existing);
+  rewriteCheckpoint(newest, [](std::string* header, std::string*) {
+    nlohmann::json h = nlohmann::json::parse(*header);
+    h["sinks"][0].erase("first_written");
+    *header = h.dump();
+  });
+  const CommandResult r = runMorphoflow(join(resume));
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find(newest.string()), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("state of output 1 is damaged"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("first_written"), std::string::npos) << r.output;
   fs::remove_all(dir);
 }
