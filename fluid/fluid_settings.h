@@ -7,6 +7,7 @@
 
 #include "fluid/domain_boundary.h"
 #include "fluid/obstacle.h"
+#include "fluid/smoke_settings.h"
 
 namespace morphoflow {
 
@@ -29,6 +30,7 @@ struct FluidSettings {
   DomainBoundaries boundaries;
   int inflowDyeStripes = 0;                // > 0: dye enters through the inflow in this many stripes
   std::vector<ObstacleSpec> obstacles;
+  SmokeSettings smoke;                     // sources, temperature, buoyancy, confinement (fluid/smoke.h)
 };
 
 }  // namespace morphoflow

@@ -9,6 +9,7 @@
 #include "fluid/advection.h"
 #include "fluid/forces.h"
 #include "fluid/obstacle.h"
+#include "fluid/smoke.h"
 
 namespace morphoflow {
 
@@ -51,6 +52,11 @@ FluidSolver<D>::FluidSolver(const FluidSettings& s)
   u_ = MacVelocity<D>(cells_, h_, constraints_.periodic());
   scratch_ = u_;
   constraints_.apply(&u_);
+  if (s.smoke.enabled) {
+    temperature_ = Grid<float, D>(cells_, float(s.smoke.ambient));
+    sourceCoverage_ = sourceCoverage<D>(s.smoke.sources, cells_, h_, constraints_.solid);
+    if (!s.smoke.sources.empty()) materialisedDye();
+  }
 }
 
 template <int D>
@@ -62,25 +68,25 @@ void FluidSolver<D>::step(double dt, const std::function<void()>& afterAdvection
     stats_.seconds[size_t(stage)] = std::chrono::duration<double>(t1 - t0).count();
     t0 = t1;
   };
-  // 1. forces
+  // 1. forces (with [smoke]: the sources' emission, buoyancy, confinement)
+  const SmokeSettings& smoke = settings_.smoke;
+  if (smoke.enabled) emitSmoke<D>(smoke, sourceCoverage_, time_, dt, &dye(), &temperature_, &u_);
   applyForces<D>(settings_, dye_.empty() ? nullptr : &dye_, dt, &u_);
+  if (smoke.enabled) applySmokeForces<D>(smoke, settings_.buoyancyDirection, dye(), temperature_, dt, &u_);
   constraints_.apply(&u_);
   lap(0);
-  // 2. advect (velocity through itself, dye through the same field)
+  // 2. advect (velocity through itself, dye and temperature through the same field)
   advectionScratch_.borrow(&pool_, settings_.advection);
   advectVelocity<D>(u_, dt, settings_.advection, &scratch_, &advectionScratch_);
   // An all-zero dye (no dye in the scene yet) advects to zero: skip the work.
-  if (!dye_.empty() && std::any_of(dye_.values().begin(), dye_.values().end(), [](float v) { return v != 0.0f; })) {
-    pool_.lend(&dyeScratch_.values());  // a work grid only while the dye moves
-    dyeScratch_.reshape(cells_);
-    advectField<D>(dye_, cellLayout(), u_, dt, settings_.advection, &dyeScratch_, &advectionScratch_);
-    std::swap(dye_, dyeScratch_);
-    pool_.give(&dyeScratch_.values());
-  }
+  if (!dye_.empty() && std::any_of(dye_.values().begin(), dye_.values().end(), [](float v) { return v != 0.0f; }))
+    advectScalar(&dye_, dt);
+  if (!temperature_.empty()) advectScalar(&temperature_, dt);
   advectionScratch_.giveBack(&pool_);
   std::swap(u_, scratch_);  // scratch_ keeps the velocity advected through (advectedVelocity())
   constraints_.apply(&u_);
   injectInflowDye();
+  if (smoke.enabled) decaySmoke<D>(smoke, dt, &dye(), &temperature_);
   lap(1);
   if (afterAdvection) afterAdvection();
   // 3. diffuse (implicit viscosity)
@@ -93,6 +99,17 @@ void FluidSolver<D>::step(double dt, const std::function<void()>& afterAdvection
   lap(3);
   time_ += dt;
   ++steps_;
+}
+
+// A cell-centred scalar carried through u_ (before the swap) with the
+// fluid's advection scheme, through a work grid lent only for it.
+template <int D>
+void FluidSolver<D>::advectScalar(Grid<float, D>* field, double dt) {
+  pool_.lend(&dyeScratch_.values());
+  dyeScratch_.reshape(cells_);
+  advectField<D>(*field, cellLayout(), u_, dt, settings_.advection, &dyeScratch_, &advectionScratch_);
+  std::swap(*field, dyeScratch_);
+  pool_.give(&dyeScratch_.values());
 }
 
 template <int D>
@@ -134,6 +151,7 @@ template <int D>
 void FluidSolver<D>::save(StateWriter* out) const {
   for (int a = 0; a < D; ++a) out->putGrid("fluid.u" + std::to_string(a), u_[a]);
   if (!dye_.empty()) out->putGrid("fluid.dye", dye_);
+  if (!temperature_.empty()) out->putGrid("fluid.temperature", temperature_);
   out->put("fluid.time", time_);
   out->put("fluid.steps", steps_);
   projection_->save(out);
@@ -145,6 +163,7 @@ void FluidSolver<D>::load(const StateReader& in) {
   for (int a = 0; a < D; ++a) in.getGrid("fluid.u" + std::to_string(a), &u_[a]);
   dye_ = Grid<float, D>();
   if (in.has("fluid.dye")) in.getGrid("fluid.dye", &dye());
+  if (!temperature_.empty()) in.getGrid("fluid.temperature", &temperature_);
   in.get("fluid.time", &time_);
   in.get("fluid.steps", &steps_);
   projection_->load(in);

@@ -1,6 +1,7 @@
 // FluidSolver<D>: Stam's stable fluids as a fixed sequence of named, timed
 // stages (forces, advect, diffuse, project), written once for 2D and 3D.
-// A passive dye rides along for rendering and buoyancy.
+// A passive dye rides along for rendering and buoyancy; with [smoke] it is
+// the smoke density, beside a temperature, sources and confinement (smoke.h).
 #pragma once
 
 #include <array>
@@ -56,6 +57,10 @@ class FluidSolver {
   Grid<float, D>& dye() { return materialisedDye(); }
   const Grid<float, D>& dye() const { return materialisedDye(); }
   bool hasDye() const { return !dye_.empty(); }
+  // The smoke's temperature (empty unless the scene has [smoke]); the smoke
+  // density is the dye.
+  const Grid<float, D>& temperature() const { return temperature_; }
+  Grid<float, D>& temperature() { return temperature_; }
   const Grid<uint8_t, D>& solid() const { return constraints_.solid; }
   const VelocityConstraints<D>& constraints() const { return constraints_; }
   Grid<float, D> pressure() const { return projection_->pressure(); }
@@ -73,6 +78,7 @@ class FluidSolver {
 
  private:
   void injectInflowDye();
+  void advectScalar(Grid<float, D>* field, double dt);
   Grid<float, D>& materialisedDye() const {
     if (dye_.empty()) dye_ = Grid<float, D>(cells_, 0.0f);
     return dye_;
@@ -87,6 +93,8 @@ class FluidSolver {
   MacVelocity<D> u_, scratch_;
   mutable Grid<float, D> dye_;  // empty: all zero
   Grid<float, D> dyeScratch_;
+  Grid<float, D> temperature_;                    // [smoke] only
+  std::vector<Grid<float, D>> sourceCoverage_;    // per smoke source
   AdvectionScratch<D> advectionScratch_;
   WorkPool pool_;  // the stages' work vectors, lent to each in turn
   double time_ = 0.0;

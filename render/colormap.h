@@ -7,6 +7,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -28,6 +29,12 @@ std::vector<std::string> colormapNames();
 bool hasColormap(const std::string& name);
 // A scalar palette by name (grayscale for an unknown or the two-species name).
 Palette namedPalette(const std::string& name);
+// An 8-bit sRGB channel as linear light in [0, 1] (IEC 61966-2-1), as
+// renderers' colour attributes expect.
+inline float srgbToLinear(uint8_t c) {
+  const double v = c / 255.0;
+  return float(v <= 0.04045 ? v / 12.92 : std::pow((v + 0.055) / 1.055, 2.4));
+}
 // "#rrggbb" (or "rrggbb") to a colour; false when malformed.
 bool parseHexColour(const std::string& text, Rgb8* colour);
 

@@ -54,11 +54,34 @@ void deactivateNearBackground(GridT* grid, float tolerance) {
   openvdb::tools::pruneInactive(grid->tree());
 }
 
+// Whether the options' shared topology applies to grid g (same cells).
+bool sharesTopology(const VolumeGrid& g, const VolumeOptions& o) {
+  return o.active && o.activeCells == g.cells && o.active->size() == g.values[0].size();
+}
+
+// The grid filled densely from `values`, or (shared topology) active exactly
+// where the options' mask is, whatever the values there.
+template <class GridT>
+void fill(GridT* grid, const VolumeGrid& g, typename GridT::ValueType* values, const VolumeOptions& o) {
+  using ValueT = typename GridT::ValueType;
+  if (!sharesTopology(g, o)) {
+    openvdb::tools::Dense<ValueT, openvdb::tools::LayoutXYZ> dense(cellBox(g), values);
+    openvdb::tools::copyFromDense(dense, *grid, ValueT(0.0f));
+    deactivateNearBackground(grid, o.tolerance);
+    return;
+  }
+  auto acc = grid->getAccessor();
+  const std::vector<uint8_t>& on = *o.active;
+  size_t i = 0;
+  for (int z = 0; z < g.cells[2]; ++z)
+    for (int y = 0; y < g.cells[1]; ++y)
+      for (int x = 0; x < g.cells[0]; ++x, ++i)
+        if (on[i]) acc.setValue(openvdb::Coord(x, y, z), values[i]);
+}
+
 openvdb::GridBase::Ptr scalarGrid(const VolumeGrid& g, const VolumeOptions& o) {
   auto grid = openvdb::FloatGrid::create(0.0f);
-  openvdb::tools::Dense<float, openvdb::tools::LayoutXYZ> dense(cellBox(g), const_cast<float*>(g.values[0].data()));
-  openvdb::tools::copyFromDense(dense, *grid, 0.0f);
-  deactivateNearBackground(grid.get(), o.tolerance);
+  fill(grid.get(), g, const_cast<float*>(g.values[0].data()), o);
   if (g.kind == VolumeGrid::Kind::FogVolume) grid->setGridClass(openvdb::GRID_FOG_VOLUME);
   return grid;
 }
@@ -67,10 +90,8 @@ openvdb::GridBase::Ptr vectorGrid(const VolumeGrid& g, const VolumeOptions& o) {
   std::vector<openvdb::Vec3s> v(g.values[0].size());
   for (size_t i = 0; i < v.size(); ++i) v[i] = openvdb::Vec3s(g.values[0][i], g.values[1][i], g.values[2][i]);
   auto grid = openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f));
-  openvdb::tools::Dense<openvdb::Vec3s, openvdb::tools::LayoutXYZ> dense(cellBox(g), v.data());
-  openvdb::tools::copyFromDense(dense, *grid, openvdb::Vec3s(0.0f));
-  deactivateNearBackground(grid.get(), o.tolerance);
-  grid->setVectorType(openvdb::VEC_CONTRAVARIANT_RELATIVE);
+  fill(grid.get(), g, v.data(), o);
+  grid->setVectorType(g.kind == VolumeGrid::Kind::Color ? openvdb::VEC_INVARIANT : openvdb::VEC_CONTRAVARIANT_RELATIVE);
   if (g.kind == VolumeGrid::Kind::Staggered) grid->setGridClass(openvdb::GRID_STAGGERED);
   return grid;
 }
@@ -95,7 +116,8 @@ openvdb::GridPtrVec buildGrids(const std::vector<VolumeGrid>& grids, const Volum
   initialiseOnce();
   openvdb::GridPtrVec out;
   for (const VolumeGrid& g : grids) {
-    const bool vector = g.kind == VolumeGrid::Kind::Vector || g.kind == VolumeGrid::Kind::Staggered;
+    const bool vector = g.kind == VolumeGrid::Kind::Vector || g.kind == VolumeGrid::Kind::Staggered ||
+                        g.kind == VolumeGrid::Kind::Color;
     openvdb::GridBase::Ptr grid = vector                                 ? vectorGrid(g, o)
                                   : g.kind == VolumeGrid::Kind::LevelSet ? levelSetGrid(g)
                                                                          : scalarGrid(g, o);

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,7 @@ struct VolumeGrid {
     Vector,     // a Vec3SGrid, vector type contravariant-relative (velocity)
     Staggered,  // the same, of class staggered: component a of voxel v on v's lower face along a (MAC velocity)
     LevelSet,   // `values` is a solid mask (nonzero inside): written as a narrow-band level set
+    Color,      // a Vec3SGrid of linear RGB in [0, 1], vector type invariant (Blender's `color`)
   };
   std::string name;
   Kind kind = Kind::Scalar;
@@ -38,6 +40,11 @@ struct VolumeMetadata {
 struct VolumeOptions {
   float tolerance = 0.0f;  // |value - background| <= tolerance: inactive
   bool half = false;       // floats saved as half
+  // When set: the active voxels of every scalar, vector and colour grid of
+  // these cells (x fastest; nonzero: active), one topology for all of them,
+  // in place of `tolerance` (a smoke frame is active where there is smoke).
+  const std::vector<uint8_t>* active = nullptr;
+  std::array<int, 3> activeCells{0, 0, 0};
 };
 
 // The .vdb file's bytes. Its UUID is derived from its content, so the same

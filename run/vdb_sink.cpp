@@ -8,6 +8,8 @@
 #include "run/scene_hash.h"
 #include "run/version.h"
 #include "core/output_file.h"
+#include "render/colormap.h"
+#include "render/field_image.h"
 
 namespace morphoflow {
 
@@ -51,8 +53,46 @@ std::vector<VolumeGrid> VdbSink<D>::grids(const Simulation<D>& sim) const {
   // The MAC faces exactly (cells + 1 voxels per axis), for a later run to read back (docs/vfx.md).
   if (o.vdbMacVelocity) g.push_back(volumeGrid<D>("vel_mac", K::Staggered, sim.field("velocity_mac"), width, 1));
   for (const std::string& f : o.vdbFields) g.push_back(volumeGrid<D>(f, K::Scalar, sim.field(f), width));
+  if (scene_.hasFluid && scene_.fluid.smoke.enabled &&
+      std::find(o.vdbFields.begin(), o.vdbFields.end(), "temperature") == o.vdbFields.end())
+    g.push_back(volumeGrid<D>("temperature", K::Scalar, sim.field("temperature"), width));
+  if (o.vdbColor) g.push_back(colorGrid(sim, width));
   if (sim.hasObstacles()) g.push_back(volumeGrid<D>("obstacle", K::LevelSet, sim.field("obstacle"), width));
   return g;
+}
+
+// The palette of the frames applied to the shown field, as linear RGB in
+// [0, 1] (Blender's Principled Volume reads a grid named `color` by default).
+template <int D>
+VolumeGrid VdbSink<D>::colorGrid(const Simulation<D>& sim, double width) const {
+  const OutputSettings& o = scene_.output;
+  const std::string shown = o.colormap == kTwoSpeciesPalette ? sim.species()[0] : o.field;
+  const Grid<float, D> f = sim.field(shown).front();
+  FieldImageOptions io;
+  io.palette = o.gradient.empty() ? namedPalette(o.colormap) : Palette{o.gradient};
+  io.autoRange = o.autoRange;
+  io.symmetric = sim.symmetric(shown);
+  io.range[0] = o.range[0];
+  io.range[1] = o.range[1];
+  const std::array<double, 2> range = valueRange(f.data(), f.size(), io);
+  const double span = range[1] > range[0] ? range[1] - range[0] : 1.0;
+  std::vector<Grid<float, D>> rgb(3, Grid<float, D>(f.dims(), 0.0f));
+  for (size_t i = 0; i < f.size(); ++i) {
+    const Rgb8 c = io.palette((double(f[i]) - range[0]) / span);
+    for (int k = 0; k < 3; ++k) rgb[size_t(k)][i] = srgbToLinear(c[size_t(k)]);
+  }
+  return volumeGrid<D>("color", VolumeGrid::Kind::Color, std::move(rgb), width);
+}
+
+// Where the smoke exceeds the tolerance: the one topology of a smoke frame
+// (every voxel with output.vdb_sparse = false).
+template <int D>
+std::vector<uint8_t> VdbSink<D>::smokeMask(const Simulation<D>& sim) const {
+  const Grid<float, D> smoke = sim.field("dye").front();
+  std::vector<uint8_t> on(smoke.size());
+  const bool sparse = scene_.output.vdbSparse;
+  for (size_t i = 0; i < on.size(); ++i) on[i] = !sparse || smoke[i] > scene_.output.vdbTolerance ? 1 : 0;
+  return on;
 }
 
 template <int D>
@@ -70,7 +110,13 @@ void VdbSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
   for (int a = 0; a < D; ++a) meta.domain[size_t(a)] = scene_.fluid.size[size_t(a)];
   meta.units = "lengths in the scene's domain units (world space fills [0, domain.size]); time in its time units; "
                "vel in domain units per time unit";
-  const VolumeOptions options{float(o.vdbTolerance), o.vdbHalf};
+  VolumeOptions options{float(o.vdbTolerance), o.vdbHalf};
+  std::vector<uint8_t> mask;
+  if (scene_.hasFluid && scene_.fluid.smoke.enabled) {
+    mask = smokeMask(sim);
+    options.active = &mask;
+    for (int a = 0; a < D; ++a) options.activeCells[size_t(a)] = sim.field("dye").front().dim(a);
+  }
   const std::string stem = fmt::format("{}.{:06d}", safeFileStem(scene_.name), at.frame);
   const std::string vdb = encodeVdb(g, meta, options);
   writeFileAtomically(dir_ / (stem + ".vdb"), vdb);

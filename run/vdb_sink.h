@@ -4,6 +4,9 @@
 // cell-centred velocity (Vec3SGrid, contravariant-relative, domain units per
 // unit time), the fluid scalars of output.vdb_fields, and "obstacle" as a
 // narrow-band level set when the scene has solids (render/vdb_volume.h).
+// With [smoke]: "density" is the smoke, "temperature" beside it, "color" the
+// palette applied to output.field (output.vdb_color), and every grid of the
+// frame active exactly where the smoke exceeds output.vdb_tolerance.
 #pragma once
 
 #include <filesystem>
@@ -27,6 +30,8 @@ class VdbSink : public OutputSink<D> {
  private:
   // The grids of the simulation's current state.
   std::vector<VolumeGrid> grids(const Simulation<D>& sim) const;
+  VolumeGrid colorGrid(const Simulation<D>& sim, double width) const;
+  std::vector<uint8_t> smokeMask(const Simulation<D>& sim) const;
   std::filesystem::path dir_;
   const Scene& scene_;
   const std::string hash_;  // the scene's settings hash, for the metadata

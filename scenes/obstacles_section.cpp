@@ -13,60 +13,65 @@ ObstacleShape parseShape(const std::string& s) {
   return ObstacleShape::Sdf;
 }
 
-void parseObstacles(SceneContext& c, Scene* sp) {
+// A shape (obstacles' and sources' alike) from the table o whose keys are
+// prefixed p: shape, center (inside the domain), radius, size or file.
+ObstacleSpec parseRegion(SceneContext& c, const toml::table* o, const std::string& p) {
   Reader& r = c.r;
-  toml::table& root = c.root;
-  Scene& s = *sp;
   const int D = c.D;
   const std::vector<double>& size = c.size;
-  const std::filesystem::path& sceneDir = c.sceneDir;
-  const toml::table* top = &root;
-  r.node(top, "", "obstacles");
-  if (const toml::node* obs = root.get("obstacles")) {
-    const toml::array* arr = obs->as_array();
-    if (!arr || !arr->is_array_of_tables())
-      r.fail(obs, "obstacles", "expected an array of tables ([[obstacles]])");
-    for (size_t i = 0; i < arr->size(); ++i) {
-      const toml::table* o = arr->get(i)->as_table();
-      const std::string p = "obstacles." + std::to_string(i) + ".";
-      ObstacleSpec spec;
-      std::string shape = r.string(o, p, "shape", "circle", {"circle", "sphere", "box", "image", "sdf"});
-      spec.shape = parseShape(shape);
-      std::vector<double> centre(static_cast<size_t>(D), 0.0);
-      for (int a = 0; a < D; ++a) centre[size_t(a)] = 0.5 * size[size_t(a)];
-      const toml::node* cn = nullptr;
-      centre = r.numbers(o, p, "center", centre, size_t(D), size_t(D), -1e9, 1e9, false, &cn);
-      for (int a = 0; a < D; ++a) {
-        if (centre[size_t(a)] < 0 || centre[size_t(a)] > size[size_t(a)])
-          r.fail(cn, p + "center", "the centre lies outside the domain", "domain.size is " + std::to_string(size[size_t(a)]) + " along axis " + std::to_string(a));
-        spec.center[size_t(a)] = centre[size_t(a)];
-      }
-      if (spec.shape == ObstacleShape::Circle || spec.shape == ObstacleShape::Sphere) {
-        if (!r.node(o, p, "radius")) r.fail(o, p + "radius", "a " + shape + " needs a radius");
-        spec.radius = r.number(o, p, "radius", 0.1, 0, 1e9, true);
-      } else if (spec.shape == ObstacleShape::Box) {
-        if (!r.node(o, p, "size")) r.fail(o, p + "size", "a box needs a size = [..] (its full extent)");
-        std::vector<double> sz = r.numbers(o, p, "size", {}, size_t(D), size_t(D), 0, 1e9, true);
-        for (int a = 0; a < D; ++a) spec.halfSize[size_t(a)] = 0.5 * sz[size_t(a)];
-      } else {
-        const std::string key = "file";
-        const toml::node* fn = r.node(o, p, key);
-        if (!fn) r.fail(o, p + key, "an " + shape + " obstacle needs file = \"path\"");
-        std::string file = r.string(o, p, key, "");
-        std::filesystem::path fp = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : sceneDir / file;
-        GrayImage img;
-        std::string err;
-        if (!readGrayImage(fp.string(), &img, &err)) r.fail(fn, p + key, "cannot read the image: " + err);
-        r.noteInput(fp, fn, p + key);
-        spec.fieldWidth = img.width;
-        spec.fieldHeight = img.height;
-        spec.field = std::move(img.pixels);
-        spec.threshold = r.number(o, p, "threshold", 0.5, -1e9, 1e9);
-        spec.invert = r.boolean(o, p, "invert", false);
-      }
-      s.fluid.obstacles.push_back(spec);
-    }
+  ObstacleSpec spec;
+  std::string shape = r.string(o, p, "shape", "circle", {"circle", "sphere", "box", "image", "sdf"});
+  spec.shape = parseShape(shape);
+  std::vector<double> centre(static_cast<size_t>(D), 0.0);
+  for (int a = 0; a < D; ++a) centre[size_t(a)] = 0.5 * size[size_t(a)];
+  const toml::node* cn = nullptr;
+  centre = r.numbers(o, p, "center", centre, size_t(D), size_t(D), -1e9, 1e9, false, &cn);
+  for (int a = 0; a < D; ++a) {
+    if (centre[size_t(a)] < 0 || centre[size_t(a)] > size[size_t(a)])
+      r.fail(cn, p + "center", "the centre lies outside the domain", "domain.size is " + std::to_string(size[size_t(a)]) + " along axis " + std::to_string(a));
+    spec.center[size_t(a)] = centre[size_t(a)];
   }
+  if (spec.shape == ObstacleShape::Circle || spec.shape == ObstacleShape::Sphere) {
+    if (!r.node(o, p, "radius")) r.fail(o, p + "radius", "a " + shape + " needs a radius");
+    spec.radius = r.number(o, p, "radius", 0.1, 0, 1e9, true);
+  } else if (spec.shape == ObstacleShape::Box) {
+    if (!r.node(o, p, "size")) r.fail(o, p + "size", "a box needs a size = [..] (its full extent)");
+    std::vector<double> sz = r.numbers(o, p, "size", {}, size_t(D), size_t(D), 0, 1e9, true);
+    for (int a = 0; a < D; ++a) spec.halfSize[size_t(a)] = 0.5 * sz[size_t(a)];
+  } else {
+    const std::string key = "file";
+    const toml::node* fn = r.node(o, p, key);
+    if (!fn) r.fail(o, p + key, "an " + shape + " region needs file = \"path\"");
+    std::string file = r.string(o, p, key, "");
+    std::filesystem::path fp = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : c.sceneDir / file;
+    GrayImage img;
+    std::string err;
+    if (!readGrayImage(fp.string(), &img, &err)) r.fail(fn, p + key, "cannot read the image: " + err);
+    r.noteInput(fp, fn, p + key);
+    spec.fieldWidth = img.width;
+    spec.fieldHeight = img.height;
+    spec.field = std::move(img.pixels);
+    spec.threshold = r.number(o, p, "threshold", 0.5, -1e9, 1e9);
+    spec.invert = r.boolean(o, p, "invert", false);
+  }
+  return spec;
+}
+
+// An array of tables ([[name]]) at the root, or none.
+const toml::array* tableArray(Reader& r, toml::table& root, const std::string& name) {
+  const toml::table* top = &root;
+  r.node(top, "", name);
+  const toml::node* n = root.get(name);
+  if (!n) return nullptr;
+  const toml::array* arr = n->as_array();
+  if (!arr || !arr->is_array_of_tables()) r.fail(n, name, "expected an array of tables ([[" + name + "]])");
+  return arr;
+}
+
+void parseObstacles(SceneContext& c, Scene* s) {
+  if (const toml::array* arr = tableArray(c.r, c.root, "obstacles"))
+    for (size_t i = 0; i < arr->size(); ++i)
+      s->fluid.obstacles.push_back(parseRegion(c, arr->get(i)->as_table(), "obstacles." + std::to_string(i) + "."));
 }
 
 }  // namespace morphoflow

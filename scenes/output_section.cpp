@@ -13,11 +13,14 @@ void parseVdbOutput(SceneContext& c, const toml::table* out, Scene& s) {
   const std::vector<std::string>& species = c.species;
   OutputSettings& o = s.output;
   o.vdb = r.boolean(out, "output.", "vdb", false);
+  // With [smoke]: the smoke is the density, and the frame is sparse where
+  // there is none (every grid active where the smoke exceeds the tolerance).
+  const bool smoke = s.hasFluid && s.fluid.smoke.enabled;
+  std::vector<std::string> fluidScalars = {"speed", "vorticity", "pressure", "dye"};
+  if (smoke) fluidScalars.push_back("temperature");
   std::vector<std::string> fields = species;
-  if (s.hasFluid)
-    for (const char* f : {"speed", "vorticity", "pressure", "dye"}) fields.push_back(f);
-  o.vdbDensity = r.string(out, "output.", "vdb_density", o.field, fields);
-  const std::vector<std::string> fluidScalars = {"speed", "vorticity", "pressure", "dye"};
+  if (s.hasFluid) fields.insert(fields.end(), fluidScalars.begin(), fluidScalars.end());
+  o.vdbDensity = r.string(out, "output.", "vdb_density", smoke ? "dye" : o.field, fields);
   if (const toml::node* vf = r.node(out, "output.", "vdb_fields")) {
     const toml::array* arr = vf->as_array();
     if (!arr) r.fail(vf, "output.vdb_fields", "expected an array of field names, e.g. [\"speed\", \"vorticity\"]");
@@ -27,12 +30,18 @@ void parseVdbOutput(SceneContext& c, const toml::table* out, Scene& s) {
     for (const toml::node& e : *arr) {
       auto name = e.value<std::string>();
       if (!name || std::find(fluidScalars.begin(), fluidScalars.end(), *name) == fluidScalars.end())
-        r.fail(&e, "output.vdb_fields", "expected names of fluid fields: speed, vorticity, pressure, dye",
+        r.fail(&e, "output.vdb_fields", "expected names of fluid fields: " + join(fluidScalars),
                name ? "did you mean '" + nearest(*name, fluidScalars) + "'?" : std::string());
       o.vdbFields.push_back(*name);
     }
   }
-  o.vdbTolerance = r.number(out, "output.", "vdb_tolerance", 0.0, 0.0, 1e30);
+  o.vdbTolerance = r.number(out, "output.", "vdb_tolerance", smoke ? 1e-3 : 0.0, 0.0, 1e30);
+  o.vdbColor = r.boolean(out, "output.", "vdb_color", smoke);
+  const toml::node* sparse = r.node(out, "output.", "vdb_sparse");
+  o.vdbSparse = r.boolean(out, "output.", "vdb_sparse", smoke);
+  if (sparse && o.vdbSparse && !smoke)
+    r.fail(sparse, "output.vdb_sparse", "a sparse volume is active where there is smoke, and this scene has no [smoke]",
+           "use output.vdb_tolerance to make voxels near 0 inactive");
   o.vdbHalf = r.boolean(out, "output.", "vdb_half", false);
   o.nanovdb = r.boolean(out, "output.", "nanovdb", false);
   const toml::node* mac = r.node(out, "output.", "vdb_mac_velocity");
@@ -41,7 +50,7 @@ void parseVdbOutput(SceneContext& c, const toml::table* out, Scene& s) {
     r.fail(mac, "output.vdb_mac_velocity", "this scene has no fluid, so it has no velocity of its own to write",
            "drop output.vdb_mac_velocity");
   if (!o.vdb)
-    for (const char* k : {"vdb_density", "vdb_fields", "vdb_tolerance", "vdb_half", "nanovdb", "vdb_mac_velocity"})
+    for (const char* k : {"vdb_density", "vdb_fields", "vdb_tolerance", "vdb_half", "nanovdb", "vdb_mac_velocity", "vdb_color", "vdb_sparse"})
       if (const toml::node* n = r.node(out, "output.", k); n && !(n->is_boolean() && !n->value<bool>().value()))
         r.fail(n, std::string("output.") + k, "only applies with output.vdb = true", "add output.vdb = true or drop it");
 }
@@ -67,14 +76,17 @@ void parseOutput(SceneContext& c, Scene* sp) {
     r.fail(r.node(out, "output.", "video"), "output.video",
            "the video is made from PNG frames, so it needs output.images = true and output.format = \"png\"",
            "turn the PNG frames on, or set output.video = false");
+  std::vector<std::string> fluidFields = {"speed", "vorticity", "dye", "pressure"};
+  const bool smoke = s.hasFluid && s.fluid.smoke.enabled;
+  if (smoke) fluidFields.push_back("temperature");
   if (s.rd.enabled && s.hasFluid) {
     std::vector<std::string> choices = species;
-    for (const char* f : {"speed", "vorticity", "dye", "pressure"}) choices.push_back(f);
+    choices.insert(choices.end(), fluidFields.begin(), fluidFields.end());
     s.output.field = r.string(out, "output.", "field", species.front(), choices);
   } else if (s.rd.enabled)
     s.output.field = r.string(out, "output.", "field", species.front(), species);
   else
-    s.output.field = r.string(out, "output.", "field", "vorticity", {"speed", "vorticity", "dye", "pressure"});
+    s.output.field = r.string(out, "output.", "field", smoke ? "dye" : "vorticity", fluidFields);
   parseVdbOutput(c, out, s);
   s.output.colormap = r.string(out, "output.", "colormap", s.output.field == "vorticity" ? "coolwarm" : "viridis",
                                colormapNames());

@@ -103,6 +103,7 @@ Scene parseScene(const std::string& text, const std::string& path, const std::ve
   parseFluid(c, &s);
   parseRD(c, &s);
   parseVelocity(c, &s);
+  parseSmoke(c, &s);
   parseCoupling(c, &s);
   parseOutput(c, &s);
   checkBackTraces(c, s);

@@ -219,6 +219,11 @@ struct SceneContext {
   std::vector<std::string> species; // of the [rd] model
 };
 
+// A shape of [[obstacles]] or [[sources]] from table o (keys prefixed p).
+ObstacleSpec parseRegion(SceneContext& c, const toml::table* o, const std::string& p);
+// The array of tables [[name]] at the root (null when absent).
+const toml::array* tableArray(Reader& r, toml::table& root, const std::string& name);
+
 // One parser per scene section, in the order loadScene calls them; each
 // fills its part of the Scene (scene.h) and reads only what earlier ones
 // resolved.
@@ -227,6 +232,7 @@ void parseTime(SceneContext& c, Scene* s);        // [time]
 void parseBoundary(SceneContext& c, Scene* s);    // [boundary], [inflow]
 void parseObstacles(SceneContext& c, Scene* s);   // [[obstacles]]
 void parseFluid(SceneContext& c, Scene* s);       // [fluid], [dye], [probes]
+void parseSmoke(SceneContext& c, Scene* s);       // [smoke], [[sources]] (after [fluid] and [velocity])
 void parseRD(SceneContext& c, Scene* s);          // [rd] and its tables
 void parseStrokes(SceneContext& c, const toml::table& rd, RDScene* out);  // [[rd.strokes]] (called by parseRD)
 void parseGeneralized(SceneContext& c, const toml::table& rd, Scene* s);  // [rd.generalized] (called by parseRD)

@@ -27,13 +27,17 @@ void initialiseDye(const Scene& scene, FluidSolver<D>* f) {
   });
 }
 
-std::vector<std::string> fluidFieldNames() { return {"speed", "vorticity", "pressure", "dye", "velocity", "obstacle"}; }
+std::vector<std::string> fluidFieldNames() {
+  return {"speed", "vorticity", "pressure", "dye", "temperature", "velocity", "obstacle"};
+}
 
 template <int D>
 std::vector<Grid<float, D>> fluidField(const FluidSolver<D>& f, const std::string& name) {
   if (name == "speed") return {speedField(f)};
   if (name == "vorticity") return {vorticityField(f)};
   if (name == "dye") return {f.dye()};
+  if (name == "temperature")  // (without [smoke]: 0 everywhere)
+    return {f.temperature().empty() ? Grid<float, D>(f.cells(), 0.0f) : f.temperature()};
   if (name == "pressure") return {f.pressure()};
   if (name == "obstacle") {
     Grid<float, D> s(f.cells(), 0.0f);

@@ -49,7 +49,11 @@ class FluidSimulation : public Simulation<D> {
   double time() const override { return stepper_->time(); }
   long steps() const override { return stepper_->steps(); }
   std::vector<std::string> fieldNames() const override { return fluidFieldNames(); }
-  std::vector<std::string> dumpFieldNames() const override { return {"speed", "vorticity", "pressure", "dye"}; }
+  std::vector<std::string> dumpFieldNames() const override {
+    std::vector<std::string> names = {"speed", "vorticity", "pressure", "dye"};
+    if (scene_.fluid.smoke.enabled) names.push_back("temperature");
+    return names;
+  }
   std::vector<Grid<float, D>> field(const std::string& name) const override {
     host_.refresh();
     return fluidField<D>(fluid_, name);

@@ -24,6 +24,8 @@ namespace {
 // The first stage of the scene with no GPU program, or "".
 std::string missingGpuStage(const Scene& s) {
   const RDScene& rd = s.rd;
+  if (s.hasFluid && s.fluid.smoke.enabled)
+    return "smoke ([smoke] and [[sources]]: emission, temperature, buoyancy and vorticity confinement)";
   if (s.hasFluid && !rd.enabled) return "";
   if (gpuSpecies(rd.settings.model) == 0) return "the reaction of model " + rd.settings.model;
   if (s.hasFluid && gpuSpecies(rd.settings.model) != 2)

@@ -155,5 +155,48 @@ grids, _ = vdb.readAll(os.path.join(dh, "vdb", "cavity_gray_scott.000001.vdb"))
 check(all(g.saveFloatAsHalf for g in grids), "half: every grid is saved as half")
 check(half < full, f"half: smaller file ({half} vs {full} bytes)")
 
+# Smoke: the grids renderers read by name, one shared sparse topology (active
+# exactly where the dumped smoke exceeds the tolerance, in every grid), the
+# values of the dump there, colour in [0, 1], and a frame much smaller than
+# the same frame written densely.
+def check_smoke(out, dims, tolerance):
+    f = sorted(x for x in os.listdir(os.path.join(out, "vdb")) if x.endswith(".vdb"))[-1]
+    frame = int(f.split(".")[-2])
+    grids, _ = vdb.readAll(os.path.join(out, "vdb", f))
+    by = {g.name: g for g in grids}
+    check(set(by) == {"density", "temperature", "vel", "color"}, f"smoke: grids {sorted(by)}")
+    dump, _, _ = read_dump(os.path.join(out, "fields", f"{frame:06d}.exr"))
+    smoke = dump["dye"].transpose(2, 1, 0)
+    want = smoke > tolerance
+    check(0 < want.sum() < 0.5 * want.size, f"smoke: the plume fills part of the box ({want.sum()} of {want.size})")
+    for g in grids:
+        acc = g.getConstAccessor()
+        on = np.zeros(smoke.shape, dtype=bool)
+        for idx in np.ndindex(*smoke.shape):
+            on[idx] = acc.isValueOn(idx)
+        check(np.array_equal(on, want), f"smoke {g.name}: {int((on != want).sum())} voxels off the smoke's topology")
+    check(by["density"].gridClass == "fog volume", "smoke: density is a fog volume")
+    for name, ref in (("density", smoke), ("temperature", dump["temperature"].transpose(2, 1, 0))):
+        got = dense(by[name], smoke.shape)
+        check(np.array_equal(got[want], ref[want]), f"smoke {name}: active values equal the dump")
+    col = by["color"]
+    check(col.valueTypeName == "vec3s" and col.vectorType == "invariant", f"smoke: color is an invariant Vec3 ({col.vectorType})")
+    c = np.zeros(tuple(dims) + (3,), dtype=np.float32)
+    col.copyToArray(c, ijk=(0, 0, 0))
+    check(c.min() >= 0 and c.max() <= 1 and len(np.unique(c[want][:, 0])) > 3, "smoke: colours in [0, 1] that vary")
+    return f, want.mean()
+
+
+sets = ["grid.resolution=[24,40,24]", "time.duration=0.6", "output.every=20", "output.fields=true", "output.images=false"]
+ds = run("smoke", "vfx/plume_3d.toml", sets)
+f, filled = check_smoke(ds, (24, 40, 24), 1e-3)
+# The same frame with every voxel active (output.vdb_sparse = false), for the size.
+dd = run("smoke_dense", "vfx/plume_3d.toml", sets + ["output.vdb_sparse=false"])
+grids, _ = vdb.readAll(os.path.join(dd, "vdb", f))
+check(all(g.activeVoxelCount() == 24 * 40 * 24 for g in grids), "smoke: vdb_sparse = false writes every voxel")
+sparse, dense_bytes = os.path.getsize(os.path.join(ds, "vdb", f)), os.path.getsize(os.path.join(dd, "vdb", f))
+print(f"smoke: {filled:.1%} of the box active: {sparse} bytes sparse, {dense_bytes} dense")
+check(filled <= 0.2 and sparse <= 0.25 * dense_bytes, f"smoke: sparse {sparse} bytes vs dense {dense_bytes}")
+
 print(f"vdb_check: {'FAILED' if failures else 'ok'} ({len(failures)} failures)")
 sys.exit(1 if failures else 0)

@@ -1,0 +1,40 @@
+// The smoke stages of the fluid step (Fedkiw, Stam & Jensen 2001, "Visual
+// simulation of smoke"), written once for 2D and 3D:
+//   emission   rho += r_rho dt c, T += r_T dt c   (c: the cell's covered fraction)
+//   buoyancy   f = (-alpha rho + beta (T - T_amb)) up               (their eq. 8)
+//   confinement f = epsilon h (N x omega), N = grad|omega| / |grad|omega||  (eq. 11)
+//   decay      rho *= exp(-k dt), T - T_amb *= exp(-c dt)  (exact for the step)
+#pragma once
+
+#include <vector>
+
+#include "core/grid.h"
+#include "core/mac_velocity.h"
+#include "fluid/fluid_settings.h"
+#include "fluid/smoke_settings.h"
+
+namespace morphoflow {
+
+// Each source's covered fraction of every cell (4^D samples a cell), solid
+// cells excluded: the emission integrates to rate x time x the region's volume.
+template <int D>
+std::vector<Grid<float, D>> sourceCoverage(const std::vector<SmokeSource>& sources, const IVec<D>& cells, double h,
+                                           const Grid<uint8_t, D>& solid);
+
+// Emission over the step [t, t + dt) (each source for the part of the step
+// inside its window) into the smoke density and the temperature; injecting
+// sources set the velocity of the faces they cover (blended by coverage).
+template <int D>
+void emitSmoke(const SmokeSettings& s, const std::vector<Grid<float, D>>& coverage, double t, double dt,
+               Grid<float, D>* density, Grid<float, D>* temperature, MacVelocity<D>* u);
+
+// u += dt f for the buoyancy and the vorticity confinement.
+template <int D>
+void applySmokeForces(const SmokeSettings& s, const std::array<double, 3>& up, const Grid<float, D>& density,
+                      const Grid<float, D>& temperature, double dt, MacVelocity<D>* u);
+
+// The decay of the step, exact: exp(-rate dt) applied once.
+template <int D>
+void decaySmoke(const SmokeSettings& s, double dt, Grid<float, D>* density, Grid<float, D>* temperature);
+
+}  // namespace morphoflow

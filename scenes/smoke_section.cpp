@@ -1,0 +1,56 @@
+// [smoke] (buoyancy, confinement, decay) and [[sources]] (what emits smoke,
+// heat and velocity, where and when): fluid/smoke_settings.h.
+#include <fmt/format.h>
+
+#include "scenes/scene_reader.h"
+
+namespace morphoflow {
+
+namespace {
+
+SmokeSource parseSource(SceneContext& c, const toml::table* t, const std::string& p) {
+  Reader& r = c.r;
+  SmokeSource src;
+  src.region = parseRegion(c, t, p);
+  src.start = r.number(t, p, "start", 0.0, 0.0, 1e12);
+  src.end = r.number(t, p, "end", src.end, 0.0, 1e300);
+  if (!(src.end > src.start))
+    r.fail(r.node(t, p, "end"), p + "end", fmt::format("the window ends (t = {:g}) before it starts (t = {:g})", src.end, src.start),
+           "give end > start, or leave end out to emit until the run ends");
+  src.density = r.number(t, p, "density", 0.0, 0.0, 1e9);
+  src.temperature = r.number(t, p, "temperature", 0.0, 0.0, 1e9);
+  const toml::node* vn = nullptr;
+  const std::vector<double> v = r.numbers(t, p, "velocity", {}, size_t(c.D), size_t(c.D), -1e6, 1e6, false, &vn);
+  src.inject = vn != nullptr;
+  for (size_t a = 0; a < v.size(); ++a) src.velocity[a] = v[a];
+  if (src.density == 0.0 && src.temperature == 0.0 && !src.inject)
+    r.fail(t, p.substr(0, p.size() - 1), "the source emits nothing",
+           "give it a density, a temperature (per unit time) or a velocity");
+  return src;
+}
+
+}  // namespace
+
+void parseSmoke(SceneContext& c, Scene* s) {
+  Reader& r = c.r;
+  const toml::table* t = r.table(c.root, "", "smoke");
+  const toml::array* sources = tableArray(r, c.root, "sources");
+  if (!t && !sources) return;
+  const toml::node* at = t ? static_cast<const toml::node*>(t) : static_cast<const toml::node*>(sources);
+  if (!s->hasFluid || c.givenVelocity)
+    r.fail(at, t ? "smoke" : "sources", "smoke needs a fluid to carry it",
+           "add a [fluid] section (a scene with [velocity] or [rd] alone has none)");
+  SmokeSettings& m = s->fluid.smoke;
+  m.enabled = true;
+  m.weight = r.number(t, "smoke.", "weight", 0.0, -1e9, 1e9);
+  m.heat = r.number(t, "smoke.", "buoyancy", 0.0, -1e9, 1e9);
+  m.ambient = r.number(t, "smoke.", "ambient", 0.0, -1e9, 1e9);
+  m.vorticity = r.number(t, "smoke.", "vorticity", 0.0, 0.0, 1e6);
+  m.dissipation = r.number(t, "smoke.", "dissipation", 0.0, 0.0, 1e9);
+  m.cooling = r.number(t, "smoke.", "cooling", 0.0, 0.0, 1e9);
+  if (sources)
+    for (size_t i = 0; i < sources->size(); ++i)
+      m.sources.push_back(parseSource(c, sources->get(i)->as_table(), "sources." + std::to_string(i) + "."));
+}
+
+}  // namespace morphoflow
