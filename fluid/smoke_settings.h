@@ -20,6 +20,7 @@ struct SmokeSource {
   double temperature = 0.0;  // temperature rise per unit time
   bool inject = false;
   std::array<double, 3> velocity{0.0, 0.0, 0.0};
+  std::vector<double> chemicals;  // a coupled scene's species set here while it emits (empty: none)
 };
 
 struct SmokeSettings {

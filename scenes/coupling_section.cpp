@@ -23,6 +23,12 @@ void parseCoupling(SceneContext& c, Scene* sp) {
     const size_t n = species.size();
     C.inflowValues = r.numbers(ct, "coupling.", "inflow_values", s.rd.initial.values, n, n, -1e12, 1e12);
     C.solidValues = r.numbers(ct, "coupling.", "solid_values", std::vector<double>(n, 0.0), n, n, -1e12, 1e12);
+    const toml::node* mask = r.node(ct, "coupling.", "smoke_mask");
+    if (mask && !(s.hasFluid && s.fluid.smoke.enabled))
+      r.fail(mask, "coupling.smoke_mask", "this scene has no smoke to mask the pattern with",
+             "add [smoke] and [[sources]], or drop coupling.smoke_mask");
+    C.smokeMask = mask ? r.number(ct, "coupling.", "smoke_mask", 0.0, 0.0, 1e12) : -1.0;
+    C.smokeValues = r.numbers(ct, "coupling.", "smoke_values", s.rd.initial.values, n, n, -1e12, 1e12);
   }
 }
 

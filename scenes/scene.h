@@ -185,6 +185,10 @@ struct CouplingScene {
   double rdTimeScale = 1.0;             // RD time per unit of fluid time
   std::vector<double> inflowValues;     // per species, chemical entering through inflow sides
   std::vector<double> solidValues;      // per species, inside obstacles
+  // With [smoke]: the layer reacts only where the smoke exceeds smokeMask
+  // (< 0: everywhere); elsewhere it is held at smokeValues (its rest state).
+  double smokeMask = -1.0;
+  std::vector<double> smokeValues;
 };
 
 // [velocity]: a given velocity carrying the [rd] layer instead of a fluid

@@ -23,9 +23,16 @@ SmokeSource parseSource(SceneContext& c, const toml::table* t, const std::string
   const std::vector<double> v = r.numbers(t, p, "velocity", {}, size_t(c.D), size_t(c.D), -1e6, 1e6, false, &vn);
   src.inject = vn != nullptr;
   for (size_t a = 0; a < v.size(); ++a) src.velocity[a] = v[a];
-  if (src.density == 0.0 && src.temperature == 0.0 && !src.inject)
+  if (const toml::node* cn = r.node(t, p, "chemicals")) {
+    if (c.species.empty())
+      r.fail(cn, p + "chemicals", "this scene has no [rd] layer whose species a source could set",
+             "add an [rd] section, or drop the key");
+    const size_t n = c.species.size();
+    src.chemicals = r.numbers(t, p, "chemicals", {}, n, n, -1e12, 1e12);
+  }
+  if (src.density == 0.0 && src.temperature == 0.0 && !src.inject && src.chemicals.empty())
     r.fail(t, p.substr(0, p.size() - 1), "the source emits nothing",
-           "give it a density, a temperature (per unit time) or a velocity");
+           "give it a density, a temperature (per unit time), a velocity or chemicals");
   return src;
 }
 

@@ -10,6 +10,8 @@
 #include "sim/steppers.h"
 #include "sim/rd_scene_setup.h"
 #include "core/parallel.h"
+#include "core/sampling.h"
+#include "fluid/smoke.h"
 #include "rd/model_registry.h"
 
 namespace morphoflow {
@@ -59,6 +61,39 @@ CoupledSimulation<D>::CoupledSimulation(const Scene& scene, Backend backend, War
   const ChemicalDomain<D> domain = chemicalDomain<D>(scene, fluid_, rd_);
   ard_ = std::make_unique<ARDSolver<D>>(&rd_, ChemicalAdvector<D>(domain, C.interpolation), C.mode, C.rdTimeScale);
   steps_ = makeCoupledSteps<D>(scene, backend, &fluid_, ard_.get(), domain);  // from the state set up here
+  if (scene.fluid.smoke.enabled)
+    sourceCoverage_ = sourceCoverage<D>(scene.fluid.smoke.sources, rd_.cells(), rd_.h(), Grid<uint8_t, D>(rd_.cells(), 0));
+}
+
+// The pattern on the smoke: sources set their chemicals (blended by cover)
+// while they emit, and where the smoke at an RD cell's centre is at most
+// coupling.smoke_mask the layer is held at its rest state (smoke_values).
+template <int D>
+void CoupledSimulation<D>::smokeOnLayer(double dt) {
+  const SmokeSettings& sm = scene_.fluid.smoke;
+  const CouplingScene& C = scene_.coupling;
+  const int ns = rd_.species();
+  const double t0 = time() - dt;
+  for (size_t q = 0; q < sm.sources.size(); ++q) {
+    const SmokeSource& src = sm.sources[q];
+    if (src.chemicals.empty() || !(std::min(t0 + dt, src.end) > std::max(t0, src.start))) continue;
+    const Grid<float, D>& cover = sourceCoverage_[q];
+    for (int s = 0; s < ns; ++s) {
+      Grid<double, D>& x = rd_.field(s);
+      const double v = src.chemicals[size_t(s)];
+      parallelFor(x.size(), [&](size_t i) { x[i] = (1.0 - cover[i]) * x[i] + cover[i] * v; }, 4096);
+    }
+  }
+  if (C.smokeMask < 0.0) return;
+  const Grid<float, D>& smoke = fluid_.dye();
+  const Layout<D> layout = fluid_.cellLayout();
+  const double h = rd_.h();
+  forEachCell<D>(rd_.cells(), [&](const IVec<D>& k, size_t i) {
+    Vec<D> x;
+    for (int a = 0; a < D; ++a) x[a] = (k[a] + 0.5) * h;
+    if (double(sampleLinear<float, D>(smoke, layout, x)) > C.smokeMask) return;
+    for (int s = 0; s < ns; ++s) rd_.field(s)[i] = C.smokeValues[size_t(s)];
+  });
 }
 
 template <int D>
@@ -72,6 +107,7 @@ double CoupledSimulation<D>::cflTimeStep(double cfl, double dtMax) const {
 template <int D>
 void CoupledSimulation<D>::step(double dt) {
   steps_->step(dt);
+  if (scene_.fluid.smoke.enabled) smokeOnLayer(dt);
   host_.stepped();
   const std::array<double, 3> sec = steps_->seconds();
   fluidSeconds_ += sec[0];

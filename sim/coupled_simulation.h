@@ -56,6 +56,8 @@ class CoupledSimulation : public Simulation<D> {
   double fluidSeconds_ = 0, ardSeconds_ = 0, stepSeconds_ = 0;
   long pressureIterations_ = 0, diffusionIterations_ = 0;
   int unconverged_ = 0;
+  std::vector<Grid<float, D>> sourceCoverage_;  // [smoke]: each source's cover of the RD cells
+  void smokeOnLayer(double dt);
 };
 
 }  // namespace morphoflow

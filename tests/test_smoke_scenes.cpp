@@ -80,6 +80,17 @@ TEST(SmokeScenes, BadSourcesAndSmokeWithoutAFluidAreLocatedErrors) {
     EXPECT_NE(r.output.find(c.what), std::string::npos) << r.output;
     EXPECT_NE(r.output.find(scene.string() + ":"), std::string::npos) << r.output;
   }
+  // Chemicals from a source need a layer; a smoke mask needs smoke.
+  {
+    const fs::path scene = write(dir / "chem.toml", std::string(kPlume) + kSource + "chemicals = [1.0]\n");
+    const CommandResult r = runMorphoflow("validate " + scene.string());
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("sources.0.chemicals"), std::string::npos) << r.output;
+    const std::string cavity = sceneFile("coupled/cavity_gray_scott.toml");
+    const CommandResult m = runMorphoflow("run " + cavity + " --set coupling.smoke_mask=0.1 --quiet --out " + (dir / "o").string());
+    EXPECT_EQ(m.status, 2) << m.output;
+    EXPECT_NE(m.output.find("no smoke to mask"), std::string::npos) << m.output;
+  }
   // A scene whose layer is carried by a given velocity has no fluid for smoke.
   const std::string given = "[grid]\nresolution = [16, 16]\n[time]\ndt = 0.01\nsteps = 2\n[rd]\nmodel = \"gray-scott\"\n"
                             "[velocity]\nfield = [\"0\", \"0\"]\n[smoke]\nbuoyancy = 1.0\n";
