@@ -70,7 +70,7 @@ void FluidSolver<D>::step(double dt, const std::function<void()>& afterAdvection
   };
   // 1. forces (with [smoke]: the sources' emission, buoyancy, confinement)
   const SmokeSettings& smoke = settings_.smoke;
-  if (smoke.enabled) emitSmoke<D>(smoke, sourceCoverage_, time_, dt, &dye(), &temperature_, &u_);
+  if (smoke.enabled) emitSmoke<D>(smoke, sourceCoverage_, constraints_.solid, time_, dt, &dye(), &temperature_, &u_);
   applyForces<D>(settings_, dye_.empty() ? nullptr : &dye_, dt, &u_);
   if (smoke.enabled) applySmokeForces<D>(smoke, settings_.buoyancyDirection, dye(), temperature_, dt, &u_);
   constraints_.apply(&u_);

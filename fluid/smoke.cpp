@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/expression.h"
 #include "core/parallel.h"
 
 namespace morphoflow {
@@ -97,38 +98,58 @@ void addConfinement(double epsilon, std::array<Grid<double, D>, D>* f, const Mac
 }  // namespace
 
 template <int D>
-std::vector<Grid<float, D>> sourceCoverage(const std::vector<SmokeSource>& sources, const IVec<D>& cells, double h,
-                                           const Grid<uint8_t, D>& solid) {
+Grid<float, D> sourceCover(const SmokeSource& src, double t, const IVec<D>& cells, double h, const Grid<uint8_t, D>& solid) {
   constexpr int kSub = 4;  // samples per cell and axis
+  ObstacleSpec region = src.region;
+  for (size_t a = 0; a < src.motion.size(); ++a) region.center[a] = Expression(src.motion[a], {"t"}).evaluate(&t);
   double size[3] = {0, 0, 0};
   for (int a = 0; a < D; ++a) size[a] = cells[a] * h;
+  // The cells an analytic region can reach (images and sdfs: all of them).
+  IVec<D> lo(0), hi = cells - IVec<D>(1);
+  const bool round = region.shape == ObstacleShape::Circle || region.shape == ObstacleShape::Sphere;
+  if (round || region.shape == ObstacleShape::Box)
+    for (int a = 0; a < D; ++a) {
+      const double reach = round ? region.radius : region.halfSize[size_t(a)];
+      if (region.shape == ObstacleShape::Circle && a == 2) continue;  // a cylinder along z
+      lo[a] = std::clamp(int(std::floor((region.center[size_t(a)] - reach) / h)) - 1, 0, cells[a] - 1);
+      hi[a] = std::clamp(int(std::floor((region.center[size_t(a)] + reach) / h)) + 1, 0, cells[a] - 1);
+    }
+  Grid<float, D> c(cells, 0.0f);
+  int total = 1;
+  for (int a = 0; a < D; ++a) total *= kSub;
+  forEachCell<D>(cells, [&](const IVec<D>& k, size_t i) {
+    for (int a = 0; a < D; ++a)
+      if (k[a] < lo[a] || k[a] > hi[a]) return;
+    if (solid[i]) return;
+    int inside = 0;
+    for (int s = 0; s < total; ++s) {
+      double x[3] = {0, 0, 0};
+      for (int a = 0, r = s; a < D; ++a, r /= kSub) x[a] = (k[a] + (r % kSub + 0.5) / kSub) * h;
+      if (obstacleDistance(region, x, D, size) < 0) ++inside;
+    }
+    c[i] = float(double(inside) / total);
+  });
+  return c;
+}
+
+template <int D>
+std::vector<Grid<float, D>> sourceCoverage(const std::vector<SmokeSource>& sources, const IVec<D>& cells, double h,
+                                           const Grid<uint8_t, D>& solid) {
   std::vector<Grid<float, D>> cover;
-  for (const SmokeSource& src : sources) {
-    Grid<float, D> c(cells, 0.0f);
-    forEachCell<D>(cells, [&](const IVec<D>& k, size_t i) {
-      if (solid[i]) return;
-      int inside = 0, total = 1;
-      for (int a = 0; a < D; ++a) total *= kSub;
-      for (int s = 0; s < total; ++s) {
-        double x[3] = {0, 0, 0};
-        for (int a = 0, r = s; a < D; ++a, r /= kSub) x[a] = (k[a] + (r % kSub + 0.5) / kSub) * h;
-        if (obstacleDistance(src.region, x, D, size) < 0) ++inside;
-      }
-      c[i] = float(double(inside) / total);
-    });
-    cover.push_back(std::move(c));
-  }
+  for (const SmokeSource& src : sources) cover.push_back(sourceCover<D>(src, 0.0, cells, h, solid));
   return cover;
 }
 
 template <int D>
-void emitSmoke(const SmokeSettings& s, const std::vector<Grid<float, D>>& coverage, double t, double dt,
-               Grid<float, D>* density, Grid<float, D>* temperature, MacVelocity<D>* u) {
+void emitSmoke(const SmokeSettings& s, const std::vector<Grid<float, D>>& coverage, const Grid<uint8_t, D>& solid, double t,
+               double dt, Grid<float, D>* density, Grid<float, D>* temperature, MacVelocity<D>* u) {
   for (size_t q = 0; q < s.sources.size(); ++q) {
     const SmokeSource& src = s.sources[q];
     const double on = std::min(t + dt, src.end) - std::max(t, src.start);  // the step's time inside the window
     if (!(on > 0.0)) continue;
-    const Grid<float, D>& c = coverage[q];
+    const Grid<float, D> moved =
+        src.motion.empty() ? Grid<float, D>() : sourceCover<D>(src, t + 0.5 * dt, density->dims(), u->h(), solid);
+    const Grid<float, D>& c = src.motion.empty() ? coverage[q] : moved;
     const double dRho = src.density * on, dT = src.temperature * on;
     parallelFor(c.size(), [&](size_t i) {
       if (c[i] == 0.0f) return;
@@ -182,9 +203,11 @@ void decaySmoke(const SmokeSettings& s, double dt, Grid<float, D>* density, Grid
 }
 
 #define MORPHOFLOW_SMOKE(D)                                                                                          \
+  template Grid<float, D> sourceCover<D>(const SmokeSource&, double, const IVec<D>&, double, const Grid<uint8_t, D>&); \
   template std::vector<Grid<float, D>> sourceCoverage<D>(const std::vector<SmokeSource>&, const IVec<D>&, double,   \
                                                          const Grid<uint8_t, D>&);                                  \
-  template void emitSmoke<D>(const SmokeSettings&, const std::vector<Grid<float, D>>&, double, double,               \
+  template void emitSmoke<D>(const SmokeSettings&, const std::vector<Grid<float, D>>&, const Grid<uint8_t, D>&,      \
+                             double, double,                                                                      \
                              Grid<float, D>*, Grid<float, D>*, MacVelocity<D>*);                                    \
   template void applySmokeForces<D>(const SmokeSettings&, const std::array<double, 3>&, const Grid<float, D>&,       \
                                     const Grid<float, D>&, double, MacVelocity<D>*);                                \

@@ -15,18 +15,23 @@
 
 namespace morphoflow {
 
-// Each source's covered fraction of every cell (4^D samples a cell), solid
-// cells excluded: the emission integrates to rate x time x the region's volume.
+// A source's covered fraction of every cell (4^D samples a cell), solid
+// cells excluded, with its region centred where its motion puts it at time
+// t: the emission integrates to rate x time x the region's volume.
+template <int D>
+Grid<float, D> sourceCover(const SmokeSource& source, double t, const IVec<D>& cells, double h, const Grid<uint8_t, D>& solid);
+// Every source's cover at t = 0 (what a fixed source keeps).
 template <int D>
 std::vector<Grid<float, D>> sourceCoverage(const std::vector<SmokeSource>& sources, const IVec<D>& cells, double h,
                                            const Grid<uint8_t, D>& solid);
 
 // Emission over the step [t, t + dt) (each source for the part of the step
-// inside its window) into the smoke density and the temperature; injecting
-// sources set the velocity of the faces they cover (blended by coverage).
+// inside its window; a moving one where it is at mid-step) into the smoke
+// density and the temperature; injecting sources set the velocity of the
+// faces they cover (blended by coverage).
 template <int D>
-void emitSmoke(const SmokeSettings& s, const std::vector<Grid<float, D>>& coverage, double t, double dt,
-               Grid<float, D>* density, Grid<float, D>* temperature, MacVelocity<D>* u);
+void emitSmoke(const SmokeSettings& s, const std::vector<Grid<float, D>>& coverage, const Grid<uint8_t, D>& solid, double t,
+               double dt, Grid<float, D>* density, Grid<float, D>* temperature, MacVelocity<D>* u);
 
 // u += dt f for the buoyancy and the vorticity confinement.
 template <int D>

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <limits>
+#include <string>
 #include <vector>
 
 #include "fluid/obstacle.h"
@@ -21,6 +22,7 @@ struct SmokeSource {
   bool inject = false;
   std::array<double, 3> velocity{0.0, 0.0, 0.0};
   std::vector<double> chemicals;  // a coupled scene's species set here while it emits (empty: none)
+  std::vector<std::string> motion;  // the centre per axis as expressions in t (empty: fixed at region.center)
 };
 
 struct SmokeSettings {

@@ -2,16 +2,46 @@
 // heat and velocity, where and when): fluid/smoke_settings.h.
 #include <fmt/format.h>
 
+#include "core/expression.h"
 #include "scenes/scene_reader.h"
 
 namespace morphoflow {
 
 namespace {
 
+// sources.N.motion: the centre per axis as expressions in t, compiled here
+// so that an error names its column.
+std::vector<std::string> parseMotion(SceneContext& c, const toml::table* t, const std::string& p) {
+  Reader& r = c.r;
+  const toml::node* n = r.node(t, p, "motion");
+  if (!n) return {};
+  const toml::array* arr = n->as_array();
+  if (!arr || arr->size() != size_t(c.D))
+    r.fail(n, p + "motion", fmt::format("expected {} expressions in t, the centre per axis", c.D),
+           c.D == 2 ? "e.g. motion = [\"0.5 + 0.2 * sin(t)\", \"0.2\"]" : "");
+  std::vector<std::string> texts;
+  for (size_t q = 0; q < arr->size(); ++q) {
+    const toml::node* e = arr->get(q);
+    const std::string key = p + "motion." + std::to_string(q);
+    if (!e->is_string() && !e->is_number()) r.fail(e, key, "expected an expression string, found " + describe(*e));
+    const std::string text = e->is_string() ? e->value<std::string>().value() : fmt::format("{}", e->value<double>().value());
+    try {
+      Expression(text, {"t"});
+    } catch (const ExpressionError& err) {
+      SourceLocation at = r.where(e, key);
+      if (at.line > 0 && e->is_string()) at.column += 1 + int(err.column());
+      throw UserError(at, key, std::string("in the motion expression: ") + err.what(), "the variable is t");
+    }
+    texts.push_back(text);
+  }
+  return texts;
+}
+
 SmokeSource parseSource(SceneContext& c, const toml::table* t, const std::string& p) {
   Reader& r = c.r;
   SmokeSource src;
   src.region = parseRegion(c, t, p);
+  src.motion = parseMotion(c, t, p);
   src.start = r.number(t, p, "start", 0.0, 0.0, 1e12);
   src.end = r.number(t, p, "end", src.end, 0.0, 1e300);
   if (!(src.end > src.start))

@@ -77,7 +77,10 @@ void CoupledSimulation<D>::smokeOnLayer(double dt) {
   for (size_t q = 0; q < sm.sources.size(); ++q) {
     const SmokeSource& src = sm.sources[q];
     if (src.chemicals.empty() || !(std::min(t0 + dt, src.end) > std::max(t0, src.start))) continue;
-    const Grid<float, D>& cover = sourceCoverage_[q];
+    const Grid<float, D> moved = src.motion.empty() ? Grid<float, D>()
+                                                    : sourceCover<D>(src, t0 + 0.5 * dt, rd_.cells(), rd_.h(),
+                                                                     Grid<uint8_t, D>(rd_.cells(), 0));
+    const Grid<float, D>& cover = src.motion.empty() ? sourceCoverage_[q] : moved;
     for (int s = 0; s < ns; ++s) {
       Grid<double, D>& x = rd_.field(s);
       const double v = src.chemicals[size_t(s)];
