@@ -24,10 +24,32 @@ namespace morphoflow {
 
 namespace {
 
+// The cavity with smoke (a hot source, buoyancy, vorticity confinement,
+// cooling and dissipation): what the smoke stages add to the step.
 template <int D>
-nlohmann::json benchFluid(int n, int threads, double minSeconds, double triad) {
+FluidSettings benchSmokyCavity(int n) {
+  FluidSettings s = benchCavity<D>(n);
+  SmokeSettings& m = s.smoke;
+  m.enabled = true;
+  m.heat = 1.0;
+  m.weight = 0.1;
+  m.vorticity = 1.0;
+  m.cooling = 0.2;
+  m.dissipation = 0.05;
+  SmokeSource src;
+  src.region.shape = ObstacleShape::Sphere;
+  src.region.center = {0.5, 0.2, 0.5};
+  src.region.radius = 0.1;
+  src.density = 2.0;
+  src.temperature = 4.0;
+  m.sources = {src};
+  return s;
+}
+
+template <int D>
+nlohmann::json benchFluid(int n, int threads, double minSeconds, double triad, bool smoke) {
   ThreadLimit limit(threads);
-  FluidSolver<D> f(benchCavity<D>(n));
+  FluidSolver<D> f(smoke ? benchSmokyCavity<D>(n) : benchCavity<D>(n));
   const double dt = f.h();  // CFL 1 at the lid speed
   for (int i = 0; i < 3; ++i) f.step(dt);  // warm-up: the flow starts to develop
   std::vector<double> pit, vit;
@@ -47,7 +69,7 @@ nlohmann::json benchFluid(int n, int threads, double minSeconds, double triad) {
   for (double v : vit) meanVit += v;
   meanIt /= double(pit.size());
   meanVit /= double(vit.size());
-  nlohmann::json j = {{"dim", D},       {"n", n},
+  nlohmann::json j = {{"dim", D},       {"n", n},          {"smoke", smoke},
                       {"threads", threads}, {"steps", times.size()},
                       {"ms_per_step_median", 1e3 * median(times)},
                       {"pressure_iterations_mean", meanIt},
@@ -68,14 +90,21 @@ bool runFluidBench(const BenchOptions& o) {
   const std::vector<BenchCase> cases = selectBenchCases({{2, 128}, {2, 256}, {2, 512}, {2, 1024}, {3, 64}, {3, 128}}, o.size);
   nlohmann::json all = nlohmann::json::array();
   const std::array<double, 3> triad = suiteTriads(o.minSeconds);
-  std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9}\n", "dim", "n", "threads",
-                           "ms/step(med)", "p-iters", "v-iters", "forces", "advect", "diffuse", "project", "of triad");
+  std::cout << fmt::format("{:>4} {:>6} {:>6} {:>7} {:>12} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9}\n", "dim", "n", "smoke",
+                           "threads", "ms/step(med)", "p-iters", "v-iters", "forces", "advect", "diffuse", "project",
+                           "of triad");
+  // 3D cases run again with smoke (sources, temperature, buoyancy, confinement), each right after the plain one.
+  std::vector<std::pair<BenchCase, bool>> runs;
   for (BenchCase c : cases) {
+    runs.push_back({c, false});
+    if (c.dim == 3) runs.push_back({c, true});
+  }
+  for (const auto& [c, smoke] : runs) {
     for (int threads : {1, 2}) {
-      nlohmann::json j = c.dim == 2 ? benchFluid<2>(c.n, threads, o.minSeconds, triad[size_t(threads)])
-                                    : benchFluid<3>(c.n, threads, o.minSeconds, triad[size_t(threads)]);
-      std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12.2f} {:>8.1f} {:>8.1f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f}{}\n",
-                               c.dim, c.n, threads, j["ms_per_step_median"].get<double>(),
+      nlohmann::json j = c.dim == 2 ? benchFluid<2>(c.n, threads, o.minSeconds, triad[size_t(threads)], smoke)
+                                    : benchFluid<3>(c.n, threads, o.minSeconds, triad[size_t(threads)], smoke);
+      std::cout << fmt::format("{:>4} {:>6} {:>6} {:>7} {:>12.2f} {:>8.1f} {:>8.1f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f}{}\n",
+                               c.dim, c.n, smoke ? "yes" : "no", threads, j["ms_per_step_median"].get<double>(),
                                j["pressure_iterations_mean"].get<double>(),
                                j["viscosity_iterations_mean"].get<double>(), j["ms_forces"].get<double>(),
                                j["ms_advect"].get<double>(), j["ms_diffuse"].get<double>(),

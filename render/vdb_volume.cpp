@@ -54,9 +54,11 @@ void deactivateNearBackground(GridT* grid, float tolerance) {
   openvdb::tools::pruneInactive(grid->tree());
 }
 
-// Whether the options' shared topology applies to grid g (same cells).
-bool sharesTopology(const VolumeGrid& g, const VolumeOptions& o) {
-  return o.active && o.activeCells == g.cells && o.active->size() == g.values[0].size();
+// The options' shared topology for grid g's cells, or null.
+const std::vector<uint8_t>* sharedTopology(const VolumeGrid& g, const VolumeOptions& o) {
+  for (const VolumeOptions::ActiveMask& m : o.active)
+    if (m.cells == g.cells && m.on.size() == g.values[0].size()) return &m.on;
+  return nullptr;
 }
 
 // The grid filled densely from `values`, or (shared topology) active exactly
@@ -64,14 +66,15 @@ bool sharesTopology(const VolumeGrid& g, const VolumeOptions& o) {
 template <class GridT>
 void fill(GridT* grid, const VolumeGrid& g, typename GridT::ValueType* values, const VolumeOptions& o) {
   using ValueT = typename GridT::ValueType;
-  if (!sharesTopology(g, o)) {
+  const std::vector<uint8_t>* shared = sharedTopology(g, o);
+  if (!shared) {
     openvdb::tools::Dense<ValueT, openvdb::tools::LayoutXYZ> dense(cellBox(g), values);
     openvdb::tools::copyFromDense(dense, *grid, ValueT(0.0f));
     deactivateNearBackground(grid, o.tolerance);
     return;
   }
   auto acc = grid->getAccessor();
-  const std::vector<uint8_t>& on = *o.active;
+  const std::vector<uint8_t>& on = *shared;
   size_t i = 0;
   for (int z = 0; z < g.cells[2]; ++z)
     for (int y = 0; y < g.cells[1]; ++y)

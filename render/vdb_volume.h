@@ -40,11 +40,15 @@ struct VolumeMetadata {
 struct VolumeOptions {
   float tolerance = 0.0f;  // |value - background| <= tolerance: inactive
   bool half = false;       // floats saved as half
-  // When set: the active voxels of every scalar, vector and colour grid of
-  // these cells (x fastest; nonzero: active), one topology for all of them,
-  // in place of `tolerance` (a smoke frame is active where there is smoke).
-  const std::vector<uint8_t>* active = nullptr;
-  std::array<int, 3> activeCells{0, 0, 0};
+  // Shared topologies: the active voxels (x fastest; nonzero: active) of
+  // every scalar, vector and colour grid of a mask's cells, one topology for
+  // all of them, in place of `tolerance` (a smoke frame is active where
+  // there is smoke, on the fluid's grid and on the chemicals').
+  struct ActiveMask {
+    std::array<int, 3> cells{0, 0, 0};
+    std::vector<uint8_t> on;
+  };
+  std::vector<ActiveMask> active;
 };
 
 // The .vdb file's bytes. Its UUID is derived from its content, so the same

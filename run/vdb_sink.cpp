@@ -8,6 +8,8 @@
 #include "run/scene_hash.h"
 #include "run/version.h"
 #include "core/output_file.h"
+#include "core/parallel.h"
+#include "core/sampling.h"
 #include "render/colormap.h"
 #include "render/field_image.h"
 
@@ -84,15 +86,33 @@ VolumeGrid VdbSink<D>::colorGrid(const Simulation<D>& sim, double width) const {
   return volumeGrid<D>("color", VolumeGrid::Kind::Color, std::move(rgb), width);
 }
 
-// Where the smoke exceeds the tolerance: the one topology of a smoke frame
-// (every voxel with output.vdb_sparse = false).
+// Where the smoke exceeds the tolerance, on the grid of `cells` (the
+// fluid's, or the chemicals' sampling the smoke at their centres): the one
+// topology of a smoke frame's grids of those cells (every voxel with
+// output.vdb_sparse = false).
 template <int D>
-std::vector<uint8_t> VdbSink<D>::smokeMask(const Simulation<D>& sim) const {
+VolumeOptions::ActiveMask VdbSink<D>::smokeMask(const Simulation<D>& sim, const IVec<D>& cells) const {
   const Grid<float, D> smoke = sim.field("dye").front();
-  std::vector<uint8_t> on(smoke.size());
-  const bool sparse = scene_.output.vdbSparse;
-  for (size_t i = 0; i < on.size(); ++i) on[i] = !sparse || smoke[i] > scene_.output.vdbTolerance ? 1 : 0;
-  return on;
+  const Layout<D> layout = Layout<D>::cellCentred(scene_.fluid.size[0] / smoke.dim(0), smoke.dims(), {});
+  const double h = scene_.fluid.size[0] / cells[0];
+  VolumeOptions::ActiveMask m;
+  for (int a = 0; a < D; ++a) m.cells[size_t(a)] = cells[a];
+  if (D == 2) m.cells[2] = 1;
+  m.on.assign(size_t(m.cells[0]) * size_t(m.cells[1]) * size_t(m.cells[2]), 1);
+  if (!scene_.output.vdbSparse) return m;
+  const bool same = cells == smoke.dims();
+  forEachCell<D>(cells, [&](const IVec<D>& k, size_t i) {
+    double s = 0.0;
+    if (same) {
+      s = smoke[i];
+    } else {
+      Vec<D> x;
+      for (int a = 0; a < D; ++a) x[a] = (k[a] + 0.5) * h;
+      s = sampleLinear<float, D>(smoke, layout, x);
+    }
+    m.on[i] = s > scene_.output.vdbTolerance ? 1 : 0;
+  });
+  return m;
 }
 
 template <int D>
@@ -111,11 +131,9 @@ void VdbSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
   meta.units = "lengths in the scene's domain units (world space fills [0, domain.size]); time in its time units; "
                "vel in domain units per time unit";
   VolumeOptions options{float(o.vdbTolerance), o.vdbHalf};
-  std::vector<uint8_t> mask;
   if (scene_.hasFluid && scene_.fluid.smoke.enabled) {
-    mask = smokeMask(sim);
-    options.active = &mask;
-    for (int a = 0; a < D; ++a) options.activeCells[size_t(a)] = sim.field("dye").front().dim(a);
+    options.active.push_back(smokeMask(sim, sim.field("dye").front().dims()));
+    if (scene_.rd.enabled) options.active.push_back(smokeMask(sim, sim.field(sim.species()[0]).front().dims()));
   }
   const std::string stem = fmt::format("{}.{:06d}", safeFileStem(scene_.name), at.frame);
   const std::string vdb = encodeVdb(g, meta, options);

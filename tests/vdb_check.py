@@ -198,5 +198,18 @@ sparse, dense_bytes = os.path.getsize(os.path.join(ds, "vdb", f)), os.path.getsi
 print(f"smoke: {filled:.1%} of the box active: {sparse} bytes sparse, {dense_bytes} dense")
 check(filled <= 0.2 and sparse <= 0.25 * dense_bytes, f"smoke: sparse {sparse} bytes vs dense {dense_bytes}")
 
+# A patterned plume: the species (and the colour of v) on the chemicals'
+# finer grid share one topology there, the fluid's grids another.
+dp = run("smoke_pattern", "vfx/plume_gray_scott_3d.toml",
+         ["grid.resolution=[24,40,24]", "rd.resolution=[48,80,48]", "time.duration=0.3", "output.every=15",
+          "output.images=false"])
+last = sorted(x for x in os.listdir(os.path.join(dp, "vdb")) if x.endswith(".vdb"))[-1]
+grids, _ = vdb.readAll(os.path.join(dp, "vdb", last))
+counts = {g.name: g.activeVoxelCount() for g in grids}
+check(set(counts) == {"u", "v", "color", "density", "temperature", "vel"}, f"smoke pattern: grids {sorted(counts)}")
+check(counts["u"] == counts["v"] == counts["color"] > 0, f"smoke pattern: the chemicals' grids share a topology {counts}")
+check(counts["density"] == counts["temperature"] == counts["vel"] > 0, f"smoke pattern: the fluid's grids share one {counts}")
+check(counts["u"] < 0.5 * 48 * 80 * 48, f"smoke pattern: the species are sparse ({counts['u']})")
+
 print(f"vdb_check: {'FAILED' if failures else 'ok'} ({len(failures)} failures)")
 sys.exit(1 if failures else 0)
