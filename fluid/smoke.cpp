@@ -10,36 +10,42 @@ namespace morphoflow {
 
 namespace {
 
-// The neighbour of k one cell along axis a (dir = +-1): wrapped on periodic
-// axes, the cell itself past a wall (so differences there are one-sided).
+// Flat neighbours of cell k along axis a: wrapped on periodic axes, the
+// cell itself past a wall (so differences there are one-sided), and the
+// distance between them in cells.
 template <int D>
-IVec<D> step(IVec<D> k, int a, int dir, const IVec<D>& n, const std::array<bool, D>& periodic) {
-  k[a] += dir;
-  if (periodic[size_t(a)]) k[a] = (k[a] + n[a]) % n[a];
-  k[a] = std::clamp(k[a], 0, n[a] - 1);
-  return k;
-}
-
-// d g / d x_a at cell k by central differences (one-sided at walls).
-template <int D, class G>
-double derivative(const G& g, const IVec<D>& k, int a, const IVec<D>& n, const std::array<bool, D>& periodic, double h) {
-  const IVec<D> lo = step<D>(k, a, -1, n, periodic), hi = step<D>(k, a, +1, n, periodic);
-  const int span = periodic[size_t(a)] ? 2 : hi[a] - lo[a];
-  return span == 0 ? 0.0 : (g(hi) - g(lo)) / (span * h);
+struct Neighbours {
+  size_t lo, hi;
+  int span;
+};
+template <int D>
+Neighbours<D> neighbours(const IVec<D>& k, size_t i, int a, const IVec<D>& n, const std::array<size_t, D>& stride,
+                         const std::array<bool, D>& periodic) {
+  const size_t s = stride[size_t(a)], last = size_t(n[a] - 1);
+  if (periodic[size_t(a)])
+    return {k[a] == 0 ? i + last * s : i - s, size_t(k[a]) == last ? i - last * s : i + s, 2};
+  const size_t lo = k[a] == 0 ? i : i - s, hi = size_t(k[a]) == last ? i : i + s;
+  return {lo, hi, (k[a] == 0 ? 0 : 1) + (size_t(k[a]) == last ? 0 : 1)};
 }
 
 // A cell-centred force added to the faces: each face takes the mean of the
 // two cells it separates (the one cell at a wall).
 template <int D>
-void addToFaces(const std::array<Grid<double, D>, D>& f, double dt, MacVelocity<D>* u) {
+void addToFaces(const std::array<Grid<float, D>, D>& f, double dt, MacVelocity<D>* u) {
   const IVec<D>& n = u->cells();
   for (int a = 0; a < D; ++a) {
     Grid<float, D>& g = (*u)[a];
+    const Grid<float, D>& fa = f[size_t(a)];
+    const size_t s = fa.stride(a);
+    const bool wrap = u->periodic()[size_t(a)];
+    const float half = float(0.5 * dt);
     forEachCell<D>(g.dims(), [&](const IVec<D>& k, size_t i) {
-      IVec<D> lo = k - unitVector<D>(a), hi = k;
-      if (lo[a] < 0) lo = u->periodic()[size_t(a)] ? lo + unitVector<D>(a) * n[a] : hi;
-      if (hi[a] >= n[a]) hi = u->periodic()[size_t(a)] ? hi - unitVector<D>(a) * n[a] : lo;
-      g[i] += float(dt * 0.5 * (f[size_t(a)](lo) + f[size_t(a)](hi)));
+      IVec<D> c = k;
+      c[a] = std::min(k[a], n[a] - 1);
+      const size_t hiCell = fa.index(c);
+      size_t lo = k[a] == 0 ? (wrap ? hiCell + size_t(n[a] - 1) * s : hiCell) : hiCell - (k[a] == n[a] ? 0 : s);
+      size_t hi = k[a] == n[a] ? (wrap ? hiCell - size_t(n[a] - 1) * s : hiCell) : hiCell;
+      g[i] += half * (fa[lo] + fa[hi]);
     });
   }
 }
@@ -47,50 +53,60 @@ void addToFaces(const std::array<Grid<double, D>, D>& f, double dt, MacVelocity<
 // Vorticity confinement, Fedkiw et al. eq. 11: omega = curl u at the cell
 // centres, N = grad|omega| / |grad|omega||, f = epsilon h (N x omega).
 template <int D>
-void addConfinement(double epsilon, std::array<Grid<double, D>, D>* f, const MacVelocity<D>& u) {
+void addConfinement(double epsilon, std::array<Grid<float, D>, D>* f, const MacVelocity<D>& u) {
   const IVec<D>& n = u.cells();
   const double h = u.h();
   const std::array<bool, D>& per = u.periodic();
-  std::array<Grid<double, D>, D> uc;
-  for (auto& g : uc) g = Grid<double, D>(n, 0.0);
+  std::array<Grid<float, D>, D> uc;
+  for (auto& g : uc) g = Grid<float, D>(n, 0.0f);
+  std::array<size_t, D> st;
+  for (int a = 0; a < D; ++a) st[size_t(a)] = uc[0].stride(a);
   forEachCell<D>(n, [&](const IVec<D>& k, size_t i) {
-    const Vec<D> v = u.atCell(k);
-    for (int a = 0; a < D; ++a) uc[size_t(a)][i] = v[a];
+    for (int a = 0; a < D; ++a) {
+      const Grid<float, D>& g = u[a];
+      const size_t j = g.index(k);
+      uc[size_t(a)][i] = 0.5f * (g[j] + g[j + g.stride(a)]);
+    }
   });
   constexpr int W = D == 2 ? 1 : 3;  // components of omega
-  std::array<Grid<double, D>, W> w;
-  for (auto& g : w) g = Grid<double, D>(n, 0.0);
-  Grid<double, D> mag(n, 0.0);
+  std::array<Grid<float, D>, W> w;
+  for (auto& g : w) g = Grid<float, D>(n, 0.0f);
+  Grid<float, D> mag(n, 0.0f);
   forEachCell<D>(n, [&](const IVec<D>& k, size_t i) {
+    Neighbours<D> nb[D];
+    for (int a = 0; a < D; ++a) nb[a] = neighbours<D>(k, i, a, n, st, per);
+    // d u_comp / d x_axis by central differences (one-sided at walls).
     auto d = [&](int comp, int axis) {
-      return derivative<D>([&](const IVec<D>& c) { return uc[size_t(comp)](c); }, k, axis, n, per, h);
+      const Neighbours<D>& q = nb[axis];
+      return q.span == 0 ? 0.0 : (double(uc[size_t(comp)][q.hi]) - uc[size_t(comp)][q.lo]) / (q.span * h);
     };
     if constexpr (D == 2) {
-      w[0][i] = d(1, 0) - d(0, 1);
-      mag[i] = std::abs(w[0][i]);
+      const double o = d(1, 0) - d(0, 1);
+      w[0][i] = float(o);
+      mag[i] = float(std::abs(o));
     } else {
-      w[0][i] = d(2, 1) - d(1, 2);
-      w[1][i] = d(0, 2) - d(2, 0);
-      w[2][i] = d(1, 0) - d(0, 1);
-      mag[i] = std::sqrt(w[0][i] * w[0][i] + w[1][i] * w[1][i] + w[2][i] * w[2][i]);
+      const double o0 = d(2, 1) - d(1, 2), o1 = d(0, 2) - d(2, 0), o2 = d(1, 0) - d(0, 1);
+      w[0][i] = float(o0), w[1][i] = float(o1), w[2][i] = float(o2);
+      mag[i] = float(std::sqrt(o0 * o0 + o1 * o1 + o2 * o2));
     }
   });
   forEachCell<D>(n, [&](const IVec<D>& k, size_t i) {
     double eta[3] = {0, 0, 0}, len2 = 0;
     for (int a = 0; a < D; ++a) {
-      eta[a] = derivative<D>([&](const IVec<D>& c) { return mag(c); }, k, a, n, per, h);
+      const Neighbours<D> q = neighbours<D>(k, i, a, n, st, per);
+      eta[a] = q.span == 0 ? 0.0 : (double(mag[q.hi]) - mag[q.lo]) / (q.span * h);
       len2 += eta[a] * eta[a];
     }
     if (!(len2 > 1e-300)) return;
     const double inv = 1.0 / std::sqrt(len2), s = epsilon * h;
     const double N[3] = {eta[0] * inv, eta[1] * inv, eta[2] * inv};
     if constexpr (D == 2) {
-      (*f)[0][i] += s * N[1] * w[0][i];
-      (*f)[1][i] -= s * N[0] * w[0][i];
+      (*f)[0][i] += float(s * N[1] * w[0][i]);
+      (*f)[1][i] -= float(s * N[0] * w[0][i]);
     } else {
-      (*f)[0][i] += s * (N[1] * w[2][i] - N[2] * w[1][i]);
-      (*f)[1][i] += s * (N[2] * w[0][i] - N[0] * w[2][i]);
-      (*f)[2][i] += s * (N[0] * w[1][i] - N[1] * w[0][i]);
+      (*f)[0][i] += float(s * (N[1] * w[2][i] - N[2] * w[1][i]));
+      (*f)[1][i] += float(s * (N[2] * w[0][i] - N[0] * w[2][i]));
+      (*f)[2][i] += float(s * (N[0] * w[1][i] - N[1] * w[0][i]));
     }
   });
 }
@@ -177,12 +193,12 @@ void applySmokeForces(const SmokeSettings& s, const std::array<double, 3>& up, c
   const bool buoyant = (s.weight != 0.0 || s.heat != 0.0);
   if (!buoyant && s.vorticity == 0.0) return;
   const IVec<D>& n = u->cells();
-  std::array<Grid<double, D>, D> f;
-  for (auto& g : f) g = Grid<double, D>(n, 0.0);
+  std::array<Grid<float, D>, D> f;
+  for (auto& g : f) g = Grid<float, D>(n, 0.0f);
   if (buoyant)
     parallelFor(density.size(), [&](size_t i) {
       const double b = -s.weight * density[i] + s.heat * (double(temperature[i]) - s.ambient);  // eq. 8
-      for (int a = 0; a < D; ++a) f[size_t(a)][i] = b * up[size_t(a)];
+      for (int a = 0; a < D; ++a) f[size_t(a)][i] = float(b * up[size_t(a)]);
     }, 4096);
   if (s.vorticity != 0.0) addConfinement<D>(s.vorticity, &f, *u);
   addToFaces<D>(f, dt, u);
