@@ -1,12 +1,15 @@
 #include "run/vdb_sink.h"
 
 #include <algorithm>
+#include <cctype>
+#include <cmath>
 
 #include <fmt/format.h>
 
 #include "run/output_kinds.h"
 #include "run/scene_hash.h"
 #include "run/version.h"
+#include "core/expression.h"
 #include "core/output_file.h"
 #include "core/parallel.h"
 #include "core/sampling.h"
@@ -48,7 +51,7 @@ std::vector<VolumeGrid> VdbSink<D>::grids(const Simulation<D>& sim) const {
   const OutputSettings& o = scene_.output;
   std::vector<VolumeGrid> g;
   for (const std::string& s : sim.species()) g.push_back(volumeGrid<D>(s, K::Scalar, sim.field(s), width));
-  g.push_back(volumeGrid<D>("density", K::FogVolume, sim.field(o.vdbDensity), width));
+  g.push_back(volumeGrid<D>("density", K::FogVolume, densityField(sim), width));
   const std::vector<std::string> names = sim.fieldNames();
   if (std::find(names.begin(), names.end(), "velocity") != names.end())
     g.push_back(volumeGrid<D>("vel", K::Vector, sim.field("velocity"), width));
@@ -61,6 +64,53 @@ std::vector<VolumeGrid> VdbSink<D>::grids(const Simulation<D>& sim) const {
   if (o.vdbColor) g.push_back(colorGrid(sim, width));
   if (sim.hasObstacles()) g.push_back(volumeGrid<D>("obstacle", K::LevelSet, sim.field("obstacle"), width));
   return g;
+}
+
+// The `density` grid: output.vdb_density's field, or its expression of
+// fields evaluated per voxel on the chemicals' grid when it names a species
+// (the fluid's fields sampled at their centres), else on the fluid's.
+template <int D>
+std::vector<Grid<float, D>> VdbSink<D>::densityField(const Simulation<D>& sim) const {
+  const std::string& text = scene_.output.vdbDensity;
+  const std::vector<std::string> all = sim.fieldNames();
+  if (std::find(all.begin(), all.end(), text) != all.end()) return sim.field(text);
+  std::vector<std::string> names = sim.species();
+  for (const char* f : {"speed", "vorticity", "pressure", "dye", "temperature"})
+    if (std::find(all.begin(), all.end(), f) != all.end()) names.push_back(f);
+  const Expression e(text, names);
+  // The fields it uses (a name as a whole word of the text).
+  auto used = [&](const std::string& n) {
+    for (size_t at = text.find(n); at != std::string::npos; at = text.find(n, at + 1)) {
+      const auto word = [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_'; };
+      if ((at == 0 || !word(text[at - 1])) && (at + n.size() == text.size() || !word(text[at + n.size()]))) return true;
+    }
+    return false;
+  };
+  std::vector<Grid<float, D>> fields(names.size());
+  IVec<D> cells = sim.field(names.back()).front().dims();
+  for (const std::string& s : sim.species())
+    if (used(s)) cells = sim.field(s).front().dims();
+  for (size_t v = 0; v < names.size(); ++v)
+    if (used(names[v])) fields[v] = sim.field(names[v]).front();
+  const double h = scene_.fluid.size[0] / cells[0];
+  Grid<float, D> out(cells, 0.0f);
+  forEachCell<D>(cells, [&](const IVec<D>& k, size_t i) {
+    std::vector<double> values(names.size(), 0.0);
+    for (size_t v = 0; v < names.size(); ++v) {
+      const Grid<float, D>& f = fields[v];
+      if (f.empty()) continue;
+      if (f.dims() == cells) {
+        values[v] = f[i];
+      } else {
+        Vec<D> x;
+        for (int a = 0; a < D; ++a) x[a] = (k[a] + 0.5) * h;
+        values[v] = sampleLinear<float, D>(f, Layout<D>::cellCentred(scene_.fluid.size[0] / f.dim(0), f.dims(), {}), x);
+      }
+    }
+    const double d = e.evaluate(values);
+    out[i] = std::isfinite(d) ? float(d) : 0.0f;  // (a division by a zero field: no density there)
+  });
+  return {out};
 }
 
 // The palette of the frames applied to the shown field, as linear RGB in

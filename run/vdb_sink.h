@@ -31,6 +31,7 @@ class VdbSink : public OutputSink<D> {
   // The grids of the simulation's current state.
   std::vector<VolumeGrid> grids(const Simulation<D>& sim) const;
   VolumeGrid colorGrid(const Simulation<D>& sim, double width) const;
+  std::vector<Grid<float, D>> densityField(const Simulation<D>& sim) const;
   VolumeOptions::ActiveMask smokeMask(const Simulation<D>& sim, const IVec<D>& cells) const;
   std::filesystem::path dir_;
   const Scene& scene_;

@@ -1,4 +1,5 @@
 // [output]: frames (field, palette, range, format), field dumps and video.
+#include "core/expression.h"
 #include "scenes/scene_reader.h"
 
 #include "render/colormap.h"
@@ -20,7 +21,22 @@ void parseVdbOutput(SceneContext& c, const toml::table* out, Scene& s) {
   if (smoke) fluidScalars.push_back("temperature");
   std::vector<std::string> fields = species;
   if (s.hasFluid) fields.insert(fields.end(), fluidScalars.begin(), fluidScalars.end());
-  o.vdbDensity = r.string(out, "output.", "vdb_density", smoke ? "dye" : o.field, fields);
+  // A field's name, or an expression of fields (e.g. "dye * v / 0.3": the
+  // smoke with the pattern cut into it), compiled here so that an error
+  // names its column.
+  o.vdbDensity = r.string(out, "output.", "vdb_density", smoke ? "dye" : o.field);
+  if (std::find(fields.begin(), fields.end(), o.vdbDensity) == fields.end()) {
+    const toml::node* dn = r.node(out, "output.", "vdb_density");
+    try {
+      if (Expression(o.vdbDensity, fields).constant())
+        r.fail(dn, "output.vdb_density", "a constant density fills the box", "name a field, or an expression of fields");
+    } catch (const ExpressionError& e) {
+      SourceLocation at = r.where(dn, "output.vdb_density");
+      if (at.line > 0) at.column += 1 + int(e.column());
+      throw UserError(at, "output.vdb_density", std::string("neither a field nor an expression of fields: ") + e.what(),
+                      "the fields are " + join(fields));
+    }
+  }
   if (const toml::node* vf = r.node(out, "output.", "vdb_fields")) {
     const toml::array* arr = vf->as_array();
     if (!arr) r.fail(vf, "output.vdb_fields", "expected an array of field names, e.g. [\"speed\", \"vorticity\"]");

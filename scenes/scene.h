@@ -31,7 +31,7 @@ struct OutputSettings {
   bool images = true;
   bool fields = false;
   bool vdb = false;                 // DIR/vdb/<name>.NNNNNN.vdb every frame
-  std::string vdbDensity;           // the field in the "density" grid (default: field)
+  std::string vdbDensity;           // the field in the "density" grid (default: field), or an expression of fields
   std::vector<std::string> vdbFields;  // fluid scalars as grids of their own
   double vdbTolerance = 0.0;        // |value| <= this: inactive voxel (with [smoke]: of the smoke, in every grid)
   bool vdbSparse = false;           // with [smoke]: every grid active where the smoke exceeds vdbTolerance (false: every voxel)

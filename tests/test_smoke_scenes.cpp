@@ -92,6 +92,15 @@ TEST(SmokeScenes, BadSourcesAndSmokeWithoutAFluidAreLocatedErrors) {
     EXPECT_EQ(m.status, 2) << m.output;
     EXPECT_NE(m.output.find("no smoke to mask"), std::string::npos) << m.output;
   }
+  // The density as an expression of fields: an unknown name is located.
+  {
+    const std::string text = std::string(kPlume) + kSource + "[output]\nvdb = true\nvdb_density = \"dye * nope\"\n";
+    const fs::path scene = write(dir / "density.toml", text);
+    const CommandResult r = runMorphoflow("validate " + scene.string());
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("output.vdb_density"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("neither a field nor an expression"), std::string::npos) << r.output;
+  }
   // A scene whose layer is carried by a given velocity has no fluid for smoke.
   const std::string given = "[grid]\nresolution = [16, 16]\n[time]\ndt = 0.01\nsteps = 2\n[rd]\nmodel = \"gray-scott\"\n"
                             "[velocity]\nfield = [\"0\", \"0\"]\n[smoke]\nbuoyancy = 1.0\n";

@@ -202,13 +202,18 @@ check(filled <= 0.2 and sparse <= 0.25 * dense_bytes, f"smoke: sparse {sparse} b
 # finer grid share one topology there, the fluid's grids another.
 dp = run("smoke_pattern", "vfx/plume_gray_scott_3d.toml",
          ["grid.resolution=[24,40,24]", "rd.resolution=[48,80,48]", "time.duration=0.3", "output.every=15",
-          "output.images=false"])
+          "output.images=false", 'output.vdb_density="dye * v / 0.25"'])
 last = sorted(x for x in os.listdir(os.path.join(dp, "vdb")) if x.endswith(".vdb"))[-1]
 grids, _ = vdb.readAll(os.path.join(dp, "vdb", last))
 counts = {g.name: g.activeVoxelCount() for g in grids}
 check(set(counts) == {"u", "v", "color", "density", "temperature", "vel"}, f"smoke pattern: grids {sorted(counts)}")
 check(counts["u"] == counts["v"] == counts["color"] > 0, f"smoke pattern: the chemicals' grids share a topology {counts}")
-check(counts["density"] == counts["temperature"] == counts["vel"] > 0, f"smoke pattern: the fluid's grids share one {counts}")
+check(counts["temperature"] == counts["vel"] > 0, f"smoke pattern: the fluid's grids share one {counts}")
+# density = dye * v / 0.25 lives on the chemicals' grid: 0 where v is, positive where both are.
+check(counts["density"] == counts["u"], f"smoke pattern: the density expression is on the chemicals' grid {counts}")
+by = {g.name: g for g in grids}
+dens, v = dense(by["density"], (48, 80, 48)), dense(by["v"], (48, 80, 48))
+check(np.all(dens[v == 0] == 0) and dens.max() > 0 and dens.min() >= 0, "smoke pattern: the density is smoke times v")
 check(counts["u"] < 0.5 * 48 * 80 * 48, f"smoke pattern: the species are sparse ({counts['u']})")
 
 print(f"vdb_check: {'FAILED' if failures else 'ok'} ({len(failures)} failures)")
