@@ -3,7 +3,11 @@ mode, Cycles on the CPU), as docs/vfx.md shows: a Volume object on the
 sequence, a Principled Volume shading the "density" grid, "vel" as the motion
 blur grid, the scene's y axis up.
 
-blender -b --factory-startup -P blender_render.py -- FIRST.vdb FRAMES FRAME OUT.png [WIDTH SAMPLES DENSITY EMISSION]"""
+blender -b --factory-startup -P blender_render.py -- FIRST.vdb FRAMES FRAME OUT.png [WIDTH SAMPLES DENSITY EMISSION]
+With DENSITY "element": a smoke element as a compositor gets it, a
+Principled Volume left at Blender's defaults (it reads `density` and
+`temperature` by name) but for its Color Attribute, which Blender leaves
+empty and its own smoke sets to `color`."""
 import math
 import sys
 
@@ -34,10 +38,14 @@ material.use_nodes = True
 nodes, links = material.node_tree.nodes, material.node_tree.links
 nodes.clear()
 shader = nodes.new("ShaderNodeVolumePrincipled")
-shader.inputs["Density"].default_value = float(argv[6]) if len(argv) > 6 else 20.0
-shader.inputs["Color"].default_value = (1.0, 0.45, 0.15, 1.0)
-shader.inputs["Emission Strength"].default_value = float(argv[7]) if len(argv) > 7 else 2.0
-shader.inputs["Emission Color"].default_value = (1.0, 0.35, 0.1, 1.0)
+element = len(argv) > 6 and argv[6] == "element"
+if element:
+    shader.inputs["Color Attribute"].default_value = "color"
+else:
+    shader.inputs["Density"].default_value = float(argv[6]) if len(argv) > 6 else 20.0
+    shader.inputs["Color"].default_value = (1.0, 0.45, 0.15, 1.0)
+    shader.inputs["Emission Strength"].default_value = float(argv[7]) if len(argv) > 7 else 2.0
+    shader.inputs["Emission Color"].default_value = (1.0, 0.35, 0.1, 1.0)
 output = nodes.new("ShaderNodeOutputMaterial")
 links.new(shader.outputs["Volume"], output.inputs["Volume"])
 volume.materials.append(material)
