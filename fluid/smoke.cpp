@@ -101,12 +101,12 @@ void addConfinement(double epsilon, std::array<Grid<float, D>, D>* f, const MacV
     const double inv = 1.0 / std::sqrt(len2), s = epsilon * h;
     const double N[3] = {eta[0] * inv, eta[1] * inv, eta[2] * inv};
     if constexpr (D == 2) {
-      (*f)[0][i] += float(s * N[1] * w[0][i]);
-      (*f)[1][i] -= float(s * N[0] * w[0][i]);
+      (*f)[0][i] += float(confinementTerm(s, N[1], w[0][i], 0.0, 0.0));
+      (*f)[1][i] += float(confinementTerm(s, 0.0, 0.0, N[0], w[0][i]));
     } else {
-      (*f)[0][i] += float(s * (N[1] * w[2][i] - N[2] * w[1][i]));
-      (*f)[1][i] += float(s * (N[2] * w[0][i] - N[0] * w[2][i]));
-      (*f)[2][i] += float(s * (N[0] * w[1][i] - N[1] * w[0][i]));
+      (*f)[0][i] += float(confinementTerm(s, N[1], w[2][i], N[2], w[1][i]));
+      (*f)[1][i] += float(confinementTerm(s, N[2], w[0][i], N[0], w[2][i]));
+      (*f)[2][i] += float(confinementTerm(s, N[0], w[1][i], N[1], w[0][i]));
     }
   });
 }
@@ -181,7 +181,7 @@ void emitSmoke(const SmokeSettings& s, const std::vector<Grid<float, D>>& covera
         IVec<D> lo = k - unitVector<D>(a), hi = k;
         const double cl = lo[a] >= 0 ? c(lo) : 0.0, ch = hi[a] < n[a] ? c(hi) : 0.0;
         const double w = 0.5 * (cl + ch);
-        if (w > 0.0) g[i] = float((1.0 - w) * g[i] + w * v);
+        if (w > 0.0) g[i] = float(coverBlend(g[i], w, v));
       });
     }
   }
@@ -197,7 +197,7 @@ void applySmokeForces(const SmokeSettings& s, const std::array<double, 3>& up, c
   for (auto& g : f) g = Grid<float, D>(n, 0.0f);
   if (buoyant)
     parallelFor(density.size(), [&](size_t i) {
-      const double b = -s.weight * density[i] + s.heat * (double(temperature[i]) - s.ambient);  // eq. 8
+      const double b = smokeBuoyancy(density[i], temperature[i], s.weight, s.heat, s.ambient);
       for (int a = 0; a < D; ++a) f[size_t(a)][i] = float(b * up[size_t(a)]);
     }, 4096);
   if (s.vorticity != 0.0) addConfinement<D>(s.vorticity, &f, *u);
@@ -208,13 +208,12 @@ template <int D>
 void decaySmoke(const SmokeSettings& s, double dt, Grid<float, D>* density, Grid<float, D>* temperature) {
   if (s.dissipation > 0.0) {
     const double k = std::exp(-s.dissipation * dt);
-    parallelFor(density->size(), [&](size_t i) { (*density)[i] = float((*density)[i] * k); }, 4096);
+    parallelFor(density->size(), [&](size_t i) { (*density)[i] = float(decayed((*density)[i], k, 0.0)); }, 4096);
   }
   if (s.cooling > 0.0) {
     const double k = std::exp(-s.cooling * dt);
-    parallelFor(temperature->size(), [&](size_t i) {
-      (*temperature)[i] = float(s.ambient + (double((*temperature)[i]) - s.ambient) * k);
-    }, 4096);
+    parallelFor(temperature->size(), [&](size_t i) { (*temperature)[i] = float(decayed((*temperature)[i], k, s.ambient)); },
+                4096);
   }
 }
 

@@ -15,6 +15,11 @@
 
 namespace morphoflow {
 
+// The per-cell formulas, shared with the GPU (kernels/README.md).
+#define SMOKE_FN(name) inline double name
+#include "kernels/smoke.inc"
+#undef SMOKE_FN
+
 // A source's covered fraction of every cell (4^D samples a cell), solid
 // cells excluded, with its region centred where its motion puts it at time
 // t: the emission integrates to rate x time x the region's volume.

@@ -8,6 +8,7 @@
 
 #include "core/multigrid.h"
 #include "fluid/pressure_projection.h"
+#include "fluid/smoke.h"
 #include "gpu/compute_program.h"
 #include "gpu/gl_context.h"
 #include "gpu/gpu_kernels.h"
@@ -94,7 +95,17 @@ GpuFluid<D>::GpuFluid(const FluidSettings& s, const VelocityConstraints<D>& vc) 
     v->boundaryRhs = GpuBuffer::of(std::vector<double>(rhs.begin(), rhs.end()));
     viscous_[size_t(a)] = std::move(v);
   }
-  dyeActive_ = s.inflowDyeStripes > 0;
+  dyeActive_ = s.inflowDyeStripes > 0 || s.smoke.enabled;
+  if (s.smoke.enabled) {
+    solidHost_ = vc.solid;
+    temp_ = GpuBuffer::of(std::vector<float>(cellCount_, float(s.smoke.ambient)));
+    tempScratch_ = GpuBuffer(cellCount_ * sizeof(float));
+    force_ = GpuBuffer(D * cellCount_ * sizeof(float));
+    centre_ = GpuBuffer(D * cellCount_ * sizeof(float));
+    omega_ = GpuBuffer((D == 2 ? 2 : 4) * cellCount_ * sizeof(float));
+    for (const Grid<float, D>& c : sourceCoverage<D>(s.smoke.sources, vc.cells, vc.h, vc.solid))
+      cover_.push_back(GpuBuffer::of(c.values()));
+  }
   speed_ = std::make_unique<GpuReduction>();
   timer_ = std::make_unique<GpuStageTimer>(FluidStepStats::kStages);
 }
@@ -170,6 +181,88 @@ void GpuFluid<D>::forces(double dt) {
   }
 }
 
+template <int D>
+void GpuFluid<D>::runSmoke(SmokeOp mode, size_t n, int axis, const std::function<void(const ComputeProgram&)>& uniforms) {
+  const ComputeProgram& p = useKernel("smoke.comp", fmt::format("#define DIM {}\n#define {}", D, define(mode)));
+  setUniform(p, "cells", cells_);
+  setUniform(p, "periodic", periodic_);
+  setUniform(p, "velOff", velocityOffsets());
+  setUniform(p, "axis", axis);
+  setUniform(p, "n", int(n));
+  uniforms(p);
+  vel_.bind(0);
+  dye_.bind(1);
+  temp_.bind(2);
+  force_.bind(4);
+  centre_.bind(5);
+  omega_.bind(6);
+  dispatchFlat(n, 16.0);
+  storageBarrier();
+}
+
+// Each source over the part of the step inside its window, where it is at
+// mid-step (a moving one's cover computed on the host and uploaded).
+template <int D>
+void GpuFluid<D>::emitSmoke(double dt) {
+  const SmokeSettings& sm = settings_.smoke;
+  for (size_t q = 0; q < sm.sources.size(); ++q) {
+    const SmokeSource& src = sm.sources[q];
+    const double on = std::min(time_ + dt, src.end) - std::max(time_, src.start);
+    if (!(on > 0.0)) continue;
+    if (!src.motion.empty()) {
+      IVec<D> cells;
+      for (int a = 0; a < D; ++a) cells[a] = cells_[size_t(a)];
+      cover_[q].upload(sourceCover<D>(src, time_ + 0.5 * dt, cells, h_, solidHost_).values());
+    }
+    cover_[q].bind(3);
+    runSmoke(SmokeOp::Emit, cellCount_, 0, [&](const ComputeProgram& p) {
+      setUniform(p, "dRho", src.density * on);
+      setUniform(p, "dT", src.temperature * on);
+    });
+    if (!src.inject) continue;
+    for (int a = 0; a < D; ++a)
+      runSmoke(SmokeOp::Inject, faces(a), a, [&](const ComputeProgram& p) { setUniform(p, "value", src.velocity[size_t(a)]); });
+  }
+}
+
+// Buoyancy and confinement as cell-centred forces, then onto the faces.
+template <int D>
+void GpuFluid<D>::smokeForces(double dt) {
+  const SmokeSettings& sm = settings_.smoke;
+  const bool buoyant = sm.weight != 0.0 || sm.heat != 0.0;
+  if (!buoyant && sm.vorticity == 0.0) return;
+  force_.zero();
+  if (buoyant)
+    runSmoke(SmokeOp::Buoyancy, cellCount_, 0, [&](const ComputeProgram& p) {
+      setUniform(p, "alpha", sm.weight);
+      setUniform(p, "beta", sm.heat);
+      setUniform(p, "ambient", sm.ambient);
+      glUniform3d(p.uniform("up"), settings_.buoyancyDirection[0], settings_.buoyancyDirection[1],
+                  settings_.buoyancyDirection[2]);
+    });
+  if (sm.vorticity != 0.0) {
+    auto hs = [&](const ComputeProgram& p) {
+      setUniform(p, "h", h_);
+      setUniform(p, "s", sm.vorticity * h_);
+    };
+    runSmoke(SmokeOp::Centre, cellCount_, 0, hs);
+    runSmoke(SmokeOp::Vorticity, cellCount_, 0, hs);
+    runSmoke(SmokeOp::Confine, cellCount_, 0, hs);
+  }
+  for (int a = 0; a < D; ++a) runSmoke(SmokeOp::AddFaces, faces(a), a, [&](const ComputeProgram& p) { setUniform(p, "dt", dt); });
+}
+
+template <int D>
+void GpuFluid<D>::decaySmoke(double dt) {
+  const SmokeSettings& sm = settings_.smoke;
+  if (sm.dissipation <= 0.0 && sm.cooling <= 0.0) return;
+  runSmoke(SmokeOp::Decay, cellCount_, 0, [&](const ComputeProgram& p) {
+    setUniform(p, "keepRho", sm.dissipation > 0.0 ? std::exp(-sm.dissipation * dt) : 1.0);
+    setUniform(p, "keepT", sm.cooling > 0.0 ? std::exp(-sm.cooling * dt) : 1.0);
+    setUniform(p, "ambient", sm.ambient);
+  });
+}
+
 // One grid through the scheme: src (at srcOff) -> dst (at dstOff), as advectField in fluid/advection.cpp.
 template <int D>
 void GpuFluid<D>::advectField(const GpuBuffer& src, size_t srcOff, const std::array<int, 3>& dims,
@@ -243,6 +336,10 @@ void GpuFluid<D>::advect(double dt) {
   if (dyeActive_) {
     advectField(dye_, 0, cells_, {0.5f, 0.5f, D == 3 ? 0.5f : 0.0f}, dt, &dyeScratch_, 0);
     std::swap(dye_, dyeScratch_);
+  }
+  if (settings_.smoke.enabled) {
+    advectField(temp_, 0, cells_, {0.5f, 0.5f, D == 3 ? 0.5f : 0.0f}, dt, &tempScratch_, 0);
+    std::swap(temp_, tempScratch_);
   }
   std::swap(vel_, velScratch_);
   applyConstraints(vel_);
@@ -342,10 +439,13 @@ void GpuFluid<D>::project(double dt) {
 template <int D>
 void GpuFluid<D>::step(double dt) {
   timer_->mark(0);
+  if (settings_.smoke.enabled) emitSmoke(dt);
   forces(dt);
+  if (settings_.smoke.enabled) smokeForces(dt);
   applyConstraints(vel_);
   timer_->mark(1);
   advect(dt);
+  if (settings_.smoke.enabled) decaySmoke(dt);
   timer_->mark(2);
   diffuse(dt);
   timer_->mark(3);
@@ -359,13 +459,13 @@ void GpuFluid<D>::step(double dt) {
 
 template <int D>
 void GpuFluid<D>::toHost(FluidSolver<D>* host) const {
-  download(&host->velocity(), &host->dye());
+  download(&host->velocity(), &host->dye(), host->temperature().empty() ? nullptr : &host->temperature());
   host->adopt(time_, steps_, phi(), lastDt_);
 }
 
 template <int D>
 void GpuFluid<D>::fromHost(const FluidSolver<D>& host) {
-  upload(host.velocity(), host.dye());
+  upload(host.velocity(), host.dye(), host.temperature().empty() ? nullptr : &host.temperature());
   time_ = host.time();
   steps_ = host.steps();
 }
@@ -377,17 +477,19 @@ void GpuFluid<D>::report(nlohmann::json* run) const {
 }
 
 template <int D>
-void GpuFluid<D>::upload(const MacVelocity<D>& u, const Grid<float, D>& dye) {
+void GpuFluid<D>::upload(const MacVelocity<D>& u, const Grid<float, D>& dye, const Grid<float, D>* temperature) {
   for (int a = 0; a < D; ++a) vel_.upload(u[a].values(), off_[size_t(a)] * sizeof(float));
   dye_.upload(dye.values());
-  dyeActive_ = settings_.inflowDyeStripes > 0 ||
+  if (temperature && settings_.smoke.enabled) temp_.upload(temperature->values());
+  dyeActive_ = settings_.inflowDyeStripes > 0 || settings_.smoke.enabled ||
                std::any_of(dye.values().begin(), dye.values().end(), [](float v) { return v != 0.0f; });
 }
 
 template <int D>
-void GpuFluid<D>::download(MacVelocity<D>* u, Grid<float, D>* dye) const {
+void GpuFluid<D>::download(MacVelocity<D>* u, Grid<float, D>* dye, Grid<float, D>* temperature) const {
   for (int a = 0; a < D; ++a) vel_.download((*u)[a].data(), faces(a) * sizeof(float), off_[size_t(a)] * sizeof(float));
   if (dye) dye_.download(dye->data(), cellCount_ * sizeof(float));
+  if (temperature && settings_.smoke.enabled) temp_.download(temperature->data(), cellCount_ * sizeof(float));
 }
 
 template <int D>

@@ -13,6 +13,7 @@
 
 #include <array>
 #include <cmath>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -25,9 +26,11 @@
 #include "fluid/velocity_constraints.h"
 #include "fluid/viscosity.h"
 #include "gpu/gpu_buffer.h"
+#include "gpu/kernel_modes.h"
 
 namespace morphoflow {
 
+class ComputeProgram;
 class GpuLaplace;
 class GpuMultigrid;
 class GpuPcg;
@@ -55,8 +58,8 @@ class GpuFluid final : public FluidStepper<D> {
   // Bytes of device memory a fluid of these cells allocates.
   static size_t deviceBytes(const IVec<D>& cells);
 
-  void upload(const MacVelocity<D>& u, const Grid<float, D>& dye);
-  void download(MacVelocity<D>* u, Grid<float, D>* dye) const;
+  void upload(const MacVelocity<D>& u, const Grid<float, D>& dye, const Grid<float, D>* temperature = nullptr);
+  void download(MacVelocity<D>* u, Grid<float, D>* dye, Grid<float, D>* temperature = nullptr) const;
   // phi of the last projection (p = rho phi / dt), and that dt.
   std::vector<double> phi() const;
   double lastDt() const { return lastDt_; }
@@ -76,6 +79,11 @@ class GpuFluid final : public FluidStepper<D> {
   struct Viscous;
   void applyConstraints(const GpuBuffer& vel);
   void forces(double dt);
+  // [smoke] (fluid/smoke.h, shaders/smoke.comp): emission, its forces, decay.
+  void emitSmoke(double dt);
+  void smokeForces(double dt);
+  void decaySmoke(double dt);
+  void runSmoke(SmokeOp mode, size_t n, int axis, const std::function<void(const ComputeProgram&)>& uniforms);
   void advect(double dt);
   void advectField(const GpuBuffer& src, size_t srcOff, const std::array<int, 3>& dims, const std::array<float, 3>& offset,
                    double dt, GpuBuffer* dst, size_t dstOff);
@@ -94,6 +102,10 @@ class GpuFluid final : public FluidStepper<D> {
   bool dyeActive_ = false;
   GpuBuffer vel_, velScratch_, fixed_, value_, dye_, dyeScratch_, solid_;
   GpuBuffer lo_, hi_, back_, fwd_;  // the second-order schemes' scratch
+  // [smoke]: the temperature, each source's cover, the forces' work vectors
+  GpuBuffer temp_, tempScratch_, force_, centre_, omega_;
+  std::vector<GpuBuffer> cover_;
+  Grid<uint8_t, D> solidHost_;  // for a moving source's cover
   // pressure
   std::unique_ptr<GpuLaplace> pressure_;
   std::unique_ptr<GpuMultigrid> multigrid_;

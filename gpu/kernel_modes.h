@@ -10,6 +10,8 @@ enum class FluidOp {
   Forces, InflowDye, Fixed, Periodic, MacCormack, BfeccCorrect, BfeccLimit,
   ViscousSetup, ViscousStore, Divergence, WarmStart, Gradient
 };
+// shaders/smoke.comp
+enum class SmokeOp { Emit, Inject, Buoyancy, Centre, Vorticity, Confine, AddFaces, Decay };
 // shaders/laplace.comp
 enum class LaplaceMode { Apply, Residual, Smooth, Jacobi };
 // shaders/multigrid.comp's grid transfers
@@ -36,6 +38,20 @@ constexpr const char* define(FluidOp m) {
     case FluidOp::Divergence: return "MODE_DIVERGENCE";
     case FluidOp::WarmStart: return "MODE_WARM_START";
     case FluidOp::Gradient: return "MODE_GRADIENT";
+  }
+  return "";
+}
+
+constexpr const char* define(SmokeOp m) {
+  switch (m) {
+    case SmokeOp::Emit: return "MODE_EMIT";
+    case SmokeOp::Inject: return "MODE_INJECT";
+    case SmokeOp::Buoyancy: return "MODE_BUOYANCY";
+    case SmokeOp::Centre: return "MODE_CENTRE";
+    case SmokeOp::Vorticity: return "MODE_VORTICITY";
+    case SmokeOp::Confine: return "MODE_CONFINE";
+    case SmokeOp::AddFaces: return "MODE_ADD_FACES";
+    case SmokeOp::Decay: return "MODE_DECAY";
   }
   return "";
 }

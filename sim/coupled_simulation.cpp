@@ -84,7 +84,7 @@ void CoupledSimulation<D>::smokeOnLayer(double dt) {
     for (int s = 0; s < ns; ++s) {
       Grid<double, D>& x = rd_.field(s);
       const double v = src.chemicals[size_t(s)];
-      parallelFor(x.size(), [&](size_t i) { x[i] = (1.0 - cover[i]) * x[i] + cover[i] * v; }, 4096);
+      parallelFor(x.size(), [&](size_t i) { x[i] = coverBlend(x[i], cover[i], v); }, 4096);
     }
   }
   if (C.smokeMask < 0.0) return;
