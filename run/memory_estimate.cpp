@@ -67,6 +67,10 @@ uintmax_t estimateRunBytes(const Scene& s) {
   const int d = s.dimension == 3 ? 1 : 0;
   double bytes = kFixedBytes;
   if (s.hasFluid) bytes += cellsOf(s.fluid.resolution) * (s.rd.enabled ? kCoupledFluidBytesPerCell[d] : kFluidBytesPerCell[d]);
+  const bool smoke = s.hasFluid && s.fluid.smoke.enabled;
+  if (smoke)  // counted, not measured: the temperature, each source's cover, and the forces' float work
+              // grids (forces, centre velocities, vorticity and its magnitude: 6 in 2D, 10 in 3D)
+    bytes += cellsOf(s.fluid.resolution) * 4.0 * (1.0 + double(s.fluid.smoke.sources.size()) + (d ? 10.0 : 6.0));
   if (s.output.vdb) {
     // species and density at the layer's cells (else the fluid's); three
     // velocity components, extra fields (and vel_mac's three, an obstacle) at the fluid's
@@ -76,6 +80,7 @@ uintmax_t estimateRunBytes(const Scene& s) {
     double voxels = layerCells * (species + 1.0) + fluidCells * (3.0 + double(s.output.vdbFields.size()));
     if (s.output.vdbMacVelocity) voxels += fluidCells * 3.0;
     if (s.hasFluid && !s.fluid.obstacles.empty()) voxels += fluidCells;
+    if (smoke) voxels += fluidCells + (s.output.vdbColor ? 3.0 * layerCells : 0.0);  // temperature, color
     bytes += kVdbBytesPerVoxel * voxels;
   }
   if (s.rd.enabled) {
