@@ -35,8 +35,12 @@ inline std::filesystem::path freshScratch(const std::string& name) {
   return dir;
 }
 
+// (A folder the input cannot make, one whose path runs through a file it
+// wrote before, is left unwritten: the input then describes fewer files.)
 inline void writeBytes(const std::filesystem::path& file, std::string_view bytes) {
-  std::filesystem::create_directories(file.parent_path());
+  std::error_code ec;
+  std::filesystem::create_directories(file.parent_path(), ec);
+  if (ec) return;
   std::ofstream(file, std::ios::binary).write(bytes.data(), std::streamsize(bytes.size()));
 }
 
