@@ -1,5 +1,6 @@
 #include "render/vdb_volume.h"
 
+#include <cmath>
 #include <cstring>
 #include <mutex>
 #include <optional>
@@ -17,6 +18,7 @@
 #include <xxhash.h>
 
 #include "render/allocation_limit.h"
+#include "render/isolated_read.h"
 
 namespace morphoflow {
 
@@ -228,8 +230,9 @@ bool readVdbTime(const std::string& path, double* time, bool* has, std::string* 
   }
 }
 
-bool readVdbVelocity(const std::string& path, VelocityVolume* out, std::string* error) {
-  initialiseOnce();
+namespace {
+
+bool readVelocityHere(const std::string& path, VelocityVolume* out, std::string* error) {
   try {
     std::optional<AllocationLimit> limit(std::in_place, kMaxReaderAllocation);  // (while OpenVDB reads)
     openvdb::io::File file(path);
@@ -256,11 +259,16 @@ bool readVdbVelocity(const std::string& path, VelocityVolume* out, std::string* 
       *error = "the grid '" + grid->getName() + "' does not have cubic voxels on a linear transform";
       return false;
     }
+    const openvdb::Vec3d o = t.indexToWorld(openvdb::Vec3d(0.0));
+    if (!(std::isfinite(vs[0]) && vs[0] > 0.0 && vs[0] < 1e30) || !std::isfinite(o[0]) || !std::isfinite(o[1]) ||
+        !std::isfinite(o[2])) {
+      *error = "the grid '" + grid->getName() + "' has a transform that is not finite (voxel size " + std::to_string(vs[0]) + ")";
+      return false;
+    }
     VelocityVolume v;
     v.grid = grid->getName();
     v.staggered = mac || grid->getGridClass() == openvdb::GRID_STAGGERED;
     v.voxelSize = vs[0];
-    const openvdb::Vec3d o = t.indexToWorld(openvdb::Vec3d(0.0));
     v.indexOrigin = {o[0], o[1], o[2]};
     if (auto m = meta->getMetadata<openvdb::DoubleMetadata>("time")) v.hasTime = true, v.time = m->value();
     if (auto m = meta->getMetadata<openvdb::Vec3DMetadata>("domain_size"))
@@ -281,7 +289,7 @@ bool readVdbVelocity(const std::string& path, VelocityVolume* out, std::string* 
       const size_t n = size_t(cells);
       std::vector<openvdb::Vec3s> dense(n);
       openvdb::tools::Dense<openvdb::Vec3s, openvdb::tools::LayoutXYZ> dst(box, dense.data());
-      openvdb::tools::copyToDense(*grid, dst);
+      openvdb::tools::copyToDense(*grid, dst, /*serial=*/true);  // (in the reader's child: no threads)
       for (int a = 0; a < 3; ++a) {
         v.values[size_t(a)].resize(n);
         for (size_t i = 0; i < n; ++i) v.values[size_t(a)][i] = dense[i][a];
@@ -292,6 +300,93 @@ bool readVdbVelocity(const std::string& path, VelocityVolume* out, std::string* 
   } catch (const std::bad_alloc&) {
     *error = kClaimsTooMuch;
     return false;
+  } catch (const std::exception& e) {
+    *error = e.what();
+    return false;
+  }
+}
+
+// The child's answer: ok, then the error or the volume, field by field.
+template <class T>
+void put(std::string* s, const T& v) {
+  s->append(reinterpret_cast<const char*>(&v), sizeof v);
+}
+void putText(std::string* s, const std::string& t) {
+  put<uint64_t>(s, t.size());
+  s->append(t);
+}
+template <class T>
+T take(const std::string& s, size_t* at) {
+  if (s.size() - *at < sizeof(T)) throw std::runtime_error("the reader's answer is cut short");
+  T v;
+  std::memcpy(&v, s.data() + *at, sizeof v);
+  *at += sizeof v;
+  return v;
+}
+std::string takeText(const std::string& s, size_t* at) {
+  const uint64_t n = take<uint64_t>(s, at);
+  if (s.size() - *at < n) throw std::runtime_error("the reader's answer is cut short");
+  std::string t = s.substr(*at, n);
+  *at += n;
+  return t;
+}
+
+std::string encodeAnswer(bool ok, const VelocityVolume& v, const std::string& error) {
+  std::string s;
+  put<uint8_t>(&s, ok);
+  if (!ok) {
+    putText(&s, error);
+    return s;
+  }
+  putText(&s, v.grid);
+  put(&s, v.staggered), put(&s, v.origin), put(&s, v.cells), put(&s, v.voxelSize), put(&s, v.indexOrigin);
+  put(&s, v.hasTime), put(&s, v.hasDomain), put(&s, v.time), put(&s, v.domain);
+  for (const std::vector<float>& c : v.values) putText(&s, std::string(reinterpret_cast<const char*>(c.data()), c.size() * sizeof(float)));
+  return s;
+}
+
+bool decodeAnswer(const std::string& s, VelocityVolume* v, std::string* error) {
+  size_t at = 0;
+  if (!take<uint8_t>(s, &at)) {
+    *error = takeText(s, &at);
+    return false;
+  }
+  v->grid = takeText(s, &at);
+  v->staggered = take<bool>(s, &at);
+  v->origin = take<std::array<int, 3>>(s, &at);
+  v->cells = take<std::array<int, 3>>(s, &at);
+  v->voxelSize = take<double>(s, &at);
+  v->indexOrigin = take<std::array<double, 3>>(s, &at);
+  v->hasTime = take<bool>(s, &at);
+  v->hasDomain = take<bool>(s, &at);
+  v->time = take<double>(s, &at);
+  v->domain = take<std::array<double, 3>>(s, &at);
+  for (std::vector<float>& c : v->values) {
+    const std::string b = takeText(s, &at);
+    c.resize(b.size() / sizeof(float));
+    std::memcpy(c.data(), b.data(), c.size() * sizeof(float));
+  }
+  return true;
+}
+
+}  // namespace
+
+// In a child process (render/isolated_read.h): a damaged file that makes
+// OpenVDB write past a buffer ends the child, not the run.
+bool readVdbVelocity(const std::string& path, VelocityVolume* out, std::string* error) {
+  initialiseOnce();
+  std::string answer;
+  if (!runIsolated(
+          [&] {
+            VelocityVolume v;
+            std::string err;
+            const bool ok = readVelocityHere(path, &v, &err);
+            return encodeAnswer(ok, v, err);
+          },
+          &answer, error))
+    return false;
+  try {
+    return decodeAnswer(answer, out, error);
   } catch (const std::exception& e) {
     *error = e.what();
     return false;

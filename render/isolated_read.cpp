@@ -1,0 +1,84 @@
+#include "render/isolated_read.h"
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <csignal>
+#include <cstdint>
+#include <cstring>
+
+namespace morphoflow {
+
+namespace {
+
+bool writeAll(int fd, const char* p, size_t n) {
+  while (n > 0) {
+    const ssize_t w = ::write(fd, p, n);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) return false;
+    p += w, n -= size_t(w);
+  }
+  return true;
+}
+
+}  // namespace
+
+bool runIsolated(const std::function<std::string()>& work, std::string* result, std::string* error) {
+  int fds[2];
+  if (::pipe(fds) != 0) {
+    *error = std::string("cannot make a pipe for the reader: ") + std::strerror(errno);
+    return false;
+  }
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    ::close(fds[0]), ::close(fds[1]);
+    *error = std::string("cannot start the reader: ") + std::strerror(errno);
+    return false;
+  }
+  if (pid == 0) {  // the child: the work, its length and bytes, and out without running exit handlers
+    ::close(fds[0]);
+    std::string bytes;
+    int status = 0;
+    try {
+      bytes = work();
+    } catch (...) {
+      status = 3;
+    }
+    const uint64_t n = bytes.size();
+    if (status == 0 && !(writeAll(fds[1], reinterpret_cast<const char*>(&n), sizeof n) && writeAll(fds[1], bytes.data(), n)))
+      status = 4;
+    ::_exit(status);
+  }
+  ::close(fds[1]);
+  std::string got;
+  char buf[1 << 16];
+  for (;;) {
+    const ssize_t r = ::read(fds[0], buf, sizeof buf);
+    if (r < 0 && errno == EINTR) continue;
+    if (r <= 0) break;
+    got.append(buf, size_t(r));
+  }
+  ::close(fds[0]);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  uint64_t n = 0;
+  if (WIFSIGNALED(status)) {
+    *error = "the file is damaged: reading it crashed the reader (" + std::string(strsignal(WTERMSIG(status))) + ")";
+    return false;
+  }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || got.size() < sizeof n) {
+    *error = "the file is damaged: its reader stopped (status " + std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")";
+    return false;
+  }
+  std::memcpy(&n, got.data(), sizeof n);
+  if (got.size() - sizeof n != n) {
+    *error = "the file is damaged: its reader's result was cut short";
+    return false;
+  }
+  *result = got.substr(sizeof n);
+  return true;
+}
+
+}  // namespace morphoflow
