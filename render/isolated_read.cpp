@@ -1,9 +1,11 @@
 #include "render/isolated_read.h"
 
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <cmath>
 #include <csignal>
 #include <cstdint>
 #include <cstring>
@@ -24,7 +26,7 @@ bool writeAll(int fd, const char* p, size_t n) {
 
 }  // namespace
 
-bool runIsolated(const std::function<std::string()>& work, std::string* result, std::string* error) {
+bool runIsolated(const std::function<std::string()>& work, double cpuSeconds, std::string* result, std::string* error) {
   int fds[2];
   if (::pipe(fds) != 0) {
     *error = std::string("cannot make a pipe for the reader: ") + std::strerror(errno);
@@ -38,6 +40,9 @@ bool runIsolated(const std::function<std::string()>& work, std::string* result, 
   }
   if (pid == 0) {  // the child: the work, its length and bytes, and out without running exit handlers
     ::close(fds[0]);
+    const rlim_t cpu = rlim_t(std::ceil(cpuSeconds));
+    const rlimit limit{cpu, cpu + 1};  // SIGXCPU at the soft limit, SIGKILL at the hard one
+    ::setrlimit(RLIMIT_CPU, &limit);
     std::string bytes;
     int status = 0;
     try {
@@ -64,6 +69,11 @@ bool runIsolated(const std::function<std::string()>& work, std::string* result, 
   while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
   uint64_t n = 0;
+  if (WIFSIGNALED(status) && (WTERMSIG(status) == SIGXCPU || WTERMSIG(status) == SIGKILL)) {
+    *error = "the file is damaged: its reader ran for more than " + std::to_string(long(std::ceil(cpuSeconds))) +
+             " s without finishing";
+    return false;
+  }
   if (WIFSIGNALED(status)) {
     *error = "the file is damaged: reading it crashed the reader (" + std::string(strsignal(WTERMSIG(status))) + ")";
     return false;

@@ -13,6 +13,8 @@
 namespace morphoflow {
 
 // True and *result the child's bytes; false and *error what became of it.
-bool runIsolated(const std::function<std::string()>& work, std::string* result, std::string* error);
+// The child may use `cpuSeconds` of processor time (a damaged file can also
+// send the reader round a loop for minutes).
+bool runIsolated(const std::function<std::string()>& work, double cpuSeconds, std::string* result, std::string* error);
 
 }  // namespace morphoflow
