@@ -180,7 +180,9 @@ void VdbSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
   for (int a = 0; a < D; ++a) meta.domain[size_t(a)] = scene_.fluid.size[size_t(a)];
   meta.units = "lengths in the scene's domain units (world space fills [0, domain.size]); time in its time units; "
                "vel in domain units per time unit";
-  VolumeOptions options{float(o.vdbTolerance), o.vdbHalf};
+  VolumeOptions options;
+  options.tolerance = float(o.vdbTolerance);
+  options.half = o.vdbHalf;
   if (scene_.hasFluid && scene_.fluid.smoke.enabled) {
     options.active.push_back(smokeMask(sim, sim.field("dye").front().dims()));
     if (scene_.rd.enabled) options.active.push_back(smokeMask(sim, sim.field(sim.species()[0]).front().dims()));
