@@ -1,4 +1,7 @@
 // [output]: frames (field, palette, range, format), field dumps and video.
+#include <algorithm>
+#include <cctype>
+
 #include "core/expression.h"
 #include "scenes/scene_reader.h"
 
@@ -25,7 +28,12 @@ void parseVdbOutput(SceneContext& c, const toml::table* out, Scene& s) {
   // smoke with the pattern cut into it), compiled here so that an error
   // names its column.
   o.vdbDensity = r.string(out, "output.", "vdb_density", smoke ? "dye" : o.field);
-  if (std::find(fields.begin(), fields.end(), o.vdbDensity) == fields.end()) {
+  const bool name = !o.vdbDensity.empty() && std::all_of(o.vdbDensity.begin(), o.vdbDensity.end(), [](char ch) {
+    return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
+  });
+  if (name) {  // a single name must be a field's (the nearest is suggested)
+    o.vdbDensity = r.string(out, "output.", "vdb_density", smoke ? "dye" : o.field, fields);
+  } else {
     const toml::node* dn = r.node(out, "output.", "vdb_density");
     try {
       if (Expression(o.vdbDensity, fields).constant())
