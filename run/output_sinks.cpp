@@ -28,6 +28,17 @@ std::filesystem::path endFile(const std::filesystem::path& dir, const std::strin
   return found;
 }
 
+FieldImageOptions frameImageOptions(const OutputSettings& o, bool symmetric) {
+  FieldImageOptions io;
+  io.palette = o.gradient.empty() ? namedPalette(o.colormap) : Palette{o.gradient};
+  io.autoRange = o.autoRange;
+  io.symmetric = symmetric;
+  io.range[0] = o.range[0];
+  io.range[1] = o.range[1];
+  io.slice = o.slice;
+  return io;
+}
+
 uintmax_t fileBytes(const std::filesystem::path& file) {
   std::error_code ec;
   const uintmax_t n = std::filesystem::file_size(file, ec);
@@ -48,13 +59,7 @@ template <int D>
 void ImageSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
   const long frame = at.frame;
   const OutputSettings& o = scene_.output;
-  FieldImageOptions io;
-  io.palette = o.gradient.empty() ? namedPalette(o.colormap) : Palette{o.gradient};
-  io.autoRange = o.autoRange;
-  io.symmetric = sim.symmetric(o.field);
-  io.range[0] = o.range[0];
-  io.range[1] = o.range[1];
-  io.slice = o.slice;
+  const FieldImageOptions io = frameImageOptions(o, sim.symmetric(o.field));
   int w, h;
   std::vector<uint8_t> rgb;
   const bool two = o.colormap == kTwoSpeciesPalette;
@@ -182,12 +187,7 @@ void NormalMapSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
     const OutputSettings& o = scene_.output;
     const std::string name = o.colormap == kTwoSpeciesPalette ? sim.species()[0] : o.field;
     Grid<float, 2> height = sim.field(name).front();
-    FieldImageOptions io;
-    io.autoRange = o.autoRange;
-    io.symmetric = sim.symmetric(name);
-    io.range[0] = o.range[0];
-    io.range[1] = o.range[1];
-    const std::array<double, 2> range = valueRange(height.data(), height.size(), io);
+    const std::array<double, 2> range = valueRange(height.data(), height.size(), frameImageOptions(o, sim.symmetric(name)));
     const double span = range[1] > range[0] ? range[1] - range[0] : 1.0;
     for (float& v : height.values()) v = float(std::clamp((double(v) - range[0]) / span, 0.0, 1.0));
     const bool periodic = scene_.rd.enabled ? scene_.rd.settings.boundary == RDBoundary::Periodic

@@ -87,15 +87,21 @@ std::vector<Grid<float, D>> VdbSink<D>::densityField(const Simulation<D>& sim) c
     return false;
   };
   std::vector<Grid<float, D>> fields(names.size());
+  std::vector<Layout<D>> layouts(names.size());
   IVec<D> cells = sim.field(names.back()).front().dims();
   for (const std::string& s : sim.species())
     if (used(s)) cells = sim.field(s).front().dims();
   for (size_t v = 0; v < names.size(); ++v)
-    if (used(names[v])) fields[v] = sim.field(names[v]).front();
+    if (used(names[v])) {
+      fields[v] = sim.field(names[v]).front();
+      layouts[v] = Layout<D>::cellCentred(scene_.fluid.size[0] / fields[v].dim(0), fields[v].dims(), {});
+    }
   const double h = scene_.fluid.size[0] / cells[0];
   Grid<float, D> out(cells, 0.0f);
+  constexpr size_t kMaxNames = 32;  // species (at most four) and five fluid fields
+  if (names.size() > kMaxNames) throw std::logic_error("too many fields for output.vdb_density");
   forEachCell<D>(cells, [&](const IVec<D>& k, size_t i) {
-    std::vector<double> values(names.size(), 0.0);
+    std::array<double, kMaxNames> values{};
     for (size_t v = 0; v < names.size(); ++v) {
       const Grid<float, D>& f = fields[v];
       if (f.empty()) continue;
@@ -104,10 +110,10 @@ std::vector<Grid<float, D>> VdbSink<D>::densityField(const Simulation<D>& sim) c
       } else {
         Vec<D> x;
         for (int a = 0; a < D; ++a) x[a] = (k[a] + 0.5) * h;
-        values[v] = sampleLinear<float, D>(f, Layout<D>::cellCentred(scene_.fluid.size[0] / f.dim(0), f.dims(), {}), x);
+        values[v] = sampleLinear<float, D>(f, layouts[v], x);
       }
     }
-    const double d = e.evaluate(values);
+    const double d = e.evaluate(values.data());
     out[i] = std::isfinite(d) ? float(d) : 0.0f;  // (a division by a zero field: no density there)
   });
   return {out};
@@ -120,12 +126,7 @@ VolumeGrid VdbSink<D>::colorGrid(const Simulation<D>& sim, double width) const {
   const OutputSettings& o = scene_.output;
   const std::string shown = o.colormap == kTwoSpeciesPalette ? sim.species()[0] : o.field;
   const Grid<float, D> f = sim.field(shown).front();
-  FieldImageOptions io;
-  io.palette = o.gradient.empty() ? namedPalette(o.colormap) : Palette{o.gradient};
-  io.autoRange = o.autoRange;
-  io.symmetric = sim.symmetric(shown);
-  io.range[0] = o.range[0];
-  io.range[1] = o.range[1];
+  const FieldImageOptions io = frameImageOptions(o, sim.symmetric(shown));
   const std::array<double, 2> range = valueRange(f.data(), f.size(), io);
   const double span = range[1] > range[0] ? range[1] - range[0] : 1.0;
   std::vector<Grid<float, D>> rgb(3, Grid<float, D>(f.dims(), 0.0f));
