@@ -40,6 +40,12 @@ class CoupledStepper final : public CoupledSteps<D> {
   void save(StateWriter*) const override {}
   void load(const StateReader&) override {}
   void report(nlohmann::json*) const override {}
+  void blendLayer(int, const Grid<float, D>& cover, const std::vector<double>& values) override {
+    morphoflow::blendLayer<D>(&ard_->rd(), cover, values);
+  }
+  void maskLayer(const SmokeTaps<D>& taps, double threshold, const std::vector<double>& rest) override {
+    morphoflow::maskLayer<D>(&ard_->rd(), fluid_->dye(), taps, threshold, rest);
+  }
 
   // Wall seconds of the last step: the fluid's, the ARD's, and the whole step.
   double fluidSeconds() const { return fluidSeconds_; }

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/state_archive.h"
+#include "coupling/smoke_layer.h"
 #include "fluid/fluid_stepper.h"
 #include "rd/rd_solver.h"
 
@@ -38,6 +39,11 @@ class CoupledSteps {
   virtual void load(const StateReader& in) = 0;
   // run.json: the backend's own entries.
   virtual void report(nlohmann::json* run) const = 0;
+  // The pattern on the smoke (smoke_layer.h) on the stepped layer: a
+  // source's blend (`id` names a cover that stays the same from step to
+  // step, -1 one that moves) and the mask.
+  virtual void blendLayer(int id, const Grid<float, D>& cover, const std::vector<double>& values) = 0;
+  virtual void maskLayer(const SmokeTaps<D>& taps, double threshold, const std::vector<double>& rest) = 0;
 };
 
 }  // namespace morphoflow

@@ -65,7 +65,7 @@ void GpuARDSolver<D>::advect(double dt, const GpuFluid<D>& fluid) {
   auto in = [&](size_t s) { return inflow && s < domain_.inflowValues.size() ? domain_.inflowValues[s] : 0.0; };
   glUniform2d(p.uniform("inValue"), in(0), in(1));
   setUniform(p, "cubic", cubic_ ? 1 : 0);
-  fluid.velocity().bind(0);
+  fluid.advectedVelocity().bind(0);
   layer_->field(0).bind(1);
   layer_->field(1).bind(2);
   scratch_[0].bind(3);

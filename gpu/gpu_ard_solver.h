@@ -26,8 +26,9 @@ class GpuARDSolver {
   GpuARDSolver(GpuRDLayer<D>* layer, const ChemicalDomain<D>& domain, ChemicalInterpolation interpolation,
                CouplingMode mode, double rdTimeScale, const IVec<D>& fluidCells, double fluidH);
 
-  // One step over dt of fluid time reading the fluid's current velocity
-  // (seed 001 eq. 6, 19, 20): react and diffuse over rdTimeScale dt, then advect over dt.
+  // One step over dt of fluid time (seed 001 eq. 6, 19, 20): react and
+  // diffuse over rdTimeScale dt, then advect over dt through the velocity the
+  // fluid's last step advected through (so after the fluid's step, as the CPU's).
   void step(double dt, const GpuFluid<D>& fluid);
   // Sets the solid cells of both species to the solid values.
   void emptySolids();

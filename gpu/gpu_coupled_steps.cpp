@@ -1,7 +1,14 @@
 #include "gpu/gpu_coupled_steps.h"
 
+#include <cstring>
+
+#include <epoxy/gl.h>
+#include <fmt/format.h>
+
 #include "core/stage_trace.h"
+#include "gpu/compute_program.h"
 #include "gpu/gl_context.h"
+#include "gpu/gpu_kernels.h"
 
 namespace morphoflow {
 
@@ -10,15 +17,20 @@ GpuCoupledSteps<D>::GpuCoupledSteps(const FluidSolver<D>& fluid, const RDSolver<
                                     ChemicalInterpolation interpolation, CouplingMode mode, double rdTimeScale)
     : fluid_(fluid.settings(), fluid.constraints()),
       layer_(layerUpload(rd)),
-      ard_(&layer_, domain, interpolation, mode, rdTimeScale, fluid.cells(), fluid.h()) {
+      ard_(&layer_, domain, interpolation, mode, rdTimeScale, fluid.cells(), fluid.h()),
+      none_(sizeof(int)) {
   fluid_.fromHost(fluid);
+  for (int a = 0; a < D; ++a) {
+    rdCells_[size_t(a)] = rd.cells()[a];
+    fluidCells_[size_t(a)] = fluid.cells()[a];
+  }
 }
 
 template <int D>
 void GpuCoupledSteps<D>::step(double dt) {
   const double t0 = traceClock();
-  ard_.step(dt, fluid_);
   fluid_.step(dt);
+  ard_.step(dt, fluid_);
   // the GPU's own time of each side (timer queries, a step late)
   seconds_ = {0.0, 0.0, 0.0};
   for (double s : fluid_.lastStats().seconds) seconds_[0] += s;
@@ -53,6 +65,54 @@ void GpuCoupledSteps<D>::load(const StateReader& in) {
 template <int D>
 void GpuCoupledSteps<D>::report(nlohmann::json* run) const {
   recordGlContext(run);
+}
+
+// shaders/smoke_layer.comp over every layer cell, all species.
+template <int D>
+void GpuCoupledSteps<D>::layerKernel(bool blend, const GpuBuffer& cover, const std::vector<double>& values,
+                                     double threshold) {
+  const int ns = layer_.species();
+  const ComputeProgram& p = useKernel("smoke_layer.comp", fmt::format("#define DIM {}\n#define NSPECIES {}\n#define {}", D,
+                                                                        ns, blend ? "MODE_BLEND" : "MODE_MASK"));
+  setUniform(p, "n", int(layer_.cells()));
+  setUniform(p, "rdCells", rdCells_);
+  setUniform(p, "cells", fluidCells_);
+  setUniform(p, "tapOff", tapOff_);
+  glUniform1dv(p.uniform("values"), ns, values.data());
+  setUniform(p, "threshold", threshold);
+  for (int s = 0; s < ns; ++s) layer_.field(s).bind(s);
+  cover.bind(8);
+  fluid_.dye().bind(9);
+  (taps_.bytes() ? taps_ : none_).bind(10);
+  dispatchFlat(layer_.cells(), 16.0 * ns + 4.0 * (blend ? 1 : 1 << D));
+  storageBarrier();
+}
+
+template <int D>
+void GpuCoupledSteps<D>::blendLayer(int id, const Grid<float, D>& cover, const std::vector<double>& values) {
+  auto it = covers_.find(id);
+  if (it == covers_.end())
+    it = covers_.emplace(id, GpuBuffer::of(cover.values())).first;
+  else if (id < 0)
+    it->second.upload(cover.values());
+  layerKernel(true, it->second, values, 0.0);
+}
+
+template <int D>
+void GpuCoupledSteps<D>::maskLayer(const SmokeTaps<D>& taps, double threshold, const std::vector<double>& rest) {
+  if (taps_.bytes() == 0) {
+    std::vector<int> flat;
+    for (int a = 0; a < D; ++a) {
+      tapOff_[size_t(a)] = int(flat.size());
+      for (size_t k = 0; k < taps.t[a].size(); ++k) {
+        int bits;
+        std::memcpy(&bits, &taps.t[a][k], sizeof bits);
+        flat.insert(flat.end(), {taps.i0[a][k], taps.i1[a][k], bits});
+      }
+    }
+    taps_ = GpuBuffer::of(flat);
+  }
+  layerKernel(false, none_, rest, threshold);
 }
 
 template class GpuCoupledSteps<2>;

@@ -1,9 +1,12 @@
 // GpuCoupledSteps<D>: the coupled step (coupling/coupled_steps.h) on the GPU:
-// the ARD step reads velocity n, then the fluid writes n + 1, the CPU's
-// serial order (coupling/coupled_stepper.h) with no copy of the velocity.
+// the fluid's step, then the ARD step through the velocity the fluid
+// advected through (velocity n with step n + 1's forces), the CPU's serial
+// order (coupling/coupled_stepper.h) with no copy of the velocity.
 // The fluid (GpuFluid), the layer (GpuRDLayer) and the chemicals' advection
 // (GpuARDSolver) stay on the device.
 #pragma once
+
+#include <map>
 
 #include "coupling/coupled_steps.h"
 #include "gpu/gpu_ard_solver.h"
@@ -29,12 +32,21 @@ class GpuCoupledSteps final : public CoupledSteps<D> {
   void save(StateWriter* out) const override;
   void load(const StateReader& in) override;
   void report(nlohmann::json* run) const override;
+  void blendLayer(int id, const Grid<float, D>& cover, const std::vector<double>& values) override;
+  void maskLayer(const SmokeTaps<D>& taps, double threshold, const std::vector<double>& rest) override;
 
  private:
   GpuFluid<D> fluid_;
   GpuRDLayer<D> layer_;
   GpuARDSolver<D> ard_;
   std::array<double, 3> seconds_{};
+  // The pattern on the smoke: the sources' covers by id (-1: the last
+  // moving one), the mask's taps (uploaded by its first step), and a buffer
+  // for the binding a mode does not read.
+  std::map<int, GpuBuffer> covers_;
+  GpuBuffer taps_, none_;
+  std::array<int, 3> rdCells_{1, 1, 1}, fluidCells_{1, 1, 1}, tapOff_{};
+  void layerKernel(bool blend, const GpuBuffer& cover, const std::vector<double>& values, double threshold);
 };
 
 }  // namespace morphoflow

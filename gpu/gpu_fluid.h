@@ -65,6 +65,12 @@ class GpuFluid final : public FluidStepper<D> {
   double lastDt() const { return lastDt_; }
   // The velocity buffer (component a at offset(a) floats) for the chemicals' advection.
   const GpuBuffer& velocity() const { return vel_; }
+  // The velocity the last step's advection traced through (its start
+  // velocity with its forces applied: FluidSolver::advectedVelocity), kept
+  // until the next step's advection.
+  const GpuBuffer& advectedVelocity() const { return velScratch_; }
+  // The dye (the smoke, with [smoke]), cell-centred.
+  const GpuBuffer& dye() const { return dye_; }
   size_t offset(int a) const { return off_[size_t(a)]; }
   // The velocity, dye, clock and last projection into `host`; the velocity, dye and clock from it.
   void toHost(FluidSolver<D>* host) const override;

@@ -61,42 +61,30 @@ CoupledSimulation<D>::CoupledSimulation(const Scene& scene, Backend backend, War
   const ChemicalDomain<D> domain = chemicalDomain<D>(scene, fluid_, rd_);
   ard_ = std::make_unique<ARDSolver<D>>(&rd_, ChemicalAdvector<D>(domain, C.interpolation), C.mode, C.rdTimeScale);
   steps_ = makeCoupledSteps<D>(scene, backend, &fluid_, ard_.get(), domain);  // from the state set up here
-  if (scene.fluid.smoke.enabled)
+  if (scene.fluid.smoke.enabled) {
     sourceCoverage_ = sourceCoverage<D>(scene.fluid.smoke.sources, rd_.cells(), rd_.h(), Grid<uint8_t, D>(rd_.cells(), 0));
+    smokeTaps_ = smokeTaps<D>(fluid_.cellLayout(), fluid_.cells(), rd_.cells(), rd_.h());
+  }
 }
 
-// The pattern on the smoke: sources set their chemicals (blended by cover)
-// while they emit, and where the smoke at an RD cell's centre is at most
-// coupling.smoke_mask the layer is held at its rest state (smoke_values).
+// The pattern on the smoke (coupling/smoke_layer.h), on the backend's
+// layer: sources blend their chemicals in while they emit, then the mask
+// holds the layer at its rest state (smoke_values) outside the smoke.
 template <int D>
 void CoupledSimulation<D>::smokeOnLayer(double dt) {
   const SmokeSettings& sm = scene_.fluid.smoke;
   const CouplingScene& C = scene_.coupling;
-  const int ns = rd_.species();
   const double t0 = time() - dt;
   for (size_t q = 0; q < sm.sources.size(); ++q) {
     const SmokeSource& src = sm.sources[q];
     if (src.chemicals.empty() || !(std::min(t0 + dt, src.end) > std::max(t0, src.start))) continue;
-    const Grid<float, D> moved = src.motion.empty() ? Grid<float, D>()
-                                                    : sourceCover<D>(src, t0 + 0.5 * dt, rd_.cells(), rd_.h(),
-                                                                     Grid<uint8_t, D>(rd_.cells(), 0));
-    const Grid<float, D>& cover = src.motion.empty() ? sourceCoverage_[q] : moved;
-    for (int s = 0; s < ns; ++s) {
-      Grid<double, D>& x = rd_.field(s);
-      const double v = src.chemicals[size_t(s)];
-      parallelFor(x.size(), [&](size_t i) { x[i] = coverBlend(x[i], cover[i], v); }, 4096);
-    }
+    if (src.motion.empty())
+      steps_->blendLayer(int(q), sourceCoverage_[q], src.chemicals);
+    else
+      steps_->blendLayer(-1, sourceCover<D>(src, t0 + 0.5 * dt, rd_.cells(), rd_.h(), Grid<uint8_t, D>(rd_.cells(), 0)),
+                         src.chemicals);
   }
-  if (C.smokeMask < 0.0) return;
-  const Grid<float, D>& smoke = fluid_.dye();
-  const Layout<D> layout = fluid_.cellLayout();
-  const double h = rd_.h();
-  forEachCell<D>(rd_.cells(), [&](const IVec<D>& k, size_t i) {
-    Vec<D> x;
-    for (int a = 0; a < D; ++a) x[a] = (k[a] + 0.5) * h;
-    if (double(sampleLinear<float, D>(smoke, layout, x)) > C.smokeMask) return;
-    for (int s = 0; s < ns; ++s) rd_.field(s)[i] = C.smokeValues[size_t(s)];
-  });
+  if (C.smokeMask >= 0.0) steps_->maskLayer(smokeTaps_, C.smokeMask, C.smokeValues);
 }
 
 template <int D>

@@ -57,6 +57,7 @@ class CoupledSimulation : public Simulation<D> {
   long pressureIterations_ = 0, diffusionIterations_ = 0;
   int unconverged_ = 0;
   std::vector<Grid<float, D>> sourceCoverage_;  // [smoke]: each source's cover of the RD cells
+  SmokeTaps<D> smokeTaps_;                      // [smoke]: the smoke's taps at the RD cells
   void smokeOnLayer(double dt);
 };
 

@@ -24,12 +24,6 @@ namespace {
 // The first stage of the scene with no GPU program, or "".
 std::string missingGpuStage(const Scene& s) {
   const RDScene& rd = s.rd;
-  if (s.hasFluid && s.fluid.smoke.enabled && rd.enabled) {
-    bool chemicals = false;
-    for (const SmokeSource& src : s.fluid.smoke.sources) chemicals |= !src.chemicals.empty();
-    if (chemicals || s.coupling.smokeMask >= 0.0)
-      return "the pattern on the smoke (coupling.smoke_mask and sources' chemicals)";
-  }
   if (s.hasFluid && !rd.enabled) return "";
   if (gpuSpecies(rd.settings.model) == 0) return "the reaction of model " + rd.settings.model;
   if (s.hasFluid && gpuSpecies(rd.settings.model) != 2)

@@ -112,9 +112,9 @@ TEST(SmokeScenes, BadSourcesAndSmokeWithoutAFluidAreLocatedErrors) {
   fs::remove_all(dir);
 }
 
-// The GPU runs smoke (its parity: GpuFluid.SmokeMatchesTheCpu) and refuses
-// the pattern on the smoke, naming it.
-TEST(SmokeScenes, TheGpuBackendRunsSmokeAndRefusesThePatternOnItNamingIt) {
+// The GPU runs smoke and the pattern on it (their parity:
+// GpuFluid.SmokeMatchesTheCpu, Gpu.PatternedPlumesMatchTheCpu).
+TEST(SmokeScenes, TheGpuBackendRunsSmokeAndThePatternOnIt) {
   const fs::path dir = tempDir("smoke_gpu");
   const fs::path scene = write(dir / "plume.toml", std::string(kPlume) + kSource);
   CommandResult r = runMorphoflow("run " + scene.string() + " --backend gpu --quiet --out " + (dir / "o").string());
@@ -122,8 +122,7 @@ TEST(SmokeScenes, TheGpuBackendRunsSmokeAndRefusesThePatternOnItNamingIt) {
   EXPECT_EQ(r.status, 0) << r.output;
   r = runMorphoflow("run " + sceneFile("vfx/plume_gray_scott_2d.toml") + " --set grid.resolution=[16,24] --set rd.resolution=[32,48]" +
                     " --set time.duration=0.05 --backend gpu --quiet --out " + (dir / "p").string());
-  EXPECT_EQ(r.status, 2) << r.output;
-  EXPECT_NE(r.output.find("no program yet for the pattern on the smoke"), std::string::npos) << r.output;
+  EXPECT_EQ(r.status, 0) << r.output;
   fs::remove_all(dir);
 }
 
