@@ -10,9 +10,21 @@
 #include <cstdint>
 #include <cstring>
 
+// In sanitizer builds, the callback a sanitizer runs before it ends the
+// process (libFuzzer's records the input as a finding); null elsewhere.
+extern "C" void __sanitizer_set_death_callback(void (*callback)(void)) __attribute__((weak));
+
 namespace morphoflow {
 
 namespace {
+
+// The child dies of what kills it: the parent's handlers of fatal signals and
+// its sanitizer death callback are the parent's business (the parent reports
+// the crash as a damaged file).
+void dieAlone() {
+  for (int sig : {SIGSEGV, SIGBUS, SIGABRT, SIGFPE, SIGILL, SIGXCPU}) std::signal(sig, SIG_DFL);
+  if (__sanitizer_set_death_callback) __sanitizer_set_death_callback(nullptr);
+}
 
 bool writeAll(int fd, const char* p, size_t n) {
   while (n > 0) {
@@ -40,6 +52,7 @@ bool runIsolated(const std::function<std::string()>& work, double cpuSeconds, st
   }
   if (pid == 0) {  // the child: the work, its length and bytes, and out without running exit handlers
     ::close(fds[0]);
+    dieAlone();
     const rlim_t cpu = rlim_t(std::ceil(cpuSeconds));
     const rlimit limit{cpu, cpu + 1};  // SIGXCPU at the soft limit, SIGKILL at the hard one
     ::setrlimit(RLIMIT_CPU, &limit);

@@ -211,24 +211,39 @@ constexpr const char* kClaimsTooMuch =
 
 }  // namespace
 
+// In a child process, as readVdbVelocity: opening a damaged file reads its
+// grids' topology, which OpenVDB misreads. The answer: "1" and the time's
+// bytes, "0" (no time), or "E" and the error.
 bool readVdbTime(const std::string& path, double* time, bool* has, std::string* error) {
   initialiseOnce();
-  try {
-    AllocationLimit limit(kMaxReaderAllocation);
-    openvdb::io::File file(path);
-    file.open(/*delayLoad=*/true);
-    openvdb::MetaMap::Ptr meta = file.getMetadata();
-    file.close();
-    *has = false;
-    if (auto m = meta->getMetadata<openvdb::DoubleMetadata>("time")) *has = true, *time = m->value();
-    return true;
-  } catch (const std::bad_alloc&) {
-    *error = kClaimsTooMuch;
+  std::string answer;
+  if (!runIsolated(
+          [&]() -> std::string {
+            try {
+              AllocationLimit limit(kMaxReaderAllocation);
+              openvdb::io::File file(path);
+              file.open(/*delayLoad=*/true);
+              openvdb::MetaMap::Ptr meta = file.getMetadata();
+              file.close();
+              auto m = meta->getMetadata<openvdb::DoubleMetadata>("time");
+              if (!m) return "0";
+              const double t = m->value();
+              return "1" + std::string(reinterpret_cast<const char*>(&t), sizeof t);
+            } catch (const std::bad_alloc&) {
+              return std::string("E") + kClaimsTooMuch;
+            } catch (const std::exception& e) {
+              return std::string("E") + e.what();
+            }
+          },
+          10.0, &answer, error))
     return false;
-  } catch (const std::exception& e) {
-    *error = e.what();
+  if (answer.empty() || answer[0] == 'E') {
+    *error = answer.empty() ? std::string("the file is damaged: its reader gave no answer") : answer.substr(1);
     return false;
   }
+  *has = answer[0] == '1' && answer.size() == 1 + sizeof(double);
+  if (*has) std::memcpy(time, answer.data() + 1, sizeof(double));
+  return true;
 }
 
 namespace {

@@ -60,7 +60,7 @@ void ImageSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
   const long frame = at.frame;
   const OutputSettings& o = scene_.output;
   const FieldImageOptions io = frameImageOptions(o, sim.symmetric(o.field));
-  int w, h;
+  int w = 0, h = 0;
   std::vector<uint8_t> rgb;
   const bool two = o.colormap == kTwoSpeciesPalette;
   const std::vector<std::string> sp = sim.species();
