@@ -7,7 +7,8 @@ blender -b --factory-startup -P blender_render.py -- FIRST.vdb FRAMES FRAME OUT.
 With DENSITY "element": a smoke element as a compositor gets it, a
 Principled Volume left at Blender's defaults (it reads `density` and
 `temperature` by name) but for its Color Attribute, which Blender leaves
-empty and its own smoke sets to `color`."""
+empty and its own smoke sets to `color`; EMISSION is then the camera's zoom
+(1: the whole domain in view)."""
 import math
 import sys
 
@@ -70,7 +71,8 @@ target = bpy.data.objects.new("target", None)
 target.location = centre
 scene.collection.objects.link(target)
 camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
-camera.location = centre + Vector((1.9, -2.4, 1.5)) * size
+zoom = float(argv[7]) if element and len(argv) > 7 else 1.0
+camera.location = centre + Vector((1.9, -2.4, 1.5)) * (size / zoom)
 track = camera.constraints.new("TRACK_TO")
 track.target = target
 scene.collection.objects.link(camera)
