@@ -37,14 +37,18 @@ const std::vector<BenchCase> kCases = {{2, 256}, {2, 512}, {2, 1024}, {2, 2048},
 struct Timed {
   double seconds;  // median per step
   double bytes;    // traffic per step
+  double dispatches, hostWaits;  // per step (gpu/gpu_counts.h)
 };
 
 // Median step time and mean traffic of `step` (which ends with the GPU idle: its solves wait on it).
 template <typename Step, typename After>
 Timed timeGpu(double minSeconds, Step&& step, After&& after) {
   const double traffic0 = gpuTrafficBytes();
+  const GpuCounts counts0 = gpuCounts();
   const std::vector<double> times = timeSteps(minSeconds, step, after);
-  return {median(times), (gpuTrafficBytes() - traffic0) / double(times.size())};
+  const double n = double(times.size());
+  const GpuCounts c = gpuCounts() - counts0;
+  return {median(times), (gpuTrafficBytes() - traffic0) / n, double(c.dispatches) / n, double(c.hostWaits) / n};
 }
 
 template <int D>
@@ -68,7 +72,8 @@ nlohmann::json benchGpuFluid(int n, double minSeconds, double peak) {
   nlohmann::json j = {{"dim", D}, {"n", n}, {"backend", "gpu"}, {"steps", steps},
                       {"ms_per_step_median", 1e3 * t.seconds}, {"steps_per_second", 1.0 / t.seconds},
                       {"pressure_iterations_mean", pit / steps}, {"viscosity_iterations_mean", vit / steps},
-                      {"pressure_converged", converged}, {"gb_per_second", t.bytes / t.seconds * 1e-9}};
+                      {"pressure_converged", converged}, {"gb_per_second", t.bytes / t.seconds * 1e-9},
+                      {"dispatches_per_step", t.dispatches}, {"host_waits_per_step", t.hostWaits}};
   for (int k = 0; k < FluidStepStats::kStages; ++k)
     j["ms_" + std::string(FluidStepStats::kStageNames[k])] = 1e3 * stage[size_t(k)] / steps;
   if (peak > 0) j["fraction_of_peak_bandwidth"] = j["gb_per_second"].get<double>() / peak;
@@ -100,7 +105,8 @@ nlohmann::json benchGpuCoupling(int n, double minSeconds, double peak) {
   nlohmann::json j = {{"dim", D}, {"n", n}, {"backend", "gpu"}, {"fluid_only_ms", 1e3 * alone},
                       {"fluid_only_steps_per_second", 1.0 / alone}, {"ms", 1e3 * t.seconds},
                       {"steps_per_second", 1.0 / t.seconds}, {"ard_part_ms", 1e3 * median(ardSeconds)},
-                      {"overhead", t.seconds / alone}, {"gb_per_second", t.bytes / t.seconds * 1e-9}};
+                      {"overhead", t.seconds / alone}, {"gb_per_second", t.bytes / t.seconds * 1e-9},
+                      {"dispatches_per_step", t.dispatches}, {"host_waits_per_step", t.hostWaits}};
   if (peak > 0) j["fraction_of_peak_bandwidth"] = j["gb_per_second"].get<double>() / peak;
   return j;
 }
@@ -109,18 +115,19 @@ nlohmann::json benchGpuCoupling(int n, double minSeconds, double peak) {
 
 bool runGpuFluidBench(const BenchOptions& o) {
   const double peak = announceGpu();
-  std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>8} {:>7}\n", "dim", "n", "backend",
-                           "ms/step(med)", "p-iters", "v-iters", "forces", "advect", "diffuse", "project", "GB/s", "of peak");
+  std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>8} {:>7} {:>10} {:>7}\n", "dim", "n",
+                           "backend", "ms/step(med)", "p-iters", "v-iters", "forces", "advect", "diffuse", "project", "GB/s",
+                           "of peak", "dispatches", "waits");
   nlohmann::json all = nlohmann::json::array();
   for (BenchCase c : selectBenchCases(kCases, o.size)) {
     const nlohmann::json j = c.dim == 2 ? benchGpuFluid<2>(c.n, o.minSeconds, peak) : benchGpuFluid<3>(c.n, o.minSeconds, peak);
-    std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12.3f} {:>8.1f} {:>8.1f} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.3f} {:>8.1f} {:>7}{}\n",
+    std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12.3f} {:>8.1f} {:>8.1f} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.3f} {:>8.1f} {:>7} {:>10.1f} {:>7.1f}{}\n",
                              c.dim, c.n, "gpu", j["ms_per_step_median"].get<double>(),
                              j["pressure_iterations_mean"].get<double>(), j["viscosity_iterations_mean"].get<double>(),
                              j["ms_forces"].get<double>(), j["ms_advect"].get<double>(), j["ms_diffuse"].get<double>(),
                              j["ms_project"].get<double>(), j["gb_per_second"].get<double>(),
-                             ofPeak(j["gb_per_second"].get<double>(), peak),
-                             j["pressure_converged"].get<bool>() ? "" : "  (unconverged)")
+                             ofPeak(j["gb_per_second"].get<double>(), peak), j["dispatches_per_step"].get<double>(),
+                             j["host_waits_per_step"].get<double>(), j["pressure_converged"].get<bool>() ? "" : "  (unconverged)")
               << std::flush;
     all.push_back(j);
   }
@@ -131,16 +138,17 @@ bool runGpuFluidBench(const BenchOptions& o) {
 bool runGpuCouplingBench(const BenchOptions& o) {
   const double peak = announceGpu();
   std::cout << "overhead = (fluid + ARD) / fluid only; targets: >= 1000 steps/s at 1024^2, >= 30 at 256^3, overhead <= 1.10\n";
-  std::cout << fmt::format("{:>4} {:>6} {:>10} {:>10} {:>10} {:>10} {:>9} {:>8} {:>7}\n", "dim", "n", "fluid/s", "gpu/s",
-                           "ms gpu", "ms ARD", "overhead", "GB/s", "of peak");
+  std::cout << fmt::format("{:>4} {:>6} {:>10} {:>10} {:>10} {:>10} {:>9} {:>8} {:>7} {:>10} {:>7}\n", "dim", "n", "fluid/s",
+                           "gpu/s", "ms gpu", "ms ARD", "overhead", "GB/s", "of peak", "dispatches", "waits");
   nlohmann::json all = nlohmann::json::array();
   for (BenchCase c : selectBenchCases(kCases, o.size)) {
     const nlohmann::json j =
         c.dim == 2 ? benchGpuCoupling<2>(c.n, o.minSeconds, peak) : benchGpuCoupling<3>(c.n, o.minSeconds, peak);
-    std::cout << fmt::format("{:>4} {:>6} {:>10.1f} {:>10.1f} {:>10.3f} {:>10.3f} {:>9.2f} {:>8.1f} {:>7}\n", c.dim, c.n,
+    std::cout << fmt::format("{:>4} {:>6} {:>10.1f} {:>10.1f} {:>10.3f} {:>10.3f} {:>9.2f} {:>8.1f} {:>7} {:>10.1f} {:>7.1f}\n", c.dim, c.n,
                              j["fluid_only_steps_per_second"].get<double>(), j["steps_per_second"].get<double>(),
                              j["ms"].get<double>(), j["ard_part_ms"].get<double>(), j["overhead"].get<double>(),
-                             j["gb_per_second"].get<double>(), ofPeak(j["gb_per_second"].get<double>(), peak))
+                             j["gb_per_second"].get<double>(), ofPeak(j["gb_per_second"].get<double>(), peak),
+                             j["dispatches_per_step"].get<double>(), j["host_waits_per_step"].get<double>())
               << std::flush;
     all.push_back(j);
   }

@@ -19,6 +19,7 @@
 #include "bench/bench_timing.h"
 #include "bench/gpu_bandwidth.h"
 #include "core/error.h"
+#include "gpu/gpu_counts.h"
 #include "gpu/gl_context.h"
 #include "gpu/gpu_explicit_rd.h"
 #include "gpu/gpu_kernels.h"
@@ -42,16 +43,20 @@ nlohmann::json benchGpuRD(int n, double minSeconds) {
   gpu.step(dt);  // warm-up: the driver's first dispatch
   gpu.finish();
   // Ten steps a sample, so a sample is the GPU's time, not the queue's.
+  const GpuCounts counts0 = gpuCounts();
   const std::vector<double> times = timeSteps(minSeconds, [&] {
     for (int k = 0; k < 10; ++k) gpu.step(dt);
     gpu.finish();
   }, [] {});
   const double med = median(times) / 10.0;
+  const GpuCounts c = gpuCounts() - counts0;
   double cells = 1;
   for (int a = 0; a < D; ++a) cells *= n;
   return {{"dim", D}, {"n", n}, {"integrator", "explicit"}, {"backend", "gpu"}, {"dt", dt},
           {"ms_per_step_median", 1e3 * med}, {"cell_updates_per_second", cells / med},
-          {"bytes_per_cell_update", 16}, {"gb_per_second", 16.0 * cells / med * 1e-9}};
+          {"bytes_per_cell_update", 16}, {"gb_per_second", 16.0 * cells / med * 1e-9},
+          {"dispatches_per_step", double(c.dispatches) / (10.0 * double(times.size()))},
+          {"host_waits_per_step", double(c.hostWaits) / (10.0 * double(times.size()))}};
 }
 
 template <int D>
@@ -63,6 +68,7 @@ nlohmann::json benchGpuKimLin(int n, double minSeconds) {
   gpu.step(dt);  // warm-up: the programs, the diffusion systems
   double diffusionIterations = 0;
   const double traffic0 = gpuTrafficBytes();
+  const GpuCounts counts0 = gpuCounts();
   const std::vector<double> times = timeSteps(minSeconds, [&] {
     gpu.step(dt);
     gpu.download(0);  // the step's end (its solves already wait on the GPU)
@@ -70,18 +76,21 @@ nlohmann::json benchGpuKimLin(int n, double minSeconds) {
   double cells = 1;
   for (int a = 0; a < D; ++a) cells *= n;
   const double med = median(times), bytes = (gpuTrafficBytes() - traffic0) / double(times.size());
+  const GpuCounts c = gpuCounts() - counts0;
   return {{"dim", D}, {"n", n}, {"integrator", "kim-lin"}, {"backend", "gpu"}, {"dt", dt},
           {"ms_per_step_median", 1e3 * med}, {"cell_updates_per_second", cells / med},
           {"bytes_per_cell_update", bytes / cells}, {"gb_per_second", bytes / med * 1e-9},
-          {"diffusion_iterations_mean", diffusionIterations / double(times.size())}};
+          {"diffusion_iterations_mean", diffusionIterations / double(times.size())},
+          {"dispatches_per_step", double(c.dispatches) / double(times.size())},
+          {"host_waits_per_step", double(c.hostWaits) / double(times.size())}};
 }
 
 }  // namespace
 
 bool runGpuRDBench(const BenchOptions& o) {
   const double peak = announceGpu();
-  std::cout << fmt::format("{:>4} {:>6} {:>10} {:>12} {:>14} {:>9} {:>7}\n", "dim", "n", "integrator", "ms/step(med)",
-                           "Mcell-updates/s", "GB/s", "of peak");
+  std::cout << fmt::format("{:>4} {:>6} {:>10} {:>12} {:>14} {:>9} {:>7} {:>10} {:>7}\n", "dim", "n", "integrator",
+                           "ms/step(med)", "Mcell-updates/s", "GB/s", "of peak", "dispatches", "waits");
   nlohmann::json all = nlohmann::json::array();
   for (BenchCase c : selectBenchCases({{2, 256}, {2, 1024}, {2, 4096}, {3, 128}, {3, 256}}, o.size)) {
     for (bool implicit : {false, true}) {
@@ -89,9 +98,10 @@ bool runGpuRDBench(const BenchOptions& o) {
                                   : (c.dim == 2 ? benchGpuRD<2>(c.n, o.minSeconds) : benchGpuRD<3>(c.n, o.minSeconds));
       const double gbs = j["gb_per_second"];
       if (peak > 0) j["fraction_of_peak_bandwidth"] = gbs / peak;
-      std::cout << fmt::format("{:>4} {:>6} {:>10} {:>12.3f} {:>14.1f} {:>9.1f} {:>7}\n", c.dim, c.n,
+      std::cout << fmt::format("{:>4} {:>6} {:>10} {:>12.3f} {:>14.1f} {:>9.1f} {:>7} {:>10.1f} {:>7.1f}\n", c.dim, c.n,
                                j["integrator"].get<std::string>(), j["ms_per_step_median"].get<double>(),
-                               1e-6 * j["cell_updates_per_second"].get<double>(), gbs, ofPeak(gbs, peak))
+                               1e-6 * j["cell_updates_per_second"].get<double>(), gbs, ofPeak(gbs, peak),
+                               j["dispatches_per_step"].get<double>(), j["host_waits_per_step"].get<double>())
                 << std::flush;
       all.push_back(j);
     }

@@ -7,6 +7,7 @@
 #include "core/parallel.h"
 #include "core/sampling.h"
 #include "core/simd_dispatch.h"
+#include "coupling/bspline.h"
 #include "fluid/advection.h"
 
 #if MORPHOFLOW_AVX2_KERNELS
@@ -247,6 +248,7 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
       fromInflow_[i] = in;
     }, 4096);
   const bool linear = interpolation_ == ChemicalInterpolation::Linear;
+  const bool spline = interpolation_ == ChemicalInterpolation::BSpline;
   const size_t cells = n;
   bool walls = true;
   for (int a = 0; a < D; ++a) walls = walls && !d.periodic[size_t(a)];
@@ -270,6 +272,8 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
         double weight[1 << D];
         linearStencil<D>(d.cells, d.periodic, c, index, weight);
         for (int k = 0; k < (1 << D); ++k) v += weight[k] * src[index[k]];
+      } else if (spline) {
+        v = sampleBSpline<D>(coefficients_, *species[s], d.periodic, c);
       } else {
         v = sampleChemical<D>(*species[s], d.periodic, c, interpolation_);
       }
@@ -292,6 +296,7 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
   for (size_t s = 0; s < ns; ++s) {
     if (pool) pool->lend(&scratch_.values());
     scratch_.reshape(d.cells);
+    if (spline) bsplineCoefficients<D>(*species[s], d.periodic, &coefficients_);
     sample(s);
     std::swap(species[s]->values(), scratch_.values());
     if (pool) pool->give(&scratch_.values());

@@ -4,8 +4,10 @@
 // the species' value at x*. The RD grid may have another resolution than the
 // fluid grid: the velocity is sampled at RD cell centres in world space.
 //
-// Interpolation is linear (eq. 20) or cubic (Catmull-Rom per axis, clamped to
-// the 2^D linear neighbours so it adds no new extrema). Feet beyond a wall are
+// Interpolation is linear (eq. 20), cubic (Catmull-Rom per axis, clamped to
+// the 2^D linear neighbours so it adds no new extrema) or bspline (the cubic
+// B-spline of the species' prefiltered coefficients, clamped the same way:
+// coupling/bspline.h). Feet beyond a wall are
 // clamped to it; periodic axes wrap. Past the outermost cell centre of an
 // inflow side the value blends linearly into the inflow concentration, which
 // it takes at the wall and beyond (chemical flowing in, seed 001 fig. 6);
@@ -56,6 +58,7 @@ class ChemicalAdvector {
   std::array<std::vector<float>, D> feet_;
   std::vector<double> fromInflow_;  // weight of the inflow value (1: the foot left through an inflow side); empty without inflow
   Grid<double, D> scratch_;  // one species' advected values (borrowed, with a pool)
+  Grid<double, D> coefficients_;  // bspline: one species' spline coefficients
 };
 
 // Value of g at continuous grid coordinate c (cell centres at integers),

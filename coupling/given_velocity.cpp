@@ -1,5 +1,7 @@
 #include "coupling/given_velocity.h"
 
+#include "core/sampling.h"
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -144,7 +146,7 @@ void resample(const VelocityVolume& v, MacVelocity<D>* u) {
       for (int b = 0; b < D; ++b) {
         double gi = (p[b] - v.indexOrigin[size_t(b)]) / v.voxelSize + (v.staggered && b == a ? 0.5 : 0.0);
         if (std::abs(gi - std::round(gi)) < 1e-9) gi = std::round(gi);
-        gi -= v.origin[size_t(b)];
+        gi = boundedCoordinate(gi - v.origin[size_t(b)]);  // (a transform far from the domain: beyond the box)
         c0[size_t(b)] = long(std::floor(gi));
         w[size_t(b)] = gi - double(c0[size_t(b)]);
       }

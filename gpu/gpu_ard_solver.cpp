@@ -1,5 +1,6 @@
 #include "gpu/gpu_ard_solver.h"
 
+#include <cmath>
 #include <stdexcept>
 
 #include <epoxy/gl.h>
@@ -14,7 +15,8 @@ namespace morphoflow {
 template <int D>
 GpuARDSolver<D>::GpuARDSolver(GpuRDLayer<D>* layer, const ChemicalDomain<D>& domain, ChemicalInterpolation interpolation,
                               CouplingMode mode, double rdTimeScale, const IVec<D>& fluidCells, double fluidH)
-    : layer_(layer), domain_(domain), cubic_(interpolation == ChemicalInterpolation::Cubic), mode_(mode),
+    : layer_(layer), domain_(domain), cubic_(interpolation == ChemicalInterpolation::Cubic),
+      spline_(interpolation == ChemicalInterpolation::BSpline), mode_(mode),
       rdTimeScale_(rdTimeScale), fluidH_(fluidH) {
   if (!(rdTimeScale > 0)) throw std::invalid_argument("coupling: the reaction-diffusion time scale must be > 0");
   for (int a = 0; a < D; ++a) {
@@ -26,6 +28,7 @@ GpuARDSolver<D>::GpuARDSolver(GpuRDLayer<D>* layer, const ChemicalDomain<D>& dom
   solid_ = GpuBuffer::of(hasSolids_ ? std::vector<uint32_t>(domain.solid.begin(), domain.solid.end())
                                     : std::vector<uint32_t>{0});
   for (GpuBuffer& b : scratch_) b = GpuBuffer(layer->cells() * sizeof(double));
+  for (GpuBuffer& b : coefficients_) b = GpuBuffer((spline_ ? layer->cells() : 1) * sizeof(double));
   if (mode_ != CouplingMode::RDOnly) emptySolids();
   timer_ = std::make_unique<GpuStageTimer>(ARDSolver<D>::kStages);
 }
@@ -44,8 +47,34 @@ void GpuARDSolver<D>::emptySolids() {
   storageBarrier();
 }
 
+// Each species' B-spline coefficients (coupling/bspline.h): a copy, then
+// one pass a line along each axis (shaders/chem_advect.comp MODE_PREFILTER).
+template <int D>
+void GpuARDSolver<D>::prefilter() {
+  const double z = std::sqrt(3.0) - 2.0;
+  for (int s = 0; s < 2; ++s) {
+    coefficients_[size_t(s)].copyFrom(layer_->field(s), layer_->cells() * sizeof(double));
+    for (int a = 0; a < D; ++a) {
+      const int n = rdCells_[size_t(a)];
+      const ComputeProgram& p = useKernel("chem_advect.comp", fmt::format("#define DIM {}\n#define MODE_PREFILTER", D));
+      setUniform(p, "rdCells", rdCells_);
+      setUniform(p, "periodic", periodic_);
+      setUniform(p, "axis", a);
+      const int lines = int(layer_->cells() / size_t(n));
+      setUniform(p, "lines", lines);
+      setUniform(p, "z", z);
+      setUniform(p, "zn", std::pow(z, n));
+      setUniform(p, "z2n", std::pow(z, 2 * n - 2));
+      coefficients_[size_t(s)].bind(3);
+      dispatchFlat(size_t(lines), 4.0 * 8.0 * n);  // each line read and written twice
+      storageBarrier();
+    }
+  }
+}
+
 template <int D>
 void GpuARDSolver<D>::advect(double dt, const GpuFluid<D>& fluid) {
+  if (spline_) prefilter();
   const ComputeProgram& p = useKernel("chem_advect.comp", fmt::format("#define DIM {}\n#define MODE_ADVECT", D));
   setUniform(p, "cells", fluidCells_);
   setUniform(p, "periodic", periodic_);
@@ -65,6 +94,9 @@ void GpuARDSolver<D>::advect(double dt, const GpuFluid<D>& fluid) {
   auto in = [&](size_t s) { return inflow && s < domain_.inflowValues.size() ? domain_.inflowValues[s] : 0.0; };
   glUniform2d(p.uniform("inValue"), in(0), in(1));
   setUniform(p, "cubic", cubic_ ? 1 : 0);
+  setUniform(p, "spline", spline_ ? 1 : 0);
+  coefficients_[0].bind(6);
+  coefficients_[1].bind(7);
   fluid.advectedVelocity().bind(0);
   layer_->field(0).bind(1);
   layer_->field(1).bind(2);

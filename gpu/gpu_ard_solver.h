@@ -2,7 +2,8 @@
 // the GPU, with the same modes: react and diffuse (gpu/gpu_rd_layer.h) over
 // rdTimeScale dt, then carry the species with the GPU fluid's velocity
 // (shaders/chem_advect.comp: the same feet, stencils, inflow blending and
-// solids as chemical_advection.h). The species never leave the GPU.
+// solids as chemical_advection.h; bspline's prefilter on the device). The
+// species never leave the GPU.
 #pragma once
 
 #include <array>
@@ -34,13 +35,15 @@ class GpuARDSolver {
   void emptySolids();
   // The GPU's seconds of the two stages of the step before the last (timer queries).
   const std::array<double, ARDSolver<D>::kStages>& stageSeconds() const { return stageSeconds_; }
+  // The stages' dispatches and host waits (gpu_counts.h).
+  const GpuStageTimer& stageTimer() const { return *timer_; }
 
  private:
   void advect(double dt, const GpuFluid<D>& fluid);
 
   GpuRDLayer<D>* layer_;
   ChemicalDomain<D> domain_;
-  bool cubic_;
+  bool cubic_, spline_;
   CouplingMode mode_;
   double rdTimeScale_;
   std::array<int, 3> fluidCells_{1, 1, 1}, rdCells_{1, 1, 1}, periodic_{};
@@ -48,6 +51,8 @@ class GpuARDSolver {
   bool hasSolids_ = false;
   GpuBuffer solid_;
   std::array<GpuBuffer, 2> scratch_;
+  std::array<GpuBuffer, 2> coefficients_;  // bspline: the species' spline coefficients
+  void prefilter();
   std::array<double, ARDSolver<D>::kStages> stageSeconds_{};
   std::unique_ptr<class GpuStageTimer> timer_;
 };

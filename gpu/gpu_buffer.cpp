@@ -5,6 +5,7 @@
 #include <epoxy/gl.h>
 
 #include "gpu/gl_context.h"
+#include "gpu/gpu_counts.h"
 
 namespace morphoflow {
 
@@ -36,6 +37,7 @@ void GpuBuffer::download(void* data, size_t bytes, size_t offset) const {
   if (bytes == 0) return;
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
   glGetNamedBufferSubData(id_, GLintptr(offset), GLsizeiptr(bytes), data);
+  countHostWait();
   GlContext::check("reading a GPU buffer");
 }
 

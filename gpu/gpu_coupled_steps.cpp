@@ -29,8 +29,11 @@ GpuCoupledSteps<D>::GpuCoupledSteps(const FluidSolver<D>& fluid, const RDSolver<
 template <int D>
 void GpuCoupledSteps<D>::step(double dt) {
   const double t0 = traceClock();
-  fluid_.step(dt);
-  ard_.step(dt, fluid_);
+  counts_.add([&] {
+    fluid_.step(dt);
+    ard_.step(dt, fluid_);
+  });
+  ++counts_.steps;
   // the GPU's own time of each side (timer queries, a step late)
   seconds_ = {0.0, 0.0, 0.0};
   for (double s : fluid_.lastStats().seconds) seconds_[0] += s;
@@ -65,6 +68,10 @@ void GpuCoupledSteps<D>::load(const StateReader& in) {
 template <int D>
 void GpuCoupledSteps<D>::report(nlohmann::json* run) const {
   recordGlContext(run);
+  nlohmann::json g = counts_.perStep();
+  g["stages"] = fluid_.stageTimer().countsPerStep(FluidStepStats::kStageNames);
+  g["stages"].update(ard_.stageTimer().countsPerStep(ARDSolver<D>::kStageNames));
+  (*run)["gpu"] = g;
 }
 
 // shaders/smoke_layer.comp over every layer cell, all species.
@@ -95,7 +102,7 @@ void GpuCoupledSteps<D>::blendLayer(int id, const Grid<float, D>& cover, const s
     it = covers_.emplace(id, GpuBuffer::of(cover.values())).first;
   else if (id < 0)
     it->second.upload(cover.values());
-  layerKernel(true, it->second, values, 0.0);
+  counts_.add([&] { layerKernel(true, it->second, values, 0.0); });
 }
 
 template <int D>
@@ -112,7 +119,7 @@ void GpuCoupledSteps<D>::maskLayer(const SmokeTaps<D>& taps, double threshold, c
     }
     taps_ = GpuBuffer::of(flat);
   }
-  layerKernel(false, none_, rest, threshold);
+  counts_.add([&] { layerKernel(false, none_, rest, threshold); });
 }
 
 template class GpuCoupledSteps<2>;

@@ -10,6 +10,7 @@
 
 #include "coupling/coupled_steps.h"
 #include "gpu/gpu_ard_solver.h"
+#include "gpu/gpu_counts.h"
 #include "gpu/gpu_fluid.h"
 #include "gpu/gpu_rd_layer.h"
 
@@ -44,6 +45,7 @@ class GpuCoupledSteps final : public CoupledSteps<D> {
   // moving one), the mask's taps (uploaded by its first step), and a buffer
   // for the binding a mode does not read.
   std::map<int, GpuBuffer> covers_;
+  StepCounts counts_;
   GpuBuffer taps_, none_;
   std::array<int, 3> rdCells_{1, 1, 1}, fluidCells_{1, 1, 1}, tapOff_{};
   void layerKernel(bool blend, const GpuBuffer& cover, const std::vector<double>& values, double threshold);

@@ -6,6 +6,7 @@
 
 #include "gpu/compute_program.h"
 #include "gpu/gl_context.h"
+#include "gpu/gpu_counts.h"
 #include "gpu/gpu_kernels.h"
 #include "gpu/gpu_models.h"
 
@@ -56,6 +57,7 @@ void GpuExplicitRD::step(double dt) {
   const int gz = cells_[2] > 1 ? 4 : 1;
   glDispatchCompute(GLuint((cells_[0] + kGroup - 1) / kGroup), GLuint((cells_[1] + kGroup - 1) / kGroup),
                     GLuint((cells_[2] + gz - 1) / gz));
+  countDispatch();
   countGpuTraffic(16.0 * double(n_));  // two species read and written
   // The next step reads what this one wrote, through storage buffers.
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT);
@@ -63,12 +65,16 @@ void GpuExplicitRD::step(double dt) {
   GlContext::check("the explicit reaction-diffusion step");
 }
 
-void GpuExplicitRD::finish() const { glFinish(); }
+void GpuExplicitRD::finish() const {
+  glFinish();
+  countHostWait();
+}
 
 std::vector<float> GpuExplicitRD::download(int species) const {
   std::vector<float> out(n_);
   glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
   glGetNamedBufferSubData(buffers_[size_t(current_ * 2 + species)], 0, GLsizeiptr(n_ * sizeof(float)), out.data());
+  countHostWait();
   GlContext::check("reading a species back");
   return out;
 }

@@ -438,6 +438,12 @@ void GpuFluid<D>::project(double dt) {
 
 template <int D>
 void GpuFluid<D>::step(double dt) {
+  counts_.add([&] { stepStages(dt); });
+  ++counts_.steps;
+}
+
+template <int D>
+void GpuFluid<D>::stepStages(double dt) {
   timer_->mark(0);
   if (settings_.smoke.enabled) emitSmoke(dt);
   forces(dt);
@@ -474,6 +480,9 @@ template <int D>
 void GpuFluid<D>::report(nlohmann::json* run) const {
   recordGlContext(run);
   (*run)["pressure_solver"] = "mgpcg";
+  nlohmann::json g = counts_.perStep();
+  g["stages"] = timer_->countsPerStep(FluidStepStats::kStageNames);
+  (*run)["gpu"] = g;
 }
 
 template <int D>

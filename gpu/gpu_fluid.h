@@ -26,6 +26,8 @@
 #include "fluid/velocity_constraints.h"
 #include "fluid/viscosity.h"
 #include "gpu/gpu_buffer.h"
+#include "gpu/gpu_counts.h"
+#include "gpu/gpu_stage_timer.h"
 #include "gpu/kernel_modes.h"
 
 namespace morphoflow {
@@ -71,6 +73,8 @@ class GpuFluid final : public FluidStepper<D> {
   const GpuBuffer& advectedVelocity() const { return velScratch_; }
   // The dye (the smoke, with [smoke]), cell-centred.
   const GpuBuffer& dye() const { return dye_; }
+  // The stages' dispatches and host waits (gpu_counts.h).
+  const GpuStageTimer& stageTimer() const { return *timer_; }
   size_t offset(int a) const { return off_[size_t(a)]; }
   // The velocity, dye, clock and last projection into `host`; the velocity, dye and clock from it.
   void toHost(FluidSolver<D>* host) const override;
@@ -124,6 +128,8 @@ class GpuFluid final : public FluidStepper<D> {
   FluidStepStats stats_;
   std::unique_ptr<class GpuReduction> speed_;
   std::unique_ptr<class GpuStageTimer> timer_;
+  StepCounts counts_;
+  void stepStages(double dt);
 };
 
 }  // namespace morphoflow

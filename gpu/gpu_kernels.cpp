@@ -7,6 +7,7 @@
 
 #include "gpu/compute_program.h"
 #include "gpu/gl_context.h"
+#include "gpu/gpu_counts.h"
 #include "gpu/shader_source.h"
 
 namespace morphoflow {
@@ -56,6 +57,7 @@ void dispatchFlat(size_t samples, double bytes) {
   if (groups == 0) return;
   const size_t gx = groups < kMaxX ? groups : kMaxX, gy = (groups + gx - 1) / gx;
   glDispatchCompute(GLuint(gx), GLuint(gy), 1);
+  countDispatch();
 }
 
 void storageBarrier() { glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT); }

@@ -9,8 +9,11 @@ namespace morphoflow {
 
 template <int D>
 void GpuLayerStepper<D>::advance(double dt, long count) {
+  counts_.add([&] {
+    for (long k = 0; k < count; ++k) layer_.step(dt);
+  });
+  counts_.steps += count;
   for (long k = 0; k < count; ++k) {
-    layer_.step(dt);
     time_ += dt;
     ++steps_;
   }
@@ -49,6 +52,7 @@ void GpuLayerStepper<D>::resolved(nlohmann::json* j) const {
 template <int D>
 void GpuLayerStepper<D>::report(nlohmann::json* run) const {
   recordGlContext(run);
+  (*run)["gpu"] = counts_.perStep();
 }
 
 namespace {
@@ -70,8 +74,11 @@ GpuExplicitLayerStepper<D>::GpuExplicitLayerStepper(const RDSolver<D>& host) : s
 
 template <int D>
 void GpuExplicitLayerStepper<D>::advance(double dt, long count) {
+  counts_.add([&] {
+    for (long k = 0; k < count; ++k) gpu_->step(dt);
+  });
+  counts_.steps += count;
   for (long k = 0; k < count; ++k) {
-    gpu_->step(dt);
     time_ += dt;
     ++steps_;
   }
@@ -111,6 +118,7 @@ void GpuExplicitLayerStepper<D>::resolved(nlohmann::json* j) const {
 template <int D>
 void GpuExplicitLayerStepper<D>::report(nlohmann::json* run) const {
   recordGlContext(run);
+  (*run)["gpu"] = counts_.perStep();
 }
 
 template class GpuLayerStepper<2>;

@@ -6,6 +6,7 @@
 
 #include <memory>
 
+#include "gpu/gpu_counts.h"
 #include "gpu/gpu_explicit_rd.h"
 #include "gpu/gpu_rd_layer.h"
 #include "rd/layer_stepper.h"
@@ -33,6 +34,7 @@ class GpuLayerStepper final : public LayerStepper<D> {
   GpuRDLayer<D> layer_;
   double time_ = 0.0;
   long steps_ = 0;
+  StepCounts counts_;
 };
 
 template <int D>
@@ -56,6 +58,7 @@ class GpuExplicitLayerStepper final : public LayerStepper<D> {
   std::unique_ptr<GpuExplicitRD> gpu_;
   double time_ = 0.0;
   long steps_ = 0;
+  StepCounts counts_;
 };
 
 }  // namespace morphoflow

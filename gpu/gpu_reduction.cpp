@@ -3,6 +3,8 @@
 #include <algorithm>
 
 #include <epoxy/gl.h>
+
+#include "gpu/gpu_counts.h"
 #include <fmt/format.h>
 
 #include "gpu/compute_program.h"
@@ -31,6 +33,7 @@ void GpuReduction::run(const char* term, const GpuBuffer& x, const GpuBuffer& y,
   scalars_.bind(4);
   x.bind(5);
   glDispatchCompute(GLuint(groups), 1, 1);
+  countDispatch();
   const std::string t = term;
   countGpuTraffic(double(n) * (t == "TERM_DOT" ? 16.0 : t == "TERM_ACTIVE_SUM" ? 12.0 : 4.0));
   storageBarrier();
@@ -40,6 +43,7 @@ void GpuReduction::run(const char* term, const GpuBuffer& x, const GpuBuffer& y,
   partial_.bind(3);
   scalars_.bind(4);
   glDispatchCompute(1, 1, 1);
+  countDispatch();
   storageBarrier();
 }
 

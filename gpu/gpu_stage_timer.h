@@ -6,6 +6,8 @@
 #include <array>
 #include <vector>
 
+#include "gpu/gpu_counts.h"
+
 namespace morphoflow {
 
 class GpuStageTimer {
@@ -20,12 +22,20 @@ class GpuStageTimer {
   // Ends the step: the seconds of each stage of the step before it (zeros
   // for the first step), which the GPU has finished by now.
   std::vector<double> endStep();
+  // The dispatches and host waits of each stage, summed over the steps ended, and those steps.
+  const std::vector<GpuCounts>& stageCounts() const { return counts_; }
+  long steps() const { return steps_; }
+  // run.json's per-stage counts: {name: perStep(...)} for the stages named.
+  nlohmann::json countsPerStep(const char* const* names) const;
 
  private:
   int stages_;
   std::array<std::vector<unsigned>, 2> queries_;  // two steps' worth, alternating
   int current_ = 0;
   bool previous_ = false;  // the other set holds a finished step
+  std::vector<GpuCounts> counts_;
+  GpuCounts atMark_;
+  long steps_ = 0;
 };
 
 }  // namespace morphoflow

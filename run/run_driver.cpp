@@ -20,6 +20,7 @@
 #include "run/run_folder.h"
 #include "run/run_log.h"
 #include "run/scene_hash.h"
+#include "run/steady_state.h"
 #include "run/stop_signal.h"
 #include "run/version.h"
 #include "core/output_file.h"
@@ -54,7 +55,9 @@ class Driver {
  public:
   Driver(Simulation<D>& sim, const Scene& scene, const RunOptions& opt, RunLog* log)
       : sim_(sim), scene_(scene), opt_(opt), log_(*log), out_(opt.out), schedule_(scene.output.every, opt),
-        clock_(runTime(scene)), hash_(sceneHash(scene)) {}
+        clock_(runTime(scene)), hash_(sceneHash(scene)) {
+    if (scene.time.untilSteady > 0) steady_.emplace(scene.time.untilSteady);
+  }
 
   int run() {
     createOutputFolder(out_);
@@ -80,13 +83,16 @@ class Driver {
     const long stepsEstimate = scene_.hasFluid ? scene_.totalSteps() : runTime(scene_).steps;
     const double endTime = scene_.time.steps > 0 ? 0.0 : scene_.time.duration;
     if (!checkpoint_) frame();
+    if (steady_ && !checkpoint_) steady_->reference(sim_);
     while (clock_.running(sim_.steps(), sim_.time()) && !schedule_.pastLast(sim_.steps())) {
       if (StopSignals::received()) return stop();
       lastDt_ = clock_.dt(sim_);
       sim_.advance(lastDt_, stepsNow());
       const long f = frame();
+      const bool steady = f > 0 && steady_ && steady_->check(sim_);
       if (f > 0 && scene_.output.checkpointEvery > 0 && f % scene_.output.checkpointEvery == 0) saveCheckpoint();
       log_.progress(lastFrame_, sim_.steps(), stepsEstimate, sim_.time(), endTime);
+      if (steady) break;
     }
     checkFinite();
     log_.endProgress();
@@ -101,6 +107,7 @@ class Driver {
     const nlohmann::json j = record("completed");
     if (j.contains("video") && !j["video"]["written"].get<bool>())
       log_.warn("warning: " + j["video"]["warning"].get<std::string>());
+    if (steady_) sayHowSteady();
     log_.say(fmt::format("done: {} steps, t = {:.5g}, {:.2f} s wall, {} frames -> {}", sim_.steps(), sim_.time(),
                          wallSeconds(), j["frames_written"].get<int>(), out_.string()));
     for (const auto& s : sinks_)
@@ -116,6 +123,30 @@ class Driver {
     const long together = sim_.stepsTogether(), step = sim_.steps();
     if (together <= 1 || !clock_.fixedDt()) return 1;
     return std::min({together, schedule_.every() - step % schedule_.every(), clock_.stepsLeft(step)});
+  }
+
+  void sayHowSteady() {
+    const double tol = steady_->tolerance();
+    if (steady_->steady())
+      log_.say(fmt::format("steady at t = {:.5g} (step {}): the velocity changes by {:.3g} per unit time, below "
+                           "time.until_steady = {:g}", sim_.time(), sim_.steps(), steady_->change(), tol));
+    else
+      log_.warn(fmt::format("warning: not steady by t = {:.5g}: the velocity still changes by {:.3g} per unit time "
+                            "(time.until_steady = {:g}); give a longer time.duration (or time.steps) to run on",
+                            sim_.time(), steady_->change(), tol));
+  }
+
+  // run.json's until_steady: the tolerance, whether and when the run became
+  // steady, the last change measured.
+  nlohmann::json steadyRecord() const {
+    nlohmann::json s = {{"tolerance", steady_->tolerance()}, {"steady", steady_->steady()}};
+    s["relative_change_per_time"] = steady_->checked() ? nlohmann::json(steady_->change()) : nlohmann::json(nullptr);
+    s["stopped_because"] = steady_->steady()                  ? "steady"
+                           : schedule_.pastLast(sim_.steps()) ? "--frames"
+                           : scene_.time.steps > 0            ? "time.steps"
+                                                              : "time.duration";
+    if (steady_->steady()) s["steady_at"] = {{"step", sim_.steps()}, {"time", sim_.time()}};
+    return s;
   }
 
   void fail(const std::string& exitState, const std::string& error) {
@@ -163,7 +194,10 @@ class Driver {
     const nlohmann::json header = {{"version", kVersion},      {"scene_hash", hash_},      {"scene", scene_.resolvedJson},
                                    {"step", sim_.steps()},     {"time", sim_.time()},      {"last_frame", lastFrame_},
                                    {"sinks", sinks},           {"log", log_.text()},       {"checkpoint_bytes", checkpointBytes_}};
-    const fs::path file = writeCheckpoint(out_, sim_.steps(), header, [this](StateWriter* w) { sim_.save(w); });
+    const fs::path file = writeCheckpoint(out_, sim_.steps(), header, [this](StateWriter* w) {
+      sim_.save(w);
+      if (steady_) steady_->save(w);
+    });
     checkpointBytes_ += fileBytes(file);
     return file;
   }
@@ -185,7 +219,9 @@ class Driver {
                       "resume with the scene as it was, add --force to continue anyway, or run without --resume");
     }
     try {
-      sim_.load(StateReader(std::move(c.state)));
+      const StateReader state(std::move(c.state));
+      sim_.load(state);
+      if (steady_) steady_->load(state, sim_);
     } catch (const StateError& e) {
       throw UserError({c.file.string(), 0, 0}, "--resume", std::string("the checkpoint does not fit this scene: ") + e.what(),
                       "run the scene without --resume to start it afresh");
@@ -242,6 +278,7 @@ class Driver {
     addBytes(&j, "checkpoints", checkpointBytes_);
     addBytes(&j, "measurements", measurementBytes_);
     sim_.report(&j);
+    if (steady_) j["until_steady"] = steadyRecord();
     try {
       writeFileAtomically(out_ / "run.json", j.dump(2) + "\n");
     } catch (const std::exception&) {
@@ -269,6 +306,7 @@ class Driver {
   std::string resumedFrom_;
   long lastFrame_ = -1;
   std::optional<FolderLock> lock_;
+  std::optional<SteadyState<D>> steady_;
   long checkedStep_ = -1;
   double lastDt_ = 0.0;
   uintmax_t checkpointBytes_ = 0, measurementBytes_ = 0;

@@ -22,8 +22,13 @@ struct TimeSettings {
   long steps = 0;          // exactly one of steps / duration is used
   double duration = 0.0;
   double cfl = 0.0;        // > 0: adaptive dt = min(dt, cfl h / |u|max)
+  // > 0: the run ends at the first frame where the velocity's relative
+  // change per unit time since the frame before is below this (run/steady_state.h).
+  double untilSteady = 0.0;
   // A run of a duration ends once it is this close to the end (run/run_clock.h).
   static constexpr double kEndTolerance = 1e-12;
+  // The duration of a run until steady that gives neither steps nor duration.
+  static constexpr double kSteadyCap = 1000.0;
 };
 
 struct OutputSettings {

@@ -107,6 +107,7 @@ Scene parseScene(const std::string& text, const std::string& path, const std::ve
   parseCoupling(c, &s);
   parseOutput(c, &s);
   checkBackTraces(c, s);
+  checkUntilSteady(c, s);
   s.inputs = r.inputs();
 
   r.checkUnknown(root, "");

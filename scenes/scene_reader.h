@@ -229,6 +229,7 @@ const toml::array* tableArray(Reader& r, toml::table& root, const std::string& n
 // resolved.
 void parseGrid(SceneContext& c, Scene* s);        // [grid], [domain]
 void parseTime(SceneContext& c, Scene* s);        // [time]
+void checkUntilSteady(SceneContext& c, const Scene& s);  // time.until_steady needs a fluid
 void parseBoundary(SceneContext& c, Scene* s);    // [boundary], [inflow]
 void parseObstacles(SceneContext& c, Scene* s);   // [[obstacles]]
 void parseFluid(SceneContext& c, Scene* s);       // [fluid], [dye], [probes]

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <csignal>
 #include <fstream>
+#include <map>
 
 #include <nlohmann/json.hpp>
 
@@ -302,8 +303,8 @@ TEST(Gpu, CoupledCavityGrayScottMatchesTheCpuAfter100Steps) {
 // Every other shipped coupled scene, smaller and shorter (the same ratio of
 // the chemicals' grid to the fluid's): every species within 1e-4 of the
 // CPU's (measured at most 2.1e-5), through each coupling mode (ard,
-// passive, rd-only), linear and cubic interpolation, inflow and solid values,
-// 2D and 3D.
+// passive, rd-only), linear, cubic and B-spline interpolation, inflow and
+// solid values, 2D and 3D.
 TEST(Gpu, ShippedCoupledScenesMatchTheCpu) {
   if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
   const std::string cavity = " --set grid.resolution=[32,32] --set rd.resolution=[64,64] --set time.steps=40 --set output.every=20";
@@ -317,6 +318,12 @@ TEST(Gpu, ShippedCoupledScenesMatchTheCpu) {
                      scene("obstacle_gray_scott_rd_only.toml", channel), scene("obstacle_passive.toml", channel),
                      scene("cavity_gray_scott_3d.toml", " --set grid.resolution=[12,12,12] --set rd.resolution=[24,24,24]"
                                                         " --set time.steps=10 --set output.every=5 --set output.vdb=false"),
+                     // the B-spline transport: walls, inflow and solids, 3D
+                     scene("cavity_gray_scott.toml", cavity + " --set 'coupling.interpolation=\"bspline\"'"),
+                     scene("obstacle_gray_scott_ard.toml", channel + " --set 'coupling.interpolation=\"bspline\"'"),
+                     scene("cavity_gray_scott_3d.toml", " --set grid.resolution=[12,12,12] --set rd.resolution=[24,24,24]"
+                                                        " --set time.steps=10 --set output.every=5 --set output.vdb=false"
+                                                        " --set 'coupling.interpolation=\"bspline\"'"),
                      scene("obstacle_gray_scott_3d.toml", " --set grid.resolution=[16,32,16] --set rd.resolution=[16,32,16]"
                                                           " --set time.steps=10 --set output.every=5")},
                     "000002.exr", {0.0, 1e-4, false});
@@ -341,6 +348,54 @@ TEST(Gpu, PatternedPlumesMatchTheCpu) {
                      scene("plume_gray_scott_3d.toml", " --set grid.resolution=[12,20,12] --set rd.resolution=[24,40,24]"
                                                        " --set time.duration=0.4 --set output.every=20")},
                     "000002.exr", {0.0, 1e-5, true});
+}
+
+// time.until_steady on the GPU: the run stops at the CPU's step, its last
+// measured change within 1e-4 of the CPU's (measured 4e-5 relative).
+TEST(Gpu, UntilSteadyStopsAtTheCpusStep) {
+  if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
+  const fs::path dir = tempDir("gpu_until_steady");
+  std::map<std::string, nlohmann::json> got;
+  for (const char* backend : {"gpu", "tbb"}) {
+    const CommandResult r = runMorphoflow("run " + sceneFile("lid_driven_cavity.toml") +
+                                          " --set grid.resolution=[24,24] --set output.images=false --set time.until_steady=5e-3"
+                                          " --quiet --backend " + backend + " --out " + (dir / backend).string());
+    ASSERT_EQ(r.status, 0) << backend << "\n" << r.output;
+    got[backend] = nlohmann::json::parse(std::ifstream(dir / backend / "run.json"))["until_steady"];
+  }
+  EXPECT_TRUE(got["gpu"]["steady"].get<bool>());
+  EXPECT_EQ(got["gpu"]["steady_at"], got["tbb"]["steady_at"]);
+  const double g = got["gpu"]["relative_change_per_time"], c = got["tbb"]["relative_change_per_time"];
+  EXPECT_NEAR(g, c, 1e-4 * c);
+  fs::remove_all(dir);
+}
+
+// The dispatches and host waits of the shipped coupled cavity's step (fluid
+// 128^2, chemicals 256^2, 20 steps, no frame after the first), pinned at
+// what they are (678.55 dispatches and 55.6 host waits a step: the CG
+// solves read their residuals back every iteration), so that a change that
+// adds one is seen; the stages' counts add up to the step's.
+TEST(Gpu, TheCoupledCavityStepsDispatchesAndHostWaitsArePinned) {
+  if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
+  const fs::path dir = tempDir("gpu_counts");
+  const CommandResult r = runMorphoflow("run " + sceneFile("coupled/cavity_gray_scott.toml") +
+                                        " --set time.steps=20 --set output.every=1000 --set output.video=false --quiet"
+                                        " --backend gpu --out " + dir.string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  const nlohmann::json g = nlohmann::json::parse(std::ifstream(dir / "run.json"))["gpu"];
+  const double dispatches = g["dispatches_per_step"], waits = g["host_waits_per_step"];
+  EXPECT_LE(dispatches, 678.55 + 1e-9) << g.dump(1);
+  EXPECT_LE(waits, 55.6 + 1e-9) << g.dump(1);
+  EXPECT_GT(waits, 0.0);
+  double sumD = 0, sumW = 0;
+  for (const char* stage : {"forces", "advect", "diffuse", "project", "reaction-diffusion", "advect chemicals"}) {
+    ASSERT_TRUE(g["stages"].contains(stage)) << stage;
+    sumD += g["stages"][stage]["dispatches_per_step"].get<double>();
+    sumW += g["stages"][stage]["host_waits_per_step"].get<double>();
+  }
+  EXPECT_NEAR(sumD, dispatches, 1e-9);
+  EXPECT_NEAR(sumW, waits, 1e-9);
+  fs::remove_all(dir);
 }
 
 // The shipped reaction-diffusion scenes with implicit integrators (Kim &

@@ -136,7 +136,11 @@ INSTANTIATE_TEST_SUITE_P(
                          "time.steps=100000", "output.every=5000"},
                         kCheckpointOften)},
         ResumeCase{"fluid_probes", "flow_past_obstacle.toml",
-                   with({"grid.resolution=[220,41]", "time.duration=4", "output.every=40"}, kCheckpointOften)}),
+                   with({"grid.resolution=[220,41]", "time.duration=4", "output.every=40"}, kCheckpointOften)},
+        // stops at steady state (time.until_steady): at the same step
+        ResumeCase{"fluid_until_steady", "lid_driven_cavity.toml",
+                   with({"grid.resolution=[96,96]", "time.until_steady=1e-5", "output.every=50", "output.images=false"},
+                        kCheckpointOften)}),
     [](const ::testing::TestParamInfo<ResumeCase>& i) { return i.param.name; });
 
 const ResumeCase kCoupled{"coupled", "coupled/cavity_gray_scott.toml",

@@ -5,13 +5,20 @@
 // fluid cell units), and both species take their value at the foot, linear
 // or Catmull-Rom (clamped to the linear stencil's range); past the outermost
 // cell centre of an inflow side the value blends into the inflow
-// concentration. MODE_SOLIDS: solid cells take the solid values.
+// concentration; with `spline`, the cubic B-spline of the coefficients C0,
+// C1 (coupling/bspline.h: mirrored at walls, wrapped on periodic axes),
+// clamped to the linear stencil's range. MODE_SOLIDS: solid cells take the
+// solid values. MODE_PREFILTER: one invocation a line along `axis` of the
+// coefficients T0, in place (bspline.cpp's prefilterLine, with the powers
+// of the pole the host computed).
 layout(std430, binding = 0) readonly buffer Vel { float vel[]; };
 layout(std430, binding = 1) readonly buffer S0 { double s0[]; };
 layout(std430, binding = 2) readonly buffer S1 { double s1[]; };
 layout(std430, binding = 3) buffer T0 { double t0[]; };
 layout(std430, binding = 4) buffer T1 { double t1[]; };
 layout(std430, binding = 5) readonly buffer Solid { uint solid[]; };
+layout(std430, binding = 6) readonly buffer C0 { double c0[]; };
+layout(std430, binding = 7) readonly buffer C1 { double c1[]; };
 
 uniform ivec3 cells, periodic, velOff;  // the fluid's
 uniform ivec3 rdCells;
@@ -20,7 +27,9 @@ uniform float r;          // h_rd / h_fluid
 uniform ivec3 inflowLo, inflowHi;
 uniform bool inflow;
 uniform dvec2 inValue, solidValue;
-uniform bool cubic;
+uniform bool cubic, spline;
+uniform int axis, lines;
+uniform double z, zn, z2n;  // the pole, z^n and z^(2n - 2) along the axis
 
 #include "mac_sampling.glsl"
 #define WEIGHTS4(name, t, w) void name(double t, precise out double w[4])
@@ -48,6 +57,80 @@ void axisWeights(double x, int n, bool wrap, out int index[4], out double w[4]) 
   catmullRomWeights(t, w);
 }
 
+// The spline's indices along an axis (splineAxis): i - 1 .. i + 2 mirrored
+// at walls or wrapped, the linear neighbours i0, i1 and the fraction t.
+void splineAxis(double x, int n, bool wrap, out int index[4], out int i0, out int i1, out double t) {
+  if (!wrap) x = clamp(x, 0.0lf, double(n - 1));
+  const double f = floor(x);
+  t = x - f;
+  const int i = int(f);
+  for (int k = 0; k < 4; ++k) {
+    int j = i - 1 + k;
+    if (wrap) {
+      j = wrapIndex(j, n);
+    } else if (n == 1) {
+      j = 0;
+    } else {
+      if (j < 0) j = -j;
+      if (j > n - 1) j = 2 * (n - 1) - j;
+      j = clamp(j, 0, n - 1);
+    }
+    index[k] = j;
+  }
+  i0 = wrap ? wrapIndex(i, n) : i;
+  i1 = wrap ? wrapIndex(i + 1, n) : min(i + 1, n - 1);
+}
+
+#if defined(MODE_PREFILTER)
+void main() {
+  const int line = flatIndex();
+  if (line >= lines) return;
+  const int n = rdCells[axis];
+  if (n < 2) return;
+  // the line's first cell: the others' coordinates from `line`, x fastest
+  ivec3 start = ivec3(0);
+  int rest = line;
+  for (int b = 0; b < DIM; ++b) {
+    if (b == axis) continue;
+    start[b] = rest % rdCells[b];
+    rest /= rdCells[b];
+  }
+  const int base = indexOf(start, rdCells);
+  const int stride = axis == 0 ? 1 : axis == 1 ? rdCells.x : rdCells.x * rdCells.y;
+  const bool wrap = periodic[axis] != 0;
+  precise double zk = 1.0lf, sum = 0.0lf;
+  if (wrap) {
+    for (int k = 0; k < n; ++k) { sum += zk * t0[base + stride * ((n - k) % n)]; zk *= z; }
+    t0[base] = sum / (1.0lf - zn);
+  } else {
+    for (int k = 0; k < n; ++k) { sum += zk * t0[base + stride * k]; zk *= z; }
+    precise double back = 0.0lf, zb = zn;
+    for (int k = n - 2; k >= 1; --k) { back += zb * t0[base + stride * k]; zb *= z; }
+    t0[base] = (sum + back) / (1.0lf - z2n);
+  }
+  for (int k = 1; k < n; ++k) {
+    precise double v = t0[base + stride * k] + z * t0[base + stride * (k - 1)];
+    t0[base + stride * k] = v;
+  }
+  if (wrap) {
+    precise double s = 0.0lf;
+    zk = 1.0lf;
+    for (int k = 0; k < n; ++k) { s += zk * t0[base + stride * ((n - 1 + k) % n)]; zk *= z; }
+    t0[base + stride * (n - 1)] = -z * s / (1.0lf - zn);
+  } else {
+    precise double e = z / (z * z - 1.0lf) * (t0[base + stride * (n - 1)] + z * t0[base + stride * (n - 2)]);
+    t0[base + stride * (n - 1)] = e;
+  }
+  for (int k = n - 2; k >= 0; --k) {
+    precise double v = z * (t0[base + stride * (k + 1)] - t0[base + stride * k]);
+    t0[base + stride * k] = v;
+  }
+  for (int k = 0; k < n; ++k) {
+    precise double v = t0[base + stride * k] * 6.0lf;
+    t0[base + stride * k] = v;
+  }
+}
+#else
 void main() {
   const int i = flatIndex();
   if (i >= rdCells.x * rdCells.y * rdCells.z) return;
@@ -74,6 +157,43 @@ void main() {
   if (w >= 1.0lf) {
     t0[i] = inValue.x;
     t1[i] = inValue.y;
+    return;
+  }
+  if (spline) {
+    int sidx[3][4], i0[3], i1[3];
+    double sw[3][4];
+    for (int a = 0; a < 3; ++a) {
+      if (a < DIM) {
+        double t;
+        splineAxis(double(foot[a]), rdCells[a], periodic[a] != 0, sidx[a], i0[a], i1[a], t);
+        bsplineWeights(t, sw[a]);
+      } else {
+        for (int q = 0; q < 4; ++q) { sidx[a][q] = 0; sw[a][q] = 1.0lf; }
+        i0[a] = 0;
+        i1[a] = 0;
+      }
+    }
+    precise dvec2 ssum = dvec2(0.0lf);
+    for (int kz = 0; kz < (DIM == 3 ? 4 : 1); ++kz)
+      for (int ky = 0; ky < 4; ++ky)
+        for (int kx = 0; kx < 4; ++kx) {
+          const int at = sidx[0][kx] + rdCells.x * (sidx[1][ky] + rdCells.y * sidx[2][kz]);
+          precise double wk = sw[0][kx] * sw[1][ky];
+          if (DIM == 3) wk = wk * sw[2][kz];
+          ssum += wk * dvec2(c0[at], c1[at]);
+        }
+    dvec2 slo = dvec2(1e300lf), shi = dvec2(-1e300lf);
+    for (int q = 0; q < (1 << DIM); ++q) {
+      const int at = ((q & 1) != 0 ? i1[0] : i0[0]) + rdCells.x * (((q & 2) != 0 ? i1[1] : i0[1]) +
+                                                                  rdCells.y * ((q & 4) != 0 ? i1[2] : i0[2]));
+      const dvec2 v = dvec2(s0[at], s1[at]);
+      slo = min(slo, v);
+      shi = max(shi, v);
+    }
+    ssum = clamp(ssum, slo, shi);
+    precise dvec2 sout = w * inValue + (1.0lf - w) * ssum;
+    t0[i] = sout.x;
+    t1[i] = sout.y;
     return;
   }
   int idx[3][4];
@@ -109,3 +229,4 @@ void main() {
   t1[i] = out_.y;
 #endif
 }
+#endif
