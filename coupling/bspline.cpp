@@ -6,16 +6,11 @@
 
 #include "core/parallel.h"
 #include "core/sampling.h"
+#include "coupling/interpolation_weights.h"
 
 namespace morphoflow {
 
 namespace {
-
-#define WEIGHTS4(name, t, w) inline void name(double t, double* w)
-#define PRECISE
-#include "kernels/interpolation.inc"
-#undef WEIGHTS4
-#undef PRECISE
 
 const double kPole = std::sqrt(3.0) - 2.0;
 

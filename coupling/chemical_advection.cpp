@@ -6,6 +6,7 @@
 
 #include "core/parallel.h"
 #include "core/sampling.h"
+#include "coupling/interpolation_weights.h"
 #include "core/simd_dispatch.h"
 #include "coupling/bspline.h"
 #include "fluid/advection.h"
@@ -17,13 +18,6 @@
 namespace morphoflow {
 
 namespace {
-
-// kernels/interpolation.inc, shared with the GPU (kernels/README.md).
-#define WEIGHTS4(name, t, w) inline void name(double t, double* w)
-#define PRECISE
-#include "kernels/interpolation.inc"
-#undef WEIGHTS4
-#undef PRECISE
 
 // Sample indices and weights along one axis: linear uses 2 (from k = 1),
 // cubic 4 (k = 0..3 at i - 1 .. i + 2).
