@@ -41,18 +41,23 @@ Grid<double, 2> blob(int n) {
   return g;
 }
 
-double roundTripError(ChemicalInterpolation interp, int rdCells, int steps) {
-  MacVelocity<2> u = rotation(32);  // the fluid grid: coarser than the chemical's
+// The relative L1 error of g's return after one turn of the rotation (the
+// fluid on fluidCells^2), in `steps` steps of the midpoint trace.
+double turnError(ChemicalInterpolation interp, int fluidCells, Grid<double, 2> g, int steps) {
+  MacVelocity<2> u = rotation(fluidCells);
   ChemicalDomain<2> d;
-  d.cells = IVec<2>(rdCells, rdCells);
-  d.h = 1.0 / rdCells;
+  d.cells = g.dims();
+  d.h = 1.0 / g.dim(0);
   ChemicalAdvector<2> adv(d, interp);
-  Grid<double, 2> g = blob(rdCells);
   const Grid<double, 2> start = g;
   for (int s = 0; s < steps; ++s) adv.advect(u, 1.0 / steps, {&g});
   double err = 0, mass = 0;
-  for (size_t i = 0; i < g.size(); ++i) err += std::abs(g[i] - start[i]), mass += start[i];
+  for (size_t i = 0; i < g.size(); ++i) err += std::abs(g[i] - start[i]), mass += std::abs(start[i]);
   return err / mass;
+}
+
+double roundTripError(ChemicalInterpolation interp, int rdCells, int steps) {
+  return turnError(interp, 32, blob(rdCells), steps);  // the fluid grid: coarser than the chemical's
 }
 
 }  // namespace
@@ -74,21 +79,12 @@ namespace {
 // the fluid and the chemicals, `steps` steps of the midpoint trace; the
 // relative L1 error of its return.
 double rotationL1(ChemicalInterpolation interp, int n, int steps) {
-  MacVelocity<2> u = rotation(n);
-  ChemicalDomain<2> d;
-  d.cells = IVec<2>(n, n);
-  d.h = 1.0 / n;
-  ChemicalAdvector<2> adv(d, interp);
-  Grid<double, 2> g(d.cells);
+  Grid<double, 2> g(IVec<2>(n, n));
   forEachCell<2>(g.dims(), [&](const IVec<2>& k, size_t i) {
     const double x = (k[0] + 0.5) / n - 0.5, y = (k[1] + 0.5) / n - 0.75;
     g[i] = std::exp(-(x * x + y * y) / (2 * 0.06 * 0.06));
   });
-  const Grid<double, 2> start = g;
-  for (int s = 0; s < steps; ++s) adv.advect(u, 1.0 / steps, {&g});
-  double err = 0, mass = 0;
-  for (size_t i = 0; i < g.size(); ++i) err += std::abs(g[i] - start[i]), mass += std::abs(start[i]);
-  return err / mass;
+  return turnError(interp, n, g, steps);
 }
 
 }  // namespace
