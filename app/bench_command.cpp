@@ -20,10 +20,14 @@ namespace {
 struct BenchArguments {
   std::string suite;
   BenchOptions bench;
+  bool interpolationGiven = false;
 };
 
 int runBench(const BenchArguments& a) {
   const BenchOptions& bench = a.bench;
+  if (a.interpolationGiven && a.suite != "coupling")
+    throw UserError({"--interpolation", 0, 0}, "", "only the coupling suite carries chemicals",
+                    "drop --interpolation or run `bench coupling`");
   if (!bench.trace.empty() && a.suite != "coupling")
     throw UserError({"--trace", 0, 0}, "", "only the coupling suite writes a trace", "drop --trace or run `bench coupling`");
   // A --size case of n^2 cells (the suites' own sizes are known to fit) needs at most ~1 kB a cell.
@@ -51,6 +55,10 @@ void addBenchCommand(CLI::App& app, Commands* commands) {
   cmd->add_option("--json", bench.json, "also write results as JSON");
   cmd->add_option("--seconds", bench.minSeconds, "minimum timed seconds per case")->check(finiteIn(0.0, 3600.0));
   cmd->add_option("--backend", bench.backend, "cpu | gpu")->check(CLI::IsMember({"cpu", "gpu"}))->capture_default_str();
+  cmd->add_option("--interpolation", bench.interpolation, "coupling: the chemicals' sample, linear | cubic | bspline | bfecc")
+      ->check(CLI::IsMember({"linear", "cubic", "bspline", "bfecc"}))
+      ->capture_default_str()
+      ->each([a](const std::string&) { a->interpolationGiven = true; });
   cmd->add_option("--trace", bench.trace, "coupling: write a Chrome trace-event JSON of the stages per thread");
   commands->add(cmd, [a] { return runBench(*a); });
 }

@@ -11,6 +11,7 @@ struct BenchOptions {
   double minSeconds = 1.0; // time each case for at least this long (after warm-up)
   std::string trace;       // coupling: write a Chrome trace of the stages here
   std::string backend = "cpu";  // cpu | gpu
+  std::string interpolation = "linear";  // coupling: the chemicals' back-trace sample (coupling_choices.h)
 };
 
 // Runs the named suite (on the CPU, or with backend "gpu" the same problems

@@ -24,6 +24,7 @@
 #include "core/parallel.h"
 #include "core/stage_trace.h"
 #include "coupling/coupled_stepper.h"
+#include "coupling/coupling_choices.h"
 #include "rd/model_registry.h"
 
 namespace morphoflow {
@@ -50,7 +51,8 @@ CoupledTiming fluidOnly(int n, double minSeconds) {
 }
 
 template <int D>
-CoupledTiming fluidWithARD(int n, CouplingBackend backend, double minSeconds, StageTrace* trace) {
+CoupledTiming fluidWithARD(int n, CouplingBackend backend, ChemicalInterpolation interpolation, double minSeconds,
+                           StageTrace* trace) {
   FluidSolver<D> f(benchCavity<D>(n));
   // on the fluid's grid, diffusion rates 0.2 h^2 and 0.1 h^2 (the `rd` suite's, per cell)
   RDSolver<D> rd(benchGrayScott<D>(n, 1.0 / n, RDIntegrator::KimLin), *findModel("gray-scott"));
@@ -60,7 +62,7 @@ CoupledTiming fluidWithARD(int n, CouplingBackend backend, double minSeconds, St
   ChemicalDomain<D> domain;
   domain.cells = rd.cells();
   domain.h = rd.h();
-  ARDSolver<D> ard(&rd, ChemicalAdvector<D>(domain, ChemicalInterpolation::Linear), CouplingMode::ARD, rdScale);
+  ARDSolver<D> ard(&rd, ChemicalAdvector<D>(domain, interpolation), CouplingMode::ARD, rdScale);
   CoupledStepper<D> stepper(&f, &ard, backend);
   for (int i = 0; i < kWarmup; ++i) stepper.step(dt);
   if (trace)
@@ -78,15 +80,17 @@ CoupledTiming fluidWithARD(int n, CouplingBackend backend, double minSeconds, St
 }
 
 template <int D>
-nlohmann::json benchCase(int n, int threads, double minSeconds, StageTrace* trace, double triad) {
+nlohmann::json benchCase(int n, int threads, ChemicalInterpolation interpolation, double minSeconds, StageTrace* trace,
+                         double triad) {
   ThreadLimit limit(threads);
   const CoupledTiming fluid = fluidOnly<D>(n, minSeconds);
   const double alone = fluid.step;
   nlohmann::json j = {{"dim", D}, {"n", n}, {"threads", threads}, {"fluid_only_ms", 1e3 * alone},
                       {"fluid_only_steps_per_second", 1.0 / alone}, {"triad_gb_per_second", triad},
+                      {"interpolation", interpolationName(interpolation)},
                       {"fluid_only_of_triad", fluid.bytes / alone / 1e9 / triad}};
   for (CouplingBackend b : {CouplingBackend::Serial, CouplingBackend::TBB}) {
-    const CoupledTiming t = fluidWithARD<D>(n, b, minSeconds, trace);
+    const CoupledTiming t = fluidWithARD<D>(n, b, interpolation, minSeconds, trace);
     const std::string k = b == CouplingBackend::TBB ? "tbb" : "serial";
     j[k] = {{"ms", 1e3 * t.step},
             {"steps_per_second", 1.0 / t.step},
@@ -105,15 +109,17 @@ bool runCouplingBench(const BenchOptions& o) {
   std::optional<StageTrace> trace;
   if (!o.trace.empty()) trace.emplace();
   nlohmann::json all = nlohmann::json::array();
-  std::cout << "overhead = (fluid + ARD) / fluid only, target <= 1.10 at 512^2 and above (2 threads)\n";
+  const ChemicalInterpolation interpolation = interpolationNamed(o.interpolation);
+  std::cout << "overhead = (fluid + ARD) / fluid only, target <= 1.10 at 512^2 and above (2 threads); chemicals: "
+            << o.interpolation << " interpolation\n";
   const std::array<double, 3> triad = suiteTriads(o.minSeconds);
   std::cout << fmt::format("{:>4} {:>6} {:>4} {:>10} {:>10} {:>10} {:>10} {:>9} {:>9} {:>9} {:>9}\n", "dim", "n", "thr",
                            "fluid/s", "serial/s", "tbb/s", "ms tbb", "ovh ser", "ovh tbb", "bw fluid", "bw tbb");
   for (BenchCase c : cases)
     for (int threads : {1, 2}) {
       StageTrace* t = trace && threads == 2 ? &*trace : nullptr;
-      nlohmann::json j = c.dim == 2 ? benchCase<2>(c.n, threads, o.minSeconds, t, triad[size_t(threads)])
-                                    : benchCase<3>(c.n, threads, o.minSeconds, t, triad[size_t(threads)]);
+      nlohmann::json j = c.dim == 2 ? benchCase<2>(c.n, threads, interpolation, o.minSeconds, t, triad[size_t(threads)])
+                                    : benchCase<3>(c.n, threads, interpolation, o.minSeconds, t, triad[size_t(threads)]);
       std::cout << fmt::format("{:>4} {:>6} {:>4} {:>10.2f} {:>10.2f} {:>10.2f} {:>10.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f}\n", c.dim,
                                c.n, threads, j["fluid_only_steps_per_second"].get<double>(),
                                j["serial"]["steps_per_second"].get<double>(), j["tbb"]["steps_per_second"].get<double>(),

@@ -18,6 +18,7 @@
 #include "bench/bench_suites.h"
 #include "bench/bench_timing.h"
 #include "bench/gpu_bandwidth.h"
+#include "coupling/coupling_choices.h"
 #include "gpu/gpu_ard_solver.h"
 #include "fluid/fluid_solver.h"
 #include "gpu/gpu_fluid.h"
@@ -81,7 +82,7 @@ nlohmann::json benchGpuFluid(int n, double minSeconds, double peak) {
 }
 
 template <int D>
-nlohmann::json benchGpuCoupling(int n, double minSeconds, double peak) {
+nlohmann::json benchGpuCoupling(int n, ChemicalInterpolation interpolation, double minSeconds, double peak) {
   const nlohmann::json fluid = benchGpuFluid<D>(n, minSeconds, peak);
   FluidSolver<D> host(benchCavity<D>(n));
   RDSolver<D> rd(benchGrayScott<D>(n, 1.0 / n, RDIntegrator::KimLin), *findModel("gray-scott"));
@@ -93,7 +94,7 @@ nlohmann::json benchGpuCoupling(int n, double minSeconds, double peak) {
   domain.h = rd.h();
   GpuFluid<D> gf(host.settings(), host.constraints());
   GpuRDLayer<D> layer(layerUpload(rd));
-  GpuARDSolver<D> ard(&layer, domain, ChemicalInterpolation::Linear, CouplingMode::ARD, rdScale, host.cells(), host.h());
+  GpuARDSolver<D> ard(&layer, domain, interpolation, CouplingMode::ARD, rdScale, host.cells(), host.h());
   auto step = [&] {
     gf.step(dt);  // then the chemicals through the velocity it advected through
     ard.step(dt, gf);
@@ -105,6 +106,7 @@ nlohmann::json benchGpuCoupling(int n, double minSeconds, double peak) {
   nlohmann::json j = {{"dim", D}, {"n", n}, {"backend", "gpu"}, {"fluid_only_ms", 1e3 * alone},
                       {"fluid_only_steps_per_second", 1.0 / alone}, {"ms", 1e3 * t.seconds},
                       {"steps_per_second", 1.0 / t.seconds}, {"ard_part_ms", 1e3 * median(ardSeconds)},
+                      {"interpolation", interpolationName(interpolation)},
                       {"overhead", t.seconds / alone}, {"gb_per_second", t.bytes / t.seconds * 1e-9},
                       {"dispatches_per_step", t.dispatches}, {"host_waits_per_step", t.hostWaits}};
   if (peak > 0) j["fraction_of_peak_bandwidth"] = j["gb_per_second"].get<double>() / peak;
@@ -137,13 +139,17 @@ bool runGpuFluidBench(const BenchOptions& o) {
 
 bool runGpuCouplingBench(const BenchOptions& o) {
   const double peak = announceGpu();
-  std::cout << "overhead = (fluid + ARD) / fluid only; targets: >= 1000 steps/s at 1024^2, >= 30 at 256^3, overhead <= 1.10\n";
+  const ChemicalInterpolation interpolation = interpolationNamed(o.interpolation);
+  std::cout << "overhead = (fluid + ARD) / fluid only; targets: >= 1000 steps/s at 1024^2, >= 30 at 256^3, overhead <= 1.10; "
+               "chemicals: "
+            << o.interpolation << " interpolation\n";
   std::cout << fmt::format("{:>4} {:>6} {:>10} {:>10} {:>10} {:>10} {:>9} {:>8} {:>7} {:>10} {:>7}\n", "dim", "n", "fluid/s",
                            "gpu/s", "ms gpu", "ms ARD", "overhead", "GB/s", "of peak", "dispatches", "waits");
   nlohmann::json all = nlohmann::json::array();
   for (BenchCase c : selectBenchCases(kCases, o.size)) {
     const nlohmann::json j =
-        c.dim == 2 ? benchGpuCoupling<2>(c.n, o.minSeconds, peak) : benchGpuCoupling<3>(c.n, o.minSeconds, peak);
+        c.dim == 2 ? benchGpuCoupling<2>(c.n, interpolation, o.minSeconds, peak)
+                   : benchGpuCoupling<3>(c.n, interpolation, o.minSeconds, peak);
     std::cout << fmt::format("{:>4} {:>6} {:>10.1f} {:>10.1f} {:>10.3f} {:>10.3f} {:>9.2f} {:>8.1f} {:>7} {:>10.1f} {:>7.1f}\n", c.dim, c.n,
                              j["fluid_only_steps_per_second"].get<double>(), j["steps_per_second"].get<double>(),
                              j["ms"].get<double>(), j["ard_part_ms"].get<double>(), j["overhead"].get<double>(),

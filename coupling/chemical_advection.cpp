@@ -210,49 +210,112 @@ void ChemicalAdvector<D>::emptySolids(const std::vector<Grid<double, D>*>& speci
   }
 }
 
+namespace {
+
+// The weight of the inflow value at every foot (1: it left through an inflow
+// side): beyond the outermost cell centre of an inflow side the value blends
+// into the inflow concentration, reached at the wall itself.
+template <int D>
+void inflowWeights(const ChemicalDomain<D>& d, const std::array<std::vector<float>, D>& feet, std::vector<double>* w) {
+  parallelFor(w->size(), [&](size_t i) {
+    double in = 0.0;
+    for (int a = 0; a < D; ++a) {
+      const double c = feet[size_t(a)][i];
+      if (d.inflow[size_t(a)][0]) in = std::max(in, std::clamp(-2.0 * c, 0.0, 1.0));
+      if (d.inflow[size_t(a)][1]) in = std::max(in, std::clamp(2.0 * (c - (d.cells[a] - 1)), 0.0, 1.0));
+    }
+    (*w)[i] = in;
+  }, 4096);
+}
+
+// Feet of every cell over dt (seed 001 eq. 19: x* = x - dt u), with the
+// fluid's vector kernels; periodic domains trace cell by cell.
+template <int D>
+void cellFeet(const ChemicalDomain<D>& d, const MacVelocity<D>& u, double dt, std::array<std::vector<float>, D>* feet) {
+  if (traceCellFeet<D>(u, dt, d.cells, d.h, feet)) return;
+  forEachCell<D>(d.cells, [&](const IVec<D>& k, size_t i) {
+    const Vec<D> x = (Vec<D>(k) + 0.5) * d.h;
+    const Vec<D> c = traceBack<D>(u, x, dt) / d.h - Vec<D>(0.5);
+    for (int a = 0; a < D; ++a) (*feet)[size_t(a)][i] = float(c[a]);
+  });
+}
+
+// Runs cell(i) over all cells in chunks; `run`, when given, does the chunk's
+// leading cells four at a time first and returns the first one not done.
+template <class Cell, class Run>
+void forChunks(size_t cells, const Cell& cell, const Run& run) {
+  constexpr size_t kRun = 1024;
+  parallelFor((cells + kRun - 1) / kRun, [&](size_t chunk) {
+    size_t i = chunk * kRun;
+    const size_t end = std::min(cells, i + kRun);
+    i = run(i, end);
+    for (; i < end; ++i) cell(i);
+  });
+}
+
+}  // namespace
+
 template <int D>
 void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::vector<Grid<double, D>*>& species,
                                  WorkPool* pool) {
   const ChemicalDomain<D>& d = domain_;
   const bool inflow = !d.inflowValues.empty();
+  const bool bfecc = interpolation_ == ChemicalInterpolation::BFECC;
   const size_t ns = species.size();
-  if (pool)
+  if (pool) {
     for (auto& f : feet_) pool->lend(&f);
+    if (bfecc)
+      for (auto& f : backFeet_) pool->lend(&f);
+  }
   size_t n = 1;
   for (int a = 0; a < D; ++a) n *= size_t(d.cells[a]);
   for (auto& f : feet_) f.resize(n);
-  // Feet once for all species (seed 001 eq. 19: x* = x - dt u), with the
-  // fluid's vector kernels; periodic domains trace cell by cell.
-  if (!traceCellFeet<D>(u, dt, d.cells, d.h, &feet_))
-    forEachCell<D>(d.cells, [&](const IVec<D>& k, size_t i) {
-      const Vec<D> x = (Vec<D>(k) + 0.5) * d.h;
-      const Vec<D> c = traceBack<D>(u, x, dt) / d.h - Vec<D>(0.5);
-      for (int a = 0; a < D; ++a) feet_[size_t(a)][i] = float(c[a]);
-    });
-  // Beyond the outermost cell centre of an inflow side the value blends
-  // into the inflow concentration, reached at the wall itself.
-  if (inflow)
-    parallelFor(fromInflow_.size(), [&](size_t i) {
-      double in = 0.0;
-      for (int a = 0; a < D; ++a) {
-        const double c = feet_[size_t(a)][i];
-        if (d.inflow[size_t(a)][0]) in = std::max(in, std::clamp(-2.0 * c, 0.0, 1.0));
-        if (d.inflow[size_t(a)][1]) in = std::max(in, std::clamp(2.0 * (c - (d.cells[a] - 1)), 0.0, 1.0));
-      }
-      fromInflow_[i] = in;
-    }, 4096);
-  const bool linear = interpolation_ == ChemicalInterpolation::Linear;
+  cellFeet<D>(d, u, dt, &feet_);
+  if (inflow) inflowWeights<D>(d, feet_, &fromInflow_);
+  if (bfecc) {  // the forward trace of BFECC's backward step: the feet over -dt
+    for (auto& f : backFeet_) f.resize(n);
+    cellFeet<D>(d, u, -dt, &backFeet_);
+    if (inflow) backFromInflow_.resize(n), inflowWeights<D>(d, backFeet_, &backFromInflow_);
+  }
   const bool spline = interpolation_ == ChemicalInterpolation::BSpline;
+  const bool linear = interpolation_ == ChemicalInterpolation::Linear || bfecc;
   const size_t cells = n;
   bool walls = true;
   for (int a = 0; a < D; ++a) walls = walls && !d.periodic[size_t(a)];
-  [[maybe_unused]] const bool wide = linear && walls && cells < (size_t(1) << 31) && useAvx2();
-  // Species s into scratch_ (2^D loads a cell), through the feet's stencils.
-  auto sample = [&](size_t s) {
-    const double in = inflow ? d.inflowValues[s] : 0.0;
-    const double* src = species[s]->data();
-    double* dst = scratch_.data();
+  [[maybe_unused]] const bool wide = walls && cells < (size_t(1) << 31) && useAvx2();
+  // src sampled linearly at `feet` into dst (2^D loads a cell), blended into
+  // the inflow value `in` by the weights w.
+  auto linearPass = [&](const std::array<std::vector<float>, D>& feet, const double* w, double in, const double* src,
+                        double* dst) {
     auto cell = [&](size_t i) {
+      const double wi = w ? w[i] : 0.0;
+      if (wi >= 1.0) {
+        dst[i] = in;
+        return;
+      }
+      Vec<D> c;
+      for (int a = 0; a < D; ++a) c[a] = feet[size_t(a)][i];
+      size_t index[1 << D];
+      double weight[1 << D];
+      linearStencil<D>(d.cells, d.periodic, c, index, weight);
+      double v = 0.0;
+      for (int k = 0; k < (1 << D); ++k) v += weight[k] * src[index[k]];
+      dst[i] = wi * in + (1.0 - wi) * v;
+    };
+    [[maybe_unused]] LinearRun<D> run{d.cells, {}, w, &in, &src, &dst, 1};
+    for (int a = 0; a < D; ++a) run.feet[size_t(a)] = feet[size_t(a)].data();
+    forChunks(cells, cell, [&](size_t i, [[maybe_unused]] size_t end) {
+#if MORPHOFLOW_AVX2_KERNELS
+      if (wide) i = linearRunAvx2<D>(run, i, end);
+#endif
+      return i;
+    });
+  };
+  // Species s into scratch_ by the cubic or the spline (16 or 64 loads a cell).
+  auto cubicPass = [&](size_t s) {
+    const double in = inflow ? d.inflowValues[s] : 0.0;
+    double* dst = scratch_.data();
+    forChunks(cells, [&](size_t i) {
       const double w = inflow ? fromInflow_[i] : 0.0;
       if (w >= 1.0) {
         dst[i] = in;
@@ -260,43 +323,66 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
       }
       Vec<D> c;
       for (int a = 0; a < D; ++a) c[a] = feet_[size_t(a)][i];
-      double v = 0.0;
-      if (linear) {
-        size_t index[1 << D];
-        double weight[1 << D];
-        linearStencil<D>(d.cells, d.periodic, c, index, weight);
-        for (int k = 0; k < (1 << D); ++k) v += weight[k] * src[index[k]];
-      } else if (spline) {
-        v = sampleBSpline<D>(coefficients_, *species[s], d.periodic, c);
-      } else {
-        v = sampleChemical<D>(*species[s], d.periodic, c, interpolation_);
-      }
+      const double v = spline ? sampleBSpline<D>(coefficients_, *species[s], d.periodic, c)
+                              : sampleChemical<D>(*species[s], d.periodic, c, interpolation_);
       dst[i] = w * in + (1.0 - w) * v;
-    };
-    [[maybe_unused]] LinearRun<D> run{d.cells, {}, inflow ? fromInflow_.data() : nullptr, &in, &src, &dst, 1};
-    for (int a = 0; a < D; ++a) run.feet[size_t(a)] = feet_[size_t(a)].data();
-    constexpr size_t kRun = 1024;
-    parallelFor((cells + kRun - 1) / kRun, [&](size_t chunk) {
-      size_t i = chunk * kRun;
-      const size_t end = std::min(cells, i + kRun);
-#if MORPHOFLOW_AVX2_KERNELS
-      if (wide) i = linearRunAvx2<D>(run, i, end);
-#endif
-      for (; i < end; ++i) cell(i);
-    });
+    }, [](size_t i, size_t) { return i; });
+  };
+  // BFECC (Kim, Liu, Llamas & Rossignac 2005): forward phi^ = A(phi) into scratch_,
+  // backward phi_b = A^-1(phi^) into coefficients_, then A(phi + (phi - phi_b) / 2),
+  // limited to the range of phi's linear neighbours of the foot.
+  auto bfeccPass = [&](size_t s) {
+    const double in = inflow ? d.inflowValues[s] : 0.0;
+    const double* phi = species[s]->data();
+    coefficients_.reshape(d.cells);
+    linearPass(feet_, inflow ? fromInflow_.data() : nullptr, in, phi, scratch_.data());
+    linearPass(backFeet_, inflow ? backFromInflow_.data() : nullptr, in, scratch_.data(), coefficients_.data());
+    const double* back = coefficients_.data();
+    double* dst = scratch_.data();
+    forChunks(cells, [&](size_t i) {
+      const double w = inflow ? fromInflow_[i] : 0.0;
+      if (w >= 1.0) {
+        dst[i] = in;
+        return;
+      }
+      Vec<D> c;
+      for (int a = 0; a < D; ++a) c[a] = feet_[size_t(a)][i];
+      size_t index[1 << D];
+      double weight[1 << D];
+      linearStencil<D>(d.cells, d.periodic, c, index, weight);
+      double v = 0.0, lo = INFINITY, hi = -INFINITY;
+      for (int k = 0; k < (1 << D); ++k) {
+        const double p = phi[index[k]];
+        v += weight[k] * (1.5 * p - 0.5 * back[index[k]]);
+        lo = std::min(lo, p), hi = std::max(hi, p);
+      }
+      dst[i] = w * in + (1.0 - w) * std::clamp(v, lo, hi);
+    }, [](size_t i, size_t) { return i; });
   };
   // One species at a time through one scratch (the species are independent):
   // after the swap it holds the old values' storage, the next one's scratch.
   for (size_t s = 0; s < ns; ++s) {
     if (pool) pool->lend(&scratch_.values());
     scratch_.reshape(d.cells);
-    if (spline) bsplineCoefficients<D>(*species[s], d.periodic, &coefficients_);
-    sample(s);
+    if (bfecc) {
+      if (pool) pool->lend(&coefficients_.values());
+      bfeccPass(s);
+      if (pool) pool->give(&coefficients_.values());
+    } else if (linear) {
+      linearPass(feet_, inflow ? fromInflow_.data() : nullptr, inflow ? d.inflowValues[s] : 0.0, species[s]->data(),
+                 scratch_.data());
+    } else {
+      if (spline) bsplineCoefficients<D>(*species[s], d.periodic, &coefficients_);
+      cubicPass(s);
+    }
     std::swap(species[s]->values(), scratch_.values());
     if (pool) pool->give(&scratch_.values());
   }
-  if (pool)
+  if (pool) {
     for (auto& f : feet_) pool->give(&f);
+    if (bfecc)
+      for (auto& f : backFeet_) pool->give(&f);
+  }
   emptySolids(species);
 }
 

@@ -7,7 +7,9 @@
 // Interpolation is linear (eq. 20), cubic (Catmull-Rom per axis, clamped to
 // the 2^D linear neighbours so it adds no new extrema) or bspline (the cubic
 // B-spline of the species' prefiltered coefficients, clamped the same way:
-// coupling/bspline.h). Feet beyond a wall are
+// coupling/bspline.h) or bfecc (linear samples forward, backward and forward
+// again, the error estimate subtracted, limited the same way: Kim et al.
+// 2005). Feet beyond a wall are
 // clamped to it; periodic axes wrap. Past the outermost cell centre of an
 // inflow side the value blends linearly into the inflow concentration, which
 // it takes at the wall and beyond (chemical flowing in, seed 001 fig. 6);
@@ -57,8 +59,10 @@ class ChemicalAdvector {
   // the fluid's own traces: 1e-7 of the domain, far below a cell).
   std::array<std::vector<float>, D> feet_;
   std::vector<double> fromInflow_;  // weight of the inflow value (1: the foot left through an inflow side); empty without inflow
+  std::array<std::vector<float>, D> backFeet_;  // bfecc: the feet over -dt
+  std::vector<double> backFromInflow_;          // bfecc: their inflow weights
   Grid<double, D> scratch_;  // one species' advected values (borrowed, with a pool)
-  Grid<double, D> coefficients_;  // bspline: one species' spline coefficients
+  Grid<double, D> coefficients_;  // bspline: one species' spline coefficients; bfecc: its backward step
 };
 
 // Value of g at continuous grid coordinate c (cell centres at integers),

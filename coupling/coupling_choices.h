@@ -11,14 +11,21 @@ namespace morphoflow {
 // the chemicals carried, no reaction or diffusion; rd-only: not carried.
 enum class CouplingMode { ARD, Passive, RDOnly };
 // The chemicals' back-trace sample: linear (seed 001 eq. 20), Catmull-Rom,
-// or the cubic B-spline of prefiltered coefficients (coupling/bspline.h).
-enum class ChemicalInterpolation { Linear, Cubic, BSpline };
+// the cubic B-spline of prefiltered coefficients (coupling/bspline.h), or
+// BFECC: linear samples with back and forth error compensation (Dupont &
+// Liu 2003; Kim et al. 2005), limited to the foot's linear neighbours.
+enum class ChemicalInterpolation { Linear, Cubic, BSpline, BFECC };
 
 inline const char* couplingModeName(CouplingMode m) {
   return m == CouplingMode::Passive ? "passive" : m == CouplingMode::RDOnly ? "rd-only" : "ard";
 }
 inline const char* interpolationName(ChemicalInterpolation i) {
-  return i == ChemicalInterpolation::Cubic ? "cubic" : i == ChemicalInterpolation::BSpline ? "bspline" : "linear";
+  switch (i) {
+    case ChemicalInterpolation::Cubic: return "cubic";
+    case ChemicalInterpolation::BSpline: return "bspline";
+    case ChemicalInterpolation::BFECC: return "bfecc";
+    default: return "linear";
+  }
 }
 
 // The names the scene reader accepts (it refuses any other, with its location).
@@ -28,7 +35,8 @@ inline CouplingMode couplingModeNamed(const std::string& name) {
   throw std::invalid_argument("no coupling mode '" + name + "'");
 }
 inline ChemicalInterpolation interpolationNamed(const std::string& name) {
-  for (ChemicalInterpolation i : {ChemicalInterpolation::Linear, ChemicalInterpolation::Cubic, ChemicalInterpolation::BSpline})
+  for (ChemicalInterpolation i : {ChemicalInterpolation::Linear, ChemicalInterpolation::Cubic, ChemicalInterpolation::BSpline,
+                                  ChemicalInterpolation::BFECC})
     if (name == interpolationName(i)) return i;
   throw std::invalid_argument("no interpolation '" + name + "'");
 }

@@ -16,7 +16,8 @@ template <int D>
 GpuARDSolver<D>::GpuARDSolver(GpuRDLayer<D>* layer, const ChemicalDomain<D>& domain, ChemicalInterpolation interpolation,
                               CouplingMode mode, double rdTimeScale, const IVec<D>& fluidCells, double fluidH)
     : layer_(layer), domain_(domain), cubic_(interpolation == ChemicalInterpolation::Cubic),
-      spline_(interpolation == ChemicalInterpolation::BSpline), mode_(mode),
+      spline_(interpolation == ChemicalInterpolation::BSpline), bfecc_(interpolation == ChemicalInterpolation::BFECC),
+      mode_(mode),
       rdTimeScale_(rdTimeScale), fluidH_(fluidH) {
   if (!(rdTimeScale > 0)) throw std::invalid_argument("coupling: the reaction-diffusion time scale must be > 0");
   for (int a = 0; a < D; ++a) {
@@ -28,7 +29,7 @@ GpuARDSolver<D>::GpuARDSolver(GpuRDLayer<D>* layer, const ChemicalDomain<D>& dom
   solid_ = GpuBuffer::of(hasSolids_ ? std::vector<uint32_t>(domain.solid.begin(), domain.solid.end())
                                     : std::vector<uint32_t>{0});
   for (GpuBuffer& b : scratch_) b = GpuBuffer(layer->cells() * sizeof(double));
-  for (GpuBuffer& b : coefficients_) b = GpuBuffer((spline_ ? layer->cells() : 1) * sizeof(double));
+  for (GpuBuffer& b : coefficients_) b = GpuBuffer((spline_ || bfecc_ ? layer->cells() : 1) * sizeof(double));
   if (mode_ != CouplingMode::RDOnly) emptySolids();
   timer_ = std::make_unique<GpuStageTimer>(ARDSolver<D>::kStages);
 }
@@ -72,9 +73,11 @@ void GpuARDSolver<D>::prefilter() {
   }
 }
 
+// One pass of chem_advect.comp's MODE_ADVECT over dt: from `from` into
+// `into`, with the interpolation's choices and `correct` for BFECC's last pass
+// (reading the backward step from coefficients_).
 template <int D>
-void GpuARDSolver<D>::advect(double dt, const GpuFluid<D>& fluid) {
-  if (spline_) prefilter();
+void GpuARDSolver<D>::advectPass(double dt, const GpuFluid<D>& fluid, Pair from, Pair into, bool correct) {
   const ComputeProgram& p = useKernel("chem_advect.comp", fmt::format("#define DIM {}\n#define MODE_ADVECT", D));
   setUniform(p, "cells", fluidCells_);
   setUniform(p, "periodic", periodic_);
@@ -95,17 +98,33 @@ void GpuARDSolver<D>::advect(double dt, const GpuFluid<D>& fluid) {
   glUniform2d(p.uniform("inValue"), in(0), in(1));
   setUniform(p, "cubic", cubic_ ? 1 : 0);
   setUniform(p, "spline", spline_ ? 1 : 0);
+  setUniform(p, "bfecc", correct ? 1 : 0);
   coefficients_[0].bind(6);
   coefficients_[1].bind(7);
   fluid.advectedVelocity().bind(0);
-  layer_->field(0).bind(1);
-  layer_->field(1).bind(2);
-  scratch_[0].bind(3);
-  scratch_[1].bind(4);
+  from[0]->bind(1);
+  from[1]->bind(2);
+  into[0]->bind(3);
+  into[1]->bind(4);
   solid_.bind(5);
   // both species read and written, the velocity once (the fluid's grid, here per chemical cell at most)
-  dispatchFlat(layer_->cells(), 32.0 + 4.0 * D);
+  dispatchFlat(layer_->cells(), (correct ? 48.0 : 32.0) + 4.0 * D);
   storageBarrier();
+}
+
+template <int D>
+void GpuARDSolver<D>::advect(double dt, const GpuFluid<D>& fluid) {
+  if (spline_) prefilter();
+  const Pair species{&layer_->field(0), &layer_->field(1)}, scratch{&scratch_[0], &scratch_[1]};
+  if (bfecc_) {
+    // BFECC (chemical_advection.cpp): forward into scratch_, backward into
+    // coefficients_, then the compensated forward step into scratch_.
+    advectPass(dt, fluid, species, scratch, false);
+    advectPass(-dt, fluid, scratch, {&coefficients_[0], &coefficients_[1]}, false);
+    advectPass(dt, fluid, species, scratch, true);
+  } else {
+    advectPass(dt, fluid, species, scratch, false);
+  }
   for (int s = 0; s < 2; ++s) std::swap(layer_->field(s), scratch_[size_t(s)]);
   emptySolids();
 }

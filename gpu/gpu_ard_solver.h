@@ -40,10 +40,12 @@ class GpuARDSolver {
 
  private:
   void advect(double dt, const GpuFluid<D>& fluid);
+  using Pair = std::array<GpuBuffer*, 2>;  // the two species' buffers
+  void advectPass(double dt, const GpuFluid<D>& fluid, Pair from, Pair into, bool correct);
 
   GpuRDLayer<D>* layer_;
   ChemicalDomain<D> domain_;
-  bool cubic_, spline_;
+  bool cubic_, spline_, bfecc_;
   CouplingMode mode_;
   double rdTimeScale_;
   std::array<int, 3> fluidCells_{1, 1, 1}, rdCells_{1, 1, 1}, periodic_{};
@@ -51,7 +53,7 @@ class GpuARDSolver {
   bool hasSolids_ = false;
   GpuBuffer solid_;
   std::array<GpuBuffer, 2> scratch_;
-  std::array<GpuBuffer, 2> coefficients_;  // bspline: the species' spline coefficients
+  std::array<GpuBuffer, 2> coefficients_;  // bspline: the species' spline coefficients; bfecc: the backward step
   void prefilter();
   std::array<double, ARDSolver<D>::kStages> stageSeconds_{};
   std::unique_ptr<class GpuStageTimer> timer_;

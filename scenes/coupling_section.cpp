@@ -18,7 +18,7 @@ void parseCoupling(SceneContext& c, Scene* sp) {
     CouplingScene& C = s.coupling;
     C.enabled = true;
     C.mode = couplingModeNamed(r.string(ct, "coupling.", "mode", "ard", {"ard", "passive", "rd-only"}));
-    C.interpolation = interpolationNamed(r.string(ct, "coupling.", "interpolation", "linear", {"linear", "cubic", "bspline"}));
+    C.interpolation = interpolationNamed(r.string(ct, "coupling.", "interpolation", "linear", {"linear", "cubic", "bspline", "bfecc"}));
     C.rdTimeScale = r.number(ct, "coupling.", "rd_time_scale", 1.0, 0, 1e9, true);
     const size_t n = species.size();
     C.inflowValues = r.numbers(ct, "coupling.", "inflow_values", s.rd.initial.values, n, n, -1e12, 1e12);

@@ -303,8 +303,8 @@ TEST(Gpu, CoupledCavityGrayScottMatchesTheCpuAfter100Steps) {
 // Every other shipped coupled scene, smaller and shorter (the same ratio of
 // the chemicals' grid to the fluid's): every species within 1e-4 of the
 // CPU's (measured at most 2.1e-5), through each coupling mode (ard,
-// passive, rd-only), linear, cubic and B-spline interpolation, inflow and
-// solid values, 2D and 3D.
+// passive, rd-only), linear, cubic, B-spline and BFECC transport, inflow
+// and solid values, 2D and 3D.
 TEST(Gpu, ShippedCoupledScenesMatchTheCpu) {
   if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
   const std::string cavity = " --set grid.resolution=[32,32] --set rd.resolution=[64,64] --set time.steps=40 --set output.every=20";
@@ -324,6 +324,12 @@ TEST(Gpu, ShippedCoupledScenesMatchTheCpu) {
                      scene("cavity_gray_scott_3d.toml", " --set grid.resolution=[12,12,12] --set rd.resolution=[24,24,24]"
                                                         " --set time.steps=10 --set output.every=5 --set output.vdb=false"
                                                         " --set 'coupling.interpolation=\"bspline\"'"),
+                     // BFECC: walls, inflow and solids, 3D
+                     scene("cavity_gray_scott.toml", cavity + " --set 'coupling.interpolation=\"bfecc\"'"),
+                     scene("obstacle_gray_scott_ard.toml", channel + " --set 'coupling.interpolation=\"bfecc\"'"),
+                     scene("cavity_gray_scott_3d.toml", " --set grid.resolution=[12,12,12] --set rd.resolution=[24,24,24]"
+                                                        " --set time.steps=10 --set output.every=5 --set output.vdb=false"
+                                                        " --set 'coupling.interpolation=\"bfecc\"'"),
                      scene("obstacle_gray_scott_3d.toml", " --set grid.resolution=[16,32,16] --set rd.resolution=[16,32,16]"
                                                           " --set time.steps=10 --set output.every=5")},
                     "000002.exr", {0.0, 1e-4, false});

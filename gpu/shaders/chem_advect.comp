@@ -7,7 +7,9 @@
 // cell centre of an inflow side the value blends into the inflow
 // concentration; with `spline`, the cubic B-spline of the coefficients C0,
 // C1 (coupling/bspline.h: mirrored at walls, wrapped on periodic axes),
-// clamped to the linear stencil's range. MODE_SOLIDS: solid cells take the
+// clamped to the linear stencil's range; with `bfecc`, the linear samples of
+// the error-compensated 1.5 S - 0.5 C, C the backward step's values, clamped
+// the same way (chemical_advection.cpp's bfecc). MODE_SOLIDS: solid cells take the
 // solid values. MODE_PREFILTER: one invocation a line along `axis` of the
 // coefficients T0, in place (bspline.cpp's prefilterLine, with the powers
 // of the pole the host computed).
@@ -28,6 +30,7 @@ uniform ivec3 inflowLo, inflowHi;
 uniform bool inflow;
 uniform dvec2 inValue, solidValue;
 uniform bool cubic, spline;
+uniform bool bfecc;       // BFECC's last pass: samples of 1.5 S - 0.5 C (C: the backward step), limited to S's range
 uniform int axis, lines;
 uniform double z, zn, z2n;  // the pole, z^n and z^(2n - 2) along the axis
 
@@ -217,13 +220,18 @@ void main() {
         precise double wk = wt[0][kx] * wt[1][ky];
         if (DIM == 3) wk = wk * wt[2][kz];
         const dvec2 v = dvec2(s0[at], s1[at]);
-        sum += wk * v;
+        if (bfecc) {
+          precise dvec2 corrected = 1.5lf * v - 0.5lf * dvec2(c0[at], c1[at]);
+          sum += wk * corrected;
+        } else {
+          sum += wk * v;
+        }
         if ((kx == 1 || kx == 2) && (ky == 1 || ky == 2) && (DIM == 2 || kz == 1 || kz == 2)) {
           lo = min(lo, v);
           hi = max(hi, v);
         }
       }
-  if (cubic) sum = clamp(sum, lo, hi);  // no new extrema
+  if (cubic || bfecc) sum = clamp(sum, lo, hi);  // no new extrema
   precise dvec2 out_ = w * inValue + (1.0lf - w) * sum;
   t0[i] = out_.x;
   t1[i] = out_.y;
