@@ -283,11 +283,11 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
   bool walls = true;
   for (int a = 0; a < D; ++a) walls = walls && !d.periodic[size_t(a)];
   [[maybe_unused]] const bool wide = walls && cells < (size_t(1) << 31) && useAvx2();
-  // src sampled linearly at `feet` into dst (2^D loads a cell), blended into
-  // the inflow value `in` by the weights w.
-  auto linearPass = [&](const std::array<std::vector<float>, D>& feet, const double* w, double in, const double* src,
-                        double* dst) {
-    auto cell = [&](size_t i) {
+  // dst[i] = the sample at cell i's foot, blended into the inflow value `in`
+  // by the weights w (null: none); `run` may do a chunk's leading cells first.
+  auto pass = [&](const std::array<std::vector<float>, D>& feet, const double* w, double in, double* dst,
+                  const auto& sampleAt, const auto& run) {
+    forChunks(cells, [&](size_t i) {
       const double wi = w ? w[i] : 0.0;
       if (wi >= 1.0) {
         dst[i] = in;
@@ -295,38 +295,36 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
       }
       Vec<D> c;
       for (int a = 0; a < D; ++a) c[a] = feet[size_t(a)][i];
+      dst[i] = wi * in + (1.0 - wi) * sampleAt(c);
+    }, run);
+  };
+  auto scalar = [](size_t i, size_t) { return i; };
+  // src sampled linearly at `feet` into dst (2^D loads a cell).
+  auto linearPass = [&](const std::array<std::vector<float>, D>& feet, const double* w, double in, const double* src,
+                        double* dst) {
+    [[maybe_unused]] LinearRun<D> run{d.cells, {}, w, &in, &src, &dst, 1};
+    for (int a = 0; a < D; ++a) run.feet[size_t(a)] = feet[size_t(a)].data();
+    pass(feet, w, in, dst, [&](const Vec<D>& c) {
       size_t index[1 << D];
       double weight[1 << D];
       linearStencil<D>(d.cells, d.periodic, c, index, weight);
       double v = 0.0;
       for (int k = 0; k < (1 << D); ++k) v += weight[k] * src[index[k]];
-      dst[i] = wi * in + (1.0 - wi) * v;
-    };
-    [[maybe_unused]] LinearRun<D> run{d.cells, {}, w, &in, &src, &dst, 1};
-    for (int a = 0; a < D; ++a) run.feet[size_t(a)] = feet[size_t(a)].data();
-    forChunks(cells, cell, [&](size_t i, [[maybe_unused]] size_t end) {
+      return v;
+    }, [&](size_t i, [[maybe_unused]] size_t end) {
 #if MORPHOFLOW_AVX2_KERNELS
       if (wide) i = linearRunAvx2<D>(run, i, end);
 #endif
       return i;
     });
   };
+  const double* inflowWeight = inflow ? fromInflow_.data() : nullptr;
   // Species s into scratch_ by the cubic or the spline (16 or 64 loads a cell).
   auto cubicPass = [&](size_t s) {
-    const double in = inflow ? d.inflowValues[s] : 0.0;
-    double* dst = scratch_.data();
-    forChunks(cells, [&](size_t i) {
-      const double w = inflow ? fromInflow_[i] : 0.0;
-      if (w >= 1.0) {
-        dst[i] = in;
-        return;
-      }
-      Vec<D> c;
-      for (int a = 0; a < D; ++a) c[a] = feet_[size_t(a)][i];
-      const double v = spline ? sampleBSpline<D>(coefficients_, *species[s], d.periodic, c)
-                              : sampleChemical<D>(*species[s], d.periodic, c, interpolation_);
-      dst[i] = w * in + (1.0 - w) * v;
-    }, [](size_t i, size_t) { return i; });
+    pass(feet_, inflowWeight, inflow ? d.inflowValues[s] : 0.0, scratch_.data(), [&](const Vec<D>& c) {
+      return spline ? sampleBSpline<D>(coefficients_, *species[s], d.periodic, c)
+                    : sampleChemical<D>(*species[s], d.periodic, c, interpolation_);
+    }, scalar);
   };
   // BFECC (Kim, Liu, Llamas & Rossignac 2005): forward phi^ = A(phi) into scratch_,
   // backward phi_b = A^-1(phi^) into coefficients_, then A(phi + (phi - phi_b) / 2),
@@ -335,18 +333,10 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
     const double in = inflow ? d.inflowValues[s] : 0.0;
     const double* phi = species[s]->data();
     coefficients_.reshape(d.cells);
-    linearPass(feet_, inflow ? fromInflow_.data() : nullptr, in, phi, scratch_.data());
+    linearPass(feet_, inflowWeight, in, phi, scratch_.data());
     linearPass(backFeet_, inflow ? backFromInflow_.data() : nullptr, in, scratch_.data(), coefficients_.data());
     const double* back = coefficients_.data();
-    double* dst = scratch_.data();
-    forChunks(cells, [&](size_t i) {
-      const double w = inflow ? fromInflow_[i] : 0.0;
-      if (w >= 1.0) {
-        dst[i] = in;
-        return;
-      }
-      Vec<D> c;
-      for (int a = 0; a < D; ++a) c[a] = feet_[size_t(a)][i];
+    pass(feet_, inflowWeight, in, scratch_.data(), [&](const Vec<D>& c) {
       size_t index[1 << D];
       double weight[1 << D];
       linearStencil<D>(d.cells, d.periodic, c, index, weight);
@@ -356,8 +346,8 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
         v += weight[k] * (1.5 * p - 0.5 * back[index[k]]);
         lo = std::min(lo, p), hi = std::max(hi, p);
       }
-      dst[i] = w * in + (1.0 - w) * std::clamp(v, lo, hi);
-    }, [](size_t i, size_t) { return i; });
+      return std::clamp(v, lo, hi);
+    }, scalar);
   };
   // One species at a time through one scratch (the species are independent):
   // after the swap it holds the old values' storage, the next one's scratch.
@@ -369,8 +359,7 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
       bfeccPass(s);
       if (pool) pool->give(&coefficients_.values());
     } else if (linear) {
-      linearPass(feet_, inflow ? fromInflow_.data() : nullptr, inflow ? d.inflowValues[s] : 0.0, species[s]->data(),
-                 scratch_.data());
+      linearPass(feet_, inflowWeight, inflow ? d.inflowValues[s] : 0.0, species[s]->data(), scratch_.data());
     } else {
       if (spline) bsplineCoefficients<D>(*species[s], d.periodic, &coefficients_);
       cubicPass(s);
