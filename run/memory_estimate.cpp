@@ -1,8 +1,5 @@
 #include "run/memory_estimate.h"
 
-#include <fstream>
-#include <sstream>
-
 #include <fmt/format.h>
 
 #include "scenes/scene.h"
@@ -42,25 +39,6 @@ double cellsOf(const std::vector<int>& res) {
   return n;
 }
 
-uintmax_t meminfoAvailable() {
-  std::ifstream in("/proc/meminfo");
-  std::string key;
-  uintmax_t kb = 0;
-  std::string unit;
-  while (in >> key >> kb >> unit)
-    if (key == "MemAvailable:") return kb * 1024;
-  return UINTMAX_MAX;
-}
-
-uintmax_t cgroupRoom() {
-  std::ifstream max("/sys/fs/cgroup/memory.max"), cur("/sys/fs/cgroup/memory.current");
-  std::string m;
-  uintmax_t c = 0;
-  if (!(max >> m) || m == "max" || !(cur >> c)) return UINTMAX_MAX;
-  const uintmax_t limit = std::stoull(m);
-  return limit > c ? limit - c : 0;
-}
-
 }  // namespace
 
 uintmax_t estimateRunBytes(const Scene& s) {
@@ -90,14 +68,6 @@ uintmax_t estimateRunBytes(const Scene& s) {
              (s.hasFluid ? kCoupledSpeciesBytesPerCell[d] : fused ? kFusedSpeciesBytesPerCell : kSpeciesBytesPerCell[d]);
   }
   return uintmax_t(bytes);
-}
-
-uintmax_t availableBytes() { return std::min(meminfoAvailable(), cgroupRoom()); }
-
-std::string humanBytes(uintmax_t b) {
-  if (b >= (uintmax_t(1) << 30)) return fmt::format("{:.2f} GiB", double(b) / double(1 << 30));
-  if (b >= (uintmax_t(1) << 20)) return fmt::format("{:.0f} MiB", double(b) / double(1 << 20));
-  return fmt::format("{:.0f} KiB", double(b) / 1024.0);
 }
 
 void checkRunFits(const Scene& scene) {

@@ -6,16 +6,13 @@
 #include <cstdint>
 #include <string>
 
+#include "core/system_memory.h"
 #include "scenes/scene.h"
 
 namespace morphoflow {
 
 // Peak resident bytes of a run of `scene`.
 uintmax_t estimateRunBytes(const Scene& scene);
-// Memory available to this process now: MemAvailable, capped by a cgroup limit.
-uintmax_t availableBytes();
-// "1.23 GiB", "456 MiB".
-std::string humanBytes(uintmax_t bytes);
 // Throws UserError (the scene file, the estimate, what is available) when
 // the run would not fit.
 void checkRunFits(const Scene& scene);

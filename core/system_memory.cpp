@@ -1,0 +1,45 @@
+#include "core/system_memory.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <fstream>
+
+namespace morphoflow {
+
+namespace {
+
+uintmax_t meminfoAvailable() {
+  std::ifstream in("/proc/meminfo");
+  std::string key;
+  uintmax_t kb = 0;
+  std::string unit;
+  while (in >> key >> kb >> unit)
+    if (key == "MemAvailable:") return kb * 1024;
+  return UINTMAX_MAX;
+}
+
+uintmax_t cgroupRoom() {
+  std::ifstream max("/sys/fs/cgroup/memory.max"), cur("/sys/fs/cgroup/memory.current");
+  std::string m;
+  uintmax_t c = 0;
+  if (!(max >> m) || m == "max" || !(cur >> c)) return UINTMAX_MAX;
+  const uintmax_t limit = std::stoull(m);
+  return limit > c ? limit - c : 0;
+}
+
+}  // namespace
+
+uintmax_t availableBytes() { return std::min(meminfoAvailable(), cgroupRoom()); }
+
+std::string humanBytes(uintmax_t b) {
+  char text[32];
+  if (b >= (uintmax_t(1) << 30))
+    std::snprintf(text, sizeof text, "%.2f GiB", double(b) / double(1 << 30));
+  else if (b >= (uintmax_t(1) << 20))
+    std::snprintf(text, sizeof text, "%.0f MiB", double(b) / double(1 << 20));
+  else
+    std::snprintf(text, sizeof text, "%.0f KiB", double(b) / 1024.0);
+  return text;
+}
+
+}  // namespace morphoflow
