@@ -10,6 +10,7 @@
 
 #include "core/error.h"
 #include "gpu/gl_context.h"
+#include "gpu/gpu_newton_check.h"
 
 namespace morphoflow {
 
@@ -34,6 +35,10 @@ inline double announceGpu() {
   const double peak = peakBandwidth(context->renderer());
   std::cout << fmt::format("gpu: {}, OpenGL {}; peak bandwidth {}\n", context->renderer(), context->version(),
                            peak > 0 ? fmt::format("{:.0f} GB/s", peak) : std::string("unknown (set MORPHOFLOW_GPU_PEAK_GBS)"));
+  // The suites' Kim & Lin rows step Gray-Scott's Newton: say when this driver cannot (gpu/gpu_newton_check.h).
+  if (const std::string defect = gpuNewtonDefect("gray-scott"); !defect.empty())
+    std::cout << "warning: this driver does not run Kim & Lin's Newton in double precision (" << defect
+              << "): its kim-lin and coupling rows time a failing Newton\n";
   return peak;
 }
 

@@ -9,6 +9,7 @@
 #include "gpu/gpu_fluid.h"
 #include "gpu/gpu_layer_steppers.h"
 #include "gpu/gpu_models.h"
+#include "gpu/gpu_newton_check.h"
 
 namespace morphoflow {
 
@@ -42,6 +43,13 @@ void checkGpuRuns(const Scene& scene) {
                     "run this scene with --backend tbb; docs/gpu.md lists what the gpu backend runs");
   const GpuInfo g = gpuInfo();
   if (!g.available) throw UserError({"--backend", 0, 0}, "", "no usable GPU context: " + g.reason, "use --backend tbb");
+  // Kim & Lin's Newton needs double precision that some drivers do not give (gpu/gpu_newton_check.h).
+  if (scene.rd.enabled && scene.rd.settings.integrator == RDIntegrator::KimLin)
+    if (const std::string defect = gpuNewtonDefect(scene.rd.settings.model); !defect.empty())
+      throw UserError({scene.path, 0, 0}, "rd.integrator",
+                      "this GPU (" + g.renderer + ", " + g.version + ") cannot run Kim & Lin's implicit reaction of model " +
+                          scene.rd.settings.model + ": " + defect,
+                      "run this scene with --backend tbb, or with another rd.integrator; docs/gpu.md says why");
   // Checked before anything is allocated: the fluid's buffers, and the
   // layer's (two float buffers per species for the explicit step).
   size_t cells = 1;
