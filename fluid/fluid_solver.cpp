@@ -72,7 +72,7 @@ void FluidSolver<D>::step(double dt, const std::function<void()>& afterAdvection
   const SmokeSettings& smoke = settings_.smoke;
   if (smoke.enabled) emitSmoke<D>(smoke, sourceCoverage_, constraints_.solid, time_, dt, &dye(), &temperature_, &u_);
   applyForces<D>(settings_, dye_.empty() ? nullptr : &dye_, dt, &u_);
-  if (smoke.enabled) applySmokeForces<D>(smoke, settings_.buoyancyDirection, dye(), temperature_, dt, &u_);
+  if (smoke.enabled) applySmokeForces<D>(smoke, settings_.buoyancyDirection, dye(), temperature_, dt, &u_, &pool_);
   constraints_.apply(&u_);
   lap(0);
   // 2. advect (velocity through itself, dye and temperature through the same field)

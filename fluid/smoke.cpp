@@ -50,15 +50,34 @@ void addToFaces(const std::array<Grid<float, D>, D>& f, double dt, MacVelocity<D
   }
 }
 
-// Vorticity confinement, Fedkiw et al. eq. 11: omega = curl u at the cell
-// centres, N = grad|omega| / |grad|omega||, f = epsilon h (N x omega).
+// The work grids of the forces, lent from the fluid's pool for the stage:
+// the force at the cells, the centre velocities, omega and |omega|. Every
+// sample is written before it is read, so none is cleared.
 template <int D>
-void addConfinement(double epsilon, std::array<Grid<float, D>, D>* f, const MacVelocity<D>& u) {
+struct SmokeWork {
+  static constexpr int W = D == 2 ? 1 : 3;  // components of omega
+  std::array<Grid<float, D>, D> f, uc;
+  std::array<Grid<float, D>, W> w;
+  Grid<float, D> mag;
+  template <class Fn>
+  void each(Fn&& fn, bool confinement) {
+    for (auto& g : f) fn(g);
+    if (!confinement) return;
+    for (auto& g : uc) fn(g);
+    for (auto& g : w) fn(g);
+    fn(mag);
+  }
+};
+
+// omega = curl u at the cell centres and |omega| (Fedkiw et al. eq. 11's
+// first half), from the centre velocities by central differences
+// (one-sided at walls).
+template <int D>
+void vorticity(const MacVelocity<D>& u, SmokeWork<D>* work) {
   const IVec<D>& n = u.cells();
   const double h = u.h();
   const std::array<bool, D>& per = u.periodic();
-  std::array<Grid<float, D>, D> uc;
-  for (auto& g : uc) g = Grid<float, D>(n, 0.0f);
+  std::array<Grid<float, D>, D>& uc = work->uc;
   std::array<size_t, D> st;
   for (int a = 0; a < D; ++a) st[size_t(a)] = uc[0].stride(a);
   forEachCell<D>(n, [&](const IVec<D>& k, size_t i) {
@@ -68,10 +87,6 @@ void addConfinement(double epsilon, std::array<Grid<float, D>, D>* f, const MacV
       uc[size_t(a)][i] = 0.5f * (g[j] + g[j + g.stride(a)]);
     }
   });
-  constexpr int W = D == 2 ? 1 : 3;  // components of omega
-  std::array<Grid<float, D>, W> w;
-  for (auto& g : w) g = Grid<float, D>(n, 0.0f);
-  Grid<float, D> mag(n, 0.0f);
   forEachCell<D>(n, [&](const IVec<D>& k, size_t i) {
     Neighbours<D> nb[D];
     for (int a = 0; a < D; ++a) nb[a] = neighbours<D>(k, i, a, n, st, per);
@@ -82,15 +97,35 @@ void addConfinement(double epsilon, std::array<Grid<float, D>, D>* f, const MacV
     };
     if constexpr (D == 2) {
       const double o = d(1, 0) - d(0, 1);
-      w[0][i] = float(o);
-      mag[i] = float(std::abs(o));
+      work->w[0][i] = float(o);
+      work->mag[i] = float(std::abs(o));
     } else {
       const double o0 = d(2, 1) - d(1, 2), o1 = d(0, 2) - d(2, 0), o2 = d(1, 0) - d(0, 1);
-      w[0][i] = float(o0), w[1][i] = float(o1), w[2][i] = float(o2);
-      mag[i] = float(std::sqrt(o0 * o0 + o1 * o1 + o2 * o2));
+      work->w[0][i] = float(o0), work->w[1][i] = float(o1), work->w[2][i] = float(o2);
+      work->mag[i] = float(std::sqrt(o0 * o0 + o1 * o1 + o2 * o2));
     }
   });
+}
+
+// The force at the cells in one pass: the buoyancy b up, plus (epsilon != 0)
+// the vorticity confinement f = epsilon h (N x omega), N = grad|omega| /
+// |grad|omega|| (Fedkiw et al. eq. 11), on the omega of `work`.
+template <int D>
+void cellForces(const SmokeSettings& s, const std::array<double, 3>& up, bool buoyant, const Grid<float, D>& density,
+                const Grid<float, D>& temperature, const MacVelocity<D>& u, SmokeWork<D>* work) {
+  const IVec<D>& n = u.cells();
+  const double h = u.h();
+  const std::array<bool, D>& per = u.periodic();
+  std::array<Grid<float, D>, D>& f = work->f;
+  const Grid<float, D>& mag = work->mag;
+  std::array<size_t, D> st;
+  for (int a = 0; a < D; ++a) st[size_t(a)] = f[0].stride(a);
+  const double epsilon = s.vorticity;
+  const auto& w = work->w;
   forEachCell<D>(n, [&](const IVec<D>& k, size_t i) {
+    const double b = buoyant ? smokeBuoyancy(density[i], temperature[i], s.weight, s.heat, s.ambient) : 0.0;
+    for (int a = 0; a < D; ++a) f[size_t(a)][i] = float(b * up[size_t(a)]);
+    if (epsilon == 0.0) return;
     double eta[3] = {0, 0, 0}, len2 = 0;
     for (int a = 0; a < D; ++a) {
       const Neighbours<D> q = neighbours<D>(k, i, a, n, st, per);
@@ -98,15 +133,15 @@ void addConfinement(double epsilon, std::array<Grid<float, D>, D>* f, const MacV
       len2 += eta[a] * eta[a];
     }
     if (!(len2 > 1e-300)) return;
-    const double inv = 1.0 / std::sqrt(len2), s = epsilon * h;
+    const double inv = 1.0 / std::sqrt(len2), sc = epsilon * h;
     const double N[3] = {eta[0] * inv, eta[1] * inv, eta[2] * inv};
     if constexpr (D == 2) {
-      (*f)[0][i] += float(confinementTerm(s, N[1], w[0][i], 0.0, 0.0));
-      (*f)[1][i] += float(confinementTerm(s, 0.0, 0.0, N[0], w[0][i]));
+      f[0][i] += float(confinementTerm(sc, N[1], w[0][i], 0.0, 0.0));
+      f[1][i] += float(confinementTerm(sc, 0.0, 0.0, N[0], w[0][i]));
     } else {
-      (*f)[0][i] += float(confinementTerm(s, N[1], w[2][i], N[2], w[1][i]));
-      (*f)[1][i] += float(confinementTerm(s, N[2], w[0][i], N[0], w[2][i]));
-      (*f)[2][i] += float(confinementTerm(s, N[0], w[1][i], N[1], w[0][i]));
+      f[0][i] += float(confinementTerm(sc, N[1], w[2][i], N[2], w[1][i]));
+      f[1][i] += float(confinementTerm(sc, N[2], w[0][i], N[0], w[2][i]));
+      f[2][i] += float(confinementTerm(sc, N[0], w[1][i], N[1], w[0][i]));
     }
   });
 }
@@ -189,19 +224,19 @@ void emitSmoke(const SmokeSettings& s, const std::vector<Grid<float, D>>& covera
 
 template <int D>
 void applySmokeForces(const SmokeSettings& s, const std::array<double, 3>& up, const Grid<float, D>& density,
-                      const Grid<float, D>& temperature, double dt, MacVelocity<D>* u) {
+                      const Grid<float, D>& temperature, double dt, MacVelocity<D>* u, WorkPool* pool) {
   const bool buoyant = (s.weight != 0.0 || s.heat != 0.0);
-  if (!buoyant && s.vorticity == 0.0) return;
-  const IVec<D>& n = u->cells();
-  std::array<Grid<float, D>, D> f;
-  for (auto& g : f) g = Grid<float, D>(n, 0.0f);
-  if (buoyant)
-    parallelFor(density.size(), [&](size_t i) {
-      const double b = smokeBuoyancy(density[i], temperature[i], s.weight, s.heat, s.ambient);
-      for (int a = 0; a < D; ++a) f[size_t(a)][i] = float(b * up[size_t(a)]);
-    }, 4096);
-  if (s.vorticity != 0.0) addConfinement<D>(s.vorticity, &f, *u);
-  addToFaces<D>(f, dt, u);
+  const bool confined = s.vorticity != 0.0;
+  if (!buoyant && !confined) return;
+  SmokeWork<D> work;
+  work.each([&](Grid<float, D>& g) {
+    pool->lend(&g.values());
+    g.reshape(u->cells());
+  }, confined);
+  if (confined) vorticity<D>(*u, &work);
+  cellForces<D>(s, up, buoyant, density, temperature, *u, &work);
+  addToFaces<D>(work.f, dt, u);
+  work.each([&](Grid<float, D>& g) { pool->give(&g.values()); }, confined);
 }
 
 template <int D>
@@ -225,7 +260,7 @@ void decaySmoke(const SmokeSettings& s, double dt, Grid<float, D>* density, Grid
                              double, double,                                                                      \
                              Grid<float, D>*, Grid<float, D>*, MacVelocity<D>*);                                    \
   template void applySmokeForces<D>(const SmokeSettings&, const std::array<double, 3>&, const Grid<float, D>&,       \
-                                    const Grid<float, D>&, double, MacVelocity<D>*);                                \
+                                    const Grid<float, D>&, double, MacVelocity<D>*, WorkPool*);                     \
   template void decaySmoke<D>(const SmokeSettings&, double, Grid<float, D>*, Grid<float, D>*);
 MORPHOFLOW_SMOKE(2)
 MORPHOFLOW_SMOKE(3)

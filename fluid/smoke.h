@@ -10,6 +10,7 @@
 
 #include "core/grid.h"
 #include "core/mac_velocity.h"
+#include "core/work_pool.h"
 #include "fluid/fluid_settings.h"
 #include "fluid/smoke_settings.h"
 
@@ -38,10 +39,11 @@ template <int D>
 void emitSmoke(const SmokeSettings& s, const std::vector<Grid<float, D>>& coverage, const Grid<uint8_t, D>& solid, double t,
                double dt, Grid<float, D>* density, Grid<float, D>* temperature, MacVelocity<D>* u);
 
-// u += dt f for the buoyancy and the vorticity confinement.
+// u += dt f for the buoyancy and the vorticity confinement, on work grids
+// lent from `pool` for the stage.
 template <int D>
 void applySmokeForces(const SmokeSettings& s, const std::array<double, 3>& up, const Grid<float, D>& density,
-                      const Grid<float, D>& temperature, double dt, MacVelocity<D>* u);
+                      const Grid<float, D>& temperature, double dt, MacVelocity<D>* u, WorkPool* pool);
 
 // The decay of the step, exact: exp(-rate dt) applied once.
 template <int D>
