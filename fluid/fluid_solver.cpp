@@ -45,7 +45,13 @@ FluidSolver<D>::FluidSolver(const FluidSettings& s)
     bool hi = s.boundaries.side(a, true).kind == BoundaryKind::Periodic;
     if (lo != hi) throw std::invalid_argument("a periodic axis must be periodic on both sides");
   }
-  constraints_ = VelocityConstraints<D>(cells_, h_, s.boundaries, solidMask<D>(s.obstacles, cells_, h_));
+  std::vector<ObstacleSpec> voxel;  // the staircase obstacles; the others are cut
+  for (const ObstacleSpec& o : s.obstacles)
+    if (o.boundary == ObstacleBoundary::Voxel) voxel.push_back(o);
+  double size[3] = {0, 0, 0};
+  for (int a = 0; a < D; ++a) size[a] = cells_[a] * h_;
+  constraints_ = VelocityConstraints<D>(cells_, h_, s.boundaries, solidMask<D>(s.obstacles, cells_, h_),
+                                        solidMask<D>(voxel, cells_, h_), CutSurface(s.obstacles, D, size));
   SolverOptions p{s.pressureTolerance, s.pressureMaxIterations};
   projection_ = std::make_unique<PressureProjection<D>>(constraints_, s.pressureSolver, p);
   viscosity_ = std::make_unique<ViscositySolver<D>>(constraints_, SolverOptions{s.viscosityTolerance, 500});

@@ -14,6 +14,7 @@
 #include "fluid/advection.h"
 #include "fluid/fluid_settings.h"
 #include "fluid/pressure_projection.h"
+#include "fluid/surface_forces.h"
 #include "fluid/velocity_constraints.h"
 #include "fluid/viscosity.h"
 
@@ -63,6 +64,11 @@ class FluidSolver {
   Grid<float, D>& temperature() { return temperature_; }
   const Grid<uint8_t, D>& solid() const { return constraints_.solid; }
   const VelocityConstraints<D>& constraints() const { return constraints_; }
+  // The cut obstacles' surface, one element per cut cell (made on first use).
+  const std::vector<SurfaceElement>& cutSurface() const {
+    if (!cutSurfaceMade_) cutSurface_ = cutSurfaceElements<D>(constraints_), cutSurfaceMade_ = true;
+    return cutSurface_;
+  }
   Grid<float, D> pressure() const { return projection_->pressure(); }
   const FluidStepStats& lastStats() const { return stats_; }
   PressureProjection<D>& projection() { return *projection_; }
@@ -95,6 +101,8 @@ class FluidSolver {
   Grid<float, D> dyeScratch_;
   Grid<float, D> temperature_;                    // [smoke] only
   std::vector<Grid<float, D>> sourceCoverage_;    // per smoke source
+  mutable std::vector<SurfaceElement> cutSurface_;
+  mutable bool cutSurfaceMade_ = false;
   AdvectionScratch<D> advectionScratch_;
   WorkPool pool_;  // the stages' work vectors, lent to each in turn
   double time_ = 0.0;

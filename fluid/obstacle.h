@@ -1,5 +1,7 @@
 // Solid obstacles: analytic shapes, or masks from an image or a signed
-// distance field. Cells whose centre lies inside are solid (no-slip).
+// distance field. Cells whose centre lies inside are solid (no-slip); the
+// fluid sees a "cut" obstacle's own surface (fluid/cut_cells.h), a "voxel"
+// one's staircase of solid cells.
 #pragma once
 
 #include <array>
@@ -11,6 +13,11 @@
 namespace morphoflow {
 
 enum class ObstacleShape { Circle, Sphere, Box, Image, Sdf };
+// How the fluid's pressure and viscosity meet the obstacle: at its surface
+// through the open fractions of the cut faces (Batty, Bertails & Bridson
+// 2007) and the distance to it (Gibou et al. 2002), or at the faces of the
+// cells whose centre lies inside (the staircase).
+enum class ObstacleBoundary { Cut, Voxel };
 
 struct ObstacleSpec {
   ObstacleShape shape = ObstacleShape::Circle;
@@ -24,6 +31,7 @@ struct ObstacleSpec {
   std::vector<float> field;
   double threshold = 0.5;
   bool invert = false;  // image: solid where value <= threshold
+  ObstacleBoundary boundary = ObstacleBoundary::Cut;  // obstacles only (sources ignore it)
 };
 
 // Signed distance (negative inside) of the obstacle at a world position.

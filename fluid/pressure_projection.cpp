@@ -11,15 +11,22 @@ template <int D>
 LaplaceSystem<D> pressureSystem(const VelocityConstraints<D>& vc) {
   const IVec<D>& n = vc.cells;
   LaplaceSystem<D> A(n, vc.periodic(), 1.0 / (vc.h * vc.h));
+  // Each face weighs its open fraction (Batty et al. 2007 eq. 9): 1 between
+  // two fluid cells, 0 at a staircase solid or inside a cut one.
   forEachCell<D>(n, [&](const IVec<D>& k, size_t i) {
-    if (vc.solid[i]) return;
+    bool fluid = false;  // any open face: the cell holds fluid and a pressure
     for (int a = 0; a < D; ++a) {
-      IVec<D> up = k + unitVector<D>(a);
-      if (up[a] == n[a]) up[a] = 0;  // wraps on periodic axes; zeroed by finalize otherwise
-      if (!vc.solid(up)) A.w[a].at(i) = 1.0f;
+      const IVec<D> up = k + unitVector<D>(a);  // the face between k and k + e_a
+      const float w = vc.open[a](up), below = vc.open[a](k);
+      A.w[a].at(i) = w;  // wraps on periodic axes; zeroed by finalize on the domain's sides
+      fluid = fluid || w > 0.0f || below > 0.0f;
+    }
+    if (!fluid) return;
+    for (int a = 0; a < D; ++a) {
       // p = 0 on an outflow side, through a ghost cell mirrored about the face.
-      if (k[a] == 0 && vc.boundaries.side(a, false).kind == BoundaryKind::Outflow) A.c.at(i) += 2.0f;
-      if (k[a] == n[a] - 1 && vc.boundaries.side(a, true).kind == BoundaryKind::Outflow) A.c.at(i) += 2.0f;
+      if (k[a] == 0 && vc.boundaries.side(a, false).kind == BoundaryKind::Outflow) A.c.at(i) += 2.0f * vc.open[a](k);
+      if (k[a] == n[a] - 1 && vc.boundaries.side(a, true).kind == BoundaryKind::Outflow)
+        A.c.at(i) += 2.0f * vc.open[a](k + unitVector<D>(a));
     }
   });
   A.finalize();
@@ -59,8 +66,12 @@ void PressureProjection<D>::divergenceTimes(const MacVelocity<D>& u, double fact
     }
     const float* lo[D];
     const float* hi[D];
+    const float* openLo[D];  // the faces' open fractions (Batty et al. 2007: the flux through the fluid part)
+    const float* openHi[D];
     lo[0] = u[0].data() + row * (nx + 1);
     hi[0] = lo[0] + 1;
+    openLo[0] = vc_.open[0].row(row);
+    openHi[0] = openLo[0] + 1;
     for (int a = 1; a < D; ++a) {
       // u_a's grid has n_a + 1 layers along a: its row index of (k_1, k_2).
       size_t r = 0;
@@ -68,13 +79,15 @@ void PressureProjection<D>::divergenceTimes(const MacVelocity<D>& u, double fact
       const size_t layer = a == 1 ? 1 : size_t(n[1]);  // rows between layers k_a and k_a + 1
       lo[a] = u[a].data() + r * nx;
       hi[a] = lo[a] + layer * nx;
+      openLo[a] = vc_.open[a].row(r);
+      openHi[a] = vc_.open[a].row(r + layer);
     }
-    const uint8_t* solid = vc_.solid.data() + row * nx;
+    const float* active = A_.diag.row(row);
     double* out = div->data() + row * nx;
     for (size_t x = 0; x < nx; ++x) {
       double d = 0.0;
-      for (int a = 0; a < D; ++a) d += double(hi[a][x]) - double(lo[a][x]);
-      out[x] = solid[x] ? 0.0 : d * factor;
+      for (int a = 0; a < D; ++a) d += double(openHi[a][x]) * double(hi[a][x]) - double(openLo[a][x]) * double(lo[a][x]);
+      out[x] = active[x] == 0.0f ? 0.0 : d * factor;
     }
   });
 }

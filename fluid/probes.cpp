@@ -42,18 +42,28 @@ Profile centerlineProfile(const FluidSolver<D>& f, int component, int along, dou
 template <int D>
 std::array<double, 3> obstacleForce(const FluidSolver<D>& f) {
   std::array<double, 3> force{0, 0, 0};
+  const VelocityConstraints<D>& vc = f.constraints();
   const Grid<uint8_t, D>& solid = f.solid();
   const Grid<float, D> p = f.pressure();
   const IVec<D>& n = f.cells();
   const double h = f.h();
   const double area = std::pow(h, D - 1);
   const double mu = f.settings().density * f.settings().viscosity;
+  // The staircase obstacles' cells (the cut ones' surface is integrated below).
+  auto staircase = [&](size_t i) {
+    if (!solid[i]) return false;
+    if (vc.cut.empty()) return true;
+    const IVec<D> k = solid.coord(i);
+    double c[3] = {0, 0, 0};
+    for (int a = 0; a < D; ++a) c[a] = (k[a] + 0.5) * h;
+    return !(vc.cut.distance(c) < 0.0);
+  };
   for (int a = 0; a < D; ++a) {
     for (int dir = -1; dir <= 1; dir += 2) {
       // Each component summed deterministically over the solid cells.
       for (int b = 0; b < D; ++b) {
         force[size_t(b)] += deterministicSum(solid.size(), [&](size_t i) -> double {
-          if (!solid[i]) return 0.0;
+          if (!staircase(i)) return 0.0;
           IVec<D> s = solid.coord(i);
           IVec<D> fl = s;
           fl[a] += dir;
@@ -65,6 +75,8 @@ std::array<double, 3> obstacleForce(const FluidSolver<D>& f) {
       }
     }
   }
+  const std::array<double, 3> cut = surfaceForce<D>(f.cutSurface(), f.velocity(), p, mu);
+  for (int b = 0; b < 3; ++b) force[size_t(b)] += cut[size_t(b)];
   return force;
 }
 

@@ -20,9 +20,11 @@ struct Profile {
 template <int D>
 Profile centerlineProfile(const FluidSolver<D>& fluid, int component, int along, double referenceSpeed);
 
-// Force the fluid exerts on all solid cells: pressure on each exposed face
-// plus viscous shear from the adjacent tangential velocity (no-slip wall half
-// a cell away). Returns the D components (3rd is 0 in 2D).
+// Force the fluid exerts on the obstacles: on a staircase (voxel) obstacle's
+// cells, pressure on each exposed face plus viscous shear from the adjacent
+// tangential velocity (no-slip wall half a cell away); on a cut obstacle,
+// the traction integrated on its surface (fluid/surface_forces.h). Returns
+// the D components (3rd is 0 in 2D).
 template <int D>
 std::array<double, 3> obstacleForce(const FluidSolver<D>& fluid);
 

@@ -9,10 +9,17 @@ namespace morphoflow {
 template <int D>
 VelocityConstraints<D>::VelocityConstraints(const IVec<D>& c, double hh, const DomainBoundaries& b,
                                             const Grid<uint8_t, D>& s)
-    : cells(c), h(hh), boundaries(b), solid(s) {
+    : VelocityConstraints(c, hh, b, s, s, CutSurface()) {}
+
+template <int D>
+VelocityConstraints<D>::VelocityConstraints(const IVec<D>& c, double hh, const DomainBoundaries& b,
+                                            const Grid<uint8_t, D>& s, const Grid<uint8_t, D>& voxel,
+                                            const CutSurface& cutSurface)
+    : cells(c), h(hh), boundaries(b), solid(s), cut(cutSurface) {
   for (int a = 0; a < D; ++a) {
     IVec<D> fd = cells + unitVector<D>(a);
     fixed[a] = Grid<uint8_t, D>(fd, 0);
+    open[a] = RowField<D>(fd, 1.0f);
     Grid<float, D> value(fd, 0.0f);
     Layout<D> layout = Layout<D>::face(a, h, cells, periodic());
     forEachCell<D>(fd, [&](const IVec<D>& k, size_t i) {
@@ -28,17 +35,23 @@ VelocityConstraints<D>::VelocityConstraints(const IVec<D>& c, double hh, const D
           value[i] = float(high ? -speed : speed);
         }
       }
-      // A face touching a solid cell is held at the obstacle's (zero) velocity.
+      // A face touching a staircase solid cell, or wholly inside a cut
+      // obstacle, is held at the obstacle's (zero) velocity.
       IVec<D> lo = k - unitVector<D>(a);
       if (boundaries.periodic(a) && lo[a] < 0) lo[a] += cells[a];
       IVec<D> hi = k;
       if (boundaries.periodic(a) && hi[a] >= cells[a]) hi[a] -= cells[a];
-      bool solidLo = lo[a] >= 0 && solid(lo), solidHi = hi[a] < cells[a] && solid(hi);
-      if (solidLo || solidHi) {
+      bool solidLo = lo[a] >= 0 && voxel(lo), solidHi = hi[a] < cells[a] && voxel(hi);
+      IVec<D> same = k;  // on a periodic axis face n is face 0
+      if (boundaries.periodic(a) && same[a] == cells[a]) same[a] = 0;
+      float o = solidLo || solidHi ? 0.0f : cut.empty() ? 1.0f : openFraction<D>(cut, a, same, h);
+      open[a].at(i) = o;
+      if (o == 0.0f) {
         fixed[a][i] = 1;
         value[i] = 0.0f;
       }
     });
+    open[a].compact();
     for (size_t i = 0; i < fixed[a].size(); ++i)
       if (fixed[a][i]) {
         fixedFaces[a].push_back(i);
@@ -66,6 +79,18 @@ double VelocityConstraints<D>::inflowSpeed(int axis, const Vec<D>& x) const {
     u *= 1.5 * 4.0 * s * (1.0 - s);
   }
   return u;
+}
+
+template <int D>
+std::array<double, 3> VelocityConstraints<D>::facePosition(int a, const IVec<D>& k) const {
+  std::array<double, 3> x{0, 0, 0};
+  for (int b = 0; b < D; ++b) x[size_t(b)] = (k[b] + (b == a ? 0.0 : 0.5)) * h;
+  return x;
+}
+
+template <int D>
+bool VelocityConstraints<D>::insideCut(int a, const IVec<D>& k) const {
+  return !cut.empty() && cut.distance(facePosition(a, k).data()) < 0.0;
 }
 
 template <int D>

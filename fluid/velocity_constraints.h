@@ -1,12 +1,15 @@
 // Which velocity faces are prescribed (walls, inflow, solid obstacles) and to
-// what value; the tangential wall velocities that no-slip ghosts reflect.
-// Built once per scene from the domain sides and the solid mask.
+// what value; the tangential wall velocities that no-slip ghosts reflect;
+// the open fraction of every face (fluid/cut_cells.h). Built once per scene
+// from the domain sides, the solid masks and the cut obstacles' surface.
 #pragma once
 
 #include <array>
 #include <vector>
 
 #include "core/mac_velocity.h"
+#include "core/row_field.h"
+#include "fluid/cut_cells.h"
 #include "fluid/domain_boundary.h"
 
 namespace morphoflow {
@@ -16,8 +19,14 @@ struct VelocityConstraints {
   IVec<D> cells{0};
   double h = 1.0;
   DomainBoundaries boundaries;
-  Grid<uint8_t, D> solid;                   // cell flags
+  Grid<uint8_t, D> solid;                   // cell flags: the centre lies inside an obstacle
   std::array<Grid<uint8_t, D>, D> fixed;    // per face grid: 1 = prescribed
+  // Per face grid, the face's open fraction: 0 on a face of a staircase
+  // (voxel) solid cell and on a face wholly inside a cut obstacle, the
+  // fluid part of a face a cut obstacle crosses, 1 elsewhere (the domain's
+  // sides too). The pressure projection weighs the faces by it.
+  std::array<RowField<D>, D> open;
+  CutSurface cut;  // the cut obstacles' surface (empty: none)
   // The indices of each grid's prescribed faces, ascending, and their
   // values: apply() visits these only, not the whole grid (a cavity
   // prescribes about 1 face in 20 at 128^3, and apply() runs several times
@@ -26,8 +35,12 @@ struct VelocityConstraints {
   std::array<std::vector<float>, D> fixedValues;
 
   VelocityConstraints() = default;
-  VelocityConstraints(const IVec<D>& cells, double h, const DomainBoundaries& b,
-                      const Grid<uint8_t, D>& solid);
+  // `voxel`: the cells of the staircase obstacles (their faces are
+  // prescribed); `cut`: the surface of the others. Without them every solid
+  // cell is a staircase one.
+  VelocityConstraints(const IVec<D>& cells, double h, const DomainBoundaries& b, const Grid<uint8_t, D>& solid);
+  VelocityConstraints(const IVec<D>& cells, double h, const DomainBoundaries& b, const Grid<uint8_t, D>& solid,
+                      const Grid<uint8_t, D>& voxel, const CutSurface& cut);
 
   std::array<bool, D> periodic() const;
   // Sets every prescribed face and copies face 0 onto face n on periodic axes.
@@ -38,6 +51,12 @@ struct VelocityConstraints {
   std::vector<float> prescribedGrid(int a) const;
   // Inflow normal speed (into the domain) at a position on the inflow side.
   double inflowSpeed(int axis, const Vec<D>& x) const;
+  // The world position of face k of grid a.
+  std::array<double, 3> facePosition(int a, const IVec<D>& k) const;
+  // Whether face k of grid a lies inside a cut obstacle: free for the
+  // projection where its open fraction is positive, but held at the
+  // obstacle's velocity by the viscosity, whose no-slip is at the surface.
+  bool insideCut(int a, const IVec<D>& k) const;
 };
 
 }  // namespace morphoflow

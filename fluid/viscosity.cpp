@@ -19,9 +19,18 @@ ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
   C.A = LaplaceSystem<D>(C.dims, periodic, 1.0);
   C.cBoundary = RowField<D>(C.dims, 0.0f);
   C.boundaryRhs = RowField<D>(C.dims, 0.0f);
+  // With cut obstacles, the distance to them at every face of the grid.
+  const bool cut = !vc.cut.empty();
+  Grid<float, D> phi;
+  if (cut) {
+    phi = Grid<float, D>(fixed.dims(), 0.0f);
+    forEachCell<D>(fixed.dims(), [&](const IVec<D>& k, size_t i) { phi[i] = float(vc.cut.distance(vc.facePosition(a, k).data())); });
+    C.insideCut.assign(C.A.size(), 0);
+  }
   forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) {
     size_t gi = fixed.index(k);
-    if (fixed[gi]) {
+    if (fixed[gi] || (cut && phi[gi] < 0.0f)) {
+      if (!fixed[gi]) C.insideCut[i] = 1;
       C.cBoundary.at(i) = -1.0f;
       return;
     }
@@ -45,7 +54,11 @@ ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
           }
         }
         size_t ni = fixed.index(nb);
-        if (fixed[ni]) {
+        if (cut && phi[ni] < 0.0f) {
+          // Gibou et al. 2002: the obstacle's (zero) velocity at the surface,
+          // a fraction theta of the way to the neighbour.
+          c += 1.0 / cutTheta(phi[gi], phi[ni]);
+        } else if (fixed[ni]) {
           c += 1.0;
           extra += double(vc.prescribed(a, ni));
         } else if (dir > 0) {
@@ -53,7 +66,7 @@ ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
         }
       }
     }
-    C.cBoundary.at(i) = float(c);  // whole: 2 per wall ghost, 1 per prescribed neighbour
+    C.cBoundary.at(i) = float(c);  // whole: 2 per wall ghost, 1 per prescribed neighbour, 1/theta per cut one
     C.boundaryRhs.at(i) = float(extra);
   });
   C.cBoundary.compact();
@@ -112,7 +125,7 @@ double ViscositySolver<D>::rightHandSide(const MacVelocity<D>& u, int a, double 
   eachUnknownRow<D>(C.dims, g, [&](size_t row, size_t i0, size_t g0) {
     const float* rhs = C.boundaryRhs.row(row);
     for (size_t x = 0; x < size_t(C.dims[0]); ++x)
-      b_[i0 + x] = fixed[g0 + x] ? 0.0 : double(g[g0 + x]) + s * double(rhs[x]);
+      b_[i0 + x] = C.held(fixed, i0 + x, g0 + x) ? 0.0 : double(g[g0 + x]) + s * double(rhs[x]);
   });
   return dot(b_, b_);
 }
@@ -177,7 +190,7 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
     x_.resize(C.A.size());
     eachUnknown<D>(C.dims, g, [&](size_t i, size_t gi) {
       const double rate = history >= 1 ? double(C.rate[i]) + (history >= 2 ? double(fromBfloat16(C.change[i])) : 0.0) : 0.0;
-      x_[i] = fixed[gi] ? 0.0 : double(g[gi]) + s * rate;
+      x_[i] = C.held(fixed, i, gi) ? 0.0 : double(g[gi]) + s * rate;
     });
     SolverOptions options = options_;
     if (ba > 0.0) options.tolerance = options_.tolerance * std::sqrt(0.5 * (ba + bAll / D) / ba);
@@ -192,10 +205,11 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
     C.change.resize(C.A.size());
     const double invS = 1.0 / s;
     eachUnknown<D>(C.dims, g, [&](size_t i, size_t gi) {
-      const float next = fixed[gi] ? 0.0f : float((x_[i] - double(g[gi])) * invS);
+      const bool held = C.held(fixed, i, gi);
+      const float next = held ? 0.0f : float((x_[i] - double(g[gi])) * invS);
       C.change[i] = toBfloat16(next - rate[i]);
       rate[i] = next;
-      if (!fixed[gi]) g[gi] = float(x_[i]);
+      if (!held) g[gi] = float(x_[i]);
     });
     C.history = std::min(C.history + 1, 2);
   }

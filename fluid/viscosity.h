@@ -41,8 +41,16 @@ struct ViscousSystem {
   // next to walls and prescribed faces):
   RowField<D> cBoundary;    // diagonal terms from walls and prescribed neighbours; -1 on a prescribed face (inactive)
   RowField<D> boundaryRhs;  // their prescribed values, times the coupling
+  // With cut obstacles: 1 on a face inside one, which the viscosity leaves
+  // as the projection made it (its no-slip is at the surface, where the
+  // neighbours' stencils put it); empty without cut obstacles.
+  std::vector<uint8_t> insideCut;
   // A for s = nu dt / h^2: c = 1/s + boundary terms, 0 on prescribed faces.
   void setRate(double s);
+  // Whether unknown i is held by the viscosity (prescribed face gi, or inside a cut obstacle).
+  bool held(const Grid<uint8_t, D>& fixed, size_t i, size_t gi) const {
+    return fixed[gi] || (!insideCut.empty() && insideCut[i]);
+  }
 };
 template <int D>
 ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& constraints, int axis);

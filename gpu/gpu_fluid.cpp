@@ -56,15 +56,17 @@ GpuFluid<D>::GpuFluid(const FluidSettings& s, const VelocityConstraints<D>& vc) 
     cellCount_ *= size_t(vc.cells[a]);
   }
   std::vector<uint32_t> fixed;
-  std::vector<float> value;
+  std::vector<float> value, open;
   for (int a = 0; a < D; ++a) {
     off_[size_t(a)] = faceCount_;
     faceCount_ += faces(a);
     maxGrid_ = std::max(maxGrid_, faces(a));
     fixed.insert(fixed.end(), vc.fixed[a].values().begin(), vc.fixed[a].values().end());
-    const std::vector<float> v = vc.prescribedGrid(a);
+    const std::vector<float> v = vc.prescribedGrid(a), o = vc.open[a].expanded();
     value.insert(value.end(), v.begin(), v.end());
+    open.insert(open.end(), o.begin(), o.end());
   }
+  open_ = GpuBuffer::of(open);
   vel_ = GpuBuffer(faceCount_ * sizeof(float));
   velScratch_ = GpuBuffer(faceCount_ * sizeof(float));
   vel_.zero();
@@ -78,6 +80,10 @@ GpuFluid<D>::GpuFluid(const FluidSettings& s, const VelocityConstraints<D>& vc) 
   for (GpuBuffer* b : {&lo_, &hi_, &back_, &fwd_}) *b = GpuBuffer(maxGrid_ * sizeof(float));
   // The pressure: the CPU's system and multigrid levels, uploaded once.
   const LaplaceSystem<D> P = pressureSystem<D>(vc);
+  const std::vector<float> diag = P.diag.expanded();
+  std::vector<uint32_t> inactive(diag.size());
+  for (size_t i = 0; i < diag.size(); ++i) inactive[i] = diag[i] == 0.0f ? 1u : 0u;
+  inactive_ = GpuBuffer::of(inactive);
   pressure_ = std::make_unique<GpuLaplace>(P);
   multigrid_ = std::make_unique<GpuMultigrid>(Multigrid<D>(P), *pressure_, MultigridOptions{});
   pressurePcg_ = std::make_unique<GpuPcg>(*pressure_);
@@ -94,6 +100,15 @@ GpuFluid<D>::GpuFluid(const FluidSettings& s, const VelocityConstraints<D>& vc) 
     const std::vector<float> rhs = v->host.boundaryRhs.expanded();  // the shader reads doubles
     v->boundaryRhs = GpuBuffer::of(std::vector<double>(rhs.begin(), rhs.end()));
     viscous_[size_t(a)] = std::move(v);
+  }
+  if (!vc.cut.empty()) {  // the viscosity holds the faces inside cut obstacles too
+    std::vector<uint32_t> held(fixed);
+    for (int a = 0; a < D; ++a) {
+      const ViscousSystem<D>& V = viscous_[size_t(a)]->host;
+      for (size_t i = 0; i < V.insideCut.size(); ++i)
+        if (V.insideCut[i]) held[off_[size_t(a)] + vc.fixed[a].index(latticeCoord<D>(V.dims, i))] = 1u;
+    }
+    viscousHeld_ = GpuBuffer::of(held);
   }
   dyeActive_ = s.inflowDyeStripes > 0 || s.smoke.enabled;
   if (s.smoke.enabled) {
@@ -121,8 +136,8 @@ size_t GpuFluid<D>::deviceBytes(const IVec<D>& cells) {
   }
   const double system = (D + 1) * 4.0;       // face weights and diagonal, float
   const double coarse = 1.0 / ((1 << D) - 1);  // the multigrid levels below the fine one, relative to it
-  const double bytes = 4.0 * 4 * double(f)     // u, its scratch, fixed flags, prescribed values
-                       + 3.0 * 4 * double(c) + 4.0 * 4 * double(g)  // dye, its scratch, solid; the schemes' scratch
+  const double bytes = 4.0 * 6 * double(f)     // u, its scratch, fixed flags, prescribed values, open fractions, held flags
+                       + 4.0 * 4 * double(c) + 4.0 * 4 * double(g)  // dye, its scratch, solid, inactive; the schemes' scratch
                        + double(c) * (system + 3 * 8 + 4 * 8 + 3 * 4 + coarse * (system + 3 * 4))  // pressure
                        + double(f) * (system + 3 * 8 + 4 * 8);  // viscosity: system, b, x, rhs, PCG vectors
   return size_t(bytes);
@@ -382,7 +397,7 @@ void GpuFluid<D>::diffuse(double dt) {
       setUniform(p, "velOff", velocityOffsets());
       setUniform(p, "s", s);
       vel_.bind(0);
-      fixed_.bind(1);
+      (viscousHeld_.bytes() ? viscousHeld_ : fixed_).bind(1);
       V.b.bind(7);
       V.x.bind(8);
       V.boundaryRhs.bind(9);
@@ -407,7 +422,8 @@ void GpuFluid<D>::diffuse(double dt) {
 template <int D>
 void GpuFluid<D>::project(double dt) {
   auto run = [&](FluidOp mode, int axis, size_t n) {
-    const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, mode));
+    const bool cut = mode == FluidOp::Divergence && viscousHeld_.bytes() > 0;  // (made for cut obstacles only)
+    const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, mode) + (cut ? "\n#define CUT_FACES" : ""));
     setUniform(p, "cells", cells_);
     setUniform(p, "periodic", periodic_);
     setUniform(p, "axis", axis);
@@ -421,8 +437,9 @@ void GpuFluid<D>::project(double dt) {
     fixed_.bind(1);
     (mode == FluidOp::Divergence ? rhs_ : phi_).bind(7);
     ratePrev_.bind(8);
-    solid_.bind(10);
-    dispatchFlat(n, mode == FluidOp::Divergence ? 8.0 * D + 12.0 : 32.0);
+    inactive_.bind(10);
+    open_.bind(12);
+    dispatchFlat(n, mode == FluidOp::Divergence ? 12.0 * D + 12.0 : 32.0);
     storageBarrier();
   };
   run(FluidOp::Divergence, 0, cellCount_);

@@ -111,6 +111,10 @@ class GpuFluid final : public FluidStepper<D> {
   double h_ = 1.0;
   bool dyeActive_ = false;
   GpuBuffer vel_, velScratch_, fixed_, value_, dye_, dyeScratch_, solid_;
+  // The faces' open fractions and the cells without a pressure (the
+  // projection's weights: fluid/cut_cells.h); with cut obstacles, the
+  // viscosity's held faces (prescribed, or inside a cut obstacle).
+  GpuBuffer open_, inactive_, viscousHeld_;
   GpuBuffer lo_, hi_, back_, fwd_;  // the second-order schemes' scratch
   // [smoke]: the temperature, each source's cover, the forces' work vectors
   GpuBuffer temp_, tempScratch_, force_, centre_, omega_;

@@ -70,8 +70,15 @@ const toml::array* tableArray(Reader& r, toml::table& root, const std::string& n
 
 void parseObstacles(SceneContext& c, Scene* s) {
   if (const toml::array* arr = tableArray(c.r, c.root, "obstacles"))
-    for (size_t i = 0; i < arr->size(); ++i)
-      s->fluid.obstacles.push_back(parseRegion(c, arr->get(i)->as_table(), "obstacles." + std::to_string(i) + "."));
+    for (size_t i = 0; i < arr->size(); ++i) {
+      const toml::table* o = arr->get(i)->as_table();
+      const std::string p = "obstacles." + std::to_string(i) + ".";
+      ObstacleSpec spec = parseRegion(c, o, p);
+      // Where the fluid meets it: its own surface (cut cells) or its cells' staircase.
+      spec.boundary = c.r.string(o, p, "boundary", "cut", {"cut", "voxel"}) == "voxel" ? ObstacleBoundary::Voxel
+                                                                                    : ObstacleBoundary::Cut;
+      s->fluid.obstacles.push_back(std::move(spec));
+    }
 }
 
 }  // namespace morphoflow

@@ -176,11 +176,12 @@ void FluidSimulation<D>::report(nlohmann::json* j) const {
   if (!pr.forces) return;
   const double start = pr.strouhalStart >= 0 ? pr.strouhalStart : 0.5 * time();
   const StrouhalEstimate st = estimateStrouhal(forceTime_, lift_, start, pr.referenceLength, pr.referenceSpeed);
-  double cdMean = 0;
+  double cdMean = 0, clMean = 0;
   int n = 0;
   for (size_t i = 0; i < drag_.size(); ++i)
     if (forceTime_[i] >= start) {
       cdMean += drag_[i];
+      clMean += lift_[i];
       ++n;
     }
   (*j)["strouhal"] = st.periods > 0 ? nlohmann::json(st.strouhal) : nlohmann::json(nullptr);
@@ -189,6 +190,7 @@ void FluidSimulation<D>::report(nlohmann::json* j) const {
                   {"period_strouhal", st.periodStrouhal},
                   {"measured_from_time", start}};
   (*j)["drag_coefficient_mean"] = n ? cdMean / n : 0.0;
+  (*j)["lift_coefficient_mean"] = n ? clMean / n : 0.0;
 }
 
 namespace {

@@ -37,16 +37,20 @@ FluidSettings box(std::vector<int> res, bool obstacle, bool channel, PressureSol
 }
 
 // The cell divergence written plainly (each face through the grid's
-// coordinates), 0 on solid cells: the reference for the projection's own.
+// coordinates, weighed by its open fraction: the cut obstacle's), 0 in cells
+// without a pressure: the reference for the projection's own.
 template <int D>
 Vector plainDivergence(FluidSolver<D>& f) {
   const MacVelocity<D>& u = f.velocity();
   const VelocityConstraints<D>& vc = f.constraints();
   Vector div(vc.solid.size(), 0.0);
   forEachCell<D>(vc.cells, [&](const IVec<D>& k, size_t i) {
-    if (vc.solid[i]) return;
+    if (f.projection().system().diag[i] == 0.0f) return;
     double d = 0.0;
-    for (int a = 0; a < D; ++a) d += double(u[a](k + unitVector<D>(a))) - double(u[a](k));
+    for (int a = 0; a < D; ++a) {
+      const IVec<D> up = k + unitVector<D>(a);
+      d += double(vc.open[a](up)) * double(u[a](up)) - double(vc.open[a](k)) * double(u[a](k));
+    }
     div[i] = d / vc.h;
   });
   return div;

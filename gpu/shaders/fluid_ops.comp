@@ -8,11 +8,12 @@
 // MODE_BFECC_CORRECT    dst = src + (src - back) / 2                    (Kim et al. 2005)
 // MODE_BFECC_LIMIT      dst = back (first order) where dst leaves [lo, hi]
 // MODE_INFLOW_DYE       dye stripes on the inflow side's cells
-// MODE_DIVERGENCE       rhs = -(div u) / h, 0 in solids (double)        (pressure_projection.cpp)
+// MODE_DIVERGENCE       rhs = -(div u) / h through the faces' open fractions, 0 in cells
+//                       without a pressure (double)                     (pressure_projection.cpp)
 // MODE_WARM_START       phi = dt (2 rate - rate_prev) (or dt rate), rate = phi / last dt
 // MODE_GRADIENT         u_a -= d phi / d x_a on free faces (outflow: ghost phi = -phi)
 // MODE_VISCOUS_SETUP    b, x of component a's implicit viscous system   (viscosity.cpp)
-// MODE_VISCOUS_STORE    u_a = x on free faces
+// MODE_VISCOUS_STORE    u_a = x on free faces (not prescribed, nor inside a cut obstacle)
 layout(std430, binding = 0) buffer Vel { float vel[]; };
 layout(std430, binding = 1) readonly buffer Fixed { uint fixedFace[]; };
 layout(std430, binding = 2) readonly buffer Value { float value[]; };
@@ -25,6 +26,7 @@ layout(std430, binding = 8) buffer D1 { double d1[]; };  // rate_prev / x / boun
 layout(std430, binding = 9) buffer D2 { double d2[]; };  // boundary rhs
 layout(std430, binding = 10) readonly buffer Solid { uint solid[]; };
 layout(std430, binding = 11) buffer F4 { float f4[]; };  // hi
+layout(std430, binding = 12) readonly buffer Open { float open[]; };  // the faces' open fractions
 
 uniform ivec3 cells, periodic, velOff;
 uniform int axis;           // the velocity component a
@@ -82,9 +84,14 @@ void main() {
     ivec3 fd = cells, up = k;
     fd[a] += 1;
     up[a] += 1;
-    d += double(vel[velOff[a] + indexOf(up, fd)]) - double(vel[velOff[a] + indexOf(k, fd)]);
+    const int hi = velOff[a] + indexOf(up, fd), lo = velOff[a] + indexOf(k, fd);
+#if defined(CUT_FACES)  // a cut obstacle's faces: the flux through their open part
+    d += double(open[hi]) * double(vel[hi]) - double(open[lo]) * double(vel[lo]);
+#else
+    d += double(vel[hi]) - double(vel[lo]);
+#endif
   }
-  d0[i] = solid[i] != 0u ? 0.0lf : d * -invH;
+  d0[i] = solid[i] != 0u ? 0.0lf : d * -invH;  // (solid: the cells without a pressure)
 #elif defined(MODE_WARM_START)  // d0 = phi, d1 = rate_prev
   const double rate = d0[i] / lastDt;
   d0[i] = dt * (extrapolate ? 2.0lf * rate - d1[i] : rate);
@@ -118,6 +125,6 @@ void main() {
   d1[i] = held ? 0.0lf : u;
 #elif defined(MODE_VISCOUS_STORE)  // d1 = x
   const int gi = indexOf(coordsOf(i, udims), faceDims());
-  if (fixedFace[velOff[axis] + gi] == 0u) vel[velOff[axis] + gi] = float(d1[i]);
+  if (fixedFace[velOff[axis] + gi] == 0u) vel[velOff[axis] + gi] = float(d1[i]);  // (or the viscosity's held flags)
 #endif
 }

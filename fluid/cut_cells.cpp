@@ -1,0 +1,71 @@
+#include "fluid/cut_cells.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace morphoflow {
+
+CutSurface::CutSurface(const std::vector<ObstacleSpec>& obstacles, int dims, const double* domainSize) : dims_(dims) {
+  for (const ObstacleSpec& o : obstacles)
+    if (o.boundary == ObstacleBoundary::Cut) obstacles_.push_back(o);
+  for (int a = 0; a < dims; ++a) size_[a] = domainSize[a];
+}
+
+double CutSurface::distance(const double* x) const {
+  double d = std::numeric_limits<double>::infinity();
+  for (const ObstacleSpec& o : obstacles_) d = std::min(d, obstacleDistance(o, x, dims_, size_));
+  return d;
+}
+
+namespace {
+
+// The fluid part (distance > 0: a face on the surface is closed) of the
+// segment whose ends have distances a and b.
+double segmentOpen(double a, double b) {
+  if (a > 0.0 && b > 0.0) return 1.0;
+  if (a <= 0.0 && b <= 0.0) return 0.0;
+  return std::max(a, b) / std::abs(a - b);
+}
+
+}  // namespace
+
+template <int D>
+float openFraction(const CutSurface& surface, int axis, const IVec<D>& k, double h) {
+  double c[3] = {0, 0, 0};  // the face's centre
+  for (int b = 0; b < D; ++b) c[b] = (k[b] + (b == axis ? 0.0 : 0.5)) * h;
+  const double centre = surface.distance(c);
+  // Farther than the face's half diagonal from the surface: wholly on one side.
+  if (std::abs(centre) > 0.5 * h * std::sqrt(double(D - 1)) + 1e-12 * h) return centre > 0.0 ? 1.0f : 0.0f;
+  int t[2] = {0, 0}, m = 0;  // the face's two tangent axes
+  for (int b = 0; b < D; ++b)
+    if (b != axis) t[m++] = b;
+  auto at = [&](double s, double r) {  // distance at face-local (s, r) in [0, 1]^2
+    double x[3] = {c[0], c[1], c[2]};
+    x[t[0]] += (s - 0.5) * h;
+    if (D == 3) x[t[1]] += (r - 0.5) * h;
+    return surface.distance(x);
+  };
+  if constexpr (D == 2) return float(segmentOpen(at(0.0, 0.0), at(1.0, 0.0)));
+  // 3D: 4 x 4 sub-squares, each's bilinear interpolant of its corners sampled 4 x 4.
+  constexpr int kSub = 4, kSamples = 4;
+  double phi[kSub + 1][kSub + 1];
+  for (int i = 0; i <= kSub; ++i)
+    for (int j = 0; j <= kSub; ++j) phi[i][j] = at(double(i) / kSub, double(j) / kSub);
+  int open = 0;
+  for (int i = 0; i < kSub; ++i)
+    for (int j = 0; j < kSub; ++j)
+      for (int p = 0; p < kSamples; ++p)
+        for (int q = 0; q < kSamples; ++q) {
+          const double u = (p + 0.5) / kSamples, v = (q + 0.5) / kSamples;
+          const double value = (1 - u) * (1 - v) * phi[i][j] + u * (1 - v) * phi[i + 1][j] + (1 - u) * v * phi[i][j + 1] +
+                               u * v * phi[i + 1][j + 1];
+          open += value > 0.0 ? 1 : 0;
+        }
+  return float(double(open) / double(kSub * kSub * kSamples * kSamples));
+}
+
+template float openFraction<2>(const CutSurface&, int, const IVec<2>&, double);
+template float openFraction<3>(const CutSurface&, int, const IVec<3>&, double);
+
+}  // namespace morphoflow
