@@ -8,7 +8,10 @@ namespace morphoflow {
 
 CutSurface::CutSurface(const std::vector<ObstacleSpec>& obstacles, int dims, const double* domainSize) : dims_(dims) {
   for (const ObstacleSpec& o : obstacles)
-    if (o.boundary == ObstacleBoundary::Cut) obstacles_.push_back(o);
+    if (o.boundary == ObstacleBoundary::Cut) {
+      obstacles_.push_back(o);
+      exact_ = exact_ && o.shape != ObstacleShape::Image;
+    }
   for (int a = 0; a < dims; ++a) size_[a] = domainSize[a];
 }
 
@@ -34,9 +37,6 @@ template <int D>
 float openFraction(const CutSurface& surface, int axis, const IVec<D>& k, double h) {
   double c[3] = {0, 0, 0};  // the face's centre
   for (int b = 0; b < D; ++b) c[b] = (k[b] + (b == axis ? 0.0 : 0.5)) * h;
-  const double centre = surface.distance(c);
-  // Farther than the face's half diagonal from the surface: wholly on one side.
-  if (std::abs(centre) > 0.5 * h * std::sqrt(double(D - 1)) + 1e-12 * h) return centre > 0.0 ? 1.0f : 0.0f;
   int t[2] = {0, 0}, m = 0;  // the face's two tangent axes
   for (int b = 0; b < D; ++b)
     if (b != axis) t[m++] = b;
@@ -46,23 +46,48 @@ float openFraction(const CutSurface& surface, int axis, const IVec<D>& k, double
     if (D == 3) x[t[1]] += (r - 0.5) * h;
     return surface.distance(x);
   };
-  if constexpr (D == 2) return float(segmentOpen(at(0.0, 0.0), at(1.0, 0.0)));
-  // 3D: 4 x 4 sub-squares, each's bilinear interpolant of its corners sampled 4 x 4.
+  const double centre = surface.distance(c);
+  if (surface.exact()) {
+    // Farther than the face's half diagonal from the surface: wholly on one side.
+    if (std::abs(centre) > 0.5 * h * std::sqrt(double(D - 1)) + 1e-12 * h) return centre > 0.0 ? 1.0f : 0.0f;
+  } else {
+    // A sign only: the face is whole where its corners and centre agree.
+    bool mixed = false;
+    for (int i = 0; i < (D == 2 ? 2 : 4); ++i) mixed = mixed || ((at(i & 1, i >> 1) > 0.0) != (centre > 0.0));
+    if (!mixed) return centre > 0.0 ? 1.0f : 0.0f;
+  }
+  if constexpr (D == 2) {
+    const double a = at(0.0, 0.0), b = at(1.0, 0.0);
+    if (surface.exact() || (a > 0.0) == (b > 0.0)) return float(segmentOpen(a, b));
+    double lo = 0.0, hi = 1.0;  // the crossing, by bisection on the sign
+    for (int it = 0; it < 30; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      ((at(mid, 0.0) > 0.0) == (a > 0.0) ? lo : hi) = mid;
+    }
+    const double cross = 0.5 * (lo + hi);
+    return float(a > 0.0 ? cross : 1.0 - cross);
+  }
+  int open = 0, total = 0;
+  if (!surface.exact()) {  // 8 x 8 samples of the sign
+    for (int p = 0; p < 8; ++p)
+      for (int q = 0; q < 8; ++q, ++total) open += at((p + 0.5) / 8, (q + 0.5) / 8) > 0.0 ? 1 : 0;
+    return float(double(open) / total);
+  }
+  // 4 x 4 sub-squares, each's bilinear interpolant of its corners sampled 4 x 4.
   constexpr int kSub = 4, kSamples = 4;
   double phi[kSub + 1][kSub + 1];
   for (int i = 0; i <= kSub; ++i)
     for (int j = 0; j <= kSub; ++j) phi[i][j] = at(double(i) / kSub, double(j) / kSub);
-  int open = 0;
   for (int i = 0; i < kSub; ++i)
     for (int j = 0; j < kSub; ++j)
       for (int p = 0; p < kSamples; ++p)
-        for (int q = 0; q < kSamples; ++q) {
+        for (int q = 0; q < kSamples; ++q, ++total) {
           const double u = (p + 0.5) / kSamples, v = (q + 0.5) / kSamples;
           const double value = (1 - u) * (1 - v) * phi[i][j] + u * (1 - v) * phi[i + 1][j] + (1 - u) * v * phi[i][j + 1] +
                                u * v * phi[i + 1][j + 1];
           open += value > 0.0 ? 1 : 0;
         }
-  return float(double(open) / double(kSub * kSub * kSamples * kSamples));
+  return float(double(open) / total);
 }
 
 template float openFraction<2>(const CutSurface&, int, const IVec<2>&, double);

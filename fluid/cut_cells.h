@@ -26,10 +26,13 @@ class CutSurface {
   CutSurface(const std::vector<ObstacleSpec>& obstacles, int dims, const double* domainSize);
   bool empty() const { return obstacles_.empty(); }
   double distance(const double* x) const;
+  // Whether distance() is one (an image shape only has a sign: -1 inside, 1 outside).
+  bool exact() const { return exact_; }
   static constexpr double kMinTheta = 0.01;
 
  private:
   std::vector<ObstacleSpec> obstacles_;
+  bool exact_ = true;
   int dims_ = 2;
   double size_[3] = {0, 0, 0};
 };
@@ -46,9 +49,10 @@ inline double cutTheta(double from, double to) {
 
 // The open fraction of face k of grid `axis` (a cell face of size h; face k
 // lies at x_axis = k h), in [0, 1]: the part where the distance is positive
-// (a face on the surface is closed), from the distances at its corners
+// (a face on the surface is closed). From the distances at its corners
 // (2D: the segment's fluid part, linearly interpolated; 3D: the bilinear
-// interpolant of 4 x 4 sub-squares' corners, sampled 4 x 4 each).
+// interpolant of 4 x 4 sub-squares' corners, sampled 4 x 4 each); with only
+// a sign (an image), by bisection for the crossing (2D) or 8 x 8 samples (3D).
 template <int D>
 float openFraction(const CutSurface& surface, int axis, const IVec<D>& k, double h);
 

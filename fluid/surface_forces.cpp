@@ -16,7 +16,6 @@ std::vector<SurfaceElement> cutSurfaceElements(const VelocityConstraints<D>& vc)
     const IVec<D> k = vc.solid.coord(i);
     double c[3] = {0, 0, 0};
     for (int a = 0; a < D; ++a) c[a] = (k[a] + 0.5) * h;
-    if (std::abs(vc.cut.distance(c)) > h * std::sqrt(double(D))) continue;  // no surface in this cell
     // The fluid part's closed boundary: the surface's area vector is the
     // sum of the faces' open area vectors (outward normals).
     SurfaceElement e;
