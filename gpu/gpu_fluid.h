@@ -49,11 +49,18 @@ class GpuFluid final : public FluidStepper<D> {
   double time() const override { return time_; }
   long steps() const override { return steps_; }
   // The solvers' results, and each stage's time on the GPU in the step
-  // before (timer queries: timing never waits on the GPU).
+  // before (timer queries: timing never waits on the GPU). The solves
+  // decide their convergence on the device (gpu_gate.h); their results are
+  // read at steps 1, 2, 4, 8 and then every 16th (statsDue, at the end of
+  // the projection) and at every read-back of the state (frames,
+  // checkpoints): each step reports the last read's (the most iterations a
+  // solve took since the read before, whether all converged, the largest
+  // residual).
   const FluidStepStats& lastStats() const override { return stats_; }
-  // (a velocity that is not finite makes the divergence, hence the pressure residual, NaN)
-  bool finite() const override { return std::isfinite(stats_.pressure.residual); }
-  // sqrt(D) max_a max |u_a|, as FluidSolver::maxSpeed (a bound of the speed).
+  // Whether the velocity is finite (the speed's reduction: a NaN or infinity makes it infinite).
+  bool finite() const override { return std::isfinite(maxSpeed()); }
+  // sqrt(D) max_a max |u_a|, as FluidSolver::maxSpeed (a bound of the speed):
+  // one read-back a step, shared by finite() and cflTimeStep().
   double maxSpeed() const;
   // Largest dt with maxSpeed() dt <= cfl h (dtMax when the fluid is at rest), as FluidSolver's.
   double cflTimeStep(double cfl, double dtMax) const override;
@@ -129,7 +136,9 @@ class GpuFluid final : public FluidStepper<D> {
   int solves_ = 0;
   std::array<std::unique_ptr<Viscous>, D> viscous_;
   double s_ = -1.0;
-  FluidStepStats stats_;
+  mutable FluidStepStats stats_;
+  void readSolverStats() const;  // the solves' tallies into stats_
+  mutable double speed_cached_ = -1.0;  // maxSpeed() of the current velocity (-1: not yet read)
   std::unique_ptr<class GpuReduction> speed_;
   std::unique_ptr<class GpuStageTimer> timer_;
   StepCounts counts_;

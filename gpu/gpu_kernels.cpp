@@ -8,6 +8,7 @@
 #include "gpu/compute_program.h"
 #include "gpu/gl_context.h"
 #include "gpu/gpu_counts.h"
+#include "gpu/gpu_gate.h"
 #include "gpu/shader_source.h"
 
 namespace morphoflow {
@@ -56,7 +57,12 @@ void dispatchFlat(size_t samples, double bytes) {
   const size_t groups = (samples + kGroup - 1) / kGroup;
   if (groups == 0) return;
   const size_t gx = groups < kMaxX ? groups : kMaxX, gy = (groups + gx - 1) / gx;
-  glDispatchCompute(GLuint(gx), GLuint(gy), 1);
+  dispatchGroups(unsigned(gx), unsigned(gy));
+}
+
+void dispatchGroups(unsigned gx, unsigned gy) {
+  if (GpuGate* gate = GpuGate::current()) return gate->dispatch(gx, gy);
+  glDispatchCompute(gx, gy, 1);
   countDispatch();
 }
 

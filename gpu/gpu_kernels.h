@@ -17,6 +17,9 @@ const ComputeProgram& useKernel(const std::string& shader, const std::string& de
 // must read or write `bytes` of the buffers at least once (the traffic model
 // the benchmarks divide by time: a lower bound of the memory traffic).
 void dispatchFlat(size_t samples, double bytes);
+// Dispatches gx x gy groups of the current kernel: indirect, through the
+// solve's gate, while one is entered (gpu_gate.h).
+void dispatchGroups(unsigned gx, unsigned gy);
 // Counts dispatched traffic (dispatchFlat's, and kernels that call it directly).
 void countGpuTraffic(double bytes);
 // The traffic counted since the process started.

@@ -1,5 +1,6 @@
 #include "gpu/gpu_pcg.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "gpu/compute_program.h"
@@ -11,12 +12,15 @@ namespace morphoflow {
 namespace {
 // The scalar slots (GpuReduction).
 enum Slot { kBB = 0, kRR = 1, kPQ = 2, kRZ0 = 3, kRZ1 = 4, kSum = 5, kCount = 6 };
+constexpr GpuGate::Slots kGateSlots{kBB, kRR, kPQ};
+constexpr int kCalibrationLook = 8;  // iterations between looks while the schedule is calibrated
 }  // namespace
 
 GpuPcg::GpuPcg(const GpuLaplace& A)
     : A_(A), r_(A.size() * sizeof(double)), p_(A.size() * sizeof(double)), q_(A.size() * sizeof(double)),
       z_(A.size() * sizeof(double)) {
   if (A_.singular()) sums_.activeCount(A_.diag(), A_.size(), kCount);
+  last_.converged = true;
 }
 
 void GpuPcg::op(VectorOp name, const GpuBuffer& x, const GpuBuffer& y, const GpuBuffer& z, const GpuBuffer& q,
@@ -41,21 +45,16 @@ void GpuPcg::removeMean(GpuBuffer* x) {
   op(VectorOp::SubMean, *x, *x, *x, *x, {kSum, kCount, 0, 0});
 }
 
-SolverResult GpuPcg::solve(GpuBuffer* bp, GpuBuffer* xp, GpuMultigrid* M, const SolverOptions& options) {
+SolverResult GpuPcg::solve(GpuBuffer* bp, GpuBuffer* xp, GpuMultigrid* M, const SolverOptions& options, bool deferred) {
   GpuBuffer &b = *bp, &x = *xp;
   const size_t n = A_.size();
-  SolverResult result;
   if (A_.singular()) removeMean(&b);
   sums_.dot(b, b, n, kBB);
-  const double bnorm = std::sqrt(sums_.read()[kBB]);
-  if (bnorm == 0.0) {
-    x.zero();
-    result.converged = true;
-    return result;
-  }
+  op(VectorOp::ZeroIfNoRhs, x, x, x, x, {kBB, 0, 0, 0});  // b = 0: x = 0, as on the CPU
   A_.residual(b, x, &r_, false);
   sums_.dot(r_, r_, n, kRR);
-  result.residual = std::sqrt(sums_.read()[kRR]) / bnorm;
+  gate_.start(sums_.scalars(), kGateSlots, options.tolerance, options.maxIterations);
+  gate_.enter();
   int rz = kRZ0;
   auto precondition = [&](int slot) {
     if (M)
@@ -64,31 +63,53 @@ SolverResult GpuPcg::solve(GpuBuffer* bp, GpuBuffer* xp, GpuMultigrid* M, const 
       op(VectorOp::Jacobi, r_, z_, z_, z_, {0, 0, 0, 0});
     sums_.dot(r_, z_, n, slot);
   };
-  if (result.residual > options.tolerance) {
-    precondition(rz);
-    op(VectorOp::UpdateP, z_, p_, p_, p_, {0, 0, 0, 0}, true);
-    for (int it = 1; it <= options.maxIterations; ++it) {
-      A_.apply(p_, &q_);
-      sums_.dot(p_, q_, n, kPQ);
-      op(VectorOp::UpdateXR, x, r_, p_, q_, {rz, kPQ, 0, 0});
-      sums_.dot(r_, r_, n, kRR);
-      const std::vector<double> s = sums_.read();
-      result.iterations = it;
-      result.residual = std::sqrt(s[kRR]) / bnorm;
-      if (!(s[kPQ] > 0.0) || result.residual <= options.tolerance) break;
-      const int next = rz == kRZ0 ? kRZ1 : kRZ0;
-      precondition(next);
-      op(VectorOp::UpdateP, z_, p_, p_, p_, {next, rz, 0, 0});
-      rz = next;
-    }
+  precondition(rz);
+  op(VectorOp::UpdateP, z_, p_, p_, p_, {0, 0, 0, 0}, true);
+  // The scheduled iterations, or (calibrating) until the device says it stopped.
+  const bool calibrating = ahead_ == 0;
+  const int queue = calibrating ? options.maxIterations : std::min(ahead_, options.maxIterations);
+  for (int it = 1; it <= queue; ++it) {
+    A_.apply(p_, &q_);
+    sums_.dot(p_, q_, n, kPQ);
+    op(VectorOp::UpdateXR, x, r_, p_, q_, {rz, kPQ, 0, 0});
+    sums_.dot(r_, r_, n, kRR);
+    gate_.check(sums_.scalars(), kGateSlots, options.tolerance, options.maxIterations);
+    const int next = rz == kRZ0 ? kRZ1 : kRZ0;
+    precondition(next);
+    op(VectorOp::UpdateP, z_, p_, p_, p_, {next, rz, 0, 0});
+    rz = next;
+    if (calibrating && it % kCalibrationLook == 0 && !gate_.going()) break;
   }
+  gate_.leave();
   // The true residual, not the recursively updated one.
   A_.residual(b, x, &r_, false);
   sums_.dot(r_, r_, n, kRR);
-  result.residual = std::sqrt(sums_.read()[kRR]) / bnorm;
+  gate_.finish(sums_.scalars(), kGateSlots, options.tolerance);
   if (A_.singular()) removeMean(&x);
-  result.converged = result.residual <= options.tolerance * 1.0001;
-  return result;
+  if (calibrating || !deferred) return fromTally(gate_.read(), true);
+  return last_;
+}
+
+SolverResult GpuPcg::fromTally(const GpuGate::Tally& t, bool last) {
+  SolverResult r;
+  r.converged = last ? t.lastConverged : t.unconverged == 0;
+  r.iterations = int(last ? t.lastIterations : (t.iterations + t.solves - 1) / std::max(t.solves, 1u));  // (a solve's mean)
+  r.residual = last ? t.lastResidual : t.maxResidual;
+  // The schedule: the most iterations seen, a quarter more and 2; doubled
+  // where it cut a solve short; calibrated again while the solves took none
+  // (a right-hand side of 0: the velocity component of a flow that has not started).
+  const int most = int(t.maxIterations);
+  const bool cut = t.unconverged > 0 && ahead_ > 0 && most >= ahead_;
+  ahead_ = cut ? 2 * ahead_ : most == 0 ? 0 : std::max(ahead_ / 2, most + most / 4 + 2);
+  gate_.resetTally();
+  last_ = r;
+  return r;
+}
+
+SolverResult GpuPcg::tally() {
+  const GpuGate::Tally t = gate_.read();
+  if (t.solves == 0) return last_;
+  return fromTally(t, false);
 }
 
 }  // namespace morphoflow

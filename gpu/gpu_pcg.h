@@ -1,12 +1,18 @@
 // Preconditioned conjugate gradients (core/pcg.cpp) on the GPU, double
 // vectors, preconditioned by a GpuMultigrid (MGPCG) or by the diagonal. The
-// scalars stay on the device; the host reads the residual once an iteration
-// to decide when to stop. Singular (pure Neumann) systems are solved for the
-// mean-free solution, as on the CPU.
+// scalars stay on the device, and so does the decision to stop: a GpuGate
+// (gpu_gate.h) turns the queued iterations past the CPU's stopping test into
+// empty dispatches, so a solve queues a scheduled number of iterations and
+// reads nothing back. The schedule is the most iterations a solve took in
+// the last tally, a quarter more and 2 (the first solve calibrates it,
+// looking every 8 iterations); a tally that shows the schedule cut a solve
+// short doubles it. Singular (pure Neumann) systems are solved for the mean-free
+// solution, as on the CPU.
 #pragma once
 
 #include "core/pcg.h"
 #include "core/solver_result.h"
+#include "gpu/gpu_gate.h"
 #include "gpu/gpu_laplace.h"
 #include "gpu/kernel_modes.h"
 #include "gpu/gpu_reduction.h"
@@ -20,17 +26,26 @@ class GpuPcg {
   explicit GpuPcg(const GpuLaplace& A);
   // Solves A x = b from x's current values to options.tolerance (relative
   // residual); b is made mean-free first when A is singular. M null: the
-  // diagonal preconditioner.
-  SolverResult solve(GpuBuffer* b, GpuBuffer* x, GpuMultigrid* M, const SolverOptions& options);
+  // diagonal preconditioner. Returns the solve's own result, read back (one
+  // host wait) unless `deferred`: then the last tally's (tally()).
+  SolverResult solve(GpuBuffer* b, GpuBuffer* x, GpuMultigrid* M, const SolverOptions& options, bool deferred = false);
+  // The solves since the last tally, read back (one host wait): converged
+  // when all were, a solve's mean iterations, the largest residual; and the
+  // schedule adapted to them.
+  SolverResult tally();
   GpuReduction& reduction() { return sums_; }
 
  private:
   void op(VectorOp name, const GpuBuffer& x, const GpuBuffer& y, const GpuBuffer& z, const GpuBuffer& q,
           std::array<int, 4> slots, bool first = false);
   void removeMean(GpuBuffer* x);
+  SolverResult fromTally(const GpuGate::Tally& t, bool last);
   const GpuLaplace& A_;
   GpuBuffer r_, p_, q_, z_;
   GpuReduction sums_;
+  GpuGate gate_;
+  int ahead_ = 0;  // iterations a solve queues; 0: not calibrated yet
+  SolverResult last_;  // what deferred solves report
 };
 
 }  // namespace morphoflow

@@ -45,6 +45,7 @@ GpuRDLayer<D>::GpuRDLayer(const LayerUpload<D>& upload)
     diffusion_[size_t(s)]->increment = GpuBuffer(n_ * sizeof(double));
   }
   stats_buffer_ = GpuBuffer(2 * sizeof(uint32_t));
+  stats_buffer_.zero();
   // each species' operator (a tensor's for the anisotropic ones), for the explicit part
   for (int s = 0; s < species_; ++s) operator_[size_t(s)] = std::make_unique<GpuLaplace>(*rd.operators[size_t(s)]);
   // parameter maps (and perturbations), concatenated
@@ -192,7 +193,7 @@ SolverResult GpuRDLayer<D>::diffuse(int s, double thetaDt) {
   // warm start: b plus the last change, rescaled to this theta dt
   x.copyFrom(b, n_ * sizeof(double));
   if (df.hasIncrement) vectorOp(VectorOp::ScaleAdd, df.increment, &x, thetaDt / df.incrementThetaDt, 1.0);
-  const SolverResult r = df.pcg->solve(&b, &x, df.M.get(), {up_.settings.tolerance, 2000});
+  const SolverResult r = df.pcg->solve(&b, &x, df.M.get(), {up_.settings.tolerance, 2000}, true);
   df.increment.copyFrom(x, n_ * sizeof(double));
   vectorOp(VectorOp::ScaleAdd, b, &df.increment, -1.0, 1.0);
   df.incrementThetaDt = thetaDt;
@@ -208,7 +209,7 @@ void GpuRDLayer<D>::step(double dt) {
   const RDIntegrator integ = up_.settings.integrator;
   const bool implicitReaction = integ == RDIntegrator::KimLin;
   const double theta = diffusionTheta(integ);
-  stats_buffer_.zero();
+  ++steps_;
   if (!frozenTaken_) {  // frozen species keep the values they start the run with
     for (int s = 0; s < species_; ++s)
       if (isFrozen_[size_t(s)]) {
@@ -238,11 +239,26 @@ void GpuRDLayer<D>::step(double dt) {
   for (int s = 0; s < species_; ++s)
     if ((clamped_ >> s) & 1u) vectorOp(VectorOp::ClampZero, x_[size_t(s)], &x_[size_t(s)], 0.0, 0.0);
   holdFixed();
-  if (implicitReaction) {
+  if (implicitReaction) stats_.newton.cells = long(n_);
+  if (statsDue(steps_)) readStats();
+}
+
+template <int D>
+void GpuRDLayer<D>::readStats() {
+  // The diffusion solves' tallies, and Newton's failures and most
+  // iterations since the last read (the sums and maxima of the steps between).
+  for (const auto& df : diffusion_)
+    if (df && df->pcg) {
+      const SolverResult r = df->pcg->tally();
+      stats_.diffusion.converged = stats_.diffusion.converged && r.converged;
+      stats_.diffusion.iterations = std::max(stats_.diffusion.iterations, r.iterations);
+      stats_.diffusion.residual = std::max(stats_.diffusion.residual, r.residual);
+    }
+  if (up_.settings.integrator == RDIntegrator::KimLin) {
     const std::vector<uint32_t> st = stats_buffer_.read<uint32_t>(2);
-    stats_.newton.cells = long(n_);
     stats_.newton.failures = long(st[0]);
     stats_.newton.maxIterations = int(st[1]);
+    stats_buffer_.zero();
   }
 }
 

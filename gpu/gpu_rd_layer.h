@@ -40,6 +40,12 @@ class GpuRDLayer {
 
   void step(double dt);
   // Newton failures and iterations, the worst diffusion solve.
+  // The step's statistics. The diffusion solves decide their convergence on
+  // the device (gpu_gate.h) and everything is read back at steps 1, 2, 4, 8 and
+  // then every 16th (statsDue): a step reports the last read's diffusion results, and Newton's
+  // failures and most iterations since the read before on the steps that
+  // read them (0 on the others, so their sums and maxima over the steps are
+  // exact).
   const RDStepStats& lastStats() const { return stats_; }
   int species() const { return species_; }
   size_t cells() const { return n_; }
@@ -92,6 +98,8 @@ class GpuRDLayer {
   std::array<std::unique_ptr<GpuLaplace>, kMax> operator_;  // -lap or -div(sigma grad) (scale 1/h^2): the explicit part
   std::array<std::unique_ptr<Diffusion>, kMax> diffusion_;
   RDStepStats stats_;
+  long steps_ = 0;
+  void readStats();
 };
 
 }  // namespace morphoflow

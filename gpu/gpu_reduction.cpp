@@ -32,8 +32,7 @@ void GpuReduction::run(const char* term, const GpuBuffer& x, const GpuBuffer& y,
   partial_.bind(3);
   scalars_.bind(4);
   x.bind(5);
-  glDispatchCompute(GLuint(groups), 1, 1);
-  countDispatch();
+  dispatchGroups(unsigned(groups), 1);
   const std::string t = term;
   countGpuTraffic(double(n) * (t == "TERM_DOT" ? 16.0 : t == "TERM_ACTIVE_SUM" ? 12.0 : 4.0));
   storageBarrier();
@@ -42,8 +41,7 @@ void GpuReduction::run(const char* term, const GpuBuffer& x, const GpuBuffer& y,
   setUniform(f, "slot", slot);
   partial_.bind(3);
   scalars_.bind(4);
-  glDispatchCompute(1, 1, 1);
-  countDispatch();
+  dispatchGroups(1, 1);
   storageBarrier();
 }
 

@@ -13,6 +13,7 @@
 //               rd_solver.cpp's order, no fused multiply-adds
 // OP_HOLD       y = x where held[i] != 0 (fixed regions; frozen species hold everywhere)
 // OP_ADD_FACES  y += ca faces (x: the Dirichlet faces per cell)
+// OP_ZERO_IF_NO_RHS x = 0 where S[bb] = 0 (a solve whose right-hand side is 0)
 layout(std430, binding = 0) buffer X { double x[]; };
 layout(std430, binding = 1) buffer Y { double y[]; };
 layout(std430, binding = 2) buffer Z { double z[]; };
@@ -56,5 +57,7 @@ void main() {
   if (held[i] != 0u) y[i] = x[i];
 #elif defined(OP_ADD_FACES)
   y[i] += ca * x[i];
+#elif defined(OP_ZERO_IF_NO_RHS)
+  if (S[slots.x] == 0.0lf) x[i] = 0.0lf;
 #endif
 }

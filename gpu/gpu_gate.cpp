@@ -1,0 +1,106 @@
+#include "gpu/gpu_gate.h"
+
+#include <algorithm>
+#include <cstring>
+
+#include <epoxy/gl.h>
+
+#include "gpu/compute_program.h"
+#include "gpu/gpu_counts.h"
+#include "gpu/gpu_kernels.h"
+
+namespace morphoflow {
+
+namespace {
+GpuGate* entered = nullptr;
+constexpr size_t kStateBytes = 8 * sizeof(uint32_t) + 2 * sizeof(double);
+}  // namespace
+
+GpuGate::GpuGate() : state_(kStateBytes) { resetTally(); }
+
+GpuGate* GpuGate::current() { return entered; }
+
+void GpuGate::enter() { entered = this; }
+void GpuGate::leave() { entered = nullptr; }
+
+void GpuGate::run(const char* mode, const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations) {
+  GpuGate* was = entered;
+  entered = nullptr;  // the gate's own kernel is not gated
+  const ComputeProgram& p = useKernel("gate.comp", std::string("#define ") + mode);
+  setUniform(p, "slot", std::array<int, 3>{slots.bb, slots.rr, slots.pq});
+  setUniform(p, "tol", tolerance);
+  setUniform(p, "limit", maxIterations);
+  setUniform(p, "slots", int(base_.size() / 3));
+  scalars.bind(0);
+  (baseBuffer_.bytes() ? baseBuffer_ : state_).bind(1);
+  (args_.bytes() ? args_ : state_).bind(2);
+  state_.bind(3);
+  glDispatchCompute(1, 1, 1);
+  countDispatch();
+  glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
+  entered = was;
+}
+
+void GpuGate::start(const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations) {
+  run("MODE_START", scalars, slots, tolerance, maxIterations);
+}
+void GpuGate::check(const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations) {
+  run("MODE_CHECK", scalars, slots, tolerance, maxIterations);
+}
+void GpuGate::finish(const GpuBuffer& scalars, Slots slots, double tolerance) {
+  run("MODE_FINISH", scalars, slots, tolerance, 0);
+}
+
+void GpuGate::refreshArgs() {
+  // Called in the middle of another kernel's dispatch: its program and the
+  // bindings the gate's kernel takes are put back after.
+  GLint program = 0, bound[4] = {0, 0, 0, 0};
+  glGetIntegerv(GL_CURRENT_PROGRAM, &program);
+  for (GLuint i = 0; i < 4; ++i) glGetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, i, &bound[i]);
+  run("MODE_REFRESH", state_, Slots{0, 0, 0}, 0.0, 0);
+  glUseProgram(GLuint(program));
+  for (GLuint i = 0; i < 4; ++i) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, i, GLuint(bound[i]));
+}
+
+void GpuGate::dispatch(unsigned gx, unsigned gy) {
+  auto it = slotOf_.find({gx, gy});
+  if (it == slotOf_.end()) {
+    // A new size: its base groups, and its arguments from the go flag as it is now.
+    it = slotOf_.emplace(std::make_pair(gx, gy), unsigned(base_.size() / 3)).first;
+    base_.insert(base_.end(), {gx, gy, 1u});
+    if (base_.size() * sizeof(uint32_t) > capacity_) {
+      capacity_ = std::max<size_t>(64 * 3 * sizeof(uint32_t), 2 * base_.size() * sizeof(uint32_t));
+      baseBuffer_ = GpuBuffer(capacity_);
+      args_ = GpuBuffer(capacity_);
+    }
+    baseBuffer_.upload(base_.data(), base_.size() * sizeof(uint32_t));
+    refreshArgs();
+  }
+  glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, args_.id());
+  glDispatchComputeIndirect(GLintptr(it->second * 3 * sizeof(uint32_t)));
+  countDispatch();
+}
+
+bool GpuGate::going() const { return state_.read<uint32_t>(1)[0] != 0u; }
+
+GpuGate::Tally GpuGate::read() const {
+  std::vector<uint8_t> raw(kStateBytes);
+  state_.download(raw.data(), kStateBytes);
+  uint32_t u[8];
+  std::memcpy(u, raw.data(), sizeof u);
+  Tally t;
+  t.solves = u[2], t.iterations = u[3], t.maxIterations = u[4], t.unconverged = u[5];
+  t.lastIterations = u[6], t.lastConverged = u[7] != 0u;
+  std::memcpy(&t.maxResidual, raw.data() + 32, sizeof(double));
+  std::memcpy(&t.lastResidual, raw.data() + 40, sizeof(double));
+  return t;
+}
+
+void GpuGate::resetTally() {
+  std::vector<uint8_t> zero(kStateBytes, 0);
+  const uint32_t go = 1;
+  std::memcpy(zero.data(), &go, sizeof go);
+  state_.upload(zero.data(), kStateBytes);
+}
+
+}  // namespace morphoflow

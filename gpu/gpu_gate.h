@@ -1,0 +1,70 @@
+// A Krylov solve's convergence decided on the device. While a gate is
+// entered, every dispatch is indirect (glDispatchComputeIndirect): its
+// groups come from the gate's argument buffer, which the gate's kernel
+// (shaders/gate.comp) sets to the dispatch's own groups while the solve has
+// not converged and to zero once it has, reading the solve's scalars in
+// place. So the host queues a bounded number of iterations without reading
+// anything back, and the iterations past convergence do no work: the result
+// is the iterate at the CPU's stopping test, at the CPU's iteration count.
+// The gate also tallies each solve (iterations, whether it converged, the
+// true residual) on the device, for the host to read when it wants them.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <utility>
+#include <vector>
+
+#include "gpu/gpu_buffer.h"
+
+namespace morphoflow {
+
+// When a stepper reads its solves' tallies: steps 1, 2, 4 and 8 (while the
+// schedules settle), then every kStatsEvery-th (step counts from 1).
+constexpr long kStatsEvery = 16;
+inline bool statsDue(long step) { return step == 1 || step == 2 || step == 4 || step == 8 || step % kStatsEvery == 0; }
+
+class GpuGate {
+ public:
+  // The scalar slots of the solve's reduction buffer the kernel reads.
+  struct Slots {
+    int bb, rr, pq;
+  };
+  // What the device counted since the last reset.
+  struct Tally {
+    uint32_t solves = 0, iterations = 0, maxIterations = 0, unconverged = 0;
+    uint32_t lastIterations = 0;
+    bool lastConverged = true;
+    double maxResidual = 0.0, lastResidual = 0.0;
+  };
+
+  GpuGate();
+  // Before the first iteration: go while ||r|| / ||b|| > tolerance (and b != 0); 0 iterations.
+  void start(const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations);
+  // After an iteration's rr: counts it while going, and goes on while
+  // p.Ap > 0, ||r|| / ||b|| > tolerance and fewer than maxIterations are done.
+  void check(const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations);
+  // After the true residual's rr: the solve's verdict into the tally.
+  void finish(const GpuBuffer& scalars, Slots slots, double tolerance);
+  // Dispatches between enter() and leave() are gated.
+  void enter();
+  void leave();
+  // The gate entered now, or null.
+  static GpuGate* current();
+  // A gated dispatch of gx x gy groups (gpu_kernels.cpp routes dispatches here).
+  void dispatch(unsigned gx, unsigned gy);
+  // Whether the solve is still going (one host wait).
+  bool going() const;
+  Tally read() const;  // one host wait
+  void resetTally();
+
+ private:
+  void run(const char* mode, const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations);
+  void refreshArgs();  // after a new slot: its arguments from the current go flag
+  std::map<std::pair<unsigned, unsigned>, unsigned> slotOf_;
+  std::vector<uint32_t> base_;  // gx, gy, 1 per slot
+  GpuBuffer baseBuffer_, args_, state_;
+  size_t capacity_ = 0;
+};
+
+}  // namespace morphoflow
