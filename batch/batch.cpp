@@ -211,7 +211,7 @@ class BatchRunner {
   BatchPlan plan_;
   const BatchOptions& opt_;
   const fs::path dir_;
-  const std::string exe_ = selfExecutable();
+  const std::string exe_ = opt_.executable.empty() ? selfExecutable() : opt_.executable;
   std::vector<RunRecord> records_;
   std::vector<Prepared> prepared_;
   size_t finished_ = 0;

@@ -17,6 +17,7 @@ struct BatchOptions {
   bool resume = false;              // skip completed runs, resume interrupted ones
   bool quiet = false;
   std::string out = "out";
+  std::string executable;           // the morphoflow executable the runs use (empty: this process's)
 };
 
 // Each returns the exit status: 0 when every run completed, 2 when any was a

@@ -21,6 +21,7 @@ namespace morphoflow {
 template <int D>
 class Simulation {
  public:
+  static constexpr int kDimension = D;
   virtual ~Simulation() = default;
 
   // Advances one step of dt.
@@ -48,6 +49,15 @@ class Simulation {
   // Each field is on its own grid (species on the RD grid, the rest on the
   // fluid's); all of them span the same domain.
   virtual std::vector<Grid<float, D>> field(const std::string& name) const = 0;
+  // Sets a field from values on its grid (field()'s shape): a species, the
+  // dye (the smoke) or the temperature; throws UserError (key "set_field")
+  // for a field computed from the state (speed, vorticity, ...) or one this
+  // simulation lacks.
+  virtual void setField(const std::string& name, const Grid<float, D>& values) {
+    throw UserError({"set_field", 0, 0}, "", "the field '" + name + "' cannot be set",
+                    "set_field takes a species, dye or temperature");
+  }
+
   // Whether the field is signed around 0 (an automatic image range is then
   // centred on 0).
   virtual bool symmetric(const std::string& name) const { return false; }

@@ -11,8 +11,6 @@
 
 namespace morphoflow {
 
-namespace {
-
 // Face k of component a sits at (k + 1/2 - e_a / 2) h.
 template <int D>
 Vec<D> facePosition(const IVec<D>& k, int a, double h) {
@@ -35,8 +33,6 @@ void wrapPeriodicFaces(MacVelocity<D>* u) {
     }
   }
 }
-
-}  // namespace
 
 template <int D>
 const std::vector<std::string>& ExpressionVelocity<D>::variables() {
@@ -232,6 +228,10 @@ void VdbVelocitySequence<D>::sample(double t, MacVelocity<D>* u) {
     for (size_t i = 0; i < (*u)[a].size(); ++i) (*u)[a][i] = float((1.0 - w) * f0[a][i] + w * f1[a][i]);
 }
 
+template Vec<2> facePosition<2>(const IVec<2>&, int, double);
+template Vec<3> facePosition<3>(const IVec<3>&, int, double);
+template void wrapPeriodicFaces<2>(MacVelocity<2>*);
+template void wrapPeriodicFaces<3>(MacVelocity<3>*);
 template class ExpressionVelocity<2>;
 template class ExpressionVelocity<3>;
 template class VdbVelocitySequence<2>;

@@ -25,6 +25,11 @@ void GpuLayerStepper<D>::toHost(RDSolver<D>* host) const {
 }
 
 template <int D>
+void GpuLayerStepper<D>::fromHost(const RDSolver<D>& host) {
+  for (int s = 0; s < layer_.species(); ++s) layer_.upload(s, host.field(s).values());
+}
+
+template <int D>
 void GpuLayerStepper<D>::save(StateWriter* out) const {
   out->put("gpu.rd.time", time_);
   out->put("gpu.rd.steps", steps_);
@@ -89,6 +94,14 @@ void GpuExplicitLayerStepper<D>::toHost(RDSolver<D>* host) const {
   for (int s = 0; s < 2; ++s) {
     const std::vector<float> f = gpu_->download(s);
     host->field(s).values().assign(f.begin(), f.end());
+  }
+}
+
+template <int D>
+void GpuExplicitLayerStepper<D>::fromHost(const RDSolver<D>& host) {
+  for (int s = 0; s < 2; ++s) {
+    const std::vector<double>& v = host.field(s).values();
+    gpu_->upload(s, std::vector<float>(v.begin(), v.end()));
   }
 }
 

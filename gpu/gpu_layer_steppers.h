@@ -24,6 +24,7 @@ class GpuLayerStepper final : public LayerStepper<D> {
   long steps() const override { return steps_; }
   const RDRunStats* runStats() const override { return nullptr; }
   void toHost(RDSolver<D>* host) const override;
+  void fromHost(const RDSolver<D>& host) override;
   void save(StateWriter* out) const override;
   void load(const StateReader& in) override;
   void resolved(nlohmann::json* j) const override;
@@ -48,6 +49,7 @@ class GpuExplicitLayerStepper final : public LayerStepper<D> {
   long steps() const override { return steps_; }
   const RDRunStats* runStats() const override { return nullptr; }
   void toHost(RDSolver<D>* host) const override;
+  void fromHost(const RDSolver<D>& host) override;
   void save(StateWriter* out) const override;
   void load(const StateReader& in) override;
   void resolved(nlohmann::json* j) const override;

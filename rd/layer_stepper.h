@@ -40,8 +40,10 @@ class LayerStepper {
   virtual long steps() const = 0;
   // The Newton and diffusion statistics over the run (null: a step with neither).
   virtual const RDRunStats* runStats() const = 0;
-  // The species into `host` (nothing where the host is what is stepped).
+  // The species into `host` (nothing where the host is what is stepped),
+  // and from it (after its fields were set).
   virtual void toHost(RDSolver<D>* host) const = 0;
+  virtual void fromHost(const RDSolver<D>& host) = 0;
   // Checkpoints: the layer's whole state.
   virtual void save(StateWriter* out) const = 0;
   virtual void load(const StateReader& in) = 0;
@@ -61,6 +63,7 @@ class CpuLayerStepper final : public LayerStepper<D> {
   long steps() const override { return rd_->steps(); }
   const RDRunStats* runStats() const override { return &stats_; }
   void toHost(RDSolver<D>*) const override {}
+  void fromHost(const RDSolver<D>&) override {}
   void save(StateWriter* out) const override;
   void load(const StateReader& in) override;
   void resolved(nlohmann::json* j) const override;
@@ -85,6 +88,7 @@ class FusedLayerStepper final : public LayerStepper<D> {
   long steps() const override { return steps_; }
   const RDRunStats* runStats() const override { return &stats_; }
   void toHost(RDSolver<D>* host) const override;
+  void fromHost(const RDSolver<D>&) override { fromHost(); }
   void save(StateWriter* out) const override;
   void load(const StateReader& in) override;
   void resolved(nlohmann::json* j) const override;

@@ -74,13 +74,21 @@ fs::path checkpointFile(const fs::path& out, long step) {
 fs::path writeCheckpoint(const fs::path& out, long step, const nlohmann::json& header,
                          const std::function<void(StateWriter*)>& save) {
   createOutputFolder(checkpointDir(out));
+  const fs::path file = checkpointFile(out, step);
+  writeCheckpointFile(file, header, save);
+  const std::vector<fs::path> all = checkpointsNewestFirst(checkpointDir(out));
+  std::error_code ec;
+  for (size_t i = 2; i < all.size(); ++i) fs::remove(all[i], ec);
+  return file;
+}
+
+void writeCheckpointFile(const fs::path& file, const nlohmann::json& header, const std::function<void(StateWriter*)>& save) {
   const std::string h = header.dump();
   // The state's length comes first in the file: one pass counts it, the
   // next streams the sections straight from the solvers into the file.
   uint64_t n = 0;
   StateWriter counter([&](std::string_view frame, const void*, size_t bytes) { n += frame.size() + bytes; });
   save(&counter);
-  const fs::path file = checkpointFile(out, step);
   AtomicFile f(file);
   std::unique_ptr<XXH64_state_t, decltype(&XXH64_freeState)> hash(XXH64_createState(), &XXH64_freeState);
   XXH64_reset(hash.get(), 0);
@@ -104,10 +112,6 @@ fs::path writeCheckpoint(const fs::path& out, long step, const nlohmann::json& h
   const uint64_t digest = XXH64_digest(hash.get());
   f.write(&digest, 8);
   f.commit();
-  const std::vector<fs::path> all = checkpointsNewestFirst(checkpointDir(out));
-  std::error_code ec;
-  for (size_t i = 2; i < all.size(); ++i) fs::remove(all[i], ec);
-  return file;
 }
 
 Checkpoint readCheckpoint(const fs::path& file) {

@@ -31,6 +31,10 @@ std::filesystem::path checkpointFile(const std::filesystem::path& out, long step
 std::filesystem::path writeCheckpoint(const std::filesystem::path& out, long step, const nlohmann::json& header,
                                       const std::function<void(StateWriter*)>& save);
 
+// The same into one file (written atomically; nothing else removed).
+void writeCheckpointFile(const std::filesystem::path& file, const nlohmann::json& header,
+                         const std::function<void(StateWriter*)>& save);
+
 // Reads one checkpoint; throws UserError naming the file when it is cut
 // short, corrupted or not a checkpoint.
 Checkpoint readCheckpoint(const std::filesystem::path& file);

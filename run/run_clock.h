@@ -11,6 +11,17 @@
 
 namespace morphoflow {
 
+// How a scene's run is clocked: a reaction-diffusion-only scene takes whole
+// steps of time.dt (duration / dt of them); a fluid may adapt dt and clip the last.
+inline TimeSettings runTime(const Scene& scene) {
+  TimeSettings t = scene.time;
+  if (!scene.hasFluid) {
+    t.steps = scene.totalSteps();
+    t.cfl = 0.0;
+  }
+  return t;
+}
+
 class RunClock {
  public:
   explicit RunClock(const TimeSettings& t)

@@ -32,17 +32,6 @@ namespace morphoflow {
 
 namespace {
 
-// How the run is clocked: a reaction-diffusion-only scene takes whole steps
-// of time.dt (duration / dt of them); a fluid may adapt dt and clip the last.
-TimeSettings runTime(const Scene& scene) {
-  TimeSettings t = scene.time;
-  if (!scene.hasFluid) {
-    t.steps = scene.totalSteps();
-    t.cfl = 0.0;
-  }
-  return t;
-}
-
 uintmax_t peakMemoryBytes() {
   struct rusage u {};
   getrusage(RUSAGE_SELF, &u);

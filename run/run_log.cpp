@@ -50,6 +50,7 @@ std::string RunLog::progressLine(long frame, long step, long totalSteps, double 
 }
 
 void RunLog::progress(long frame, long step, long totalSteps, double time, double endTime) {
+  if (listener_) listener_(frame, step, totalSteps, time, endTime);
   const Clock::time_point now = Clock::now();
   if (startStep_ < 0) {
     startStep_ = step > 0 ? step - 1 : 0;

@@ -6,6 +6,7 @@
 
 #include <chrono>
 #include <filesystem>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,9 @@ class RunLog {
   // Progress after a step: frame, step (of about `totalSteps`, 0 if not
   // known), simulated time (of `endTime`, 0 if not known).
   void progress(long frame, long step, long totalSteps, double time, double endTime);
+  // Also hands each progress report to `listener` (the Python module's callback).
+  using Listener = std::function<void(long frame, long step, long totalSteps, double time, double endTime)>;
+  void listen(Listener listener) { listener_ = std::move(listener); }
   // Ends a progress line drawn in place.
   void endProgress();
   // The lines so far, as DIR/log.txt holds them.
@@ -33,6 +37,7 @@ class RunLog {
  private:
   using Clock = std::chrono::steady_clock;
   std::string progressLine(long frame, long step, long totalSteps, double time, double endTime) const;
+  Listener listener_;
   bool quiet_, terminal_;
   bool drawn_ = false;
   std::vector<std::string> lines_;

@@ -14,6 +14,7 @@ extern "C" void onStop(int sig) { g_received = sig; }
 }  // namespace
 
 StopSignals::StopSignals() {
+  g_received = 0;  // a new run (the Python module runs several in one process)
   struct sigaction sa {};
   sa.sa_handler = onStop;
   sigemptyset(&sa.sa_mask);

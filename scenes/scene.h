@@ -202,6 +202,7 @@ struct VelocityScene {
   bool enabled = false;
   std::vector<std::string> field;    // one expression per axis in x, y, z (domain units) and t
   std::string vdb;                   // or a VDB sequence: a path whose '#'s stand for the frame number
+  bool python = false;               // or the Python module's Simulation.set_velocity (an array or a callable)
   double frameTime = 0.0;            // time between VDB frames that carry no `time` metadata
   double speedRange[2] = {0.0, 1.0}; // [rd.maps] P = "speed": P = lo + (hi - lo) |u| / referenceSpeed
   double referenceSpeed = 0.0;       // 0: the largest speed of the first velocity sampled

@@ -44,9 +44,17 @@ void parseVelocity(SceneContext& c, Scene* sp) {
   V.enabled = true;
   const toml::node* fn = r.node(vt, p, "field");
   const toml::node* vn = r.node(vt, p, "vdb");
+  const toml::node* pn = r.node(vt, p, "python");
+  V.python = pn && r.boolean(vt, p, "python", false);
+  if (V.python) {  // the velocity comes from the Python module (Simulation.set_velocity)
+    if (fn || vn) r.fail(fn ? fn : vn, p + (fn ? "field" : "vdb"), "python = true takes the velocity from Python: give no field or vdb");
+    V.where = r.where(pn, p + "python");
+    V.key = p + "python";
+  }
   if (fn && vn) r.fail(vn, p + "vdb", "give either field (expressions) or vdb (a volume sequence), not both");
-  if (!fn && !vn)
-    r.fail(vt, p + "field", "[velocity] needs field = [\"u(x, y, t)\", \"v(x, y, t)\"] or vdb = \"path/name.####.vdb\"");
+  if (!fn && !vn && !V.python)
+    r.fail(vt, p + "field",
+           "[velocity] needs field = [\"u(x, y, t)\", \"v(x, y, t)\"], vdb = \"path/name.####.vdb\" or python = true");
   const std::string axes = c.D == 2 ? "two" : "three";
   if (fn) {
     V.where = r.where(fn, p + "field");

@@ -124,6 +124,14 @@ std::vector<std::string> CoupledSimulation<D>::fieldNames() const {
 }
 
 template <int D>
+void CoupledSimulation<D>::setField(const std::string& name, const Grid<float, D>& values) {
+  host_.refresh();
+  if (!setSpeciesField<D>(&rd_, name, values) && !setFluidField<D>(&fluid_, name, values))
+    Simulation<D>::setField(name, values);
+  steps_->fromHost(fluid_, rd_);
+}
+
+template <int D>
 std::vector<Grid<float, D>> CoupledSimulation<D>::field(const std::string& name) const {
   host_.refresh();
   const std::vector<std::string> sp = species();

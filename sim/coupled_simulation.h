@@ -37,6 +37,7 @@ class CoupledSimulation : public Simulation<D> {
   std::vector<std::string> species() const override { return rd_.model().info().species; }
   std::vector<std::string> dumpFieldNames() const override { return species(); }
   std::vector<Grid<float, D>> field(const std::string& name) const override;
+  void setField(const std::string& name, const Grid<float, D>& values) override;
   bool symmetric(const std::string& name) const override { return name == "vorticity" && D == 2; }
   bool hasObstacles() const override { return !scene_.fluid.obstacles.empty(); }
   void checkFinite(const std::string& when) const override;

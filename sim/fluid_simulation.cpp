@@ -253,6 +253,19 @@ template void checkFluidLeft<2>(const Scene&, const FluidSolver<2>&);
 template void checkFluidLeft<3>(const Scene&, const FluidSolver<3>&);
 template void initialiseDye<2>(const Scene&, FluidSolver<2>*);
 template void initialiseDye<3>(const Scene&, FluidSolver<3>*);
+template <int D>
+bool setFluidField(FluidSolver<D>* fluid, const std::string& name, const Grid<float, D>& values) {
+  const bool temperature = name == "temperature" && !fluid->temperature().empty();
+  if (name != "dye" && !temperature) return false;
+  Grid<float, D>& g = temperature ? fluid->temperature() : fluid->dye();
+  if (values.dims() != g.dims())
+    throw UserError({"set_field", 0, 0}, "", "the values of '" + name + "' are not on its grid", "give field()'s shape");
+  g.values() = values.values();
+  return true;
+}
+
+template bool setFluidField<2>(FluidSolver<2>*, const std::string&, const Grid<float, 2>&);
+template bool setFluidField<3>(FluidSolver<3>*, const std::string&, const Grid<float, 3>&);
 template std::vector<Grid<float, 2>> fluidField<2>(const FluidSolver<2>&, const std::string&);
 template std::vector<Grid<float, 3>> fluidField<3>(const FluidSolver<3>&, const std::string&);
 template class FluidSimulation<2>;

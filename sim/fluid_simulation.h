@@ -37,6 +37,10 @@ void checkFluidFinite(const FluidSolver<D>& fluid, const std::string& where);
 std::vector<std::string> fluidFieldNames();
 template <int D>
 std::vector<Grid<float, D>> fluidField(const FluidSolver<D>& fluid, const std::string& name);
+// Sets the dye (the smoke) or, in a smoke scene, the temperature from values
+// on the fluid's grid; false for another name; UserError for another shape.
+template <int D>
+bool setFluidField(FluidSolver<D>* fluid, const std::string& name, const Grid<float, D>& values);
 
 template <int D>
 class FluidSimulation : public Simulation<D> {
@@ -57,6 +61,11 @@ class FluidSimulation : public Simulation<D> {
   std::vector<Grid<float, D>> field(const std::string& name) const override {
     host_.refresh();
     return fluidField<D>(fluid_, name);
+  }
+  void setField(const std::string& name, const Grid<float, D>& values) override {
+    host_.refresh();
+    if (!setFluidField<D>(&fluid_, name, values)) Simulation<D>::setField(name, values);
+    stepper_->fromHost(fluid_);
   }
   bool symmetric(const std::string& name) const override { return name == "vorticity" && D == 2; }
   bool hasObstacles() const override { return !scene_.fluid.obstacles.empty(); }

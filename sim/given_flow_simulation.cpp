@@ -25,7 +25,10 @@ std::unique_ptr<GivenVelocity<D>> velocitySource(const VelocityScene& v, const R
 }  // namespace
 
 template <int D>
-GivenFlowSimulation<D>::GivenFlowSimulation(const Scene& scene)
+GivenFlowSimulation<D>::GivenFlowSimulation(const Scene& scene) : GivenFlowSimulation(scene, nullptr) {}
+
+template <int D>
+GivenFlowSimulation<D>::GivenFlowSimulation(const Scene& scene, std::unique_ptr<GivenVelocity<D>> source)
     : scene_(scene), rd_(scene.rd.settings, *findModel(scene.rd.settings.model)) {
   initialState<D>(scene, &rd_);
   applyScene<D>(scene, &rd_);
@@ -40,8 +43,12 @@ GivenFlowSimulation<D>::GivenFlowSimulation(const Scene& scene)
       &rd_, ChemicalAdvector<D>(domain, C.interpolation),
       C.mode, C.rdTimeScale);
   u_ = MacVelocity<D>(rd_.cells(), rd_.h(), domain.periodic);
+  if (scene.velocity.python && !source)
+    throw UserError(scene.velocity.where, scene.velocity.key,
+                    "this scene takes its velocity from Python (python = true)",
+                    "run it from the Python module: morphoflow.Simulation(scene).set_velocity(...)");
   try {
-    source_ = velocitySource<D>(scene.velocity, scene.rd.settings);
+    source_ = source ? std::move(source) : velocitySource<D>(scene.velocity, scene.rd.settings);
   } catch (const VelocityFileError& e) {
     throw UserError(scene.velocity.where, scene.velocity.key, e.path() + ": " + e.what());
   }

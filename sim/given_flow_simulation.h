@@ -22,6 +22,8 @@ template <int D>
 class GivenFlowSimulation : public Simulation<D> {
  public:
   explicit GivenFlowSimulation(const Scene& scene);
+  // With the velocity from `source` (a scene whose [velocity] has python = true).
+  GivenFlowSimulation(const Scene& scene, std::unique_ptr<GivenVelocity<D>> source);
 
   void step(double dt) override;
   double time() const override { return time_; }
@@ -30,6 +32,14 @@ class GivenFlowSimulation : public Simulation<D> {
   std::vector<std::string> species() const override { return rd_.model().info().species; }
   std::vector<std::string> dumpFieldNames() const override { return species(); }
   std::vector<Grid<float, D>> field(const std::string& name) const override;
+  // The source's field changed (Python's set_velocity): sampled again now.
+  void velocityChanged() {
+    sampled_ = false;
+    sampleVelocity(time_);
+  }
+  void setField(const std::string& name, const Grid<float, D>& values) override {
+    if (!setSpeciesField<D>(&rd_, name, values)) Simulation<D>::setField(name, values);
+  }
   void checkFinite(const std::string& when) const override;
   void save(StateWriter* out) const override;
   void load(const StateReader& in) override;

@@ -18,6 +18,25 @@ std::vector<Grid<float, D>> speciesField(const RDSolver<D>& rd, const std::strin
 }
 
 template <int D>
+bool setSpeciesField(RDSolver<D>* rd, const std::string& name, const Grid<float, D>& values) {
+  const std::vector<std::string>& names = rd->model().info().species;
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it == names.end()) return false;
+  Grid<double, D>& g = rd->field(int(it - names.begin()));
+  if (values.dims() != g.dims())
+    throw UserError({"set_field", 0, 0}, "", "the values of '" + name + "' are not on its grid", "give field()'s shape");
+  for (size_t i = 0; i < g.size(); ++i) g[i] = double(values[i]);
+  return true;
+}
+
+template <int D>
+void RDSimulation<D>::setField(const std::string& name, const Grid<float, D>& values) {
+  host_.refresh();
+  if (!setSpeciesField<D>(&rd_, name, values)) Simulation<D>::setField(name, values);
+  stepper_->fromHost(rd_);
+}
+
+template <int D>
 RDSimulation<D>::RDSimulation(const Scene& scene, Backend backend, const Log& log)
     : scene_(scene),
       backend_(backend),
@@ -116,6 +135,8 @@ void reportRDSolvers(const RDRunStats& stats, long rdSteps, nlohmann::json* j) {
 
 template std::vector<Grid<float, 2>> speciesField<2>(const RDSolver<2>&, const std::string&);
 template std::vector<Grid<float, 3>> speciesField<3>(const RDSolver<3>&, const std::string&);
+template bool setSpeciesField<2>(RDSolver<2>*, const std::string&, const Grid<float, 2>&);
+template bool setSpeciesField<3>(RDSolver<3>*, const std::string&, const Grid<float, 3>&);
 template nlohmann::json resolvedLayer<2>(const Scene&, const RDSolver<2>&);
 template nlohmann::json resolvedLayer<3>(const Scene&, const RDSolver<3>&);
 template class RDSimulation<2>;

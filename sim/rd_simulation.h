@@ -31,6 +31,10 @@ nlohmann::json resolvedLayer(const Scene& scene, const RDSolver<D>& rd);
 // The species of an RD layer as fields.
 template <int D>
 std::vector<Grid<float, D>> speciesField(const RDSolver<D>& rd, const std::string& name);
+// Sets species `name` of the layer from float values on its grid; false
+// when it has no such species; UserError for values of another shape.
+template <int D>
+bool setSpeciesField(RDSolver<D>* rd, const std::string& name, const Grid<float, D>& values);
 
 template <int D>
 class RDSimulation : public Simulation<D> {
@@ -47,6 +51,7 @@ class RDSimulation : public Simulation<D> {
   std::vector<std::string> species() const override { return rd_.model().info().species; }
   std::vector<std::string> dumpFieldNames() const override { return species(); }
   std::vector<Grid<float, D>> field(const std::string& name) const override;
+  void setField(const std::string& name, const Grid<float, D>& values) override;
   void checkFinite(const std::string& when) const override;
   void save(StateWriter* out) const override;
   void load(const StateReader& in) override;

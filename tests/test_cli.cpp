@@ -188,6 +188,8 @@ INSTANTIATE_TEST_SUITE_P(
                  "5:1", "has a [fluid]"},
         BadScene{"velocity_both", "[rd]\nmodel = \"gray-scott\"\n[velocity]\nfield = [\"1\", \"0\"]\nvdb = \"a.vdb\"\n", "5:7",
                  "not both"},
+        BadScene{"velocity_python_and_field", "[rd]\nmodel = \"gray-scott\"\n[velocity]\npython = true\nfield = [\"1\", \"0\"]\n",
+                 "5:9", "give no field or vdb"},
         BadScene{"speed_map_without_velocity", "[rd]\nmodel = \"turing-sanderson\"\n[rd.maps]\ns = \"speed\"\n", "4:5",
                  "has no [velocity]"},
         BadScene{"coupling_without_rd", "[fluid]\nreynolds = 100\n[coupling]\nmode = \"ard\"\n", "3:1", "lacks one of them"},
@@ -196,6 +198,20 @@ INSTANTIATE_TEST_SUITE_P(
         BadScene{"coupling_boundary_mismatch", "[fluid]\nreynolds = 100\n[rd]\nmodel = \"gray-scott\"\nboundary = \"periodic\"\n",
                  "5:12", "must wrap exactly where the fluid does"}),
     [](const ::testing::TestParamInfo<BadScene>& i) { return i.param.name; });
+
+// A scene whose velocity comes from Python validates, but the command line
+// cannot run it: exit 2 at the key, pointing to the module.
+TEST(Cli, APythonVelocitySceneIsRefusedByRun) {
+  auto dir = tempDir("python_velocity");
+  fs::path p = writeScene(dir, "p.toml", "[rd]\nmodel = \"gray-scott\"\n[velocity]\npython = true\n");
+  EXPECT_EQ(runMorphoflow("validate " + p.string()).status, 0);
+  CommandResult run = runMorphoflow("run " + p.string() + " --out " + (dir / "out").string());
+  EXPECT_EQ(run.status, 2) << run.output;
+  EXPECT_NE(run.output.find(p.string() + ":4:10"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("set_velocity"), std::string::npos) << run.output;
+  EXPECT_FALSE(fs::exists(dir / "out" / "run.json"));
+  fs::remove_all(dir);
+}
 
 TEST(Cli, MissingFileAndBadOverrideExitTwo) {
   CommandResult r = runMorphoflow("validate /nonexistent/scene.toml");
