@@ -11,14 +11,6 @@
 
 namespace morphoflow {
 
-// Face k of component a sits at (k + 1/2 - e_a / 2) h.
-template <int D>
-Vec<D> facePosition(const IVec<D>& k, int a, double h) {
-  Vec<D> p;
-  for (int b = 0; b < D; ++b) p[b] = (k[b] + (b == a ? 0.0 : 0.5)) * h;
-  return p;
-}
-
 // On a periodic axis face n duplicates face 0.
 template <int D>
 void wrapPeriodicFaces(MacVelocity<D>* u) {
@@ -54,12 +46,11 @@ ExpressionVelocity<D>::ExpressionVelocity(const std::vector<std::string>& expres
 
 template <int D>
 void ExpressionVelocity<D>::sample(double t, MacVelocity<D>* u) {
-  const double h = u->h();
   for (int a = 0; a < D; ++a) {
     Grid<float, D>& g = (*u)[a];
     const Expression& e = components_[size_t(a)];
     forEachCell<D>(g.dims(), [&](const IVec<D>& k, size_t i) {
-      const Vec<D> p = facePosition<D>(k, a, h);
+      const Vec<D> p = u->layout(a).toWorld(k);  // face k of component a: (k + 1/2 - e_a / 2) h
       const double v[4] = {p[0], p[1], D == 3 ? p[D - 1] : 0.0, t};
       g[i] = float(e.evaluate(v));
     });
@@ -131,11 +122,10 @@ void resample(const VelocityVolume& v, MacVelocity<D>* u) {
       if (c[size_t(b)] < 0 || c[size_t(b)] >= v.cells[size_t(b)]) return 0.0;  // inactive: the background
     return v.values[size_t(comp)][(size_t(c[2]) * size_t(v.cells[1]) + size_t(c[1])) * size_t(v.cells[0]) + size_t(c[0])];
   };
-  const double h = u->h();
   for (int a = 0; a < D; ++a) {
     Grid<float, D>& g = (*u)[a];
     forEachCell<D>(g.dims(), [&](const IVec<D>& k, size_t i) {
-      const Vec<D> p = facePosition<D>(k, a, h);
+      const Vec<D> p = u->layout(a).toWorld(k);  // face k of component a: (k + 1/2 - e_a / 2) h
       // Continuous index into the box; a staggered component a sits half a voxel lower along a.
       std::array<long, 3> c0{0, 0, 0};
       std::array<double, 3> w{0, 0, 0};
@@ -228,8 +218,6 @@ void VdbVelocitySequence<D>::sample(double t, MacVelocity<D>* u) {
     for (size_t i = 0; i < (*u)[a].size(); ++i) (*u)[a][i] = float((1.0 - w) * f0[a][i] + w * f1[a][i]);
 }
 
-template Vec<2> facePosition<2>(const IVec<2>&, int, double);
-template Vec<3> facePosition<3>(const IVec<3>&, int, double);
 template void wrapPeriodicFaces<2>(MacVelocity<2>*);
 template void wrapPeriodicFaces<3>(MacVelocity<3>*);
 template class ExpressionVelocity<2>;

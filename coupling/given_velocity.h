@@ -29,9 +29,6 @@ class GivenVelocity {
   virtual bool steady() const = 0;
 };
 
-// Face k of component a sits at (k + 1/2 - e_a / 2) h.
-template <int D>
-Vec<D> facePosition(const IVec<D>& k, int a, double h);
 // On a periodic axis face n duplicates face 0: copies it there.
 template <int D>
 void wrapPeriodicFaces(MacVelocity<D>* u);

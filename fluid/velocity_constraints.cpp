@@ -83,14 +83,10 @@ double VelocityConstraints<D>::inflowSpeed(int axis, const Vec<D>& x) const {
 
 template <int D>
 std::array<double, 3> VelocityConstraints<D>::facePosition(int a, const IVec<D>& k) const {
+  const Vec<D> p = Layout<D>::face(a, h, cells, periodic()).toWorld(k);
   std::array<double, 3> x{0, 0, 0};
-  for (int b = 0; b < D; ++b) x[size_t(b)] = (k[b] + (b == a ? 0.0 : 0.5)) * h;
+  for (int b = 0; b < D; ++b) x[size_t(b)] = p[b];
   return x;
-}
-
-template <int D>
-bool VelocityConstraints<D>::insideCut(int a, const IVec<D>& k) const {
-  return !cut.empty() && cut.distance(facePosition(a, k).data()) < 0.0;
 }
 
 template <int D>

@@ -51,12 +51,8 @@ struct VelocityConstraints {
   std::vector<float> prescribedGrid(int a) const;
   // Inflow normal speed (into the domain) at a position on the inflow side.
   double inflowSpeed(int axis, const Vec<D>& x) const;
-  // The world position of face k of grid a.
+  // The world position of face k of grid a (x, y, z; 0 beyond D).
   std::array<double, 3> facePosition(int a, const IVec<D>& k) const;
-  // Whether face k of grid a lies inside a cut obstacle: free for the
-  // projection where its open fraction is positive, but held at the
-  // obstacle's velocity by the viscosity, whose no-slip is at the surface.
-  bool insideCut(int a, const IVec<D>& k) const;
 };
 
 }  // namespace morphoflow

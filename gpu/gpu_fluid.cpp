@@ -163,12 +163,7 @@ void GpuFluid<D>::readSolverStats() const {
   stats_.pressure = pressurePcg_->tally();
   SolverResult v;
   v.converged = true;
-  for (const auto& V : viscous_) {
-    const SolverResult r = V->pcg->tally();
-    v.converged = v.converged && r.converged;
-    v.iterations = std::max(v.iterations, r.iterations);
-    v.residual = std::max(v.residual, r.residual);
-  }
+  for (const auto& V : viscous_) foldWorst(&v, V->pcg->tally());
   stats_.viscosity = v;
 }
 
@@ -424,9 +419,7 @@ void GpuFluid<D>::diffuse(double dt) {
     // Each component to the tolerance; its result read with the others' (readSolverStats).
     const SolverResult r = V.pcg->solve(&V.b, &V.x, nullptr, {settings_.viscosityTolerance, 500}, true);
     run(FluidOp::ViscousStore);
-    stats_.viscosity.iterations = std::max(stats_.viscosity.iterations, r.iterations);
-    stats_.viscosity.converged = stats_.viscosity.converged && r.converged;
-    stats_.viscosity.residual = std::max(stats_.viscosity.residual, r.residual);
+    foldWorst(&stats_.viscosity, r);
   }
   s_ = s;
   applyConstraints(vel_);

@@ -6,7 +6,7 @@
 
 #include <fmt/format.h>
 
-#include "core/random.h"
+#include "gpu/gpu_layer_difference.h"
 #include "gpu/gpu_rd_layer.h"
 #include "rd/layer_upload.h"
 #include "rd/model_registry.h"
@@ -37,25 +37,12 @@ std::string check(const ReactionModel& m) {
     for (int c = 0; c < ns; ++c) row += std::abs(J[size_t(r * ns + c)]);
     rate = std::max(rate, row);
   }
-  std::vector<std::vector<double>> start(static_cast<size_t>(ns));
-  for (int k = 0; k < ns; ++k) {
-    const double v = info.initial[size_t(k)];
-    for (size_t i = 0; i < cpu.field(k).size(); ++i)
-      cpu.field(k)[i] = v + 0.1 * (1.0 + std::abs(v)) * (uniform01(11, uint64_t(k), i) - 0.5);
-    start[size_t(k)] = cpu.field(k).values();
-  }
+  const std::vector<std::vector<double>> start = perturbNearInitial<2>(&cpu, 11);
   GpuRDLayer<2> gpu(layerUpload(cpu));
   const double dt = 10.0 / rate;
   cpu.step(dt);
   gpu.step(dt);
-  double worst = 0, moved = 0;
-  for (int k = 0; k < ns; ++k) {
-    const std::vector<double> g = gpu.download(k);
-    for (size_t i = 0; i < g.size(); ++i) {
-      worst = std::max(worst, std::abs(g[i] - cpu.field(k)[i]));
-      moved = std::max(moved, std::abs(cpu.field(k)[i] - start[size_t(k)][i]));
-    }
-  }
+  const auto [worst, moved] = layerDifference<2>(gpu, cpu, start);
   const int gpuFailures = gpu.lastStats().newton.failures, cpuFailures = cpu.lastStats().newton.failures;
   if (!(worst <= 1e-9 * moved) || gpuFailures > cpuFailures)
     return fmt::format("its Newton failed in {} of {} cells (the CPU's in {}) and its roots differ from the CPU's by {:.2g} of "

@@ -232,9 +232,7 @@ void GpuRDLayer<D>::step(double dt) {
                 dt, explicitD, ghost);
     }
     const SolverResult r = diffuse(s, theta * dt);
-    stats_.diffusion.converged = stats_.diffusion.converged && r.converged;
-    stats_.diffusion.iterations = std::max(stats_.diffusion.iterations, r.iterations);
-    stats_.diffusion.residual = std::max(stats_.diffusion.residual, r.residual);
+    foldWorst(&stats_.diffusion, r);
   }
   for (int s = 0; s < species_; ++s)
     if ((clamped_ >> s) & 1u) vectorOp(VectorOp::ClampZero, x_[size_t(s)], &x_[size_t(s)], 0.0, 0.0);
@@ -248,12 +246,7 @@ void GpuRDLayer<D>::readStats() {
   // The diffusion solves' tallies, and Newton's failures and most
   // iterations since the last read (the sums and maxima of the steps between).
   for (const auto& df : diffusion_)
-    if (df && df->pcg) {
-      const SolverResult r = df->pcg->tally();
-      stats_.diffusion.converged = stats_.diffusion.converged && r.converged;
-      stats_.diffusion.iterations = std::max(stats_.diffusion.iterations, r.iterations);
-      stats_.diffusion.residual = std::max(stats_.diffusion.residual, r.residual);
-    }
+    if (df && df->pcg) foldWorst(&stats_.diffusion, df->pcg->tally());
   if (up_.settings.integrator == RDIntegrator::KimLin) {
     const std::vector<uint32_t> st = stats_buffer_.read<uint32_t>(2);
     stats_.newton.failures = long(st[0]);

@@ -39,8 +39,7 @@ class GpuRDLayer {
   GpuRDLayer& operator=(const GpuRDLayer&) = delete;
 
   void step(double dt);
-  // Newton failures and iterations, the worst diffusion solve.
-  // The step's statistics. The diffusion solves decide their convergence on
+  // The step's statistics (Newton failures and iterations, the worst diffusion solve). The diffusion solves decide their convergence on
   // the device (gpu_gate.h) and everything is read back at steps 1, 2, 4, 8 and
   // then every 16th (statsDue): a step reports the last read's diffusion results, and Newton's
   // failures and most iterations since the read before on the steps that

@@ -54,7 +54,6 @@ void PythonVelocity<D>::sampleFromPython(double t, MacVelocity<D>* u) {
     return;
   }
   const IVec<D> cells = u->cells();
-  const double h = u->h();
   if (PyCallable_Check(source_.ptr())) {
     for (int a = 0; a < D; ++a) {  // the callable at component a's faces
       Grid<float, D>& g = (*u)[a];
@@ -64,7 +63,7 @@ void PythonVelocity<D>::sampleFromPython(double t, MacVelocity<D>* u) {
         for (int k = D - 1; k >= 0; --k) shape.push_back(g.dims()[k]);
         py::array_t<double> x(shape);
         double* p = x.mutable_data();
-        for (size_t i = 0; i < g.size(); ++i) p[i] = facePosition<D>(g.coord(i), a, h)[b];
+        for (size_t i = 0; i < g.size(); ++i) p[i] = u->layout(a).toWorld(g.coord(i))[b];
         coords.append(x);
       }
       coords.append(t);

@@ -10,6 +10,7 @@
 #include "core/parallel.h"
 #include "core/random.h"
 #include "gpu_context.h"
+#include "gpu/gpu_layer_difference.h"
 #include "gpu/gpu_models.h"
 #include "gpu/gpu_rd_layer.h"
 #include "rd/cosine_lobe.h"
@@ -28,13 +29,7 @@ template <int D>
 double relativeDifference(RDSettings s, const ReactionModel& m, double dt, int steps) {
   RDSolver<D> cpu(s, m);
   const ModelInfo& info = m.info();
-  const int ns = int(info.species.size());
-  std::vector<std::vector<double>> start(static_cast<size_t>(ns));
-  for (int k = 0; k < ns; ++k) {
-    for (size_t i = 0; i < cpu.field(k).size(); ++i)
-      cpu.field(k)[i] = info.initial[size_t(k)] + 0.1 * (1.0 + std::abs(info.initial[size_t(k)])) * (uniform01(3, uint64_t(k), i) - 0.5);
-    start[size_t(k)] = cpu.field(k).values();
-  }
+  const std::vector<std::vector<double>> start = perturbNearInitial<D>(&cpu, 3);
   GpuRDLayer<D> gpu(layerUpload(cpu));
   for (int n = 0; n < steps; ++n) {
     cpu.step(dt);
@@ -42,14 +37,7 @@ double relativeDifference(RDSettings s, const ReactionModel& m, double dt, int s
     EXPECT_TRUE(gpu.lastStats().diffusion.converged) << info.name;
     EXPECT_EQ(gpu.lastStats().newton.failures, cpu.lastStats().newton.failures) << info.name;
   }
-  double worst = 0, moved = 0;
-  for (int k = 0; k < ns; ++k) {
-    const std::vector<double> g = gpu.download(k);
-    for (size_t i = 0; i < g.size(); ++i) {
-      worst = std::max(worst, std::abs(g[i] - cpu.field(k)[i]));
-      moved = std::max(moved, std::abs(cpu.field(k)[i] - start[size_t(k)][i]));
-    }
-  }
+  const auto [worst, moved] = layerDifference<D>(gpu, cpu, start);
   EXPECT_GT(moved, 1e-4) << info.name << ": the steps must change the state";
   return worst / moved;
 }
