@@ -23,7 +23,8 @@ GpuGate* GpuGate::current() { return entered; }
 void GpuGate::enter() { entered = this; }
 void GpuGate::leave() { entered = nullptr; }
 
-void GpuGate::run(const char* mode, const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations) {
+void GpuGate::run(const char* mode, const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations,
+                  const Finals& finals) {
   GpuGate* was = entered;
   entered = nullptr;  // the gate's own kernel is not gated
   const ComputeProgram& p = useKernel("gate.comp", std::string("#define ") + mode);
@@ -31,7 +32,10 @@ void GpuGate::run(const char* mode, const GpuBuffer& scalars, Slots slots, doubl
   setUniform(p, "tol", tolerance);
   setUniform(p, "limit", maxIterations);
   setUniform(p, "slots", int(base_.size() / 3));
+  glUniform2i(p.uniform("finals"), finals.slots[0], finals.slots[1]);
+  setUniform(p, "groups", int(finals.groups));
   scalars.bind(0);
+  (finals.partials ? *finals.partials : state_).bind(4);
   (baseBuffer_.bytes() ? baseBuffer_ : state_).bind(1);
   (args_.bytes() ? args_ : state_).bind(2);
   state_.bind(3);
@@ -41,25 +45,25 @@ void GpuGate::run(const char* mode, const GpuBuffer& scalars, Slots slots, doubl
   entered = was;
 }
 
-void GpuGate::start(const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations) {
-  run("MODE_START", scalars, slots, tolerance, maxIterations);
+void GpuGate::start(const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations, const Finals& finals) {
+  run("MODE_START", scalars, slots, tolerance, maxIterations, finals);
 }
-void GpuGate::check(const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations) {
-  run("MODE_CHECK", scalars, slots, tolerance, maxIterations);
+void GpuGate::check(const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations, const Finals& finals) {
+  run("MODE_CHECK", scalars, slots, tolerance, maxIterations, finals);
 }
-void GpuGate::finish(const GpuBuffer& scalars, Slots slots, double tolerance) {
-  run("MODE_FINISH", scalars, slots, tolerance, 0);
+void GpuGate::finish(const GpuBuffer& scalars, Slots slots, double tolerance, const Finals& finals) {
+  run("MODE_FINISH", scalars, slots, tolerance, 0, finals);
 }
 
 void GpuGate::refreshArgs() {
   // Called in the middle of another kernel's dispatch: its program and the
   // bindings the gate's kernel takes are put back after.
-  GLint program = 0, bound[4] = {0, 0, 0, 0};
+  GLint program = 0, bound[5] = {0, 0, 0, 0, 0};
   glGetIntegerv(GL_CURRENT_PROGRAM, &program);
-  for (GLuint i = 0; i < 4; ++i) glGetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, i, &bound[i]);
+  for (GLuint i = 0; i < 5; ++i) glGetIntegeri_v(GL_SHADER_STORAGE_BUFFER_BINDING, i, &bound[i]);
   run("MODE_REFRESH", state_, Slots{0, 0, 0}, 0.0, 0);
   glUseProgram(GLuint(program));
-  for (GLuint i = 0; i < 4; ++i) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, i, GLuint(bound[i]));
+  for (GLuint i = 0; i < 5; ++i) glBindBufferBase(GL_SHADER_STORAGE_BUFFER, i, GLuint(bound[i]));
 }
 
 void GpuGate::dispatch(unsigned gx, unsigned gy) {

@@ -24,12 +24,21 @@ namespace morphoflow {
 constexpr long kStatsEvery = 16;
 inline bool statsDue(long step) { return step == 1 || step == 2 || step == 4 || step == 8 || step % kStatsEvery == 0; }
 
+// Sums whose final pass a gate's kernel makes first (fused_sum.glsl): up to
+// two slots of `partials`, each of `groups` partials.
+struct GateFinals {
+  const GpuBuffer* partials = nullptr;
+  int slots[2] = {-1, -1};
+  unsigned groups = 0;
+};
+
 class GpuGate {
  public:
   // The scalar slots of the solve's reduction buffer the kernel reads.
   struct Slots {
     int bb, rr, pq;
   };
+  using Finals = GateFinals;
   // What the device counted since the last reset.
   struct Tally {
     uint32_t solves = 0, iterations = 0, maxIterations = 0, unconverged = 0;
@@ -40,12 +49,12 @@ class GpuGate {
 
   GpuGate();
   // Before the first iteration: go while ||r|| / ||b|| > tolerance (and b != 0); 0 iterations.
-  void start(const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations);
+  void start(const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations, const Finals& finals = {});
   // After an iteration's rr: counts it while going, and goes on while
   // p.Ap > 0, ||r|| / ||b|| > tolerance and fewer than maxIterations are done.
-  void check(const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations);
+  void check(const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations, const Finals& finals = {});
   // After the true residual's rr: the solve's verdict into the tally.
-  void finish(const GpuBuffer& scalars, Slots slots, double tolerance);
+  void finish(const GpuBuffer& scalars, Slots slots, double tolerance, const Finals& finals = {});
   // Dispatches between enter() and leave() are gated.
   void enter();
   void leave();
@@ -59,7 +68,8 @@ class GpuGate {
   void resetTally();
 
  private:
-  void run(const char* mode, const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations);
+  void run(const char* mode, const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations,
+           const Finals& finals = {});
   void refreshArgs();  // after a new slot: its arguments from the current go flag
   std::map<std::pair<unsigned, unsigned>, unsigned> slotOf_;
   std::vector<uint32_t> base_;  // gx, gy, 1 per slot

@@ -105,11 +105,12 @@ bool GpuLaplace::mixesColours() const {
 }
 
 void GpuLaplace::run(LaplaceMode mode, bool single, const GpuBuffer& x, const GpuBuffer* y, const GpuBuffer* b,
-                     int colour, float omega) const {
+                     int colour, float omega, const FusedDot* dot) const {
   const bool cross = hasCross_ && !single && (mode == LaplaceMode::Apply || mode == LaplaceMode::Residual);
-  const ComputeProgram& p = useKernel("laplace.comp", fmt::format("#define DIM {}\n#define REAL {}\n#define {}{}", dim_,
+  const ComputeProgram& p = useKernel("laplace.comp", fmt::format("#define DIM {}\n#define REAL {}\n#define {}{}{}", dim_,
                                                                   single ? "float" : "double", define(mode),
-                                                                  cross ? "\n#define CROSS" : ""));
+                                                                  cross ? "\n#define CROSS" : "",
+                                                                  dot ? "\n#define DOT_PARTIAL" : ""));
   setUniform(p, "dims", dims_);
   setUniform(p, "scale", scale_);
   setUniform(p, "colour", colour);
@@ -126,7 +127,14 @@ void GpuLaplace::run(LaplaceMode mode, bool single, const GpuBuffer& x, const Gp
   // terms); a smoothing pass touches half the cells
   const double real = single ? 4.0 : 8.0, coefficients = 4.0 * (dim_ + 2 + crossBuffers);
   const double bytes = mode == LaplaceMode::Smooth ? 0.5 * (3 * real + coefficients) : (y ? 2 : 1) * real + (b ? real : 0) + coefficients;
-  dispatchFlat(n_, bytes);
+  if (dot) {
+    setUniform(p, "slot", dot->slot);
+    dot->partials->bind(14);
+    countGpuTraffic(double(n_) * bytes);
+    dispatchGroups(GpuReduction::groups(n_), 1);
+  } else {
+    dispatchFlat(n_, bytes);
+  }
   storageBarrier();
 }
 
@@ -134,6 +142,14 @@ void GpuLaplace::apply(const GpuBuffer& x, GpuBuffer* y) const { run(LaplaceMode
 
 void GpuLaplace::residual(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* r, bool single) const {
   run(LaplaceMode::Residual, single, x, r, &b, 0, 0.0f);
+}
+
+void GpuLaplace::apply(const GpuBuffer& x, GpuBuffer* y, FusedDot dot) const {
+  run(LaplaceMode::Apply, false, x, y, nullptr, 0, 0.0f, &dot);
+}
+
+void GpuLaplace::residual(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* r, FusedDot dot) const {
+  run(LaplaceMode::Residual, false, x, r, &b, 0, 0.0f, &dot);
 }
 
 void GpuLaplace::smooth(const GpuBuffer& b, GpuBuffer* x, int colour) const {

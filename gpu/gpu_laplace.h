@@ -8,6 +8,7 @@
 #include "core/anisotropic_system.h"
 #include "core/laplace_system.h"
 #include "gpu/gpu_buffer.h"
+#include "gpu/gpu_reduction.h"
 #include "gpu/kernel_modes.h"
 
 namespace morphoflow {
@@ -52,6 +53,11 @@ class GpuLaplace {
   void apply(const GpuBuffer& x, GpuBuffer* y) const;  // y = A x (double)
   // r = b - A x, in double or (`single`) float.
   void residual(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* r, bool single) const;
+  // The same in double with the partial pass of x . y (apply) or r . r
+  // (residual) into `dot`: bitwise a GpuReduction::dot after them, one
+  // dispatch fewer.
+  void apply(const GpuBuffer& x, GpuBuffer* y, FusedDot dot) const;
+  void residual(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* r, FusedDot dot) const;
   // One colour of a red-black Gauss-Seidel sweep on float vectors.
   void smooth(const GpuBuffer& b, GpuBuffer* x, int colour) const;
   // y = x + omega (D^-1 (b / scale + N x) - x) on float vectors.
@@ -59,7 +65,7 @@ class GpuLaplace {
 
  private:
   void run(LaplaceMode mode, bool single, const GpuBuffer& x, const GpuBuffer* y, const GpuBuffer* b, int colour,
-           float omega) const;
+           float omega, const FusedDot* dot = nullptr) const;
   std::array<int, 3> dims_{1, 1, 1};
   std::array<bool, 3> periodic_{};
   int dim_ = 2;

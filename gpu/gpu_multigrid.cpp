@@ -195,22 +195,31 @@ void GpuMultigrid::cycle(size_t l) {
   smooth(L, true, options_.postSmooth);
 }
 
-void GpuMultigrid::apply(const GpuBuffer& r, GpuBuffer* z, const GpuBuffer& scalars, int slot) {
+void GpuMultigrid::apply(const GpuBuffer& r, GpuBuffer* z, const GpuBuffer& scalars, int slot, FusedDot rz) {
   Level& L = levels_[0];
   const size_t n = L.A->size();
   auto convert = [&](VectorOp op, const GpuBuffer& in, const GpuBuffer& out) {
-    const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + define(op));
+    const bool fused = op == VectorOp::FromFloat;  // with r . z's partials
+    const ComputeProgram& p =
+        useKernel("vector_ops.comp", std::string("#define ") + define(op) + (fused ? "\n#define DOT_PARTIAL" : ""));
     setUniform(p, "n", int(n));
-    setUniform(p, "slots", std::array<int, 4>{slot, 0, 0, 0});
+    setUniform(p, "slots", std::array<int, 4>{slot, rz.slot, 0, 0});
     in.bind(0);
     out.bind(1);
-    in.bind(2);
+    (fused ? r : in).bind(2);
     in.bind(3);
     L.b.bind(4);
-    if (op == VectorOp::FromFloat) L.x.bind(4);
+    if (fused) L.x.bind(4);
     L.A->diag().bind(5);
     scalars.bind(6);
-    dispatchFlat(n, 12.0);
+    if (fused) {
+      rz.partials->bind(8);
+      in.bind(9);
+      countGpuTraffic(double(n) * 20.0);
+      dispatchGroups(GpuReduction::groups(n), 1);
+    } else {
+      dispatchFlat(n, 12.0);
+    }
     storageBarrier();
   };
   convert(VectorOp::ToFloat, r, r);

@@ -11,6 +11,7 @@
 
 #include "core/multigrid.h"
 #include "gpu/gpu_laplace.h"
+#include "gpu/gpu_reduction.h"
 
 namespace morphoflow {
 
@@ -24,8 +25,9 @@ class GpuMultigrid {
   void update(const Multigrid<D>& levels);
 
   // z = M r for double vectors: one cycle on r / s, times s, where s^2 is
-  // scalars[slot] (r . r), so single precision neither under- nor overflows.
-  void apply(const GpuBuffer& r, GpuBuffer* z, const GpuBuffer& scalars, int slot);
+  // scalars[slot] (r . r), so single precision neither under- nor overflows;
+  // with the partial pass of r . z into `rz` (gpu_reduction.h).
+  void apply(const GpuBuffer& r, GpuBuffer* z, const GpuBuffer& scalars, int slot, FusedDot rz);
 
  private:
   struct Level {

@@ -24,8 +24,9 @@ GpuPcg::GpuPcg(const GpuLaplace& A)
 }
 
 void GpuPcg::op(VectorOp name, const GpuBuffer& x, const GpuBuffer& y, const GpuBuffer& z, const GpuBuffer& q,
-                std::array<int, 4> slots, bool first) {
-  const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + define(name));
+                std::array<int, 4> slots, bool first, bool fused) {
+  const ComputeProgram& p =
+      useKernel("vector_ops.comp", std::string("#define ") + define(name) + (fused ? "\n#define DOT_PARTIAL" : ""));
   setUniform(p, "n", int(A_.size()));
   setUniform(p, "slots", slots);
   setUniform(p, "first", first ? 1 : 0);
@@ -36,7 +37,15 @@ void GpuPcg::op(VectorOp name, const GpuBuffer& x, const GpuBuffer& y, const Gpu
   A_.diag().bind(4);  // (no float vector in these ops)
   A_.diag().bind(5);
   sums_.scalars().bind(6);
-  dispatchFlat(A_.size(), name == VectorOp::UpdateXR ? 48.0 : name == VectorOp::UpdateP ? 24.0 : 20.0);
+  const double bytes = name == VectorOp::UpdateXR ? (slots[3] >= 0 ? 68.0 : 48.0) : name == VectorOp::UpdateP ? 24.0 : 20.0;
+  if (fused) {
+    sums_.partials().bind(8);
+    z_.bind(9);  // the fused diagonal preconditioner's z
+    countGpuTraffic(double(A_.size()) * bytes);
+    dispatchGroups(GpuReduction::groups(A_.size()), 1);
+  } else {
+    dispatchFlat(A_.size(), bytes);
+  }
   storageBarrier();
 }
 
@@ -48,43 +57,43 @@ void GpuPcg::removeMean(GpuBuffer* x) {
 SolverResult GpuPcg::solve(GpuBuffer* bp, GpuBuffer* xp, GpuMultigrid* M, const SolverOptions& options, bool deferred) {
   GpuBuffer &b = *bp, &x = *xp;
   const size_t n = A_.size();
+  // Each dot product's partial pass is fused into the kernel that makes its
+  // terms, its final pass into the gate's kernel or the kernel that uses it.
+  const unsigned groups = GpuReduction::groups(n);
+  const auto finals = [&](int a, int b2) { return GpuGate::Finals{&sums_.partials(), {a, b2}, groups}; };
   if (A_.singular()) removeMean(&b);
   sums_.dot(b, b, n, kBB);
   op(VectorOp::ZeroIfNoRhs, x, x, x, x, {kBB, 0, 0, 0});  // b = 0: x = 0, as on the CPU
-  A_.residual(b, x, &r_, false);
-  sums_.dot(r_, r_, n, kRR);
-  gate_.start(sums_.scalars(), kGateSlots, options.tolerance, options.maxIterations);
+  A_.residual(b, x, &r_, sums_.fused(kRR));
+  gate_.start(sums_.scalars(), kGateSlots, options.tolerance, options.maxIterations, finals(kRR, -1));
   gate_.enter();
   int rz = kRZ0;
-  auto precondition = [&](int slot) {
+  auto precondition = [&](int slot) {  // z = M r, with r . z's partials
     if (M)
-      M->apply(r_, &z_, sums_.scalars(), kRR);
+      M->apply(r_, &z_, sums_.scalars(), kRR, sums_.fused(slot));
     else
-      op(VectorOp::Jacobi, r_, z_, z_, z_, {0, 0, 0, 0});
-    sums_.dot(r_, z_, n, slot);
+      op(VectorOp::Jacobi, r_, z_, z_, z_, {slot, 0, 0, 0}, false, true);
   };
   precondition(rz);
-  op(VectorOp::UpdateP, z_, p_, p_, p_, {0, 0, 0, 0}, true);
+  op(VectorOp::UpdateP, z_, p_, p_, p_, {rz, rz, 0, 0}, true, true);
   // The scheduled iterations, or (calibrating) until the device says it stopped.
   const bool calibrating = ahead_ == 0;
   const int queue = calibrating ? options.maxIterations : std::min(ahead_, options.maxIterations);
   for (int it = 1; it <= queue; ++it) {
-    A_.apply(p_, &q_);
-    sums_.dot(p_, q_, n, kPQ);
-    op(VectorOp::UpdateXR, x, r_, p_, q_, {rz, kPQ, 0, 0});
-    sums_.dot(r_, r_, n, kRR);
-    gate_.check(sums_.scalars(), kGateSlots, options.tolerance, options.maxIterations);
     const int next = rz == kRZ0 ? kRZ1 : kRZ0;
-    precondition(next);
-    op(VectorOp::UpdateP, z_, p_, p_, p_, {next, rz, 0, 0});
+    A_.apply(p_, &q_, sums_.fused(kPQ));
+    // x += alpha p, r -= alpha q (and, diagonal, z = D^-1 r)
+    op(VectorOp::UpdateXR, x, r_, p_, q_, {rz, kPQ, kRR, M ? -1 : next}, false, true);
+    gate_.check(sums_.scalars(), kGateSlots, options.tolerance, options.maxIterations, finals(kPQ, kRR));
+    if (M) precondition(next);
+    op(VectorOp::UpdateP, z_, p_, p_, p_, {next, rz, 0, 0}, false, true);
     rz = next;
     if (calibrating && it % kCalibrationLook == 0 && !gate_.going()) break;
   }
   gate_.leave();
   // The true residual, not the recursively updated one.
-  A_.residual(b, x, &r_, false);
-  sums_.dot(r_, r_, n, kRR);
-  gate_.finish(sums_.scalars(), kGateSlots, options.tolerance);
+  A_.residual(b, x, &r_, sums_.fused(kRR));
+  gate_.finish(sums_.scalars(), kGateSlots, options.tolerance, finals(kRR, -1));
   if (A_.singular()) removeMean(&x);
   if (calibrating || !deferred) return fromTally(gate_.read(), true);
   return last_;

@@ -16,23 +16,26 @@ namespace {
 constexpr size_t kGroups = 256;  // partial sums: a fixed count, so the sum's order is fixed
 }
 
-GpuReduction::GpuReduction() : partial_(kGroups * sizeof(double)), scalars_(kSlots * sizeof(double)) {
+unsigned GpuReduction::groups(size_t n) { return unsigned(std::clamp<size_t>((n + 255) / 256, 1, kGroups)); }
+
+GpuReduction::GpuReduction() : partial_(kSlots * kGroups * sizeof(double)), scalars_(kSlots * sizeof(double)) {
   partial_.zero();
   scalars_.zero();
 }
 
 void GpuReduction::run(const char* term, const GpuBuffer& x, const GpuBuffer& y, const GpuBuffer& diag, size_t n,
                        int slot) {
-  const size_t groups = std::clamp<size_t>((n + 255) / 256, 1, kGroups);
+  const unsigned groups = GpuReduction::groups(n);
   const ComputeProgram& p = useKernel("reduce.comp", fmt::format("#define MODE_PARTIAL\n#define {}", term));
   setUniform(p, "n", int(n));
+  setUniform(p, "slot", slot);
   x.bind(0);
   y.bind(1);
   diag.bind(2);
   partial_.bind(3);
   scalars_.bind(4);
   x.bind(5);
-  dispatchGroups(unsigned(groups), 1);
+  dispatchGroups(groups, 1);
   const std::string t = term;
   countGpuTraffic(double(n) * (t == "TERM_DOT" ? 16.0 : t == "TERM_ACTIVE_SUM" ? 12.0 : 4.0));
   storageBarrier();

@@ -5,9 +5,11 @@
 // MODE_FINISH  the true residual ||r|| / ||b||: the solve's verdict (<= tol, with
 //              core/pcg.cpp's 1e-4 slack) into the tally
 // MODE_REFRESH only the arguments
+// First, the final passes of the sums whose partials the kernels before
+// wrote (finals: up to two slots, -1 none; fused_sum.glsl) into their slots.
 // Then every slot's dispatch arguments: its groups while going, 0 after.
 // (one group of common.glsl's 256 invocations)
-layout(std430, binding = 0) readonly buffer Scalars { double S[]; };
+layout(std430, binding = 0) buffer Scalars { double S[]; };
 layout(std430, binding = 1) readonly buffer Base { uint base[]; };
 layout(std430, binding = 2) buffer Args { uint args[]; };
 layout(std430, binding = 3) buffer State {
@@ -15,7 +17,12 @@ layout(std430, binding = 3) buffer State {
   double maxResidual, lastResidual;
 };
 
+layout(std430, binding = 4) buffer Partials { double partial[]; };
+#include "fused_sum.glsl"
+
 uniform ivec3 slot;  // bb, rr, pq
+uniform ivec2 finals;
+uniform int groups;  // the partials of each final
 uniform double tol;
 uniform int limit;
 uniform int slots;
@@ -26,6 +33,11 @@ double relative() { return S[slot.x] > 0.0lf ? sqrt(S[slot.y]) / sqrt(S[slot.x])
 
 void main() {
   const uint lid = gl_LocalInvocationID.x;
+  for (int k = 0; k < 2; ++k) {
+    if (finals[k] < 0) continue;
+    const double v = finalSum(finals[k], groups);
+    if (lid == 0u) S[finals[k]] = v;
+  }
   if (lid == 0u) {
 #if defined(MODE_START)
     iterations = 0u;

@@ -10,6 +10,8 @@
 // CROSS (apply and residual): the mixed terms of a tensor diffusion operator
 // (core/anisotropic_system.h), pair couplings K (x_i - x_q) with the four
 // diagonal neighbours in each plane; the preconditioners take the axis part.
+// DOT_PARTIAL (apply and residual, double): with the partial pass of the
+// dot product the PCG takes next (see main).
 layout(std430, binding = 0) buffer X { REAL x[]; };
 layout(std430, binding = 1) buffer Y { REAL y[]; };
 layout(std430, binding = 2) readonly buffer B { REAL b[]; };
@@ -76,9 +78,51 @@ REAL neighbourSum(ivec3 c, int i) {
   return s;
 }
 
+#if defined(MODE_APPLY) || defined(MODE_RESIDUAL)
+// A x (MODE_APPLY) or b - A x (MODE_RESIDUAL) at cell i; 0 on inactive cells.
+REAL operatorAt(int i) {
+  if (diag[i] <= 0.0) return REAL(0);
+  const ivec3 c = coordsOf(i, dims);
+  // precise: rounded as the CPU's (the explicit step depends on it bit for bit)
+  precise REAL ax = REAL(scale) * (REAL(cTerm[i]) * x[i] + faceSum(c, i));
+#if defined(CROSS)
+  ax += REAL(scale) * crossSum(c, i);
+#endif
+#if defined(MODE_APPLY)
+  return ax;
+#else
+  return b[i] - ax;
+#endif
+}
+#endif
+
+#if defined(DOT_PARTIAL)
+// With the partial pass of x . y (MODE_APPLY: p . Ap) or y . y (MODE_RESIDUAL:
+// r . r) into slot `slot` (fused_sum.glsl), over the reduction's groups.
+layout(std430, binding = 14) buffer Partials { double partial[]; };
+uniform int slot;
+#include "fused_sum.glsl"
+
+void main() {
+  double s = 0.0lf;
+  FOR_REDUCTION(i, dims.x * dims.y * dims.z) {
+    const REAL v = operatorAt(i);
+    y[i] = v;
+#if defined(MODE_APPLY)
+    s = s + x[i] * v;
+#else
+    s = s + v * v;
+#endif
+  }
+  writePartial(s, slot);
+}
+#else
 void main() {
   const int i = flatIndex();
   if (i >= dims.x * dims.y * dims.z) return;
+#if defined(MODE_APPLY) || defined(MODE_RESIDUAL)
+  y[i] = operatorAt(i);
+#else
   const ivec3 c = coordsOf(i, dims);
 #if defined(MODE_SMOOTH)
   if (((c.x + c.y + c.z) & 1) != colour) return;
@@ -92,24 +136,13 @@ void main() {
 #endif
     return;
   }
-#if defined(MODE_APPLY) || defined(MODE_RESIDUAL)
-  // precise: rounded as the CPU's (the explicit step depends on it bit for bit)
-  precise REAL ax = REAL(scale) * (REAL(cTerm[i]) * x[i] + faceSum(c, i));
-#if defined(CROSS)
-  ax += REAL(scale) * crossSum(c, i);
-#endif
-#if defined(MODE_APPLY)
-  y[i] = ax;
-#else
-  y[i] = b[i] - ax;
-#endif
-#else
   const REAL s = neighbourSum(c, i);
-#endif
 #if defined(MODE_SMOOTH)
   x[i] = (b[i] / REAL(scale) + s) / REAL(d);
 #elif defined(MODE_JACOBI)
   const REAL g = (b[i] / REAL(scale) + s) / REAL(d);
   y[i] = x[i] + REAL(omega) * (g - x[i]);
 #endif
+#endif
 }
+#endif

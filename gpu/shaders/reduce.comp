@@ -1,7 +1,8 @@
 // Deterministic sums in double: MODE_PARTIAL has each of the dispatch's
 // (fixed number of) work groups sum a fixed, strided share of the terms in
-// a fixed tree order into partial[group]; MODE_FINAL sums those partials the
-// same way in one work group into scalars[slot]. Terms (MODE_PARTIAL):
+// a fixed tree order into partial[slot * 256 + group]; MODE_FINAL sums those
+// partials the same way in one work group into scalars[slot] (kernels that
+// make the terms can do the partial pass themselves: fused_sum.glsl). Terms (MODE_PARTIAL):
 // TERM_DOT x_i y_i, TERM_ACTIVE_SUM x_i where diag_i > 0, TERM_ACTIVE_COUNT
 // 1 where diag_i > 0, TERM_MAX_ABS |f_i| (a float vector, combined by max).
 layout(std430, binding = 0) readonly buffer X { double x[]; };
@@ -18,7 +19,7 @@ layout(std430, binding = 5) readonly buffer Fl { float fl[]; };
 #endif
 
 uniform int n;      // terms (MODE_PARTIAL) or partials (MODE_FINAL)
-uniform int slot;   // MODE_FINAL: where the sum goes
+uniform int slot;   // where the sum goes (its partials at slot * 256)
 
 shared double sums[256];
 
@@ -41,7 +42,7 @@ void main() {
   const int stride = int(gl_NumWorkGroups.x) * 256;
   for (int i = int(gl_WorkGroupID.x) * 256 + lid; i < n; i += stride) s = COMBINE(s, term(i));
 #else
-  for (int i = lid; i < n; i += 256) s = COMBINE(s, partial[i]);
+  for (int i = lid; i < n; i += 256) s = COMBINE(s, partial[slot * 256 + i]);
 #endif
   sums[lid] = s;
   barrier();
@@ -51,7 +52,7 @@ void main() {
   }
   if (lid != 0) return;
 #if defined(MODE_PARTIAL)
-  partial[gl_WorkGroupID.x] = sums[0];
+  partial[slot * 256 + int(gl_WorkGroupID.x)] = sums[0];
 #else
   scalars[slot] = sums[0];
 #endif

@@ -14,13 +14,21 @@
 // OP_HOLD       y = x where held[i] != 0 (fixed regions; frozen species hold everywhere)
 // OP_ADD_FACES  y += ca faces (x: the Dirichlet faces per cell)
 // OP_ZERO_IF_NO_RHS x = 0 where S[bb] = 0 (a solve whose right-hand side is 0)
+// DOT_PARTIAL: the PCG's ops with the reductions next to them fused in
+// (fused_sum.glsl), over the reduction's groups, bitwise the separate passes:
+// OP_UPDATE_XR  S[pq] summed from its partials (slots.y) in each group; the
+//               partials of r . r into slots.z; and, slots.w >= 0, the
+//               diagonal preconditioner too: w = r / diag, r . w into slots.w
+// OP_UPDATE_P   S[rzNew] summed from its partials (slots.x), and stored
+// OP_JACOBI     y = x / diag, the partials of x . y into slots.x
+// OP_FROM_FLOAT y = double(f) sqrt(S[rr]), the partials of z . y into slots.y
 layout(std430, binding = 0) buffer X { double x[]; };
 layout(std430, binding = 1) buffer Y { double y[]; };
 layout(std430, binding = 2) buffer Z { double z[]; };
 layout(std430, binding = 3) buffer Q { double q[]; };
 layout(std430, binding = 4) buffer F { float f[]; };
 layout(std430, binding = 5) readonly buffer Diag { float diag[]; };
-layout(std430, binding = 6) readonly buffer Scalars { double S[]; };
+layout(std430, binding = 6) buffer Scalars { double S[]; };
 layout(std430, binding = 7) readonly buffer Held { uint held[]; };
 
 uniform int n;
@@ -28,6 +36,57 @@ uniform ivec4 slots;   // the scalar slots each op reads
 uniform bool first;
 uniform double ca, cb, cc;
 
+#if defined(DOT_PARTIAL)
+layout(std430, binding = 8) buffer Partials { double partial[]; };
+layout(std430, binding = 9) buffer W { double w[]; };
+#include "fused_sum.glsl"
+
+double jacobi(double r, int i) { return diag[i] > 0.0 ? r / double(diag[i]) : 0.0lf; }
+
+void main() {
+  const int groups = int(gl_NumWorkGroups.x);
+#if defined(OP_UPDATE_XR)  // x, y = r, z = p, q
+  const double pq = finalSum(slots.y, groups);
+  const double alpha = pq > 0.0lf ? S[slots.x] / pq : 0.0lf;  // 0 on breakdown
+  double rr = 0.0lf, rw = 0.0lf;
+  FOR_REDUCTION(i, n) {
+    x[i] += alpha * z[i];
+    const double r = y[i] - alpha * q[i];
+    y[i] = r;
+    rr = rr + r * r;
+    if (slots.w >= 0) {
+      const double wi = jacobi(r, i);
+      w[i] = wi;
+      rw = rw + r * wi;
+    }
+  }
+  if (slots.w >= 0)
+    writePartials(dvec2(rr, rw), slots.z, slots.w);
+  else
+    writePartial(rr, slots.z);
+#elif defined(OP_UPDATE_P)  // x = z, y = p
+  const double rzNew = finalSum(slots.x, groups);
+  FOR_REDUCTION(i, n) y[i] = first ? x[i] : x[i] + (rzNew / S[slots.y]) * y[i];
+  if (gl_WorkGroupID.x == 0u && gl_LocalInvocationID.x == 0u) S[slots.x] = rzNew;
+#elif defined(OP_JACOBI)  // x = r, y = z
+  double s = 0.0lf;
+  FOR_REDUCTION(i, n) {
+    const double zi = jacobi(x[i], i);
+    y[i] = zi;
+    s = s + x[i] * zi;
+  }
+  writePartial(s, slots.x);
+#elif defined(OP_FROM_FLOAT)  // y = z, z = r
+  double s = 0.0lf;
+  FOR_REDUCTION(i, n) {
+    const double zi = double(f[i]) * sqrt(S[slots.x]);
+    y[i] = zi;
+    s = s + z[i] * zi;
+  }
+  writePartial(s, slots.y);
+#endif
+}
+#else
 void main() {
   const int i = flatIndex();
   if (i >= n) return;
@@ -61,3 +120,4 @@ void main() {
   if (S[slots.x] == 0.0lf) x[i] = 0.0lf;
 #endif
 }
+#endif
