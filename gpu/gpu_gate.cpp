@@ -28,10 +28,10 @@ void GpuGate::run(const char* mode, const GpuBuffer& scalars, Slots slots, doubl
   GpuGate* was = entered;
   entered = nullptr;  // the gate's own kernel is not gated
   const ComputeProgram& p = useKernel("gate.comp", std::string("#define ") + mode);
-  setUniform(p, "slot", std::array<int, 3>{slots.bb, slots.rr, slots.pq});
-  setUniform(p, "tol", tolerance);
-  setUniform(p, "limit", maxIterations);
-  setUniform(p, "slots", int(base_.size() / 3));
+  setUniform(p, "gateSlot", std::array<int, 3>{slots.bb, slots.rr, slots.pq});
+  setUniform(p, "gateTol", tolerance);
+  setUniform(p, "gateLimit", maxIterations);
+  setUniform(p, "gateCount", int(base_.size() / 3));
   glUniform2i(p.uniform("finals"), finals.slots[0], finals.slots[1]);
   setUniform(p, "groups", int(finals.groups));
   scalars.bind(0);
@@ -48,11 +48,15 @@ void GpuGate::run(const char* mode, const GpuBuffer& scalars, Slots slots, doubl
 void GpuGate::start(const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations, const Finals& finals) {
   run("MODE_START", scalars, slots, tolerance, maxIterations, finals);
 }
-void GpuGate::check(const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations, const Finals& finals) {
-  run("MODE_CHECK", scalars, slots, tolerance, maxIterations, finals);
-}
 void GpuGate::finish(const GpuBuffer& scalars, Slots slots, double tolerance, const Finals& finals) {
   run("MODE_FINISH", scalars, slots, tolerance, 0, finals);
+}
+
+void GpuGate::checkInNext(const ComputeProgram& p, Slots slots, double tolerance, int maxIterations) {
+  setUniform(p, "gateSlot", std::array<int, 3>{slots.bb, slots.rr, slots.pq});
+  setUniform(p, "gateTol", tolerance);
+  setUniform(p, "gateLimit", maxIterations);
+  checkInNext_ = true;
 }
 
 void GpuGate::refreshArgs() {
@@ -80,9 +84,20 @@ void GpuGate::dispatch(unsigned gx, unsigned gy) {
     baseBuffer_.upload(base_.data(), base_.size() * sizeof(uint32_t));
     refreshArgs();
   }
+  const bool checks = checkInNext_;
+  if (checks) {  // the kernel makes the check: the gate's buffers as they are now
+    GLint program = 0;
+    glGetIntegerv(GL_CURRENT_PROGRAM, &program);
+    glUniform1i(glGetUniformLocation(GLuint(program), "gateCount"), GLint(base_.size() / 3));
+    baseBuffer_.bind(kCheckBindings);
+    args_.bind(kCheckBindings + 1);
+    state_.bind(kCheckBindings + 2);
+    checkInNext_ = false;
+  }
   glBindBuffer(GL_DISPATCH_INDIRECT_BUFFER, args_.id());
   glDispatchComputeIndirect(GLintptr(it->second * 3 * sizeof(uint32_t)));
   countDispatch();
+  if (checks) glMemoryBarrier(GL_COMMAND_BARRIER_BIT);  // its arguments, for the next dispatches
 }
 
 bool GpuGate::going() const { return state_.read<uint32_t>(1)[0] != 0u; }

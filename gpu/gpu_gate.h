@@ -1,9 +1,10 @@
 // A Krylov solve's convergence decided on the device. While a gate is
 // entered, every dispatch is indirect (glDispatchComputeIndirect): its
-// groups come from the gate's argument buffer, which the gate's kernel
-// (shaders/gate.comp) sets to the dispatch's own groups while the solve has
-// not converged and to zero once it has, reading the solve's scalars in
-// place. So the host queues a bounded number of iterations without reading
+// groups come from the gate's argument buffer, which the stopping test
+// (shaders/gate_logic.glsl: the gate's kernel at a solve's start and end, the
+// p update's last pass after each iteration) sets to the dispatch's own
+// groups while the solve has not converged and to zero once it has, reading
+// the solve's scalars in place. So the host queues a bounded number of iterations without reading
 // anything back, and the iterations past convergence do no work: the result
 // is the iterate at the CPU's stopping test, at the CPU's iteration count.
 // The gate also tallies each solve (iterations, whether it converged, the
@@ -18,6 +19,8 @@
 #include "gpu/gpu_buffer.h"
 
 namespace morphoflow {
+
+class ComputeProgram;
 
 // When a stepper reads its solves' tallies: steps 1, 2, 4 and 8 (while the
 // schedules settle), then every kStatsEvery-th (step counts from 1).
@@ -50,9 +53,13 @@ class GpuGate {
   GpuGate();
   // Before the first iteration: go while ||r|| / ||b|| > tolerance (and b != 0); 0 iterations.
   void start(const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations, const Finals& finals = {});
-  // After an iteration's rr: counts it while going, and goes on while
-  // p.Ap > 0, ||r|| / ||b|| > tolerance and fewer than maxIterations are done.
-  void check(const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations, const Finals& finals = {});
+  // After an iteration: counts it while going, and goes on while p.Ap > 0,
+  // ||r|| / ||b|| > tolerance and fewer than maxIterations are done. Made
+  // by the next gated dispatch's kernel as its last pass (vector_ops.comp's
+  // OP_UPDATE_P with GATE; gate_logic.glsl at bindings kCheckBindings..+2),
+  // `p` being current.
+  static constexpr int kCheckBindings = 10;
+  void checkInNext(const ComputeProgram& p, Slots slots, double tolerance, int maxIterations);
   // After the true residual's rr: the solve's verdict into the tally.
   void finish(const GpuBuffer& scalars, Slots slots, double tolerance, const Finals& finals = {});
   // Dispatches between enter() and leave() are gated.
@@ -75,6 +82,7 @@ class GpuGate {
   std::vector<uint32_t> base_;  // gx, gy, 1 per slot
   GpuBuffer baseBuffer_, args_, state_;
   size_t capacity_ = 0;
+  bool checkInNext_ = false;
 };
 
 }  // namespace morphoflow

@@ -34,6 +34,7 @@ class GpuLaplace {
   int dimension() const { return dim_; }
   const std::array<int, 3>& dims() const { return dims_; }
   const std::array<bool, 3>& periodic() const { return periodic_; }
+  double scale() const { return scale_; }
   const GpuBuffer& diag() const { return diag_; }
   // The coefficients, for kernels that build an operator on the GPU (cosine lobes).
   GpuBuffer& weights(int a) { return w_[size_t(a)]; }

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <utility>
 
+#include <epoxy/gl.h>
 #include <fmt/format.h>
 
 #include "core/parallel.h"
@@ -101,7 +102,8 @@ constexpr int kCoarseSweeps = 40;
 }  // namespace
 
 template <int D>
-GpuMultigrid::GpuMultigrid(const Multigrid<D>& levels, const GpuLaplace& fine, const MultigridOptions& options)
+GpuMultigrid::GpuMultigrid(const Multigrid<D>& levels, const GpuLaplace& fine, const MultigridOptions& options,
+                           size_t tailCells)
     : options_(options) {
   for (int l = 0; l < levels.levels(); ++l) {
     Level L;
@@ -118,12 +120,14 @@ GpuMultigrid::GpuMultigrid(const Multigrid<D>& levels, const GpuLaplace& fine, c
     levels_.push_back(std::move(L));
   }
   invertCoarsest(levels.level(levels.levels() - 1));
+  chooseTail(tailCells);
 }
 
 template <int D>
 void GpuMultigrid::update(const Multigrid<D>& levels) {
   for (int l = 1; l < levels.levels(); ++l) levels_[size_t(l)].own->update(levels.level(l));
   invertCoarsest(levels.level(levels.levels() - 1));
+  packTail();
 }
 
 template <int D>
@@ -134,6 +138,78 @@ void GpuMultigrid::invertCoarsest(const LaplaceSystem<D>& A) {
   }
   const std::vector<double> inv = invert(denseMatrix<D>(A), A.size());
   dense_ = GpuBuffer::of(std::vector<float>(inv.begin(), inv.end()));
+}
+
+void GpuMultigrid::chooseTail(size_t tailCells) {
+  // From level 1 on, the last levels that are small, solved exactly at the
+  // end and smoothed red-black (vcycle_tail.comp has no Jacobi smoother).
+  tail_ = levels_.size();
+  if (!dense_.id()) return;
+  while (tail_ > 1 && levels_.size() - tail_ < size_t(kMaxTailLevels)) {
+    const GpuLaplace& A = *levels_[tail_ - 1].A;
+    if (A.size() > tailCells || A.mixesColours()) break;
+    --tail_;
+  }
+  if (levels_.size() - tail_ < 2) {  // one level: nothing to fuse
+    tail_ = levels_.size();
+    return;
+  }
+  offsets_.clear();
+  size_t total = 0;
+  for (size_t l = tail_; l < levels_.size(); ++l) {
+    offsets_.push_back(int(total));
+    total += levels_[l].A->size();
+  }
+  Level& T = levels_[tail_];
+  for (GpuBuffer* v : {&T.x, &T.b, &T.r}) *v = GpuBuffer(total * sizeof(float));
+  for (size_t l = tail_ + 1; l < levels_.size(); ++l)
+    for (GpuBuffer* v : {&levels_[l].x, &levels_[l].b, &levels_[l].r}) *v = GpuBuffer();
+  for (GpuBuffer* v : {&tailW_[0], &tailW_[1], &tailW_[2], &tailDiag_, &tailC_}) *v = GpuBuffer(total * sizeof(float));
+  packTail();
+}
+
+void GpuMultigrid::packTail() {
+  for (size_t l = tail_; l < levels_.size(); ++l) {
+    GpuLaplace& A = *levels_[l].own;
+    const size_t bytes = A.size() * sizeof(float), at = size_t(offsets_[l - tail_]) * sizeof(float);
+    for (int a = 0; a < A.dimension(); ++a) tailW_[size_t(a)].copyFrom(A.weights(a), bytes, 0, at);
+    tailDiag_.copyFrom(A.diag(), bytes, 0, at);
+    tailC_.copyFrom(A.cBuffer(), bytes, 0, at);
+  }
+}
+
+void GpuMultigrid::runTail() {
+  const GpuLaplace& A = *levels_[tail_].A;
+  const int count = int(levels_.size() - tail_);
+  const ComputeProgram& p = useKernel("vcycle_tail.comp", fmt::format("#define DIM {}", A.dimension()));
+  std::vector<int> dims;
+  std::vector<double> scales;
+  double bytes = 0.0;
+  for (size_t l = tail_; l < levels_.size(); ++l) {
+    const GpuLaplace& L = *levels_[l].A;
+    dims.insert(dims.end(), L.dims().begin(), L.dims().end());
+    scales.push_back(L.scale());
+    // per smoothing sweep as GpuLaplace::smooth counts it, the residual and the transfers
+    bytes += double(L.size()) * 4.0 * (4 * (options_.preSmooth + options_.postSmooth) + 2 * L.dimension() + 10);
+  }
+  setUniform(p, "levels", count);
+  glUniform3iv(p.uniform("dimsOf"), count, dims.data());
+  glUniform1iv(p.uniform("offsetOf"), count, offsets_.data());
+  glUniform1dv(p.uniform("scaleOf"), count, scales.data());
+  setUniformBools(p, "periodic", A.periodic());
+  setUniform(p, "preSmooth", options_.preSmooth);
+  setUniform(p, "postSmooth", options_.postSmooth);
+  const Level& T = levels_[tail_];
+  T.x.bind(0);
+  T.b.bind(1);
+  T.r.bind(2);
+  for (int a = 0; a < 3; ++a) tailW_[size_t(a < A.dimension() ? a : 0)].bind(3 + a);
+  tailDiag_.bind(6);
+  tailC_.bind(7);
+  dense_.bind(8);
+  countGpuTraffic(bytes);
+  dispatchGroups(1, 1);
+  storageBarrier();
 }
 
 void GpuMultigrid::smooth(Level& L, bool reverse, int sweeps) {
@@ -149,6 +225,7 @@ void GpuMultigrid::smooth(Level& L, bool reverse, int sweeps) {
 }
 
 void GpuMultigrid::cycle(size_t l) {
+  if (l == tail_) return runTail();
   Level& L = levels_[l];
   const int dim = L.A->dimension();
   if (l + 1 == levels_.size()) {
@@ -198,28 +275,23 @@ void GpuMultigrid::cycle(size_t l) {
 void GpuMultigrid::apply(const GpuBuffer& r, GpuBuffer* z, const GpuBuffer& scalars, int slot, FusedDot rz) {
   Level& L = levels_[0];
   const size_t n = L.A->size();
+  // To float with r . r's final pass, back with r . z's partial one.
   auto convert = [&](VectorOp op, const GpuBuffer& in, const GpuBuffer& out) {
-    const bool fused = op == VectorOp::FromFloat;  // with r . z's partials
-    const ComputeProgram& p =
-        useKernel("vector_ops.comp", std::string("#define ") + define(op) + (fused ? "\n#define DOT_PARTIAL" : ""));
+    const bool back = op == VectorOp::FromFloat;
+    const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + define(op) + "\n#define DOT_PARTIAL");
     setUniform(p, "n", int(n));
     setUniform(p, "slots", std::array<int, 4>{slot, rz.slot, 0, 0});
     in.bind(0);
     out.bind(1);
-    (fused ? r : in).bind(2);
+    r.bind(2);
     in.bind(3);
-    L.b.bind(4);
-    if (fused) L.x.bind(4);
+    (back ? L.x : L.b).bind(4);
     L.A->diag().bind(5);
     scalars.bind(6);
-    if (fused) {
-      rz.partials->bind(8);
-      in.bind(9);
-      countGpuTraffic(double(n) * 20.0);
-      dispatchGroups(GpuReduction::groups(n), 1);
-    } else {
-      dispatchFlat(n, 12.0);
-    }
+    rz.partials->bind(8);
+    in.bind(9);
+    countGpuTraffic(double(n) * (back ? 20.0 : 12.0));
+    dispatchGroups(GpuReduction::groups(n), 1);
     storageBarrier();
   };
   convert(VectorOp::ToFloat, r, r);
@@ -227,8 +299,8 @@ void GpuMultigrid::apply(const GpuBuffer& r, GpuBuffer* z, const GpuBuffer& scal
   convert(VectorOp::FromFloat, *z, *z);
 }
 
-template GpuMultigrid::GpuMultigrid(const Multigrid<2>&, const GpuLaplace&, const MultigridOptions&);
-template GpuMultigrid::GpuMultigrid(const Multigrid<3>&, const GpuLaplace&, const MultigridOptions&);
+template GpuMultigrid::GpuMultigrid(const Multigrid<2>&, const GpuLaplace&, const MultigridOptions&, size_t);
+template GpuMultigrid::GpuMultigrid(const Multigrid<3>&, const GpuLaplace&, const MultigridOptions&, size_t);
 template void GpuMultigrid::update(const Multigrid<2>&);
 template void GpuMultigrid::update(const Multigrid<3>&);
 

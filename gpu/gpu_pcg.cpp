@@ -24,9 +24,11 @@ GpuPcg::GpuPcg(const GpuLaplace& A)
 }
 
 void GpuPcg::op(VectorOp name, const GpuBuffer& x, const GpuBuffer& y, const GpuBuffer& z, const GpuBuffer& q,
-                std::array<int, 4> slots, bool first, bool fused) {
-  const ComputeProgram& p =
-      useKernel("vector_ops.comp", std::string("#define ") + define(name) + (fused ? "\n#define DOT_PARTIAL" : ""));
+                std::array<int, 4> slots, bool first, bool fused, const SolverOptions* check) {
+  const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + define(name) +
+                                                             (fused ? "\n#define DOT_PARTIAL" : "") +
+                                                             (check ? "\n#define GATE" : ""));
+  if (check) gate_.checkInNext(p, kGateSlots, check->tolerance, check->maxIterations);
   setUniform(p, "n", int(A_.size()));
   setUniform(p, "slots", slots);
   setUniform(p, "first", first ? 1 : 0);
@@ -84,9 +86,10 @@ SolverResult GpuPcg::solve(GpuBuffer* bp, GpuBuffer* xp, GpuMultigrid* M, const 
     A_.apply(p_, &q_, sums_.fused(kPQ));
     // x += alpha p, r -= alpha q (and, diagonal, z = D^-1 r)
     op(VectorOp::UpdateXR, x, r_, p_, q_, {rz, kPQ, kRR, M ? -1 : next}, false, true);
-    gate_.check(sums_.scalars(), kGateSlots, options.tolerance, options.maxIterations, finals(kPQ, kRR));
     if (M) precondition(next);
-    op(VectorOp::UpdateP, z_, p_, p_, p_, {next, rz, 0, 0}, false, true);
+    // p = z + beta p, then the stopping test (past it, the p update and the
+    // multigrid cycle before it were work the result does not use)
+    op(VectorOp::UpdateP, z_, p_, p_, p_, {next, rz, kPQ, kRR}, false, true, &options);
     rz = next;
     if (calibrating && it % kCalibrationLook == 0 && !gate_.going()) break;
   }

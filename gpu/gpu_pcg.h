@@ -37,7 +37,7 @@ class GpuPcg {
 
  private:
   void op(VectorOp name, const GpuBuffer& x, const GpuBuffer& y, const GpuBuffer& z, const GpuBuffer& q,
-          std::array<int, 4> slots, bool first = false, bool fused = false);
+          std::array<int, 4> slots, bool first = false, bool fused = false, const SolverOptions* check = nullptr);
   void removeMean(GpuBuffer* x);
   SolverResult fromTally(const GpuGate::Tally& t, bool last);
   const GpuLaplace& A_;

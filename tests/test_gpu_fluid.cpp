@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 
 #include "core/multigrid.h"
 #include "core/pcg.h"
@@ -17,6 +18,7 @@
 #include "gpu/gpu_laplace.h"
 #include "gpu/gpu_multigrid.h"
 #include "gpu/gpu_pcg.h"
+#include "gpu/gpu_reduction.h"
 
 using namespace morphoflow;
 
@@ -77,7 +79,45 @@ void pressureSolveMeetsTolerance(const FluidSettings& s) {
   EXPECT_GE(r.iterations, 2);
 }
 
+// One V-cycle of the pressure system of `s` on a random residual, with its
+// coarse levels in one dispatch (vcycle_tail.comp) and with a dispatch a
+// pass: the same z, bit for bit. Returns the levels the tail ran.
+template <int D>
+int tailCycleMatchesTheLevelByLevelOne(const FluidSettings& s) {
+  FluidSolver<D> cpu(s);
+  const LaplaceSystem<D>& A = cpu.projection().system();
+  const size_t n = A.size();
+  Vector r(n);
+  for (size_t i = 0; i < n; ++i) r[i] = A.diag[i] > 0 ? uniform01(11, 0, i) - 0.5 : 0.0;
+  GpuLaplace gA(A);
+  const Multigrid<D> levels(A);
+  GpuMultigrid tail(levels, gA, MultigridOptions{}), each(levels, gA, MultigridOptions{}, 0);
+  EXPECT_EQ(each.tailLevels(), 0);
+  GpuReduction sums;
+  GpuBuffer gr = GpuBuffer::of(r), z1(n * sizeof(double)), z2(n * sizeof(double));
+  sums.dot(gr, gr, n, 0);
+  tail.apply(gr, &z1, sums.scalars(), 0, sums.fused(1));
+  each.apply(gr, &z2, sums.scalars(), 0, sums.fused(2));
+  const Vector a = z1.read<double>(n), b = z2.read<double>(n);
+  size_t differ = 0;
+  for (size_t i = 0; i < n; ++i) differ += std::memcmp(&a[i], &b[i], sizeof(double)) != 0;
+  EXPECT_EQ(differ, 0u);
+  double zz = 0;
+  for (double v : a) zz += v * v;
+  EXPECT_GT(zz, 0.0);
+  return tail.tailLevels();
+}
+
 }  // namespace
+
+TEST(GpuSolvers, TheVCyclesCoarseLevelsInOneDispatchAreBitwiseTheLevelByLevelCycle) {
+  if (const std::string why = gpuContextMissing(); !why.empty()) GTEST_SKIP() << why;
+  EXPECT_EQ(tailCycleMatchesTheLevelByLevelOne<2>(box({128, 128}, false, false, false)), 5);  // 64^2 .. 4^2
+  EXPECT_GE(tailCycleMatchesTheLevelByLevelOne<2>(box({96, 48}, true, true, false)), 2);
+  EXPECT_GE(tailCycleMatchesTheLevelByLevelOne<2>(box({64, 32}, true, true, true)), 2);
+  EXPECT_GE(tailCycleMatchesTheLevelByLevelOne<3>(box({24, 24, 24}, false, false, false)), 2);
+  EXPECT_GE(tailCycleMatchesTheLevelByLevelOne<3>(box({32, 16, 16}, true, true, true)), 2);
+}
 
 TEST(GpuSolvers, MgpcgMeetsThePressureToleranceOnEveryKindOfBox) {
   if (const std::string why = gpuContextMissing(); !why.empty()) GTEST_SKIP() << why;

@@ -55,28 +55,9 @@ REAL crossSum(ivec3 c, int i) {
 #endif
 
 float weight(int a, int i) { return a == 0 ? w0[i] : a == 1 ? w1[i] : w2[i]; }
-
-// sum_f w_f (x_i - x_j(f)) over the 2 DIM faces of cell c (index i), the CPU's face sum.
-REAL faceSum(ivec3 c, int i) {
-  const REAL xi = x[i];
-  precise REAL s = REAL(0);
-  for (int a = 0; a < DIM; ++a) {
-    const int iu = indexOf(stepWrapped(c, a, 1, dims), dims), il = indexOf(stepWrapped(c, a, -1, dims), dims);
-    s += REAL(weight(a, i)) * (xi - x[iu]) + REAL(weight(a, il)) * (xi - x[il]);
-  }
-  return s;
-}
-
-// sum_f w_f x_j(f) over the 2 DIM faces of cell c (index i); the lower
-// face of cell 0 on a non-periodic axis is the zeroed one of cell n - 1.
-REAL neighbourSum(ivec3 c, int i) {
-  REAL s = REAL(0);
-  for (int a = 0; a < DIM; ++a) {
-    const int iu = indexOf(stepWrapped(c, a, 1, dims), dims), il = indexOf(stepWrapped(c, a, -1, dims), dims);
-    s += REAL(weight(a, i)) * x[iu] + REAL(weight(a, il)) * x[il];
-  }
-  return s;
-}
+#define LX(i) x[i]
+#define LW(a, i) weight(a, i)
+#include "laplace_stencil.glsl"
 
 #if defined(MODE_APPLY) || defined(MODE_RESIDUAL)
 // A x (MODE_APPLY) or b - A x (MODE_RESIDUAL) at cell i; 0 on inactive cells.
@@ -84,7 +65,7 @@ REAL operatorAt(int i) {
   if (diag[i] <= 0.0) return REAL(0);
   const ivec3 c = coordsOf(i, dims);
   // precise: rounded as the CPU's (the explicit step depends on it bit for bit)
-  precise REAL ax = REAL(scale) * (REAL(cTerm[i]) * x[i] + faceSum(c, i));
+  precise REAL ax = REAL(scale) * (REAL(cTerm[i]) * x[i] + faceSum(c, i, dims));
 #if defined(CROSS)
   ax += REAL(scale) * crossSum(c, i);
 #endif
@@ -136,7 +117,7 @@ void main() {
 #endif
     return;
   }
-  const REAL s = neighbourSum(c, i);
+  const REAL s = neighbourSum(c, i, dims);
 #if defined(MODE_SMOOTH)
   x[i] = (b[i] / REAL(scale) + s) / REAL(d);
 #elif defined(MODE_JACOBI)

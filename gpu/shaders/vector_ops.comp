@@ -19,7 +19,10 @@
 // OP_UPDATE_XR  S[pq] summed from its partials (slots.y) in each group; the
 //               partials of r . r into slots.z; and, slots.w >= 0, the
 //               diagonal preconditioner too: w = r / diag, r . w into slots.w
-// OP_UPDATE_P   S[rzNew] summed from its partials (slots.x), and stored
+// OP_UPDATE_P   S[rzNew] summed from its partials (slots.x), and stored;
+//               GATE: then group 0 makes the solve's check (gate_logic.glsl)
+//               with S[pq] and S[rr] summed from theirs (slots.z, slots.w)
+// OP_TO_FLOAT   S[rr] summed from its partials (slots.x), and stored
 // OP_JACOBI     y = x / diag, the partials of x . y into slots.x
 // OP_FROM_FLOAT y = double(f) sqrt(S[rr]), the partials of z . y into slots.y
 layout(std430, binding = 0) buffer X { double x[]; };
@@ -40,6 +43,12 @@ uniform double ca, cb, cc;
 layout(std430, binding = 8) buffer Partials { double partial[]; };
 layout(std430, binding = 9) buffer W { double w[]; };
 #include "fused_sum.glsl"
+#if defined(GATE)
+#define GATE_BASE 10
+#define GATE_ARGS 11
+#define GATE_STATE 12
+#include "gate_logic.glsl"
+#endif
 
 double jacobi(double r, int i) { return diag[i] > 0.0 ? r / double(diag[i]) : 0.0lf; }
 
@@ -68,6 +77,21 @@ void main() {
   const double rzNew = finalSum(slots.x, groups);
   FOR_REDUCTION(i, n) y[i] = first ? x[i] : x[i] + (rzNew / S[slots.y]) * y[i];
   if (gl_WorkGroupID.x == 0u && gl_LocalInvocationID.x == 0u) S[slots.x] = rzNew;
+#if defined(GATE)
+  if (gl_WorkGroupID.x == 0u) {
+    const double pq = finalSum(slots.z, groups), rr = finalSum(slots.w, groups);
+    if (gl_LocalInvocationID.x == 0u) {
+      S[slots.z] = pq;
+      S[slots.w] = rr;
+      gateCheck();
+    }
+    writeGateArgs();
+  }
+#endif
+#elif defined(OP_TO_FLOAT)
+  const double rr = finalSum(slots.x, groups);
+  FOR_REDUCTION(i, n) f[i] = float(x[i] / sqrt(rr));
+  if (gl_WorkGroupID.x == 0u && gl_LocalInvocationID.x == 0u) S[slots.x] = rr;
 #elif defined(OP_JACOBI)  // x = r, y = z
   double s = 0.0lf;
   FOR_REDUCTION(i, n) {
