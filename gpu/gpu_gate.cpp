@@ -52,11 +52,15 @@ void GpuGate::finish(const GpuBuffer& scalars, Slots slots, double tolerance, co
   run("MODE_FINISH", scalars, slots, tolerance, 0, finals);
 }
 
-void GpuGate::checkInNext(const ComputeProgram& p, Slots slots, double tolerance, int maxIterations) {
-  setUniform(p, "gateSlot", std::array<int, 3>{slots.bb, slots.rr, slots.pq});
-  setUniform(p, "gateTol", tolerance);
-  setUniform(p, "gateLimit", maxIterations);
+void GpuGate::checkInNext(Slots slots, double tolerance, int maxIterations) {
   checkInNext_ = true;
+  checkSlots_ = slots;
+  checkTolerance_ = tolerance;
+  checkLimit_ = maxIterations;
+}
+
+void GpuGate::check(const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations, const Finals& finals) {
+  run("MODE_CHECK", scalars, slots, tolerance, maxIterations, finals);
 }
 
 void GpuGate::refreshArgs() {
@@ -88,7 +92,11 @@ void GpuGate::dispatch(unsigned gx, unsigned gy) {
   if (checks) {  // the kernel makes the check: the gate's buffers as they are now
     GLint program = 0;
     glGetIntegerv(GL_CURRENT_PROGRAM, &program);
-    glUniform1i(glGetUniformLocation(GLuint(program), "gateCount"), GLint(base_.size() / 3));
+    const auto at = [&](const char* name) { return glGetUniformLocation(GLuint(program), name); };
+    glUniform3i(at("gateSlot"), checkSlots_.bb, checkSlots_.rr, checkSlots_.pq);
+    glUniform1d(at("gateTol"), checkTolerance_);
+    glUniform1i(at("gateLimit"), checkLimit_);
+    glUniform1i(at("gateCount"), GLint(base_.size() / 3));
     baseBuffer_.bind(kCheckBindings);
     args_.bind(kCheckBindings + 1);
     state_.bind(kCheckBindings + 2);

@@ -20,8 +20,6 @@
 
 namespace morphoflow {
 
-class ComputeProgram;
-
 // When a stepper reads its solves' tallies: steps 1, 2, 4 and 8 (while the
 // schedules settle), then every kStatsEvery-th (step counts from 1).
 constexpr long kStatsEvery = 16;
@@ -56,10 +54,12 @@ class GpuGate {
   // After an iteration: counts it while going, and goes on while p.Ap > 0,
   // ||r|| / ||b|| > tolerance and fewer than maxIterations are done. Made
   // by the next gated dispatch's kernel as its last pass (vector_ops.comp's
-  // OP_UPDATE_P with GATE; gate_logic.glsl at bindings kCheckBindings..+2),
-  // `p` being current.
+  // OP_UPDATE_P with GATE, laplace.comp's P_UPDATE; gate_logic.glsl, its
+  // buffers at bindings kCheckBindings..+2, its uniforms set at the dispatch).
   static constexpr int kCheckBindings = 10;
-  void checkInNext(const ComputeProgram& p, Slots slots, double tolerance, int maxIterations);
+  void checkInNext(Slots slots, double tolerance, int maxIterations);
+  // The same, by the gate's own kernel (pq, rr: partials to sum first).
+  void check(const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations, const Finals& finals);
   // After the true residual's rr: the solve's verdict into the tally.
   void finish(const GpuBuffer& scalars, Slots slots, double tolerance, const Finals& finals = {});
   // Dispatches between enter() and leave() are gated.
@@ -83,6 +83,9 @@ class GpuGate {
   GpuBuffer baseBuffer_, args_, state_;
   size_t capacity_ = 0;
   bool checkInNext_ = false;
+  Slots checkSlots_{0, 0, 0};
+  double checkTolerance_ = 0.0;
+  int checkLimit_ = 0;
 };
 
 }  // namespace morphoflow

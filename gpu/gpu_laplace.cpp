@@ -105,12 +105,14 @@ bool GpuLaplace::mixesColours() const {
 }
 
 void GpuLaplace::run(LaplaceMode mode, bool single, const GpuBuffer& x, const GpuBuffer* y, const GpuBuffer* b,
-                     int colour, float omega, const FusedDot* dot) const {
+                     int colour, float omega, const FusedDot* dot, const PUpdate* pUpdate) const {
   const bool cross = hasCross_ && !single && (mode == LaplaceMode::Apply || mode == LaplaceMode::Residual);
   const ComputeProgram& p = useKernel("laplace.comp", fmt::format("#define DIM {}\n#define REAL {}\n#define {}{}{}", dim_,
                                                                   single ? "float" : "double", define(mode),
                                                                   cross ? "\n#define CROSS" : "",
-                                                                  dot ? "\n#define DOT_PARTIAL" : ""));
+                                                                  dot ? (pUpdate ? "\n#define DOT_PARTIAL\n#define P_UPDATE"
+                                                                                  : "\n#define DOT_PARTIAL")
+                                                                      : ""));
   setUniform(p, "dims", dims_);
   setUniform(p, "scale", scale_);
   setUniform(p, "colour", colour);
@@ -127,6 +129,11 @@ void GpuLaplace::run(LaplaceMode mode, bool single, const GpuBuffer& x, const Gp
   // terms); a smoothing pass touches half the cells
   const double real = single ? 4.0 : 8.0, coefficients = 4.0 * (dim_ + 2 + crossBuffers);
   const double bytes = mode == LaplaceMode::Smooth ? 0.5 * (3 * real + coefficients) : (y ? 2 : 1) * real + (b ? real : 0) + coefficients;
+  if (pUpdate) {
+    pUpdate->pNew->bind(8);
+    pUpdate->scalars->bind(15);
+    setUniform(p, "pSlots", pUpdate->slots);
+  }
   if (dot) {
     setUniform(p, "slot", dot->slot);
     dot->partials->bind(14);
@@ -150,6 +157,13 @@ void GpuLaplace::apply(const GpuBuffer& x, GpuBuffer* y, FusedDot dot) const {
 
 void GpuLaplace::residual(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* r, FusedDot dot) const {
   run(LaplaceMode::Residual, false, x, r, &b, 0, 0.0f, &dot);
+}
+
+void GpuLaplace::applyUpdatingP(const GpuBuffer& p, const GpuBuffer& z, GpuBuffer* pNew, GpuBuffer* q, FusedDot pq,
+                                const GpuBuffer& scalars, std::array<int, 4> slots) const {
+  const PUpdate u{pNew, &scalars, slots};
+  countGpuTraffic(double(n_) * 8.0);  // p' written (z is run's b)
+  run(LaplaceMode::Apply, false, p, q, &z, 0, 0.0f, &pq, &u);
 }
 
 void GpuLaplace::smooth(const GpuBuffer& b, GpuBuffer* x, int colour) const {

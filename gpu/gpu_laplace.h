@@ -13,6 +13,13 @@
 
 namespace morphoflow {
 
+// What applyUpdatingP's kernel takes besides the operator's buffers.
+struct PUpdate {
+  const GpuBuffer* pNew;
+  const GpuBuffer* scalars;
+  std::array<int, 4> slots;
+};
+
 class GpuLaplace {
  public:
   GpuLaplace() = default;
@@ -59,6 +66,15 @@ class GpuLaplace {
   // dispatch fewer.
   void apply(const GpuBuffer& x, GpuBuffer* y, FusedDot dot) const;
   void residual(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* r, FusedDot dot) const;
+  // The PCG's operator with its p update fused in (laplace.comp's P_UPDATE;
+  // not with mixed terms): pNew = z + beta p and q = A pNew, with pNew . q's
+  // partials into `pq`; beta from `scalars` at slots[0] (rzNew, summed from
+  // its partials and stored) over slots[1]; then the entered gate's stopping
+  // test of the iteration before (GpuGate::checkInNext first), with p . Ap
+  // and r . r summed from their partials at slots[2] and slots[3].
+  void applyUpdatingP(const GpuBuffer& p, const GpuBuffer& z, GpuBuffer* pNew, GpuBuffer* q, FusedDot pq,
+                      const GpuBuffer& scalars, std::array<int, 4> slots) const;
+  bool hasCross() const { return hasCross_; }
   // One colour of a red-black Gauss-Seidel sweep on float vectors.
   void smooth(const GpuBuffer& b, GpuBuffer* x, int colour) const;
   // y = x + omega (D^-1 (b / scale + N x) - x) on float vectors.
@@ -66,7 +82,7 @@ class GpuLaplace {
 
  private:
   void run(LaplaceMode mode, bool single, const GpuBuffer& x, const GpuBuffer* y, const GpuBuffer* b, int colour,
-           float omega, const FusedDot* dot = nullptr) const;
+           float omega, const FusedDot* dot = nullptr, const PUpdate* pUpdate = nullptr) const;
   std::array<int, 3> dims_{1, 1, 1};
   std::array<bool, 3> periodic_{};
   int dim_ = 2;

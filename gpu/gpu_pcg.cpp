@@ -11,14 +11,14 @@ namespace morphoflow {
 
 namespace {
 // The scalar slots (GpuReduction).
-enum Slot { kBB = 0, kRR = 1, kPQ = 2, kRZ0 = 3, kRZ1 = 4, kSum = 5, kCount = 6 };
+enum Slot { kBB = 0, kRR = 1, kPQ = 2, kRZ0 = 3, kRZ1 = 4, kSum = 5, kCount = 6, kPQ1 = 7 };
 constexpr GpuGate::Slots kGateSlots{kBB, kRR, kPQ};
 constexpr int kCalibrationLook = 8;  // iterations between looks while the schedule is calibrated
 }  // namespace
 
 GpuPcg::GpuPcg(const GpuLaplace& A)
     : A_(A), r_(A.size() * sizeof(double)), p_(A.size() * sizeof(double)), q_(A.size() * sizeof(double)),
-      z_(A.size() * sizeof(double)) {
+      z_(A.size() * sizeof(double)), p2_(A.size() * sizeof(double)) {
   if (A_.singular()) sums_.activeCount(A_.diag(), A_.size(), kCount);
   last_.converged = true;
 }
@@ -28,7 +28,7 @@ void GpuPcg::op(VectorOp name, const GpuBuffer& x, const GpuBuffer& y, const Gpu
   const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + define(name) +
                                                              (fused ? "\n#define DOT_PARTIAL" : "") +
                                                              (check ? "\n#define GATE" : ""));
-  if (check) gate_.checkInNext(p, kGateSlots, check->tolerance, check->maxIterations);
+  if (check) gate_.checkInNext(kGateSlots, check->tolerance, check->maxIterations);
   setUniform(p, "n", int(A_.size()));
   setUniform(p, "slots", slots);
   setUniform(p, "first", first ? 1 : 0);
@@ -69,29 +69,27 @@ SolverResult GpuPcg::solve(GpuBuffer* bp, GpuBuffer* xp, GpuMultigrid* M, const 
   A_.residual(b, x, &r_, sums_.fused(kRR));
   gate_.start(sums_.scalars(), kGateSlots, options.tolerance, options.maxIterations, finals(kRR, -1));
   gate_.enter();
-  int rz = kRZ0;
-  auto precondition = [&](int slot) {  // z = M r, with r . z's partials
-    if (M)
-      M->apply(r_, &z_, sums_.scalars(), kRR, sums_.fused(slot));
-    else
-      op(VectorOp::Jacobi, r_, z_, z_, z_, {slot, 0, 0, 0}, false, true);
-  };
-  precondition(rz);
-  op(VectorOp::UpdateP, z_, p_, p_, p_, {rz, rz, 0, 0}, true, true);
+  precondition(M, kRZ0);
+  op(VectorOp::UpdateP, z_, p_, p_, p_, {kRZ0, kRZ0, 0, 0}, true, true);
   // The scheduled iterations, or (calibrating) until the device says it stopped.
   const bool calibrating = ahead_ == 0;
   const int queue = calibrating ? options.maxIterations : std::min(ahead_, options.maxIterations);
-  for (int it = 1; it <= queue; ++it) {
-    const int next = rz == kRZ0 ? kRZ1 : kRZ0;
-    A_.apply(p_, &q_, sums_.fused(kPQ));
-    // x += alpha p, r -= alpha q (and, diagonal, z = D^-1 r)
-    op(VectorOp::UpdateXR, x, r_, p_, q_, {rz, kPQ, kRR, M ? -1 : next}, false, true);
-    if (M) precondition(next);
-    // p = z + beta p, then the stopping test (past it, the p update and the
-    // multigrid cycle before it were work the result does not use)
-    op(VectorOp::UpdateP, z_, p_, p_, p_, {next, rz, kPQ, kRR}, false, true, &options);
-    rz = next;
-    if (calibrating && it % kCalibrationLook == 0 && !gate_.going()) break;
+  if (!calibrating && !A_.hasCross()) {
+    iterateFused(&x, M, options, queue);
+  } else {
+    int rz = kRZ0;
+    for (int it = 1; it <= queue; ++it) {
+      const int next = rz == kRZ0 ? kRZ1 : kRZ0;
+      A_.apply(p_, &q_, sums_.fused(kPQ));
+      // x += alpha p, r -= alpha q (and, diagonal, z = D^-1 r)
+      op(VectorOp::UpdateXR, x, r_, p_, q_, {rz, kPQ, kRR, M ? -1 : next}, false, true);
+      if (M) precondition(M, next);
+      // p = z + beta p, then the stopping test (past it, the p update and the
+      // multigrid cycle before it were work the result does not use)
+      op(VectorOp::UpdateP, z_, p_, p_, p_, {next, rz, kPQ, kRR}, false, true, &options);
+      rz = next;
+      if (calibrating && it % kCalibrationLook == 0 && !gate_.going()) break;
+    }
   }
   gate_.leave();
   // The true residual, not the recursively updated one.
@@ -100,6 +98,38 @@ SolverResult GpuPcg::solve(GpuBuffer* bp, GpuBuffer* xp, GpuMultigrid* M, const 
   if (A_.singular()) removeMean(&x);
   if (calibrating || !deferred) return fromTally(gate_.read(), true);
   return last_;
+}
+
+void GpuPcg::precondition(GpuMultigrid* M, int slot) {  // z = M r, with r . z's partials
+  if (M)
+    M->apply(r_, &z_, sums_.scalars(), kRR, sums_.fused(slot));
+  else
+    op(VectorOp::Jacobi, r_, z_, z_, z_, {slot, 0, 0, 0}, false, true);
+}
+
+void GpuPcg::iterateFused(GpuBuffer* xp, GpuMultigrid* M, const SolverOptions& options, int queue) {
+  GpuBuffer &x = *xp, *p = &p_, *pOther = &p2_;
+  int rz = kRZ0, rzBefore = kRZ0, pq = kPQ, pqBefore = kPQ1;
+  for (int it = 1; it <= queue; ++it) {
+    const int next = rz == kRZ0 ? kRZ1 : kRZ0;
+    if (it == 1) {
+      A_.apply(*p, &q_, sums_.fused(pq));
+    } else {
+      // p = z + beta p and q = A p in one pass, then the stopping test of the iteration before
+      gate_.checkInNext({kBB, kRR, pqBefore}, options.tolerance, options.maxIterations);
+      A_.applyUpdatingP(*p, z_, pOther, &q_, sums_.fused(pq), sums_.scalars(), {rz, rzBefore, pqBefore, kRR});
+      std::swap(p, pOther);
+    }
+    // x += alpha p, r -= alpha q (and, diagonal, z = D^-1 r)
+    op(VectorOp::UpdateXR, x, r_, *p, q_, {rz, pq, kRR, M ? -1 : next}, false, true);
+    if (M && it < queue) precondition(M, next);
+    rzBefore = rz;
+    rz = next;
+    std::swap(pq, pqBefore);
+  }
+  // the last iteration's test
+  gate_.check(sums_.scalars(), {kBB, kRR, pqBefore}, options.tolerance, options.maxIterations,
+              GpuGate::Finals{&sums_.partials(), {pqBefore, kRR}, GpuReduction::groups(A_.size())});
 }
 
 SolverResult GpuPcg::fromTally(const GpuGate::Tally& t, bool last) {

@@ -39,9 +39,13 @@ class GpuPcg {
   void op(VectorOp name, const GpuBuffer& x, const GpuBuffer& y, const GpuBuffer& z, const GpuBuffer& q,
           std::array<int, 4> slots, bool first = false, bool fused = false, const SolverOptions* check = nullptr);
   void removeMean(GpuBuffer* x);
+  // The scheduled iterations with each p update fused into the next
+  // iteration's operator (GpuLaplace::applyUpdatingP).
+  void precondition(GpuMultigrid* M, int slot);
+  void iterateFused(GpuBuffer* x, GpuMultigrid* M, const SolverOptions& options, int queue);
   SolverResult fromTally(const GpuGate::Tally& t, bool last);
   const GpuLaplace& A_;
-  GpuBuffer r_, p_, q_, z_;
+  GpuBuffer r_, p_, q_, z_, p2_;  // p2_: the p update's other buffer
   GpuReduction sums_;
   GpuGate gate_;
   int ahead_ = 0;  // iterations a solve queues; 0: not calibrated yet

@@ -1,6 +1,7 @@
 // A Krylov solve's device-side convergence (gpu/gpu_gate.h, gate_logic.glsl):
 // one work group of common.glsl's 256 invocations.
 // MODE_START   go = b != 0 and ||r|| / ||b|| > tol; iterations = 0
+// MODE_CHECK   the test after an iteration
 // MODE_FINISH  the solve's verdict into the tally
 // MODE_REFRESH only the arguments
 // First, the final passes of the sums whose partials the kernels before
@@ -27,6 +28,8 @@ void main() {
   if (lid == 0u) {
 #if defined(MODE_START)
     gateStart();
+#elif defined(MODE_CHECK)
+    gateCheck();
 #elif defined(MODE_FINISH)
     gateFinish();
 #endif

@@ -55,7 +55,16 @@ REAL crossSum(ivec3 c, int i) {
 #endif
 
 float weight(int a, int i) { return a == 0 ? w0[i] : a == 1 ? w1[i] : w2[i]; }
+#if defined(P_UPDATE)
+// The PCG's p update fused into its operator (MODE_APPLY, DOT_PARTIAL; not
+// with CROSS): A is applied to p' = z + beta p (b holds z, x holds p),
+// computed where it is read as OP_UPDATE_P computes it, and p' is written.
+layout(std430, binding = 8) buffer PNew { double pNew[]; };
+double beta_ = 0.0lf;
+#define LX(i) (b[i] + beta_ * x[i])
+#else
 #define LX(i) x[i]
+#endif
 #define LW(a, i) weight(a, i)
 #include "laplace_stencil.glsl"
 
@@ -65,7 +74,7 @@ REAL operatorAt(int i) {
   if (diag[i] <= 0.0) return REAL(0);
   const ivec3 c = coordsOf(i, dims);
   // precise: rounded as the CPU's (the explicit step depends on it bit for bit)
-  precise REAL ax = REAL(scale) * (REAL(cTerm[i]) * x[i] + faceSum(c, i, dims));
+  precise REAL ax = REAL(scale) * (REAL(cTerm[i]) * LX(i) + faceSum(c, i, dims));
 #if defined(CROSS)
   ax += REAL(scale) * crossSum(c, i);
 #endif
@@ -80,22 +89,55 @@ REAL operatorAt(int i) {
 #if defined(DOT_PARTIAL)
 // With the partial pass of x . y (MODE_APPLY: p . Ap) or y . y (MODE_RESIDUAL:
 // r . r) into slot `slot` (fused_sum.glsl), over the reduction's groups.
+// P_UPDATE: beta = S[rzNew] / S[rz], S[rzNew] summed from its partials
+// (pSlots.x, pSlots.y), and stored; then group 0 makes the solve's stopping
+// test of the iteration before (gate_logic.glsl) with S[pq] and S[rr] summed
+// from theirs (pSlots.z, pSlots.w), as OP_UPDATE_P with GATE does.
 layout(std430, binding = 14) buffer Partials { double partial[]; };
 uniform int slot;
 #include "fused_sum.glsl"
+#if defined(P_UPDATE)
+layout(std430, binding = 15) buffer Scalars { double S[]; };
+#define GATE_BASE 10
+#define GATE_ARGS 11
+#define GATE_STATE 12
+#include "gate_logic.glsl"
+uniform ivec4 pSlots;
+#endif
 
 void main() {
+#if defined(P_UPDATE)
+  const int groups = int(gl_NumWorkGroups.x);
+  const double rzNew = finalSum(pSlots.x, groups);
+  beta_ = rzNew / S[pSlots.y];
+#endif
   double s = 0.0lf;
   FOR_REDUCTION(i, dims.x * dims.y * dims.z) {
     const REAL v = operatorAt(i);
     y[i] = v;
-#if defined(MODE_APPLY)
+#if defined(P_UPDATE)
+    const double pi = LX(i);
+    pNew[i] = pi;
+    s = s + pi * v;
+#elif defined(MODE_APPLY)
     s = s + x[i] * v;
 #else
     s = s + v * v;
 #endif
   }
   writePartial(s, slot);
+#if defined(P_UPDATE)
+  if (gl_WorkGroupID.x == 0u) {
+    const double pq = finalSum(pSlots.z, groups), rr = finalSum(pSlots.w, groups);
+    if (gl_LocalInvocationID.x == 0u) {
+      S[pSlots.x] = rzNew;
+      S[pSlots.z] = pq;
+      S[pSlots.w] = rr;
+      gateCheck();
+    }
+    writeGateArgs();
+  }
+#endif
 }
 #else
 void main() {

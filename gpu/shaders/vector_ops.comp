@@ -75,7 +75,8 @@ void main() {
     writePartial(rr, slots.z);
 #elif defined(OP_UPDATE_P)  // x = z, y = p
   const double rzNew = finalSum(slots.x, groups);
-  FOR_REDUCTION(i, n) y[i] = first ? x[i] : x[i] + (rzNew / S[slots.y]) * y[i];
+  const double beta = first ? 0.0lf : rzNew / S[slots.y];
+  FOR_REDUCTION(i, n) y[i] = first ? x[i] : x[i] + beta * y[i];
   if (gl_WorkGroupID.x == 0u && gl_LocalInvocationID.x == 0u) S[slots.x] = rzNew;
 #if defined(GATE)
   if (gl_WorkGroupID.x == 0u) {
