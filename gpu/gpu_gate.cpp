@@ -28,10 +28,7 @@ void GpuGate::run(const char* mode, const GpuBuffer& scalars, Slots slots, doubl
   GpuGate* was = entered;
   entered = nullptr;  // the gate's own kernel is not gated
   const ComputeProgram& p = useKernel("gate.comp", std::string("#define ") + mode);
-  setUniform(p, "gateSlot", std::array<int, 3>{slots.bb, slots.rr, slots.pq});
-  setUniform(p, "gateTol", tolerance);
-  setUniform(p, "gateLimit", maxIterations);
-  setUniform(p, "gateCount", int(base_.size() / 3));
+  setTestUniforms(slots, tolerance, maxIterations);
   glUniform2i(p.uniform("finals"), finals.slots[0], finals.slots[1]);
   setUniform(p, "groups", int(finals.groups));
   scalars.bind(0);
@@ -43,6 +40,16 @@ void GpuGate::run(const char* mode, const GpuBuffer& scalars, Slots slots, doubl
   countDispatch();
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
   entered = was;
+}
+
+void GpuGate::setTestUniforms(Slots slots, double tolerance, int maxIterations) const {
+  GLint program = 0;  // gate_logic.glsl's uniforms, on the current program
+  glGetIntegerv(GL_CURRENT_PROGRAM, &program);
+  const auto at = [&](const char* name) { return glGetUniformLocation(GLuint(program), name); };
+  glUniform3i(at("gateSlot"), slots.bb, slots.rr, slots.pq);
+  glUniform1d(at("gateTol"), tolerance);
+  glUniform1i(at("gateLimit"), maxIterations);
+  glUniform1i(at("gateCount"), GLint(base_.size() / 3));
 }
 
 void GpuGate::start(const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations, const Finals& finals) {
@@ -90,13 +97,7 @@ void GpuGate::dispatch(unsigned gx, unsigned gy) {
   }
   const bool checks = checkInNext_;
   if (checks) {  // the kernel makes the check: the gate's buffers as they are now
-    GLint program = 0;
-    glGetIntegerv(GL_CURRENT_PROGRAM, &program);
-    const auto at = [&](const char* name) { return glGetUniformLocation(GLuint(program), name); };
-    glUniform3i(at("gateSlot"), checkSlots_.bb, checkSlots_.rr, checkSlots_.pq);
-    glUniform1d(at("gateTol"), checkTolerance_);
-    glUniform1i(at("gateLimit"), checkLimit_);
-    glUniform1i(at("gateCount"), GLint(base_.size() / 3));
+    setTestUniforms(checkSlots_, checkTolerance_, checkLimit_);
     baseBuffer_.bind(kCheckBindings);
     args_.bind(kCheckBindings + 1);
     state_.bind(kCheckBindings + 2);

@@ -77,6 +77,7 @@ class GpuGate {
  private:
   void run(const char* mode, const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations,
            const Finals& finals = {});
+  void setTestUniforms(Slots slots, double tolerance, int maxIterations) const;
   void refreshArgs();  // after a new slot: its arguments from the current go flag
   std::map<std::pair<unsigned, unsigned>, unsigned> slotOf_;
   std::vector<uint32_t> base_;  // gx, gy, 1 per slot

@@ -61,8 +61,6 @@ SolverResult GpuPcg::solve(GpuBuffer* bp, GpuBuffer* xp, GpuMultigrid* M, const 
   const size_t n = A_.size();
   // Each dot product's partial pass is fused into the kernel that makes its
   // terms, its final pass into the gate's kernel or the kernel that uses it.
-  const unsigned groups = GpuReduction::groups(n);
-  const auto finals = [&](int a, int b2) { return GpuGate::Finals{&sums_.partials(), {a, b2}, groups}; };
   if (A_.singular()) removeMean(&b);
   sums_.dot(b, b, n, kBB);
   op(VectorOp::ZeroIfNoRhs, x, x, x, x, {kBB, 0, 0, 0});  // b = 0: x = 0, as on the CPU
@@ -100,6 +98,10 @@ SolverResult GpuPcg::solve(GpuBuffer* bp, GpuBuffer* xp, GpuMultigrid* M, const 
   return last_;
 }
 
+GpuGate::Finals GpuPcg::finals(int a, int b) const {
+  return GpuGate::Finals{&sums_.partials(), {a, b}, GpuReduction::groups(A_.size())};
+}
+
 void GpuPcg::precondition(GpuMultigrid* M, int slot) {  // z = M r, with r . z's partials
   if (M)
     M->apply(r_, &z_, sums_.scalars(), kRR, sums_.fused(slot));
@@ -128,8 +130,7 @@ void GpuPcg::iterateFused(GpuBuffer* xp, GpuMultigrid* M, const SolverOptions& o
     std::swap(pq, pqBefore);
   }
   // the last iteration's test
-  gate_.check(sums_.scalars(), {kBB, kRR, pqBefore}, options.tolerance, options.maxIterations,
-              GpuGate::Finals{&sums_.partials(), {pqBefore, kRR}, GpuReduction::groups(A_.size())});
+  gate_.check(sums_.scalars(), {kBB, kRR, pqBefore}, options.tolerance, options.maxIterations, finals(pqBefore, kRR));
 }
 
 SolverResult GpuPcg::fromTally(const GpuGate::Tally& t, bool last) {

@@ -42,6 +42,8 @@ class GpuPcg {
   // The scheduled iterations with each p update fused into the next
   // iteration's operator (GpuLaplace::applyUpdatingP).
   void precondition(GpuMultigrid* M, int slot);
+  // The gate's final passes of these slots' partials (-1: none).
+  GpuGate::Finals finals(int a, int b) const;
   void iterateFused(GpuBuffer* x, GpuMultigrid* M, const SolverOptions& options, int queue);
   SolverResult fromTally(const GpuGate::Tally& t, bool last);
   const GpuLaplace& A_;

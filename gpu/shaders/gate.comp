@@ -12,8 +12,8 @@ layout(std430, binding = 4) buffer Partials { double partial[]; };
 #define GATE_BASE 1
 #define GATE_ARGS 2
 #define GATE_STATE 3
-#include "gate_logic.glsl"
 #include "fused_sum.glsl"
+#include "gate_logic.glsl"
 
 uniform ivec2 finals;
 uniform int groups;  // the partials of each final

@@ -1,8 +1,9 @@
 // A Krylov solve's stopping test on the device (gpu/gpu_gate.h): the solve's
 // state, its verdicts, and the arguments of its gated dispatches. Used by
 // gate.comp and by the kernel that makes the test as its last pass
-// (vector_ops.comp's OP_UPDATE_P with GATE). Define GATE_BASE, GATE_ARGS and
-// GATE_STATE (bindings) and declare S (the solve's scalars) before including.
+// (vector_ops.comp's OP_UPDATE_P with GATE, laplace.comp's P_UPDATE). Define
+// GATE_BASE, GATE_ARGS and GATE_STATE (bindings), declare S (the solve's
+// scalars) and include fused_sum.glsl before including.
 layout(std430, binding = GATE_BASE) readonly buffer Base { uint base[]; };
 layout(std430, binding = GATE_ARGS) buffer Args { uint args[]; };
 layout(std430, binding = GATE_STATE) buffer State {
@@ -60,4 +61,18 @@ void writeGateArgs() {
     args[3 * k + 1] = base[3 * k + 1];
     args[3 * k + 2] = 1u;
   }
+}
+
+// The test as the last pass of a kernel over the reduction's groups (its
+// first group calls it): S[pq] and S[rr] summed from their partials, then
+// the test and the arguments.
+void checkAsLastPass(int pqSlot, int rrSlot) {
+  const int groups = int(gl_NumWorkGroups.x);
+  const double pq = finalSum(pqSlot, groups), rr = finalSum(rrSlot, groups);
+  if (gl_LocalInvocationID.x == 0u) {
+    S[pqSlot] = pq;
+    S[rrSlot] = rr;
+    gateCheck();
+  }
+  writeGateArgs();
 }

@@ -128,14 +128,8 @@ void main() {
   writePartial(s, slot);
 #if defined(P_UPDATE)
   if (gl_WorkGroupID.x == 0u) {
-    const double pq = finalSum(pSlots.z, groups), rr = finalSum(pSlots.w, groups);
-    if (gl_LocalInvocationID.x == 0u) {
-      S[pSlots.x] = rzNew;
-      S[pSlots.z] = pq;
-      S[pSlots.w] = rr;
-      gateCheck();
-    }
-    writeGateArgs();
+    if (gl_LocalInvocationID.x == 0u) S[pSlots.x] = rzNew;
+    checkAsLastPass(pSlots.z, pSlots.w);
   }
 #endif
 }

@@ -79,15 +79,7 @@ void main() {
   FOR_REDUCTION(i, n) y[i] = first ? x[i] : x[i] + beta * y[i];
   if (gl_WorkGroupID.x == 0u && gl_LocalInvocationID.x == 0u) S[slots.x] = rzNew;
 #if defined(GATE)
-  if (gl_WorkGroupID.x == 0u) {
-    const double pq = finalSum(slots.z, groups), rr = finalSum(slots.w, groups);
-    if (gl_LocalInvocationID.x == 0u) {
-      S[slots.z] = pq;
-      S[slots.w] = rr;
-      gateCheck();
-    }
-    writeGateArgs();
-  }
+  if (gl_WorkGroupID.x == 0u) checkAsLastPass(slots.z, slots.w);
 #endif
 #elif defined(OP_TO_FLOAT)
   const double rr = finalSum(slots.x, groups);
