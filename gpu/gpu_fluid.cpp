@@ -22,13 +22,12 @@
 namespace morphoflow {
 
 // Component a's implicit viscous system: the host copy (its diagonal
-// follows nu dt / h^2), the GPU copy, its solver and vectors.
+// follows nu dt / h^2) and its boundary terms; the components are solved
+// together (GpuFluid::viscousA_, one block system).
 template <int D>
 struct GpuFluid<D>::Viscous {
   ViscousSystem<D> host;
-  std::unique_ptr<GpuLaplace> A;
-  std::unique_ptr<GpuPcg> pcg;
-  GpuBuffer b, x, boundaryRhs;
+  GpuBuffer boundaryRhs;
 };
 
 namespace {
@@ -89,18 +88,20 @@ GpuFluid<D>::GpuFluid(const FluidSettings& s, const VelocityConstraints<D>& vc) 
   pressurePcg_ = std::make_unique<GpuPcg>(*pressure_);
   for (GpuBuffer* b : {&phi_, &rhs_, &ratePrev_}) *b = GpuBuffer(cellCount_ * sizeof(double));
   phi_.zero();
+  std::vector<const LaplaceSystem<D>*> blocks;
   for (int a = 0; a < D; ++a) {
     auto v = std::make_unique<Viscous>();
     v->host = viscousSystem<D>(vc, a);
     v->host.setRate(1.0);
-    v->A = std::make_unique<GpuLaplace>(v->host.A);
-    v->pcg = std::make_unique<GpuPcg>(*v->A);
-    v->b = GpuBuffer(v->host.A.size() * sizeof(double));
-    v->x = GpuBuffer(v->host.A.size() * sizeof(double));
     const std::vector<float> rhs = v->host.boundaryRhs.expanded();  // the shader reads doubles
     v->boundaryRhs = GpuBuffer::of(std::vector<double>(rhs.begin(), rhs.end()));
+    blocks.push_back(&v->host.A);
     viscous_[size_t(a)] = std::move(v);
   }
+  viscousA_ = std::make_unique<GpuLaplace>(blocks);
+  viscousPcg_ = std::make_unique<GpuPcg>(*viscousA_);
+  viscousB_ = GpuBuffer(viscousA_->size() * sizeof(double));
+  viscousX_ = GpuBuffer(viscousA_->size() * sizeof(double));
   if (!vc.cut.empty()) {  // the viscosity holds the faces inside cut obstacles too
     std::vector<uint32_t> held(fixed);
     for (int a = 0; a < D; ++a) {
@@ -161,10 +162,7 @@ double GpuFluid<D>::maxSpeed() const {
 template <int D>
 void GpuFluid<D>::readSolverStats() const {
   stats_.pressure = pressurePcg_->tally();
-  SolverResult v;
-  v.converged = true;
-  for (const auto& V : viscous_) foldWorst(&v, V->pcg->tally());
-  stats_.viscosity = v;
+  stats_.viscosity = viscousPcg_->tally();
 }
 
 template <int D>
@@ -391,36 +389,39 @@ void GpuFluid<D>::diffuse(double dt) {
   const double nu = settings_.viscosity;
   if (nu <= 0 || dt <= 0) return;
   const double s = nu * dt / (h_ * h_);
-  for (int a = 0; a < D; ++a) {
-    Viscous& V = *viscous_[size_t(a)];
-    if (s != s_) {
-      V.host.setRate(s);
-      V.A->update(V.host.A);
-    }
+  auto run = [&](FluidOp mode, int a) {
+    const Viscous& V = *viscous_[size_t(a)];
     std::array<int, 3> udims{1, 1, 1};
     for (int b = 0; b < D; ++b) udims[size_t(b)] = V.host.dims[b];
-    auto run = [&](FluidOp mode) {
-      const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, mode));
-      setUniform(p, "cells", cells_);
-      setUniform(p, "axis", a);
-      setUniform(p, "n", int(V.host.A.size()));
-      setUniform(p, "udims", udims);
-      setUniform(p, "velOff", velocityOffsets());
-      setUniform(p, "s", s);
-      vel_.bind(0);
-      (viscousHeld_.bytes() ? viscousHeld_ : fixed_).bind(1);
-      V.b.bind(7);
-      V.x.bind(8);
-      V.boundaryRhs.bind(9);
-      dispatchFlat(V.host.A.size(), mode == FluidOp::ViscousSetup ? 32.0 : 16.0);
-      storageBarrier();
-    };
-    run(FluidOp::ViscousSetup);
-    // Each component to the tolerance; its result read with the others' (readSolverStats).
-    const SolverResult r = V.pcg->solve(&V.b, &V.x, nullptr, {settings_.viscosityTolerance, 500}, true);
-    run(FluidOp::ViscousStore);
-    foldWorst(&stats_.viscosity, r);
+    const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, mode));
+    setUniform(p, "cells", cells_);
+    setUniform(p, "axis", a);
+    setUniform(p, "n", int(V.host.A.size()));
+    setUniform(p, "udims", udims);
+    setUniform(p, "velOff", velocityOffsets());
+    setUniform(p, "s", s);
+    setUniform(p, "blockOff", int(viscousA_->blockStart(a)));
+    vel_.bind(0);
+    (viscousHeld_.bytes() ? viscousHeld_ : fixed_).bind(1);
+    viscousB_.bind(7);
+    viscousX_.bind(8);
+    V.boundaryRhs.bind(9);
+    dispatchFlat(V.host.A.size(), mode == FluidOp::ViscousSetup ? 32.0 : 16.0);
+  };
+  for (int a = 0; a < D; ++a) {
+    if (s != s_) {
+      viscous_[size_t(a)]->host.setRate(s);
+      viscousA_->updateBlock(a, viscous_[size_t(a)]->host.A);
+    }
+    run(FluidOp::ViscousSetup, a);
   }
+  storageBarrier();
+  // The components as one block system, to the relative residual of the
+  // whole velocity system (the CPU's: sum_a ||r_a||^2 <= tol^2 sum_a
+  // ||b_a||^2); its result read with the pressure's (readSolverStats).
+  foldWorst(&stats_.viscosity, viscousPcg_->solve(&viscousB_, &viscousX_, nullptr, {settings_.viscosityTolerance, 500}, true));
+  for (int a = 0; a < D; ++a) run(FluidOp::ViscousStore, a);
+  storageBarrier();
   s_ = s;
   applyConstraints(vel_);
 }

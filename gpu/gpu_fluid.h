@@ -135,6 +135,9 @@ class GpuFluid final : public FluidStepper<D> {
   double lastDt_ = 0.0;
   int solves_ = 0;
   std::array<std::unique_ptr<Viscous>, D> viscous_;
+  std::unique_ptr<GpuLaplace> viscousA_;  // the components' systems, one block system
+  std::unique_ptr<GpuPcg> viscousPcg_;
+  GpuBuffer viscousB_, viscousX_;  // the components' right-hand sides and solutions, as its blocks
   double s_ = -1.0;
   mutable FluidStepStats stats_;
   void readSolverStats() const;  // the solves' tallies into stats_

@@ -32,6 +32,7 @@ uniform ivec3 cells, periodic, velOff;
 uniform int axis;           // the velocity component a
 uniform int n;              // samples of the grid the mode runs over
 uniform ivec3 udims;        // MODE_VISCOUS_*: the unknowns (faces less a periodic duplicate layer)
+uniform int blockOff;       // MODE_VISCOUS_*: the component's first unknown in b and x (one block system)
 uniform float fa, fb;       // MODE_FORCES: dt f_a, dt b dir_a
 uniform int f1Off, dstOff;  // offsets into f1 / f0 (MODE_MACCORMACK / BFECC)
 uniform double invH, dt, lastDt, s;
@@ -121,10 +122,10 @@ void main() {
   const int gi = indexOf(coordsOf(i, udims), faceDims());
   const bool held = fixedFace[velOff[axis] + gi] != 0u;
   const double u = double(vel[velOff[axis] + gi]);
-  d0[i] = held ? 0.0lf : u + s * d2[i];
-  d1[i] = held ? 0.0lf : u;
+  d0[blockOff + i] = held ? 0.0lf : u + s * d2[i];
+  d1[blockOff + i] = held ? 0.0lf : u;
 #elif defined(MODE_VISCOUS_STORE)  // d1 = x
   const int gi = indexOf(coordsOf(i, udims), faceDims());
-  if (fixedFace[velOff[axis] + gi] == 0u) vel[velOff[axis] + gi] = float(d1[i]);  // (or the viscosity's held flags)
+  if (fixedFace[velOff[axis] + gi] == 0u) vel[velOff[axis] + gi] = float(d1[blockOff + i]);  // (or the viscosity's held flags)
 #endif
 }

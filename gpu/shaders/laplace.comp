@@ -12,6 +12,9 @@
 // diagonal neighbours in each plane; the preconditioners take the axis part.
 // DOT_PARTIAL (apply and residual, double): with the partial pass of the
 // dot product the PCG takes next (see main).
+// BLOCK (apply and residual): a block-diagonal system of up to 4 systems in
+// one vector (gpu_laplace.h), block k's cells from blockStart[k], each with
+// its own dims and scale: several systems solved as one.
 layout(std430, binding = 0) buffer X { REAL x[]; };
 layout(std430, binding = 1) buffer Y { REAL y[]; };
 layout(std430, binding = 2) readonly buffer B { REAL b[]; };
@@ -21,8 +24,30 @@ layout(std430, binding = 5) readonly buffer W2 { float w2[]; };
 layout(std430, binding = 6) readonly buffer Diag { float diag[]; };
 layout(std430, binding = 7) readonly buffer C { float cTerm[]; };
 
+#if defined(BLOCK)
+uniform ivec4 blockStart;  // unused blocks start past the last cell
+uniform ivec3 blockDims[4];
+uniform double blockScale[4];
+uniform int cells;  // all blocks'
+ivec3 dims;
+double scale;
+int base_ = 0;
+// Makes cell i's block current; i's index in its block.
+int enterBlock(int i) {
+  const int k = int(i >= blockStart.y) + int(i >= blockStart.z) + int(i >= blockStart.w);
+  base_ = blockStart[k];
+  dims = blockDims[k];
+  scale = blockScale[k];
+  return i - base_;
+}
+#define CELLS cells
+#else
 uniform ivec3 dims;
 uniform double scale;
+#define base_ 0
+int enterBlock(int i) { return i; }
+#define CELLS (dims.x * dims.y * dims.z)
+#endif
 uniform int colour;    // MODE_SMOOTH: the cells with (x + y + z) % 2 == colour
 uniform float omega;   // MODE_JACOBI
 
@@ -54,34 +79,35 @@ REAL crossSum(ivec3 c, int i) {
 }
 #endif
 
-float weight(int a, int i) { return a == 0 ? w0[i] : a == 1 ? w1[i] : w2[i]; }
+float weight(int a, int i) { return a == 0 ? w0[base_ + i] : a == 1 ? w1[base_ + i] : w2[base_ + i]; }
 #if defined(P_UPDATE)
 // The PCG's p update fused into its operator (MODE_APPLY, DOT_PARTIAL; not
 // with CROSS): A is applied to p' = z + beta p (b holds z, x holds p),
 // computed where it is read as OP_UPDATE_P computes it, and p' is written.
 layout(std430, binding = 8) buffer PNew { double pNew[]; };
 double beta_ = 0.0lf;
-#define LX(i) (b[i] + beta_ * x[i])
+#define LX(i) (b[base_ + (i)] + beta_ * x[base_ + (i)])
 #else
-#define LX(i) x[i]
+#define LX(i) x[base_ + (i)]
 #endif
 #define LW(a, i) weight(a, i)
 #include "laplace_stencil.glsl"
 
 #if defined(MODE_APPLY) || defined(MODE_RESIDUAL)
-// A x (MODE_APPLY) or b - A x (MODE_RESIDUAL) at cell i; 0 on inactive cells.
+// A x (MODE_APPLY) or b - A x (MODE_RESIDUAL) at cell i of the current
+// block (enterBlock); 0 on inactive cells.
 REAL operatorAt(int i) {
-  if (diag[i] <= 0.0) return REAL(0);
+  if (diag[base_ + i] <= 0.0) return REAL(0);
   const ivec3 c = coordsOf(i, dims);
   // precise: rounded as the CPU's (the explicit step depends on it bit for bit)
-  precise REAL ax = REAL(scale) * (REAL(cTerm[i]) * LX(i) + faceSum(c, i, dims));
+  precise REAL ax = REAL(scale) * (REAL(cTerm[base_ + i]) * LX(i) + faceSum(c, i, dims));
 #if defined(CROSS)
   ax += REAL(scale) * crossSum(c, i);
 #endif
 #if defined(MODE_APPLY)
   return ax;
 #else
-  return b[i] - ax;
+  return b[base_ + i] - ax;
 #endif
 }
 #endif
@@ -112,11 +138,12 @@ void main() {
   beta_ = rzNew / S[pSlots.y];
 #endif
   double s = 0.0lf;
-  FOR_REDUCTION(i, dims.x * dims.y * dims.z) {
-    const REAL v = operatorAt(i);
+  FOR_REDUCTION(i, CELLS) {
+    const int li = enterBlock(i);
+    const REAL v = operatorAt(li);
     y[i] = v;
 #if defined(P_UPDATE)
-    const double pi = LX(i);
+    const double pi = LX(li);
     pNew[i] = pi;
     s = s + pi * v;
 #elif defined(MODE_APPLY)
@@ -136,9 +163,9 @@ void main() {
 #else
 void main() {
   const int i = flatIndex();
-  if (i >= dims.x * dims.y * dims.z) return;
+  if (i >= CELLS) return;
 #if defined(MODE_APPLY) || defined(MODE_RESIDUAL)
-  y[i] = operatorAt(i);
+  y[i] = operatorAt(enterBlock(i));
 #else
   const ivec3 c = coordsOf(i, dims);
 #if defined(MODE_SMOOTH)
