@@ -149,7 +149,8 @@ bool GpuLaplace::mixesColours() const {
 }
 
 void GpuLaplace::run(LaplaceMode mode, bool single, const GpuBuffer& x, const GpuBuffer* y, const GpuBuffer* b,
-                     int colour, float omega, const FusedDot* dot, const PUpdate* pUpdate) const {
+                     int colour, float omega, const FusedDot* dot, const PUpdate* pUpdate,
+                     const ResidualExtras* extras) const {
   const bool cross = hasCross_ && !single && (mode == LaplaceMode::Apply || mode == LaplaceMode::Residual);
   const bool block = !blocks_.empty();
   if (block && (mode == LaplaceMode::Smooth || mode == LaplaceMode::Jacobi))
@@ -158,9 +159,10 @@ void GpuLaplace::run(LaplaceMode mode, bool single, const GpuBuffer& x, const Gp
                                                                   single ? "float" : "double", define(mode),
                                                                   cross ? "\n#define CROSS" : "",
                                                                   block ? "\n#define BLOCK" : "",
-                                                                  dot ? (pUpdate ? "\n#define DOT_PARTIAL\n#define P_UPDATE"
-                                                                                  : "\n#define DOT_PARTIAL")
-                                                                      : ""));
+                                                                  !dot      ? ""
+                                                                  : !pUpdate ? "\n#define DOT_PARTIAL"
+                                                                  : pUpdate->first ? "\n#define DOT_PARTIAL\n#define P_UPDATE\n#define P_FIRST"
+                                                                                   : "\n#define DOT_PARTIAL\n#define P_UPDATE"));
   if (block) {
     setBlockUniforms(p);
   } else {
@@ -186,6 +188,14 @@ void GpuLaplace::run(LaplaceMode mode, bool single, const GpuBuffer& x, const Gp
     pUpdate->scalars->bind(15);
     setUniform(p, "pSlots", pUpdate->slots);
   }
+  if (dot && mode == LaplaceMode::Residual) {
+    const ResidualExtras none;
+    const ResidualExtras& e = extras ? *extras : none;
+    glUniform3i(p.uniform("extra"), e.bb, e.rz, e.noRhs);
+    (e.scalars ? *e.scalars : x).bind(15);
+    if (!cross) (e.z ? *e.z : x).bind(8);
+    countGpuTraffic(double(n_) * ((e.rz >= 0 ? 8.0 : 0.0) + (e.noRhs >= 0 ? 8.0 : 0.0)));
+  }
   if (dot) {
     setUniform(p, "slot", dot->slot);
     dot->partials->bind(14);
@@ -207,13 +217,17 @@ void GpuLaplace::apply(const GpuBuffer& x, GpuBuffer* y, FusedDot dot) const {
   run(LaplaceMode::Apply, false, x, y, nullptr, 0, 0.0f, &dot);
 }
 
-void GpuLaplace::residual(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* r, FusedDot dot) const {
-  run(LaplaceMode::Residual, false, x, r, &b, 0, 0.0f, &dot);
+void GpuLaplace::residual(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* r, FusedDot dot,
+                          const ResidualExtras& extras) const {
+  if (extras.noRhs >= 0 && !extras.scalars) throw GpuError("the residual's noRhs test needs the scalars");
+  if (extras.rz >= 0 && (!extras.z || hasCross_))
+    throw GpuError("the residual's diagonal preconditioner needs z and no mixed terms");
+  run(LaplaceMode::Residual, false, x, r, &b, 0, 0.0f, &dot, nullptr, &extras);
 }
 
 void GpuLaplace::applyUpdatingP(const GpuBuffer& p, const GpuBuffer& z, GpuBuffer* pNew, GpuBuffer* q, FusedDot pq,
-                                const GpuBuffer& scalars, std::array<int, 4> slots) const {
-  const PUpdate u{pNew, &scalars, slots};
+                                const GpuBuffer& scalars, std::array<int, 4> slots, bool first) const {
+  const PUpdate u{pNew, &scalars, slots, first};
   countGpuTraffic(double(n_) * 8.0);  // p' written (z is run's b)
   run(LaplaceMode::Apply, false, p, q, &z, 0, 0.0f, &pq, &u);
 }

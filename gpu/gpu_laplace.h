@@ -21,6 +21,18 @@ struct PUpdate {
   const GpuBuffer* pNew;
   const GpuBuffer* scalars;
   std::array<int, 4> slots;
+  bool first = false;
+};
+
+// What a PCG's first and last residual kernels do besides r = b - A x and
+// r . r's partials (laplace.comp's MODE_RESIDUAL with DOT_PARTIAL; -1: not):
+// b . b's partials into slot bb; z = r / diag (the diagonal preconditioner)
+// and r . z's partials into slot rz; x = 0 first where scalars[noRhs] (b . b)
+// is 0 (then r = b).
+struct ResidualExtras {
+  const GpuBuffer* scalars = nullptr;
+  int bb = -1, rz = -1, noRhs = -1;
+  const GpuBuffer* z = nullptr;
 };
 
 class GpuLaplace {
@@ -59,6 +71,8 @@ class GpuLaplace {
   // The coefficients, for kernels that build an operator on the GPU (cosine lobes).
   GpuBuffer& weights(int a) { return w_[size_t(a)]; }
   GpuBuffer& cBuffer() { return c_; }
+  const GpuBuffer& weights(int a) const { return w_[size_t(a)]; }
+  const GpuBuffer& cBuffer() const { return c_; }
   GpuBuffer& diagBuffer() { return diag_; }
   // The mixed terms' couplings (up, down per plane), allocated (zero) if the
   // system had none: for an operator rebuilt on the GPU.
@@ -78,15 +92,16 @@ class GpuLaplace {
   // (residual) into `dot`: bitwise a GpuReduction::dot after them, one
   // dispatch fewer.
   void apply(const GpuBuffer& x, GpuBuffer* y, FusedDot dot) const;
-  void residual(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* r, FusedDot dot) const;
+  void residual(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* r, FusedDot dot, const ResidualExtras& extras = {}) const;
   // The PCG's operator with its p update fused in (laplace.comp's P_UPDATE;
   // not with mixed terms): pNew = z + beta p and q = A pNew, with pNew . q's
   // partials into `pq`; beta from `scalars` at slots[0] (rzNew, summed from
   // its partials and stored) over slots[1]; then the entered gate's stopping
   // test of the iteration before (GpuGate::checkInNext first), with p . Ap
   // and r . r summed from their partials at slots[2] and slots[3].
+  // first: the first iteration's, pNew = z (S[slots[0]] summed and stored; no test).
   void applyUpdatingP(const GpuBuffer& p, const GpuBuffer& z, GpuBuffer* pNew, GpuBuffer* q, FusedDot pq,
-                      const GpuBuffer& scalars, std::array<int, 4> slots) const;
+                      const GpuBuffer& scalars, std::array<int, 4> slots, bool first = false) const;
   bool hasCross() const { return hasCross_; }
   // One colour of a red-black Gauss-Seidel sweep on float vectors.
   void smooth(const GpuBuffer& b, GpuBuffer* x, int colour) const;
@@ -95,7 +110,8 @@ class GpuLaplace {
 
  private:
   void run(LaplaceMode mode, bool single, const GpuBuffer& x, const GpuBuffer* y, const GpuBuffer* b, int colour,
-           float omega, const FusedDot* dot = nullptr, const PUpdate* pUpdate = nullptr) const;
+           float omega, const FusedDot* dot = nullptr, const PUpdate* pUpdate = nullptr,
+           const ResidualExtras* extras = nullptr) const;
   void setBlockUniforms(const ComputeProgram& p) const;
   struct Block {
     size_t start;

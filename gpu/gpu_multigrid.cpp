@@ -212,16 +212,21 @@ void GpuMultigrid::runTail() {
   storageBarrier();
 }
 
-void GpuMultigrid::smooth(Level& L, bool reverse, int sweeps) {
+void GpuMultigrid::smooth(Level& L, bool reverse, int sweeps, bool skipFirst, bool skipLast) {
   for (int s = 0; s < sweeps; ++s) {
     if (L.A->mixesColours()) {  // damped Jacobi, r as the other buffer
       L.A->jacobi(L.b, L.x, &L.r, L.A->dimension() == 3 ? 6.0f / 7.0f : 0.8f);
       std::swap(L.x, L.r);
       continue;
     }
-    L.A->smooth(L.b, &L.x, reverse ? 1 : 0);
-    L.A->smooth(L.b, &L.x, reverse ? 0 : 1);
+    if (!(skipFirst && s == 0)) L.A->smooth(L.b, &L.x, reverse ? 1 : 0);
+    if (!(skipLast && s == sweeps - 1)) L.A->smooth(L.b, &L.x, reverse ? 0 : 1);
   }
+}
+
+bool GpuMultigrid::sweepsFused() const {
+  const GpuLaplace& A = *levels_[0].A;
+  return levels_.size() > 1 && tail_ > 0 && !A.mixesColours() && options_.preSmooth > 0 && options_.postSmooth > 0;
 }
 
 void GpuMultigrid::cycle(size_t l) {
@@ -247,9 +252,10 @@ void GpuMultigrid::cycle(size_t l) {
     return;
   }
   Level& C = levels_[l + 1];
-  L.x.zero();
-  smooth(L, false, options_.preSmooth);
-  L.A->residual(L.b, L.x, &L.r, true);
+  // (the finest level's first and last colours: in apply()'s conversions)
+  const bool fused = l == 0 && sweepsFused();
+  if (!fused) L.x.zero();
+  smooth(L, false, options_.preSmooth, fused, false);
   auto transfer = [&](TransferMode mode, const GpuBuffer& fine, const GpuBuffer& coarse, const GpuBuffer& fineX,
                       const GpuBuffer& diag, size_t samples) {
     const ComputeProgram& p = useKernel("multigrid.comp", fmt::format("#define DIM {}\n#define {}", dim, define(mode)));
@@ -261,24 +267,49 @@ void GpuMultigrid::cycle(size_t l) {
     fineX.bind(2);
     diag.bind(3);
     fine.bind(4);
-    // restrict: the fine residual once (2^D fine cells a coarse one), b, diag; prolong: x read and written, diag
     const bool restriction = mode == TransferMode::Restrict;
-    dispatchFlat(samples, restriction ? 4.0 * (1 << dim) + 8.0 : 12.0);
+    if (restriction) {  // the fine residual made in place: the fine level's b and system
+      setUniform(p, "fineScale", L.A->scale());
+      L.b.bind(5);
+      for (int a = 0; a < 3; ++a) L.A->weights(a < dim ? a : 0).bind(6 + a);
+      L.A->diag().bind(9);
+      L.A->cBuffer().bind(10);
+    }
+    // restrict: the fine level's x, b, face weights, c and diag once (2^D fine
+    // cells a coarse one), b, diag; prolong: x read and written, diag
+    dispatchFlat(samples, restriction ? 4.0 * (dim + 4) * (1 << dim) + 8.0 : 12.0);
     storageBarrier();
   };
-  transfer(TransferMode::Restrict, L.r, C.b, L.x, C.A->diag(), C.A->size());
+  transfer(TransferMode::Restrict, L.b, C.b, L.x, C.A->diag(), C.A->size());
   cycle(l + 1);
   transfer(TransferMode::Prolong, L.r, C.x, L.x, L.A->diag(), L.A->size());
-  smooth(L, true, options_.postSmooth);
+  smooth(L, true, options_.postSmooth, false, fused);
 }
 
 void GpuMultigrid::apply(const GpuBuffer& r, GpuBuffer* z, const GpuBuffer& scalars, int slot, FusedDot rz) {
   Level& L = levels_[0];
   const size_t n = L.A->size();
-  // To float with r . r's final pass, back with r . z's partial one.
+  // To float with r . r's final pass, back with r . z's partial one; with
+  // the finest level's first pre-smoothing colour and last post-smoothing one.
+  const bool fused = sweepsFused();
   auto convert = [&](VectorOp op, const GpuBuffer& in, const GpuBuffer& out) {
     const bool back = op == VectorOp::FromFloat;
-    const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + define(op) + "\n#define DOT_PARTIAL");
+    const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + define(op) + "\n#define DOT_PARTIAL" +
+                                                               (!fused  ? ""
+                                                                : fmt::format("\n#define DIM {}\n#define {}", L.A->dimension(),
+                                                                              back ? "SWEEP_LAST" : "SWEEP_FIRST")));
+    if (fused) {
+      setUniform(p, "levelDims", L.A->dims());
+      setUniform(p, "levelScale", L.A->scale());
+      if (back) {
+        for (int a = 0; a < 3; ++a) L.A->weights(a < L.A->dimension() ? a : 0).bind(11 + a);
+        L.b.bind(14);
+      } else {
+        L.x.bind(10);
+      }
+      // the sweep's update on half the cells (GpuLaplace::smooth's count)
+      countGpuTraffic(0.5 * double(n) * 4.0 * (back ? 3 + L.A->dimension() + 2 : 2));
+    }
     setUniform(p, "n", int(n));
     setUniform(p, "slots", std::array<int, 4>{slot, rz.slot, 0, 0});
     in.bind(0);

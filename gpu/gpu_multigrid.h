@@ -45,7 +45,10 @@ class GpuMultigrid {
     GpuBuffer x, b, r;
   };
   void cycle(size_t l);
-  void smooth(Level& L, bool reverse, int sweeps);
+  // skipFirst, skipLast: without the first sweep's first colour or the last sweep's last
+  void smooth(Level& L, bool reverse, int sweeps, bool skipFirst = false, bool skipLast = false);
+  // Whether apply()'s conversions make the finest level's first and last colours.
+  bool sweepsFused() const;
   template <int D>
   void invertCoarsest(const LaplaceSystem<D>& A);
   void chooseTail(size_t tailCells);

@@ -58,23 +58,22 @@ void GpuPcg::removeMean(GpuBuffer* x) {
 
 SolverResult GpuPcg::solve(GpuBuffer* bp, GpuBuffer* xp, GpuMultigrid* M, const SolverOptions& options, bool deferred) {
   GpuBuffer &b = *bp, &x = *xp;
-  const size_t n = A_.size();
   // Each dot product's partial pass is fused into the kernel that makes its
   // terms, its final pass into the gate's kernel or the kernel that uses it.
   if (A_.singular()) removeMean(&b);
-  sums_.dot(b, b, n, kBB);
-  op(VectorOp::ZeroIfNoRhs, x, x, x, x, {kBB, 0, 0, 0});  // b = 0: x = 0, as on the CPU
-  A_.residual(b, x, &r_, sums_.fused(kRR));
-  gate_.start(sums_.scalars(), kGateSlots, options.tolerance, options.maxIterations, finals(kRR, -1));
+  // r = b - A x with r . r's partials, b . b's, and (diagonal) z = D^-1 r with r . z's
+  const bool jacobiApart = M || A_.hasCross();  // (the kernel with mixed terms has no room for z)
+  A_.residual(b, x, &r_, sums_.fused(kRR), {&sums_.scalars(), kBB, jacobiApart ? -1 : kRZ0, -1, &z_});
+  gate_.start(sums_.scalars(), kGateSlots, options.tolerance, options.maxIterations, finals(kRR, kBB));
   gate_.enter();
-  precondition(M, kRZ0);
-  op(VectorOp::UpdateP, z_, p_, p_, p_, {kRZ0, kRZ0, 0, 0}, true, true);
+  if (jacobiApart) precondition(M, kRZ0);
   // The scheduled iterations, or (calibrating) until the device says it stopped.
   const bool calibrating = ahead_ == 0;
   const int queue = calibrating ? options.maxIterations : std::min(ahead_, options.maxIterations);
   if (!calibrating && !A_.hasCross()) {
     iterateFused(&x, M, options, queue);
   } else {
+    op(VectorOp::UpdateP, z_, p_, p_, p_, {kRZ0, kRZ0, 0, 0}, true, true);
     int rz = kRZ0;
     for (int it = 1; it <= queue; ++it) {
       const int next = rz == kRZ0 ? kRZ1 : kRZ0;
@@ -90,8 +89,8 @@ SolverResult GpuPcg::solve(GpuBuffer* bp, GpuBuffer* xp, GpuMultigrid* M, const 
     }
   }
   gate_.leave();
-  // The true residual, not the recursively updated one.
-  A_.residual(b, x, &r_, sums_.fused(kRR));
+  // The true residual, not the recursively updated one (b = 0: x = 0 first, as on the CPU).
+  A_.residual(b, x, &r_, sums_.fused(kRR), {&sums_.scalars(), -1, -1, kBB, nullptr});
   gate_.finish(sums_.scalars(), kGateSlots, options.tolerance, finals(kRR, -1));
   if (A_.singular()) removeMean(&x);
   if (calibrating || !deferred) return fromTally(gate_.read(), true);
@@ -114,8 +113,9 @@ void GpuPcg::iterateFused(GpuBuffer* xp, GpuMultigrid* M, const SolverOptions& o
   int rz = kRZ0, rzBefore = kRZ0, pq = kPQ, pqBefore = kPQ1;
   for (int it = 1; it <= queue; ++it) {
     const int next = rz == kRZ0 ? kRZ1 : kRZ0;
-    if (it == 1) {
-      A_.apply(*p, &q_, sums_.fused(pq));
+    if (it == 1) {  // p = z and q = A p in one pass
+      A_.applyUpdatingP(*p, z_, pOther, &q_, sums_.fused(pq), sums_.scalars(), {rz, rz, 0, 0}, true);
+      std::swap(p, pOther);
     } else {
       // p = z + beta p and q = A p in one pass, then the stopping test of the iteration before
       gate_.checkInNext({kBB, kRR, pqBefore}, options.tolerance, options.maxIterations);

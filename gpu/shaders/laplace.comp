@@ -84,9 +84,14 @@ float weight(int a, int i) { return a == 0 ? w0[base_ + i] : a == 1 ? w1[base_ +
 // The PCG's p update fused into its operator (MODE_APPLY, DOT_PARTIAL; not
 // with CROSS): A is applied to p' = z + beta p (b holds z, x holds p),
 // computed where it is read as OP_UPDATE_P computes it, and p' is written.
+// P_FIRST: the first iteration's, p' = z.
 layout(std430, binding = 8) buffer PNew { double pNew[]; };
 double beta_ = 0.0lf;
+#if defined(P_FIRST)
+#define LX(i) b[base_ + (i)]
+#else
 #define LX(i) (b[base_ + (i)] + beta_ * x[base_ + (i)])
+#endif
 #else
 #define LX(i) x[base_ + (i)]
 #endif
@@ -99,8 +104,7 @@ double beta_ = 0.0lf;
 REAL operatorAt(int i) {
   if (diag[base_ + i] <= 0.0) return REAL(0);
   const ivec3 c = coordsOf(i, dims);
-  // precise: rounded as the CPU's (the explicit step depends on it bit for bit)
-  precise REAL ax = REAL(scale) * (REAL(cTerm[base_ + i]) * LX(i) + faceSum(c, i, dims));
+  precise REAL ax = operatorTerm(c, i, dims, scale, cTerm[base_ + i]);
 #if defined(CROSS)
   ax += REAL(scale) * crossSum(c, i);
 #endif
@@ -118,29 +122,60 @@ REAL operatorAt(int i) {
 // P_UPDATE: beta = S[rzNew] / S[rz], S[rzNew] summed from its partials
 // (pSlots.x, pSlots.y), and stored; then group 0 makes the solve's stopping
 // test of the iteration before (gate_logic.glsl) with S[pq] and S[rr] summed
-// from theirs (pSlots.z, pSlots.w), as OP_UPDATE_P with GATE does.
+// from theirs (pSlots.z, pSlots.w), as OP_UPDATE_P with GATE does (P_FIRST:
+// S[rzNew] only). MODE_RESIDUAL, the solve's first and last residuals: also
+// (extra.x >= 0) the partials of b . b; (extra.y >= 0, not with CROSS) the diagonal
+// preconditioner, zOut = r / diag, and the partials of r . zOut (OP_JACOBI's);
+// (extra.z >= 0) where S[extra.z] (b . b) is 0, x = 0 first
+// (OP_ZERO_IF_NO_RHS's; then r = b, A 0 being 0).
 layout(std430, binding = 14) buffer Partials { double partial[]; };
 uniform int slot;
 #include "fused_sum.glsl"
-#if defined(P_UPDATE)
+#if defined(P_UPDATE) || defined(MODE_RESIDUAL)
 layout(std430, binding = 15) buffer Scalars { double S[]; };
+#endif
+#if defined(P_UPDATE) && !defined(P_FIRST)
 #define GATE_BASE 10
 #define GATE_ARGS 11
 #define GATE_STATE 12
 #include "gate_logic.glsl"
+#endif
+#if defined(P_UPDATE)
 uniform ivec4 pSlots;
+#endif
+#if defined(MODE_RESIDUAL)
+uniform ivec3 extra;  // (CROSS: the mixed terms take zOut's binding; extra.y < 0)
+#if !defined(CROSS)
+layout(std430, binding = 8) buffer ZOut { double zOut[]; };
+#endif
 #endif
 
 void main() {
 #if defined(P_UPDATE)
   const int groups = int(gl_NumWorkGroups.x);
   const double rzNew = finalSum(pSlots.x, groups);
+#if !defined(P_FIRST)
   beta_ = rzNew / S[pSlots.y];
 #endif
+#endif
   double s = 0.0lf;
+#if defined(MODE_RESIDUAL)
+  double bb = 0.0lf, rz = 0.0lf;
+  const bool noRhs = extra.z >= 0 && S[extra.z] == 0.0lf;
+#endif
   FOR_REDUCTION(i, CELLS) {
     const int li = enterBlock(i);
+#if defined(MODE_RESIDUAL)
+    REAL v;
+    if (noRhs) {
+      x[i] = REAL(0);
+      v = diag[i] <= 0.0 ? REAL(0) : b[i];
+    } else {
+      v = operatorAt(li);
+    }
+#else
     const REAL v = operatorAt(li);
+#endif
     y[i] = v;
 #if defined(P_UPDATE)
     const double pi = LX(li);
@@ -150,13 +185,31 @@ void main() {
     s = s + x[i] * v;
 #else
     s = s + v * v;
+    if (extra.x >= 0) bb = bb + b[i] * b[i];
+#if !defined(CROSS)
+    if (extra.y >= 0) {
+      const double zi = diag[i] > 0.0 ? v / double(diag[i]) : 0.0lf;
+      zOut[i] = zi;
+      rz = rz + v * zi;
+    }
+#endif
 #endif
   }
+#if defined(MODE_RESIDUAL)
+  if (extra.y >= 0)
+    writePartials(dvec2(s, rz), slot, extra.y);
+  else
+    writePartial(s, slot);
+  if (extra.x >= 0) writePartial(bb, extra.x);
+#else
   writePartial(s, slot);
+#endif
 #if defined(P_UPDATE)
   if (gl_WorkGroupID.x == 0u) {
     if (gl_LocalInvocationID.x == 0u) S[pSlots.x] = rzNew;
+#if !defined(P_FIRST)
     checkAsLastPass(pSlots.z, pSlots.w);
+#endif
   }
 #endif
 }
@@ -180,11 +233,10 @@ void main() {
 #endif
     return;
   }
-  const REAL s = neighbourSum(c, i, dims);
+  const REAL g = gaussSeidelAt(c, i, dims, scale, b[i], d);
 #if defined(MODE_SMOOTH)
-  x[i] = (b[i] / REAL(scale) + s) / REAL(d);
+  x[i] = g;
 #elif defined(MODE_JACOBI)
-  const REAL g = (b[i] / REAL(scale) + s) / REAL(d);
   y[i] = x[i] + REAL(omega) * (g - x[i]);
 #endif
 #endif

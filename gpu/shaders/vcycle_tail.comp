@@ -60,8 +60,7 @@ void smoothColour(int k, int colour) {
       xs[lo + i] = 0.0;
       continue;
     }
-    const float s = neighbourSum(c, i, d);
-    xs[lo + i] = (bs[lo + i] / float(scaleOf[k]) + s) / dg;
+    xs[lo + i] = gaussSeidelAt(c, i, d, scaleOf[k], bs[lo + i], dg);
   }
   sync();
 }
@@ -83,7 +82,7 @@ void residual(int k) {
       continue;
     }
     const ivec3 c = coordsOf(i, d);
-    precise float ax = float(scaleOf[k]) * (float(cTerm[lo + i]) * xs[lo + i] + faceSum(c, i, d));
+    precise float ax = operatorTerm(c, i, d, scaleOf[k], cTerm[lo + i]);
     rs[lo + i] = bs[lo + i] - ax;
   }
   sync();

@@ -25,6 +25,11 @@
 // OP_TO_FLOAT   S[rr] summed from its partials (slots.x), and stored
 // OP_JACOBI     y = x / diag, the partials of x . y into slots.x
 // OP_FROM_FLOAT y = double(f) sqrt(S[rr]), the partials of z . y into slots.y
+// SWEEP_FIRST (OP_TO_FLOAT) and SWEEP_LAST (OP_FROM_FLOAT): the multigrid's
+// finest level (f: its b, then its x) with its first pre-smoothing colour
+// (colour 0 from x = 0, written into levelX) or its last post-smoothing
+// colour (colour 0, into f) made first, as laplace.comp's MODE_SMOOTH
+// does (gpu_multigrid.cpp)
 layout(std430, binding = 0) buffer X { double x[]; };
 layout(std430, binding = 1) buffer Y { double y[]; };
 layout(std430, binding = 2) buffer Z { double z[]; };
@@ -48,6 +53,42 @@ layout(std430, binding = 9) buffer W { double w[]; };
 #define GATE_ARGS 11
 #define GATE_STATE 12
 #include "gate_logic.glsl"
+#endif
+
+#if defined(SWEEP_FIRST) || defined(SWEEP_LAST)
+uniform ivec3 levelDims;
+uniform double levelScale;
+bool colour0(int i) {
+  const ivec3 c = coordsOf(i, levelDims);
+  return ((c.x + c.y + c.z) & 1) == 0;
+}
+#endif
+#if defined(SWEEP_FIRST)
+layout(std430, binding = 10) buffer LevelX { float levelX[]; };
+// The sweep's update from x = 0: the neighbours' sum is +0.
+float firstSweepAt(int i, float bi) {
+  if (!colour0(i) || diag[i] <= 0.0) return 0.0;
+  precise float t = bi / float(levelScale) + 0.0;
+  return t / diag[i];
+}
+#endif
+#if defined(SWEEP_LAST)
+layout(std430, binding = 11) readonly buffer W0 { float w0[]; };
+layout(std430, binding = 12) readonly buffer W1 { float w1[]; };
+layout(std430, binding = 13) readonly buffer W2 { float w2[]; };
+layout(std430, binding = 14) readonly buffer LevelB { float levelB[]; };
+#define REAL float
+#define LX(i) f[i]
+#define LW(a, i) ((a) == 0 ? w0[i] : (a) == 1 ? w1[i] : w2[i])
+#include "laplace_stencil.glsl"
+// Cell i's x after the sweep's last colour (written where it changes).
+float lastSweepAt(int i) {
+  if (!colour0(i)) return f[i];
+  const float d = diag[i];
+  const float xi = d <= 0.0 ? 0.0 : gaussSeidelAt(coordsOf(i, levelDims), i, levelDims, levelScale, levelB[i], d);
+  f[i] = xi;
+  return xi;
+}
 #endif
 
 double jacobi(double r, int i) { return diag[i] > 0.0 ? r / double(diag[i]) : 0.0lf; }
@@ -83,7 +124,13 @@ void main() {
 #endif
 #elif defined(OP_TO_FLOAT)
   const double rr = finalSum(slots.x, groups);
-  FOR_REDUCTION(i, n) f[i] = float(x[i] / sqrt(rr));
+  FOR_REDUCTION(i, n) {
+    const float bi = float(x[i] / sqrt(rr));
+    f[i] = bi;
+#if defined(SWEEP_FIRST)
+    levelX[i] = firstSweepAt(i, bi);
+#endif
+  }
   if (gl_WorkGroupID.x == 0u && gl_LocalInvocationID.x == 0u) S[slots.x] = rr;
 #elif defined(OP_JACOBI)  // x = r, y = z
   double s = 0.0lf;
@@ -96,7 +143,11 @@ void main() {
 #elif defined(OP_FROM_FLOAT)  // y = z, z = r
   double s = 0.0lf;
   FOR_REDUCTION(i, n) {
+#if defined(SWEEP_LAST)
+    const double zi = double(lastSweepAt(i)) * sqrt(S[slots.x]);
+#else
     const double zi = double(f[i]) * sqrt(S[slots.x]);
+#endif
     y[i] = zi;
     s = s + z[i] * zi;
   }
