@@ -153,12 +153,14 @@ void GpuLaplace::run(LaplaceMode mode, bool single, const GpuBuffer& x, const Gp
                      const ResidualExtras* extras) const {
   const bool cross = hasCross_ && !single && (mode == LaplaceMode::Apply || mode == LaplaceMode::Residual);
   const bool block = !blocks_.empty();
+  const bool meanFree = extras && extras->bSum >= 0;
   if (block && (mode == LaplaceMode::Smooth || mode == LaplaceMode::Jacobi))
     throw GpuError("a block system is not smoothed (no multigrid)");
   const ComputeProgram& p = useKernel("laplace.comp", fmt::format("#define DIM {}\n#define REAL {}\n#define {}{}{}{}", dim_,
                                                                   single ? "float" : "double", define(mode),
                                                                   cross ? "\n#define CROSS" : "",
-                                                                  block ? "\n#define BLOCK" : "",
+                                                                  std::string(block ? "\n#define BLOCK" : "") +
+                                                                      (meanFree ? "\n#define MEAN_FREE" : ""),
                                                                   !dot      ? ""
                                                                   : !pUpdate ? "\n#define DOT_PARTIAL"
                                                                   : pUpdate->first ? "\n#define DOT_PARTIAL\n#define P_UPDATE\n#define P_FIRST"
@@ -191,7 +193,8 @@ void GpuLaplace::run(LaplaceMode mode, bool single, const GpuBuffer& x, const Gp
   if (dot && mode == LaplaceMode::Residual) {
     const ResidualExtras none;
     const ResidualExtras& e = extras ? *extras : none;
-    glUniform3i(p.uniform("extra"), e.bb, e.rz, e.noRhs);
+    glUniform4i(p.uniform("extra"), e.bb, e.rz, e.noRhs, e.xSum);
+    glUniform2i(p.uniform("mean"), e.bSum, e.count);
     (e.scalars ? *e.scalars : x).bind(15);
     if (!cross) (e.z ? *e.z : x).bind(8);
     countGpuTraffic(double(n_) * ((e.rz >= 0 ? 8.0 : 0.0) + (e.noRhs >= 0 ? 8.0 : 0.0)));
@@ -219,9 +222,10 @@ void GpuLaplace::apply(const GpuBuffer& x, GpuBuffer* y, FusedDot dot) const {
 
 void GpuLaplace::residual(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* r, FusedDot dot,
                           const ResidualExtras& extras) const {
-  if (extras.noRhs >= 0 && !extras.scalars) throw GpuError("the residual's noRhs test needs the scalars");
+  if ((extras.noRhs >= 0 || extras.bSum >= 0) && !extras.scalars) throw GpuError("the residual's b = 0 test and mean read the scalars");
   if (extras.rz >= 0 && (!extras.z || hasCross_))
     throw GpuError("the residual's diagonal preconditioner needs z and no mixed terms");
+  if (extras.rz >= 0 && extras.xSum >= 0) throw GpuError("the residual sums r . z or x, not both");
   run(LaplaceMode::Residual, false, x, r, &b, 0, 0.0f, &dot, nullptr, &extras);
 }
 

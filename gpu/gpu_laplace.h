@@ -28,11 +28,14 @@ struct PUpdate {
 // r . r's partials (laplace.comp's MODE_RESIDUAL with DOT_PARTIAL; -1: not):
 // b . b's partials into slot bb; z = r / diag (the diagonal preconditioner)
 // and r . z's partials into slot rz; x = 0 first where scalars[noRhs] (b . b)
-// is 0 (then r = b).
+// is 0 (then r = b); the partials of x's sum on the active cells into slot
+// xSum (not with rz); b made mean-free first, its sum's partials at slot
+// bSum, the active cells' count at slot count.
 struct ResidualExtras {
   const GpuBuffer* scalars = nullptr;
   int bb = -1, rz = -1, noRhs = -1;
   const GpuBuffer* z = nullptr;
+  int xSum = -1, bSum = -1, count = -1;
 };
 
 class GpuLaplace {

@@ -51,19 +51,18 @@ void GpuPcg::op(VectorOp name, const GpuBuffer& x, const GpuBuffer& y, const Gpu
   storageBarrier();
 }
 
-void GpuPcg::removeMean(GpuBuffer* x) {
-  sums_.activeSum(*x, A_.diag(), A_.size(), kSum);
-  op(VectorOp::SubMean, *x, *x, *x, *x, {kSum, kCount, 0, 0});
-}
 
 SolverResult GpuPcg::solve(GpuBuffer* bp, GpuBuffer* xp, GpuMultigrid* M, const SolverOptions& options, bool deferred) {
   GpuBuffer &b = *bp, &x = *xp;
   // Each dot product's partial pass is fused into the kernel that makes its
   // terms, its final pass into the gate's kernel or the kernel that uses it.
-  if (A_.singular()) removeMean(&b);
-  // r = b - A x with r . r's partials, b . b's, and (diagonal) z = D^-1 r with r . z's
+  // r = b - A x with r . r's partials, b . b's, and (diagonal) z = D^-1 r
+  // with r . z's; singular, b made mean-free first (its sum's partials before)
+  const bool singular = A_.singular();
+  if (singular) sums_.activeSum(b, A_.diag(), A_.size(), kSum, true);
   const bool jacobiApart = M || A_.hasCross();  // (the kernel with mixed terms has no room for z)
-  A_.residual(b, x, &r_, sums_.fused(kRR), {&sums_.scalars(), kBB, jacobiApart ? -1 : kRZ0, -1, &z_});
+  A_.residual(b, x, &r_, sums_.fused(kRR),
+              {&sums_.scalars(), kBB, jacobiApart ? -1 : kRZ0, -1, &z_, -1, singular ? kSum : -1, kCount});
   gate_.start(sums_.scalars(), kGateSlots, options.tolerance, options.maxIterations, finals(kRR, kBB));
   gate_.enter();
   if (jacobiApart) precondition(M, kRZ0);
@@ -89,10 +88,11 @@ SolverResult GpuPcg::solve(GpuBuffer* bp, GpuBuffer* xp, GpuMultigrid* M, const 
     }
   }
   gate_.leave();
-  // The true residual, not the recursively updated one (b = 0: x = 0 first, as on the CPU).
-  A_.residual(b, x, &r_, sums_.fused(kRR), {&sums_.scalars(), -1, -1, kBB, nullptr});
+  // The true residual, not the recursively updated one (b = 0: x = 0 first,
+  // as on the CPU); singular, with x's sum's partials, then x made mean-free.
+  A_.residual(b, x, &r_, sums_.fused(kRR), {&sums_.scalars(), -1, -1, kBB, nullptr, singular ? kSum : -1});
   gate_.finish(sums_.scalars(), kGateSlots, options.tolerance, finals(kRR, -1));
-  if (A_.singular()) removeMean(&x);
+  if (singular) op(VectorOp::SubMean, x, x, x, x, {kSum, kCount, 0, 0}, false, true);
   if (calibrating || !deferred) return fromTally(gate_.read(), true);
   return last_;
 }

@@ -24,7 +24,7 @@ GpuReduction::GpuReduction() : partial_(kSlots * kGroups * sizeof(double)), scal
 }
 
 void GpuReduction::run(const char* term, const GpuBuffer& x, const GpuBuffer& y, const GpuBuffer& diag, size_t n,
-                       int slot) {
+                       int slot, bool partialOnly) {
   const unsigned groups = GpuReduction::groups(n);
   const ComputeProgram& p = useKernel("reduce.comp", fmt::format("#define MODE_PARTIAL\n#define {}", term));
   setUniform(p, "n", int(n));
@@ -39,6 +39,7 @@ void GpuReduction::run(const char* term, const GpuBuffer& x, const GpuBuffer& y,
   const std::string t = term;
   countGpuTraffic(double(n) * (t == "TERM_DOT" ? 16.0 : t == "TERM_ACTIVE_SUM" ? 12.0 : 4.0));
   storageBarrier();
+  if (partialOnly) return;
   const ComputeProgram& f = useKernel("reduce.comp", std::string("#define MODE_FINAL\n#define ") + term);
   setUniform(f, "n", int(groups));
   setUniform(f, "slot", slot);
@@ -50,8 +51,8 @@ void GpuReduction::run(const char* term, const GpuBuffer& x, const GpuBuffer& y,
 
 void GpuReduction::dot(const GpuBuffer& x, const GpuBuffer& y, size_t n, int slot) { run("TERM_DOT", x, y, x, n, slot); }
 
-void GpuReduction::activeSum(const GpuBuffer& x, const GpuBuffer& diag, size_t n, int slot) {
-  run("TERM_ACTIVE_SUM", x, x, diag, n, slot);
+void GpuReduction::activeSum(const GpuBuffer& x, const GpuBuffer& diag, size_t n, int slot, bool partialOnly) {
+  run("TERM_ACTIVE_SUM", x, x, diag, n, slot, partialOnly);
 }
 
 void GpuReduction::activeCount(const GpuBuffer& diag, size_t n, int slot) {

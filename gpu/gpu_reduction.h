@@ -30,7 +30,8 @@ class GpuReduction {
   static unsigned groups(size_t n);
 
   void dot(const GpuBuffer& x, const GpuBuffer& y, size_t n, int slot);       // x . y (double vectors)
-  void activeSum(const GpuBuffer& x, const GpuBuffer& diag, size_t n, int slot);  // sum of x where diag > 0
+  // The sum of x where diag > 0; partialOnly: its partials only (a kernel after makes the final pass).
+  void activeSum(const GpuBuffer& x, const GpuBuffer& diag, size_t n, int slot, bool partialOnly = false);
   void activeCount(const GpuBuffer& diag, size_t n, int slot);
   void maxAbs(const GpuBuffer& f, size_t n, int slot);  // max |f_i| of a float vector
   std::vector<double> read() const;  // every slot (waits for the queued work)
@@ -39,7 +40,8 @@ class GpuReduction {
   FusedDot fused(int slot) const { return {&partial_, slot}; }
 
  private:
-  void run(const char* term, const GpuBuffer& x, const GpuBuffer& y, const GpuBuffer& diag, size_t n, int slot);
+  void run(const char* term, const GpuBuffer& x, const GpuBuffer& y, const GpuBuffer& diag, size_t n, int slot,
+           bool partialOnly = false);
   GpuBuffer partial_, scalars_;
 };
 

@@ -17,7 +17,11 @@
 // its own dims and scale: several systems solved as one.
 layout(std430, binding = 0) buffer X { REAL x[]; };
 layout(std430, binding = 1) buffer Y { REAL y[]; };
+#if defined(MODE_RESIDUAL) && defined(DOT_PARTIAL)
+layout(std430, binding = 2) buffer B { REAL b[]; };  // (made mean-free in place)
+#else
 layout(std430, binding = 2) readonly buffer B { REAL b[]; };
+#endif
 layout(std430, binding = 3) readonly buffer W0 { float w0[]; };
 layout(std430, binding = 4) readonly buffer W1 { float w1[]; };
 layout(std430, binding = 5) readonly buffer W2 { float w2[]; };
@@ -99,19 +103,24 @@ double beta_ = 0.0lf;
 #include "laplace_stencil.glsl"
 
 #if defined(MODE_APPLY) || defined(MODE_RESIDUAL)
-// A x (MODE_APPLY) or b - A x (MODE_RESIDUAL) at cell i of the current
-// block (enterBlock); 0 on inactive cells.
-REAL operatorAt(int i) {
-  if (diag[base_ + i] <= 0.0) return REAL(0);
+// A x at active cell i of the current block (enterBlock).
+REAL axAt(int i) {
   const ivec3 c = coordsOf(i, dims);
   precise REAL ax = operatorTerm(c, i, dims, scale, cTerm[base_ + i]);
 #if defined(CROSS)
   ax += REAL(scale) * crossSum(c, i);
 #endif
-#if defined(MODE_APPLY)
   return ax;
+}
+
+// A x (MODE_APPLY) or b - A x (MODE_RESIDUAL, b = bi) at cell i of the
+// current block; 0 on inactive cells.
+REAL operatorAt(int i, REAL bi) {
+  if (diag[base_ + i] <= 0.0) return REAL(0);
+#if defined(MODE_APPLY)
+  return axAt(i);
 #else
-  return b[base_ + i] - ax;
+  return bi - axAt(i);
 #endif
 }
 #endif
@@ -124,10 +133,14 @@ REAL operatorAt(int i) {
 // test of the iteration before (gate_logic.glsl) with S[pq] and S[rr] summed
 // from theirs (pSlots.z, pSlots.w), as OP_UPDATE_P with GATE does (P_FIRST:
 // S[rzNew] only). MODE_RESIDUAL, the solve's first and last residuals: also
+// (MEAN_FREE, mean.x >= 0) b made mean-free on the active cells first, its sum summed
+// from its partials (mean.x) over the count S[mean.y] (OP_SUB_MEAN's);
 // (extra.x >= 0) the partials of b . b; (extra.y >= 0, not with CROSS) the diagonal
 // preconditioner, zOut = r / diag, and the partials of r . zOut (OP_JACOBI's);
 // (extra.z >= 0) where S[extra.z] (b . b) is 0, x = 0 first
-// (OP_ZERO_IF_NO_RHS's; then r = b, A 0 being 0).
+// (OP_ZERO_IF_NO_RHS's; then r = b, A 0 being 0); (extra.w >= 0, not with
+// extra.y) the partials of the sum of x on the active cells (reduce.comp's
+// TERM_ACTIVE_SUM).
 layout(std430, binding = 14) buffer Partials { double partial[]; };
 uniform int slot;
 #include "fused_sum.glsl"
@@ -144,7 +157,8 @@ layout(std430, binding = 15) buffer Scalars { double S[]; };
 uniform ivec4 pSlots;
 #endif
 #if defined(MODE_RESIDUAL)
-uniform ivec3 extra;  // (CROSS: the mixed terms take zOut's binding; extra.y < 0)
+uniform ivec4 extra;  // (CROSS: the mixed terms take zOut's binding; extra.y < 0)
+uniform ivec2 mean;
 #if !defined(CROSS)
 layout(std430, binding = 8) buffer ZOut { double zOut[]; };
 #endif
@@ -160,21 +174,32 @@ void main() {
 #endif
   double s = 0.0lf;
 #if defined(MODE_RESIDUAL)
-  double bb = 0.0lf, rz = 0.0lf;
+  double bb = 0.0lf, rz = 0.0lf, xs = 0.0lf;
   const bool noRhs = extra.z >= 0 && S[extra.z] == 0.0lf;
+#if defined(MEAN_FREE)  // (a compile-time branch: the final sum's barriers in uniform control flow)
+  const double bSum = finalSum(mean.x, int(gl_NumWorkGroups.x));
+  if (gl_WorkGroupID.x == 0u && gl_LocalInvocationID.x == 0u) S[mean.x] = bSum;
+#else
+  const double bSum = 0.0lf;
+#endif
 #endif
   FOR_REDUCTION(i, CELLS) {
     const int li = enterBlock(i);
 #if defined(MODE_RESIDUAL)
+    REAL bi = b[i];
+    if (mean.x >= 0) {  // MEAN_FREE (b is read at i only)
+      bi = diag[i] > 0.0 ? bi - bSum / S[mean.y] : REAL(0);
+      b[i] = bi;
+    }
     REAL v;
     if (noRhs) {
       x[i] = REAL(0);
-      v = diag[i] <= 0.0 ? REAL(0) : b[i];
+      v = diag[i] <= 0.0 ? REAL(0) : bi;
     } else {
-      v = operatorAt(li);
+      v = operatorAt(li, bi);
     }
 #else
-    const REAL v = operatorAt(li);
+    const REAL v = operatorAt(li, REAL(0));
 #endif
     y[i] = v;
 #if defined(P_UPDATE)
@@ -185,7 +210,8 @@ void main() {
     s = s + x[i] * v;
 #else
     s = s + v * v;
-    if (extra.x >= 0) bb = bb + b[i] * b[i];
+    if (extra.x >= 0) bb = bb + bi * bi;
+    if (extra.w >= 0) xs = xs + (diag[i] > 0.0 ? (noRhs ? 0.0lf : x[i]) : 0.0lf);
 #if !defined(CROSS)
     if (extra.y >= 0) {
       const double zi = diag[i] > 0.0 ? v / double(diag[i]) : 0.0lf;
@@ -196,10 +222,7 @@ void main() {
 #endif
   }
 #if defined(MODE_RESIDUAL)
-  if (extra.y >= 0)
-    writePartials(dvec2(s, rz), slot, extra.y);
-  else
-    writePartial(s, slot);
+  writePartials(dvec2(s, extra.y >= 0 ? rz : xs), slot, extra.y >= 0 ? extra.y : extra.w);
   if (extra.x >= 0) writePartial(bb, extra.x);
 #else
   writePartial(s, slot);
@@ -218,7 +241,12 @@ void main() {
   const int i = flatIndex();
   if (i >= CELLS) return;
 #if defined(MODE_APPLY) || defined(MODE_RESIDUAL)
-  y[i] = operatorAt(enterBlock(i));
+  const int li = enterBlock(i);
+#if defined(MODE_RESIDUAL)
+  y[i] = operatorAt(li, b[i]);
+#else
+  y[i] = operatorAt(li, REAL(0));
+#endif
 #else
   const ivec3 c = coordsOf(i, dims);
 #if defined(MODE_SMOOTH)

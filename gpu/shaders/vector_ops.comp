@@ -25,6 +25,7 @@
 // OP_TO_FLOAT   S[rr] summed from its partials (slots.x), and stored
 // OP_JACOBI     y = x / diag, the partials of x . y into slots.x
 // OP_FROM_FLOAT y = double(f) sqrt(S[rr]), the partials of z . y into slots.y
+// OP_SUB_MEAN   S[sum] summed from its partials (slots.x), and stored, first
 // SWEEP_FIRST (OP_TO_FLOAT) and SWEEP_LAST (OP_FROM_FLOAT): the multigrid's
 // finest level (f: its b, then its x) with its first pre-smoothing colour
 // (colour 0 from x = 0, written into levelX) or its last post-smoothing
@@ -140,6 +141,10 @@ void main() {
     s = s + x[i] * zi;
   }
   writePartial(s, slots.x);
+#elif defined(OP_SUB_MEAN)
+  const double sum = finalSum(slots.x, groups);
+  FOR_REDUCTION(i, n) x[i] = diag[i] > 0.0 ? x[i] - sum / S[slots.y] : 0.0lf;
+  if (gl_WorkGroupID.x == 0u && gl_LocalInvocationID.x == 0u) S[slots.x] = sum;
 #elif defined(OP_FROM_FLOAT)  // y = z, z = r
   double s = 0.0lf;
   FOR_REDUCTION(i, n) {
