@@ -51,7 +51,6 @@ void GpuPcg::op(VectorOp name, const GpuBuffer& x, const GpuBuffer& y, const Gpu
   storageBarrier();
 }
 
-
 SolverResult GpuPcg::solve(GpuBuffer* bp, GpuBuffer* xp, GpuMultigrid* M, const SolverOptions& options, bool deferred) {
   GpuBuffer &b = *bp, &x = *xp;
   // Each dot product's partial pass is fused into the kernel that makes its
@@ -62,7 +61,8 @@ SolverResult GpuPcg::solve(GpuBuffer* bp, GpuBuffer* xp, GpuMultigrid* M, const 
   if (singular) sums_.activeSum(b, A_.diag(), A_.size(), kSum, true);
   const bool jacobiApart = M || A_.hasCross();  // (the kernel with mixed terms has no room for z)
   A_.residual(b, x, &r_, sums_.fused(kRR),
-              {&sums_.scalars(), kBB, jacobiApart ? -1 : kRZ0, -1, &z_, -1, singular ? kSum : -1, kCount});
+              {.scalars = &sums_.scalars(), .bb = kBB, .rz = jacobiApart ? -1 : kRZ0, .z = &z_,
+               .bSum = singular ? kSum : -1, .count = kCount});
   gate_.start(sums_.scalars(), kGateSlots, options.tolerance, options.maxIterations, finals(kRR, kBB));
   gate_.enter();
   if (jacobiApart) precondition(M, kRZ0);
@@ -90,7 +90,7 @@ SolverResult GpuPcg::solve(GpuBuffer* bp, GpuBuffer* xp, GpuMultigrid* M, const 
   gate_.leave();
   // The true residual, not the recursively updated one (b = 0: x = 0 first,
   // as on the CPU); singular, with x's sum's partials, then x made mean-free.
-  A_.residual(b, x, &r_, sums_.fused(kRR), {&sums_.scalars(), -1, -1, kBB, nullptr, singular ? kSum : -1});
+  A_.residual(b, x, &r_, sums_.fused(kRR), {.scalars = &sums_.scalars(), .noRhs = kBB, .xSum = singular ? kSum : -1});
   gate_.finish(sums_.scalars(), kGateSlots, options.tolerance, finals(kRR, -1));
   if (singular) op(VectorOp::SubMean, x, x, x, x, {kSum, kCount, 0, 0}, false, true);
   if (calibrating || !deferred) return fromTally(gate_.read(), true);

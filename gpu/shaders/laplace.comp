@@ -133,7 +133,7 @@ REAL operatorAt(int i, REAL bi) {
 // test of the iteration before (gate_logic.glsl) with S[pq] and S[rr] summed
 // from theirs (pSlots.z, pSlots.w), as OP_UPDATE_P with GATE does (P_FIRST:
 // S[rzNew] only). MODE_RESIDUAL, the solve's first and last residuals: also
-// (MEAN_FREE, mean.x >= 0) b made mean-free on the active cells first, its sum summed
+// (MEAN_FREE) b made mean-free on the active cells first, its sum summed
 // from its partials (mean.x) over the count S[mean.y] (OP_SUB_MEAN's);
 // (extra.x >= 0) the partials of b . b; (extra.y >= 0, not with CROSS) the diagonal
 // preconditioner, zOut = r / diag, and the partials of r . zOut (OP_JACOBI's);
@@ -176,21 +176,19 @@ void main() {
 #if defined(MODE_RESIDUAL)
   double bb = 0.0lf, rz = 0.0lf, xs = 0.0lf;
   const bool noRhs = extra.z >= 0 && S[extra.z] == 0.0lf;
-#if defined(MEAN_FREE)  // (a compile-time branch: the final sum's barriers in uniform control flow)
+#if defined(MEAN_FREE)  // (a define, not a uniform test: the final sum's barriers in uniform control flow)
   const double bSum = finalSum(mean.x, int(gl_NumWorkGroups.x));
   if (gl_WorkGroupID.x == 0u && gl_LocalInvocationID.x == 0u) S[mean.x] = bSum;
-#else
-  const double bSum = 0.0lf;
 #endif
 #endif
   FOR_REDUCTION(i, CELLS) {
     const int li = enterBlock(i);
 #if defined(MODE_RESIDUAL)
     REAL bi = b[i];
-    if (mean.x >= 0) {  // MEAN_FREE (b is read at i only)
-      bi = diag[i] > 0.0 ? bi - bSum / S[mean.y] : REAL(0);
-      b[i] = bi;
-    }
+#if defined(MEAN_FREE)  // (b is read at i only)
+    bi = diag[i] > 0.0 ? bi - bSum / S[mean.y] : REAL(0);
+    b[i] = bi;
+#endif
     REAL v;
     if (noRhs) {
       x[i] = REAL(0);
