@@ -39,13 +39,13 @@ GpuLaplace::GpuLaplace(const std::vector<const LaplaceSystem<D>*>& blocks) : dim
 
 template <int D>
 void GpuLaplace::updateBlock(int k, const LaplaceSystem<D>& A) {
+  if (A.singular()) throw GpuError("a block system's blocks must not be singular");
   Block& B = blocks_.at(size_t(k));
   const size_t at = B.start * sizeof(float);
   for (int a = 0; a < D; ++a) w_[size_t(a)].upload(A.w[a].expanded(), at);
   diag_.upload(A.diag.expanded(), at);
   c_.upload(A.c.expanded(), at);
   B.scale = A.scale;
-  if (A.singular()) throw GpuError("a block system's blocks must not be singular");
 }
 
 void GpuLaplace::setBlockUniforms(const ComputeProgram& p) const {
@@ -153,18 +153,19 @@ void GpuLaplace::run(LaplaceMode mode, bool single, const GpuBuffer& x, const Gp
                      const ResidualExtras* extras) const {
   const bool cross = hasCross_ && !single && (mode == LaplaceMode::Apply || mode == LaplaceMode::Residual);
   const bool block = !blocks_.empty();
-  const bool meanFree = extras && extras->bSum >= 0;
   if (block && (mode == LaplaceMode::Smooth || mode == LaplaceMode::Jacobi))
     throw GpuError("a block system is not smoothed (no multigrid)");
-  const ComputeProgram& p = useKernel("laplace.comp", fmt::format("#define DIM {}\n#define REAL {}\n#define {}{}{}{}", dim_,
-                                                                  single ? "float" : "double", define(mode),
-                                                                  cross ? "\n#define CROSS" : "",
-                                                                  std::string(block ? "\n#define BLOCK" : "") +
-                                                                      (meanFree ? "\n#define MEAN_FREE" : ""),
-                                                                  !dot      ? ""
-                                                                  : !pUpdate ? "\n#define DOT_PARTIAL"
-                                                                  : pUpdate->first ? "\n#define DOT_PARTIAL\n#define P_UPDATE\n#define P_FIRST"
-                                                                                   : "\n#define DOT_PARTIAL\n#define P_UPDATE"));
+  std::string defines = fmt::format("#define DIM {}\n#define REAL {}\n#define {}", dim_, single ? "float" : "double", define(mode));
+  const auto add = [&](bool on, const char* name) {
+    if (on) defines += std::string("\n#define ") + name;
+  };
+  add(cross, "CROSS");
+  add(block, "BLOCK");
+  add(extras && extras->bSum >= 0, "MEAN_FREE");
+  add(dot, "DOT_PARTIAL");
+  add(pUpdate, "P_UPDATE");
+  add(pUpdate && pUpdate->first, "P_FIRST");
+  const ComputeProgram& p = useKernel("laplace.comp", defines);
   if (block) {
     setBlockUniforms(p);
   } else {
@@ -211,10 +212,6 @@ void GpuLaplace::run(LaplaceMode mode, bool single, const GpuBuffer& x, const Gp
 }
 
 void GpuLaplace::apply(const GpuBuffer& x, GpuBuffer* y) const { run(LaplaceMode::Apply, false, x, y, nullptr, 0, 0.0f); }
-
-void GpuLaplace::residual(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* r, bool single) const {
-  run(LaplaceMode::Residual, single, x, r, &b, 0, 0.0f);
-}
 
 void GpuLaplace::apply(const GpuBuffer& x, GpuBuffer* y, FusedDot dot) const {
   run(LaplaceMode::Apply, false, x, y, nullptr, 0, 0.0f, &dot);

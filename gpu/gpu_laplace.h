@@ -89,11 +89,9 @@ class GpuLaplace {
   bool mixesColours() const;
 
   void apply(const GpuBuffer& x, GpuBuffer* y) const;  // y = A x (double)
-  // r = b - A x, in double or (`single`) float.
-  void residual(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* r, bool single) const;
-  // The same in double with the partial pass of x . y (apply) or r . r
-  // (residual) into `dot`: bitwise a GpuReduction::dot after them, one
-  // dispatch fewer.
+  // y = A x or r = b - A x in double with the partial pass of x . y (apply)
+  // or r . r (residual) into `dot`: bitwise a GpuReduction::dot after them,
+  // one dispatch fewer.
   void apply(const GpuBuffer& x, GpuBuffer* y, FusedDot dot) const;
   void residual(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* r, FusedDot dot, const ResidualExtras& extras = {}) const;
   // The PCG's operator with its p update fused in (laplace.comp's P_UPDATE;

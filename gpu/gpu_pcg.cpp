@@ -24,9 +24,9 @@ GpuPcg::GpuPcg(const GpuLaplace& A)
 }
 
 void GpuPcg::op(VectorOp name, const GpuBuffer& x, const GpuBuffer& y, const GpuBuffer& z, const GpuBuffer& q,
-                std::array<int, 4> slots, bool first, bool fused, const SolverOptions* check) {
-  const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + define(name) +
-                                                             (fused ? "\n#define DOT_PARTIAL" : "") +
+                std::array<int, 4> slots, bool first, const SolverOptions* check) {
+  // (every PCG op has its reductions fused in: DOT_PARTIAL)
+  const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + define(name) + "\n#define DOT_PARTIAL" +
                                                              (check ? "\n#define GATE" : ""));
   if (check) gate_.checkInNext(kGateSlots, check->tolerance, check->maxIterations);
   setUniform(p, "n", int(A_.size()));
@@ -40,14 +40,10 @@ void GpuPcg::op(VectorOp name, const GpuBuffer& x, const GpuBuffer& y, const Gpu
   A_.diag().bind(5);
   sums_.scalars().bind(6);
   const double bytes = name == VectorOp::UpdateXR ? (slots[3] >= 0 ? 68.0 : 48.0) : name == VectorOp::UpdateP ? 24.0 : 20.0;
-  if (fused) {
-    sums_.partials().bind(8);
-    z_.bind(9);  // the fused diagonal preconditioner's z
-    countGpuTraffic(double(A_.size()) * bytes);
-    dispatchGroups(GpuReduction::groups(A_.size()), 1);
-  } else {
-    dispatchFlat(A_.size(), bytes);
-  }
+  sums_.partials().bind(8);
+  z_.bind(9);  // the fused diagonal preconditioner's z
+  countGpuTraffic(double(A_.size()) * bytes);
+  dispatchGroups(GpuReduction::groups(A_.size()), 1);
   storageBarrier();
 }
 
@@ -72,17 +68,17 @@ SolverResult GpuPcg::solve(GpuBuffer* bp, GpuBuffer* xp, GpuMultigrid* M, const 
   if (!calibrating && !A_.hasCross()) {
     iterateFused(&x, M, options, queue);
   } else {
-    op(VectorOp::UpdateP, z_, p_, p_, p_, {kRZ0, kRZ0, 0, 0}, true, true);
+    op(VectorOp::UpdateP, z_, p_, p_, p_, {kRZ0, kRZ0, 0, 0}, true);
     int rz = kRZ0;
     for (int it = 1; it <= queue; ++it) {
       const int next = rz == kRZ0 ? kRZ1 : kRZ0;
       A_.apply(p_, &q_, sums_.fused(kPQ));
       // x += alpha p, r -= alpha q (and, diagonal, z = D^-1 r)
-      op(VectorOp::UpdateXR, x, r_, p_, q_, {rz, kPQ, kRR, M ? -1 : next}, false, true);
+      op(VectorOp::UpdateXR, x, r_, p_, q_, {rz, kPQ, kRR, M ? -1 : next});
       if (M) precondition(M, next);
       // p = z + beta p, then the stopping test (past it, the p update and the
       // multigrid cycle before it were work the result does not use)
-      op(VectorOp::UpdateP, z_, p_, p_, p_, {next, rz, kPQ, kRR}, false, true, &options);
+      op(VectorOp::UpdateP, z_, p_, p_, p_, {next, rz, kPQ, kRR}, false, &options);
       rz = next;
       if (calibrating && it % kCalibrationLook == 0 && !gate_.going()) break;
     }
@@ -92,7 +88,7 @@ SolverResult GpuPcg::solve(GpuBuffer* bp, GpuBuffer* xp, GpuMultigrid* M, const 
   // as on the CPU); singular, with x's sum's partials, then x made mean-free.
   A_.residual(b, x, &r_, sums_.fused(kRR), {.scalars = &sums_.scalars(), .noRhs = kBB, .xSum = singular ? kSum : -1});
   gate_.finish(sums_.scalars(), kGateSlots, options.tolerance, finals(kRR, -1));
-  if (singular) op(VectorOp::SubMean, x, x, x, x, {kSum, kCount, 0, 0}, false, true);
+  if (singular) op(VectorOp::SubMean, x, x, x, x, {kSum, kCount, 0, 0});
   if (calibrating || !deferred) return fromTally(gate_.read(), true);
   return last_;
 }
@@ -105,7 +101,7 @@ void GpuPcg::precondition(GpuMultigrid* M, int slot) {  // z = M r, with r . z's
   if (M)
     M->apply(r_, &z_, sums_.scalars(), kRR, sums_.fused(slot));
   else
-    op(VectorOp::Jacobi, r_, z_, z_, z_, {slot, 0, 0, 0}, false, true);
+    op(VectorOp::Jacobi, r_, z_, z_, z_, {slot, 0, 0, 0});
 }
 
 void GpuPcg::iterateFused(GpuBuffer* xp, GpuMultigrid* M, const SolverOptions& options, int queue) {
@@ -123,7 +119,7 @@ void GpuPcg::iterateFused(GpuBuffer* xp, GpuMultigrid* M, const SolverOptions& o
       std::swap(p, pOther);
     }
     // x += alpha p, r -= alpha q (and, diagonal, z = D^-1 r)
-    op(VectorOp::UpdateXR, x, r_, *p, q_, {rz, pq, kRR, M ? -1 : next}, false, true);
+    op(VectorOp::UpdateXR, x, r_, *p, q_, {rz, pq, kRR, M ? -1 : next});
     if (M && it < queue) precondition(M, next);
     rzBefore = rz;
     rz = next;

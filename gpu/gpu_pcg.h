@@ -37,7 +37,7 @@ class GpuPcg {
 
  private:
   void op(VectorOp name, const GpuBuffer& x, const GpuBuffer& y, const GpuBuffer& z, const GpuBuffer& q,
-          std::array<int, 4> slots, bool first = false, bool fused = false, const SolverOptions* check = nullptr);
+          std::array<int, 4> slots, bool first = false, const SolverOptions* check = nullptr);
   // The scheduled iterations with each p update fused into the next
   // iteration's operator (GpuLaplace::applyUpdatingP).
   void precondition(GpuMultigrid* M, int slot);

@@ -18,7 +18,7 @@ enum class LaplaceMode { Apply, Residual, Smooth, Jacobi };
 enum class TransferMode { Restrict, Prolong };
 // shaders/vector_ops.comp
 enum class VectorOp {
-  FromFloat, ToFloat, Jacobi, SubMean, UpdateP, UpdateXR, AddFaces, ClampZero, Hold, ScaleAdd, ThetaStep, ZeroIfNoRhs
+  FromFloat, ToFloat, Jacobi, SubMean, UpdateP, UpdateXR, AddFaces, ClampZero, Hold, ScaleAdd, ThetaStep
 };
 // shaders/rd_lobes.comp and shaders/rd_tensor.comp
 enum class LobeMode { A, Faces };
@@ -81,7 +81,6 @@ constexpr const char* define(VectorOp m) {
     case VectorOp::Hold: return "OP_HOLD";
     case VectorOp::ScaleAdd: return "OP_SCALE_ADD";
     case VectorOp::ThetaStep: return "OP_THETA_STEP";
-    case VectorOp::ZeroIfNoRhs: return "OP_ZERO_IF_NO_RHS";
   }
   return "";
 }

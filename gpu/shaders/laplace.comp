@@ -1,8 +1,9 @@
 // The 5-/7-point systems of core/laplace_system.h on the GPU:
 //   (A x)_i = scale (c_i x_i + sum_f w_f (x_i - x_j(f))),  diag = c + sum_f w_f,
 // w[a]_i couples i and i + e_a (0 across a non-periodic edge), a cell with
-// diag 0 is inactive. MODE_APPLY: y = A x; MODE_RESIDUAL: y = b - A x (both
-// in the CPU's form: c and the face differences, not the rounded diagonal);
+// diag 0 is inactive. MODE_APPLY: y = A x; MODE_RESIDUAL (with DOT_PARTIAL
+// only): y = b - A x (both in the CPU's form: c and the face differences,
+// not the rounded diagonal);
 // MODE_SMOOTH: one colour of a red-black Gauss-Seidel sweep,
 // x_i = (b_i / scale + sum_f w_f x_j) / diag_i; MODE_JACOBI: y = x + omega
 // (that update - x) (levels whose odd periodic axis mixes the colours).
@@ -238,13 +239,8 @@ void main() {
 void main() {
   const int i = flatIndex();
   if (i >= CELLS) return;
-#if defined(MODE_APPLY) || defined(MODE_RESIDUAL)
-  const int li = enterBlock(i);
-#if defined(MODE_RESIDUAL)
-  y[i] = operatorAt(li, b[i]);
-#else
-  y[i] = operatorAt(li, REAL(0));
-#endif
+#if defined(MODE_APPLY)
+  y[i] = operatorAt(enterBlock(i), REAL(0));
 #else
   const ivec3 c = coordsOf(i, dims);
 #if defined(MODE_SMOOTH)

@@ -1,11 +1,5 @@
-// Element-wise steps of the preconditioned CG (core/pcg.cpp) on double
-// vectors, with the scalars read from the device (no round trip):
-// OP_UPDATE_XR  x += alpha p, r -= alpha q, alpha = S[rz] / S[pq]
-// OP_UPDATE_P   p = z + beta p, beta = S[rzNew] / S[rz] (first: p = z)
-// OP_JACOBI     z = r / diag (0 on inactive cells)
-// OP_SUB_MEAN   x -= S[sum] / S[count] on active cells, 0 on inactive ones
-// OP_TO_FLOAT   f = float(x / sqrt(S[rr]))       (into a multigrid level)
-// OP_FROM_FLOAT z = double(f) sqrt(S[rr])
+// Element-wise steps on double vectors. The reaction-diffusion layer's, one
+// invocation a cell:
 // OP_SCALE_ADD  y = a x + b y (a, b uniforms)
 // OP_CLAMP_ZERO y = max(y, 0)
 // OP_THETA_STEP y += ca x + cb (-z + cc q): the theta scheme's explicit part
@@ -13,19 +7,24 @@
 //               rd_solver.cpp's order, no fused multiply-adds
 // OP_HOLD       y = x where held[i] != 0 (fixed regions; frozen species hold everywhere)
 // OP_ADD_FACES  y += ca faces (x: the Dirichlet faces per cell)
-// OP_ZERO_IF_NO_RHS x = 0 where S[bb] = 0 (a solve whose right-hand side is 0)
-// DOT_PARTIAL: the PCG's ops with the reductions next to them fused in
-// (fused_sum.glsl), over the reduction's groups, bitwise the separate passes:
-// OP_UPDATE_XR  S[pq] summed from its partials (slots.y) in each group; the
+// DOT_PARTIAL: the preconditioned CG's (core/pcg.cpp), with the scalars read
+// on the device (no round trip) and the reductions next to them fused in
+// (fused_sum.glsl), over the reduction's groups, bitwise separate passes:
+// OP_UPDATE_XR  x += alpha p, r -= alpha q, alpha = S[rz] / S[pq], S[pq]
+//               summed from its partials (slots.y) in each group; the
 //               partials of r . r into slots.z; and, slots.w >= 0, the
 //               diagonal preconditioner too: w = r / diag, r . w into slots.w
-// OP_UPDATE_P   S[rzNew] summed from its partials (slots.x), and stored;
+// OP_UPDATE_P   p = z + beta p, beta = S[rzNew] / S[rz] (first: p = z),
+//               S[rzNew] summed from its partials (slots.x), and stored;
 //               GATE: then group 0 makes the solve's check (gate_logic.glsl)
 //               with S[pq] and S[rr] summed from theirs (slots.z, slots.w)
-// OP_TO_FLOAT   S[rr] summed from its partials (slots.x), and stored
-// OP_JACOBI     y = x / diag, the partials of x . y into slots.x
+// OP_TO_FLOAT   f = float(x / sqrt(S[rr])) (into a multigrid level), S[rr]
+//               summed from its partials (slots.x), and stored
+// OP_JACOBI     y = x / diag (0 on inactive cells), the partials of x . y
+//               into slots.x
 // OP_FROM_FLOAT y = double(f) sqrt(S[rr]), the partials of z . y into slots.y
-// OP_SUB_MEAN   S[sum] summed from its partials (slots.x), and stored, first
+// OP_SUB_MEAN   x -= S[sum] / S[count] on active cells, 0 on inactive ones,
+//               S[sum] summed from its partials (slots.x), and stored, first
 // SWEEP_FIRST (OP_TO_FLOAT) and SWEEP_LAST (OP_FROM_FLOAT): the multigrid's
 // finest level (f: its b, then its x) with its first pre-smoothing colour
 // (colour 0 from x = 0, written into levelX) or its last post-smoothing
@@ -163,21 +162,7 @@ void main() {
 void main() {
   const int i = flatIndex();
   if (i >= n) return;
-#if defined(OP_UPDATE_XR)  // x, y = r, z = p, q
-  const double alpha = S[slots.y] > 0.0lf ? S[slots.x] / S[slots.y] : 0.0lf;  // 0 on breakdown
-  x[i] += alpha * z[i];
-  y[i] -= alpha * q[i];
-#elif defined(OP_UPDATE_P)  // x = z, y = p
-  y[i] = first ? x[i] : x[i] + (S[slots.x] / S[slots.y]) * y[i];
-#elif defined(OP_JACOBI)  // x = r, y = z
-  y[i] = diag[i] > 0.0 ? x[i] / double(diag[i]) : 0.0lf;
-#elif defined(OP_SUB_MEAN)
-  x[i] = diag[i] > 0.0 ? x[i] - S[slots.x] / S[slots.y] : 0.0lf;
-#elif defined(OP_TO_FLOAT)
-  f[i] = float(x[i] / sqrt(S[slots.x]));
-#elif defined(OP_FROM_FLOAT)  // y = z
-  y[i] = double(f[i]) * sqrt(S[slots.x]);
-#elif defined(OP_SCALE_ADD)
+#if defined(OP_SCALE_ADD)
   y[i] = ca * x[i] + cb * y[i];
 #elif defined(OP_THETA_STEP)
   precise double L = -z[i] + cc * q[i];
@@ -189,8 +174,6 @@ void main() {
   if (held[i] != 0u) y[i] = x[i];
 #elif defined(OP_ADD_FACES)
   y[i] += ca * x[i];
-#elif defined(OP_ZERO_IF_NO_RHS)
-  if (S[slots.x] == 0.0lf) x[i] = 0.0lf;
 #endif
 }
 #endif
