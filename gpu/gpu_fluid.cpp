@@ -139,8 +139,9 @@ size_t GpuFluid<D>::deviceBytes(const IVec<D>& cells) {
   const double coarse = 1.0 / ((1 << D) - 1);  // the multigrid levels below the fine one, relative to it
   const double bytes = 4.0 * 6 * double(f)     // u, its scratch, fixed flags, prescribed values, open fractions, held flags
                        + 4.0 * 4 * double(c) + 4.0 * 4 * double(g)  // dye, its scratch, solid, inactive; the schemes' scratch
-                       + double(c) * (system + 3 * 8 + 4 * 8 + 3 * 4 + coarse * (system + 3 * 4))  // pressure
-                       + double(f) * (system + 3 * 8 + 4 * 8);  // viscosity: system, b, x, rhs, PCG vectors
+                       // pressure: system, phi, rhs, rate; PCG vectors; each level's x and b
+                       + double(c) * (system + 3 * 8 + 5 * 8 + 2 * 4 + coarse * (system + 2 * 4))
+                       + double(f) * (system + 3 * 8 + 5 * 8);  // viscosity: system, b, x, rhs, PCG vectors
   return size_t(bytes);
 }
 

@@ -116,7 +116,7 @@ GpuMultigrid::GpuMultigrid(const Multigrid<D>& levels, const GpuLaplace& fine, c
     const size_t n = levels.level(l).size() * sizeof(float);
     L.x = GpuBuffer(n);
     L.b = GpuBuffer(n);
-    L.r = GpuBuffer(n);
+    if (L.A->mixesColours()) L.r = GpuBuffer(n);  // the damped Jacobi's other vector (the tail's: its own)
     levels_.push_back(std::move(L));
   }
   invertCoarsest(levels.level(levels.levels() - 1));
@@ -282,7 +282,7 @@ void GpuMultigrid::cycle(size_t l) {
   };
   transfer(TransferMode::Restrict, L.b, C.b, L.x, C.A->diag(), C.A->size());
   cycle(l + 1);
-  transfer(TransferMode::Prolong, L.r, C.x, L.x, L.A->diag(), L.A->size());
+  transfer(TransferMode::Prolong, L.b, C.x, L.x, L.A->diag(), L.A->size());  // (fine unread)
   smooth(L, true, options_.postSmooth, false, fused);
 }
 
