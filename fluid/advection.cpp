@@ -1,8 +1,11 @@
 #include "fluid/advection.h"
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <optional>
 #include <cmath>
+#include <cfloat>
 #include <cstring>
 
 #include "core/linear_sampler.h"
@@ -326,12 +329,73 @@ __attribute__((target("avx2"))) int feetRow8(const FeetRow<D>& j, int x) {
 }
 #endif
 
+// The rows of a grid a pass writes without tracing: skip[r] where every row
+// within `reach` of row r (along y and z; a trace can end anywhere along
+// x) holds one finite value, bitwise, in all its samples. There the
+// interpolation of any stencil gives value + 0 (v + t (v - v)) and the
+// stencil's min and max are the value; `bounds`: the pass writes those too.
+struct UniformRows {
+  std::vector<uint8_t> skip;
+  std::vector<float> value;
+  bool bounds = true;
+};
+
+// UniformRows from each row's flatness (flat[r]: every sample's bits are
+// bits[r]); nullopt where no row is flat.
+template <int D>
+std::optional<UniformRows> uniformRows(const IVec<D>& dims, const std::vector<uint8_t>& flat,
+                                       const std::vector<uint32_t>& bits, const std::array<int, D>& reach) {
+  if (std::find(flat.begin(), flat.end(), uint8_t(1)) == flat.end()) return std::nullopt;
+  const size_t rows = flat.size(), ny = size_t(dims[1]);
+  UniformRows u{std::vector<uint8_t>(rows, 0), std::vector<float>(rows)};
+  const int ry = reach[1], rz = D == 3 ? reach[D - 1] : 0;
+  const int nz = D == 3 ? dims[D - 1] : 1;
+  parallelFor(rows, [&](size_t r) {
+    if (!flat[r]) return;
+    const int y = int(r % ny), z = int(r / ny);
+    for (int zz = std::max(z - rz, 0); zz <= std::min(z + rz, nz - 1); ++zz)
+      for (int yy = std::max(y - ry, 0); yy <= std::min(y + ry, int(ny) - 1); ++yy) {
+        const size_t q = size_t(zz) * ny + size_t(yy);
+        if (!flat[q] || bits[q] != bits[r]) return;
+      }
+    u.skip[r] = 1;
+    u.value[r] = std::bit_cast<float>(bits[r]);
+  }, 64);
+  return u;
+}
+
+// ... of a grid, from its samples.
+template <int D>
+std::optional<UniformRows> uniformRows(const Grid<float, D>& g, const std::array<int, D>& reach) {
+  const size_t nx = size_t(g.dims()[0]), rows = g.size() / nx;
+  std::vector<uint8_t> flat(rows);
+  std::vector<uint32_t> bits(rows);
+  parallelFor(rows, [&](size_t r) {
+    const float* p = g.data() + r * nx;
+    const uint32_t b = std::bit_cast<uint32_t>(p[0]);
+    bool same = std::isfinite(p[0]);
+    for (size_t x = 1; x < nx; ++x) same &= std::bit_cast<uint32_t>(p[x]) == b;
+    flat[r] = same;
+    bits[r] = b;
+  }, rowGrain<D>(g.dims()));
+  return uniformRows<D>(g.dims(), flat, bits, reach);
+}
+
+// ... of what a pass wrote from `before`: its skipped rows are flat (value
+// + 0); the others are taken as not flat (skipping less is still exact).
+template <int D>
+std::optional<UniformRows> uniformRows(const IVec<D>& dims, const UniformRows& before, const std::array<int, D>& reach) {
+  std::vector<uint32_t> bits(before.value.size());
+  for (size_t r = 0; r < bits.size(); ++r) bits[r] = std::bit_cast<uint32_t>(before.value[r] + 0.0f);
+  return uniformRows<D>(dims, before.skip, bits, reach);
+}
+
 // One semi-Lagrangian pass; optionally records the min/max of each stencil.
 // Works in cell units: p = k + offset, foot = p - (dt/h) u(p - (dt/2h) u(p)).
 template <int D>
-void semiLagrangian(const Grid<float, D>& src, const Layout<D>& layout, const MacVelocity<D>& u,
+size_t semiLagrangian(const Grid<float, D>& src, const Layout<D>& layout, const MacVelocity<D>& u,
                     double dt, Grid<float, D>* dst, Grid<float, D>* lo, Grid<float, D>* hi,
-                    StartVelocity<D> start = {}) {
+                    StartVelocity<D> start = {}, const UniformRows* uniform = nullptr) {
   const LinearSampler<D> field(src, layout);
   const MacSampler<D> vel(u);
   const float c = float(dt / u.h());
@@ -339,13 +403,22 @@ void semiLagrangian(const Grid<float, D>& src, const Layout<D>& layout, const Ma
   const bool simd = allClamped<D>(field, vel);
   [[maybe_unused]] const bool wide = useAvx2();
   parallelForRows<D>(dims, [&](size_t row) {
+    const size_t base = row * size_t(dims[0]);
+    if (uniform && uniform->skip[row]) {
+      const float c = uniform->value[row];
+      std::fill_n(dst->data() + base, dims[0], c + 0.0f);
+      if (lo && uniform->bounds) {
+        std::fill_n(lo->data() + base, dims[0], c);
+        std::fill_n(hi->data() + base, dims[0], c);
+      }
+      return;
+    }
     float p[D], m[D], f[D], v[D];
     size_t rest = row;
     for (int a = 1; a < D; ++a) {
       p[a] = float(int(rest % size_t(dims[a]))) + field.axis[a].offset;
       rest /= size_t(dims[a]);
     }
-    const size_t base = row * size_t(dims[0]);
     int x = 0;
     if (simd) {
       const RowVelocity<D> rv(vel, p, field.axis[0].offset, dims[0]);
@@ -374,16 +447,25 @@ void semiLagrangian(const Grid<float, D>& src, const Layout<D>& layout, const Ma
         (*dst)[i] = field(f);
     }
   });
+  size_t rows = src.size() / size_t(dims[0]);
+  if (uniform) rows -= size_t(std::count(uniform->skip.begin(), uniform->skip.end(), uint8_t(1)));
+  return rows;
 }
 
 }  // namespace
 
 template <int D>
-void advectField(const Grid<float, D>& src, const Layout<D>& layout, const MacVelocity<D>& u,
-                 double dt, AdvectionScheme scheme, Grid<float, D>* dst, AdvectionScratch<D>* scratch) {
+size_t advectField(const Grid<float, D>& src, const Layout<D>& layout, const MacVelocity<D>& u,
+                 double dt, AdvectionScheme scheme, Grid<float, D>* dst, AdvectionScratch<D>* scratch,
+                 const std::array<int, D>* reach) {
+  // The rows of g a pass from g writes without tracing.
+  std::optional<UniformRows> map;
+  auto uniform = [&](const Grid<float, D>& g) -> const UniformRows* {
+    if (reach) map = uniformRows<D>(g, *reach);
+    return map ? &*map : nullptr;
+  };
   if (scheme == AdvectionScheme::SemiLagrangian) {
-    semiLagrangian<D>(src, layout, u, dt, dst, nullptr, nullptr);
-    return;
+    return semiLagrangian<D>(src, layout, u, dt, dst, nullptr, nullptr, {}, uniform(src));
   }
   AdvectionScratch<D> local;
   typename AdvectionScratch<D>::Set& s = (scratch ? *scratch : local).forShape(src.dims());
@@ -391,27 +473,76 @@ void advectField(const Grid<float, D>& src, const Layout<D>& layout, const MacVe
   if (scheme == AdvectionScheme::MacCormack) {
     // phi^ = A(phi); phi~ = A^-1(phi^); phi = phi^ + (phi - phi~) / 2, limited.
     Grid<float, D>& fwd = *dst;
-    semiLagrangian<D>(src, layout, u, dt, &fwd, &lo, &hi);
-    semiLagrangian<D>(fwd, layout, u, -dt, &back, nullptr, nullptr);
-    parallelFor(src.size(), [&](size_t i) {
-      float v = fwd[i] + 0.5f * (src[i] - back[i]);
-      // Revert to first order where the correction leaves the stencil's range.
-      if (v >= lo[i] && v <= hi[i]) fwd[i] = v;
-    }, 4096);
-    return;
+    std::optional<UniformRows> first = reach ? uniformRows<D>(src, *reach) : std::nullopt, second;
+    if (first) first->bounds = false;  // lo = hi = the row's value there
+    size_t traced = semiLagrangian<D>(src, layout, u, dt, &fwd, &lo, &hi, {}, first ? &*first : nullptr);
+    if (first) second = uniformRows<D>(src.dims(), *first, *reach);
+    traced += semiLagrangian<D>(fwd, layout, u, -dt, &back, nullptr, nullptr, {}, second ? &*second : nullptr);
+    const size_t nx = size_t(src.dims()[0]);
+    parallelForRows<D>(src.dims(), [&](size_t row) {
+      const bool flat = first && first->skip[row];
+      // Both passes skipped: phi^ = phi~ = phi + 0, so phi^ stands.
+      if (flat && second && second->skip[row]) return;
+      const float c = flat ? first->value[row] : 0.0f;
+      for (size_t i = row * nx; i < (row + 1) * nx; ++i) {
+        float v = fwd[i] + 0.5f * (src[i] - back[i]);
+        // Revert to first order where the correction leaves the stencil's range.
+        if (v >= (flat ? c : lo[i]) && v <= (flat ? c : hi[i])) fwd[i] = v;
+      }
+    });
+    return traced;
   }
   // BFECC: phi_bar = phi + (phi - A^-1 A phi) / 2, then A(phi_bar), limited.
   Grid<float, D>& fwd = s.fwd;
   fwd.reshape(src.dims());
-  semiLagrangian<D>(src, layout, u, dt, &fwd, nullptr, nullptr);
-  semiLagrangian<D>(fwd, layout, u, -dt, &back, nullptr, nullptr);
+  size_t traced = semiLagrangian<D>(src, layout, u, dt, &fwd, nullptr, nullptr, {}, uniform(src));
+  traced += semiLagrangian<D>(fwd, layout, u, -dt, &back, nullptr, nullptr, {}, uniform(fwd));
   Grid<float, D>& corrected = fwd;  // fwd is no longer needed
   parallelFor(src.size(), [&](size_t i) { corrected[i] = src[i] + 0.5f * (src[i] - back[i]); }, 4096);
-  semiLagrangian<D>(corrected, layout, u, dt, dst, nullptr, nullptr);
-  semiLagrangian<D>(src, layout, u, dt, &back, &lo, &hi);  // first-order fallback
+  traced += semiLagrangian<D>(corrected, layout, u, dt, dst, nullptr, nullptr, {}, uniform(corrected));
+  traced += semiLagrangian<D>(src, layout, u, dt, &back, &lo, &hi, {}, uniform(src));  // first-order fallback
   parallelFor(src.size(), [&](size_t i) {
     if ((*dst)[i] < lo[i] || (*dst)[i] > hi[i]) (*dst)[i] = back[i];
   }, 4096);
+  return traced;
+}
+
+namespace {
+
+// max |v|, or infinity where some v is not finite (any order gives the same).
+double maxMagnitude(const std::vector<float>& v) {
+  constexpr size_t kChunk = 1 << 14;
+  std::vector<float> part((v.size() + kChunk - 1) / kChunk);
+  parallelFor(part.size(), [&](size_t k) {
+    float m = 0.0f;
+    bool finite = true;
+    for (size_t i = k * kChunk; i < std::min(v.size(), (k + 1) * kChunk); ++i) {
+      const float a = std::fabs(v[i]);
+      finite &= a <= FLT_MAX;
+      m = a > m ? a : m;
+    }
+    part[k] = finite ? m : HUGE_VALF;
+  });
+  float m = 0.0f;
+  for (float p : part) m = std::max(m, p);
+  return m;
+}
+
+}  // namespace
+
+template <int D>
+std::optional<std::array<int, D>> traceReach(const MacVelocity<D>& u, double dt) {
+  std::array<int, D> reach;
+  for (int a = 0; a < D; ++a) {
+    if (u.periodic()[size_t(a)]) return std::nullopt;
+    const double m = maxMagnitude(u[a].values());
+    // |foot - p| <= |dt| / h max|u_a| (the traces interpolate u); the
+    // stencil adds a row, and one more covers the positions' rounding.
+    const double cells = std::abs(dt) / u.h() * m;
+    if (!(cells < 1e6)) return std::nullopt;
+    reach[size_t(a)] = int(std::ceil(cells)) + 2;
+  }
+  return reach;
 }
 
 template <int D>
@@ -420,10 +551,12 @@ void advectVelocity(const MacVelocity<D>& u, double dt, AdvectionScheme scheme, 
   for (int a = 0; a < D; ++a) advectField<D>(u[a], u.layout(a), u, dt, scheme, &(*dst)[a], scratch);
 }
 
-template void advectField<2>(const Grid<float, 2>&, const Layout<2>&, const MacVelocity<2>&, double,
-                             AdvectionScheme, Grid<float, 2>*, AdvectionScratch<2>*);
-template void advectField<3>(const Grid<float, 3>&, const Layout<3>&, const MacVelocity<3>&, double,
-                             AdvectionScheme, Grid<float, 3>*, AdvectionScratch<3>*);
+template size_t advectField<2>(const Grid<float, 2>&, const Layout<2>&, const MacVelocity<2>&, double,
+                             AdvectionScheme, Grid<float, 2>*, AdvectionScratch<2>*, const std::array<int, 2>*);
+template size_t advectField<3>(const Grid<float, 3>&, const Layout<3>&, const MacVelocity<3>&, double,
+                             AdvectionScheme, Grid<float, 3>*, AdvectionScratch<3>*, const std::array<int, 3>*);
+template std::optional<std::array<int, 2>> traceReach<2>(const MacVelocity<2>&, double);
+template std::optional<std::array<int, 3>> traceReach<3>(const MacVelocity<3>&, double);
 template void advectVelocity<2>(const MacVelocity<2>&, double, AdvectionScheme, MacVelocity<2>*, AdvectionScratch<2>*);
 template void advectVelocity<3>(const MacVelocity<3>&, double, AdvectionScheme, MacVelocity<3>*, AdvectionScratch<3>*);
 

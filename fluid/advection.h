@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <optional>
 #include <vector>
 
 #include "core/mac_velocity.h"
@@ -45,12 +46,24 @@ struct AdvectionScratch {
   }
 };
 
-// dst(x) = src(x - dt u(x)): every sample of `src` (laid out by `layout`) is
-// traced back through `u`. src and dst must not alias.
+// How many rows along each axis a trace through u over +-dt can move a
+// sample and its interpolation stencil, at most (from the largest |u_a| on
+// the faces); nullopt where u is not finite or an axis is periodic.
 template <int D>
-void advectField(const Grid<float, D>& src, const Layout<D>& layout, const MacVelocity<D>& u,
+std::optional<std::array<int, D>> traceReach(const MacVelocity<D>& u, double dt);
+
+// dst(x) = src(x - dt u(x)): every sample of `src` (laid out by `layout`) is
+// traced back through `u`. src and dst must not alias. With `reach`
+// (traceReach of the same u and dt; a field on u's cells or faces), a row
+// of samples whose every trace ends among samples bitwise equal to its own
+// (a row of empty space: no smoke, the ambient temperature) is written
+// without tracing, as the value the interpolation of equal samples gives:
+// the result is bitwise the same, at a cost that follows the rows that
+// hold something. Returns the rows its passes traced.
+template <int D>
+size_t advectField(const Grid<float, D>& src, const Layout<D>& layout, const MacVelocity<D>& u,
                  double dt, AdvectionScheme scheme, Grid<float, D>* dst,
-                 AdvectionScratch<D>* scratch = nullptr);
+                 AdvectionScratch<D>* scratch = nullptr, const std::array<int, D>* reach = nullptr);
 
 // Advects every component of a MAC velocity through itself.
 template <int D>

@@ -85,9 +85,14 @@ void FluidSolver<D>::step(double dt, const std::function<void()>& afterAdvection
   advectionScratch_.borrow(&pool_, settings_.advection);
   advectVelocity<D>(u_, dt, settings_.advection, &scratch_, &advectionScratch_);
   // An all-zero dye (no dye in the scene yet) advects to zero: skip the work.
-  if (!dye_.empty() && std::any_of(dye_.values().begin(), dye_.values().end(), [](float v) { return v != 0.0f; }))
-    advectScalar(&dye_, dt);
-  if (!temperature_.empty()) advectScalar(&temperature_, dt);
+  const bool dyed =
+      !dye_.empty() && std::any_of(dye_.values().begin(), dye_.values().end(), [](float v) { return v != 0.0f; });
+  if (dyed || !temperature_.empty()) {
+    // The scalars skip the rows of empty space (fluid/advection.h).
+    const std::optional<std::array<int, D>> reach = traceReach<D>(u_, dt);
+    if (dyed) advectScalar(&dye_, dt, reach);
+    if (!temperature_.empty()) advectScalar(&temperature_, dt, reach);
+  }
   advectionScratch_.giveBack(&pool_);
   std::swap(u_, scratch_);  // scratch_ keeps the velocity advected through (advectedVelocity())
   constraints_.apply(&u_);
@@ -108,12 +113,14 @@ void FluidSolver<D>::step(double dt, const std::function<void()>& afterAdvection
 }
 
 // A cell-centred scalar carried through u_ (before the swap) with the
-// fluid's advection scheme, through a work grid lent only for it.
+// fluid's advection scheme, through a work grid lent only for it; with
+// reach, rows of empty space are written without tracing.
 template <int D>
-void FluidSolver<D>::advectScalar(Grid<float, D>* field, double dt) {
+void FluidSolver<D>::advectScalar(Grid<float, D>* field, double dt, const std::optional<std::array<int, D>>& reach) {
   pool_.lend(&dyeScratch_.values());
   dyeScratch_.reshape(cells_);
-  advectField<D>(*field, cellLayout(), u_, dt, settings_.advection, &dyeScratch_, &advectionScratch_);
+  advectField<D>(*field, cellLayout(), u_, dt, settings_.advection, &dyeScratch_, &advectionScratch_,
+                 reach ? &*reach : nullptr);
   std::swap(*field, dyeScratch_);
   pool_.give(&dyeScratch_.values());
 }

@@ -84,7 +84,7 @@ class FluidSolver {
 
  private:
   void injectInflowDye();
-  void advectScalar(Grid<float, D>* field, double dt);
+  void advectScalar(Grid<float, D>* field, double dt, const std::optional<std::array<int, D>>& reach);
   Grid<float, D>& materialisedDye() const {
     if (dye_.empty()) dye_ = Grid<float, D>(cells_, 0.0f);
     return dye_;
