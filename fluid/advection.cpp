@@ -347,20 +347,29 @@ std::optional<UniformRows> uniformRows(const IVec<D>& dims, const std::vector<ui
                                        const std::vector<uint32_t>& bits, const std::array<int, D>& reach) {
   if (std::find(flat.begin(), flat.end(), uint8_t(1)) == flat.end()) return std::nullopt;
   const size_t rows = flat.size(), ny = size_t(dims[1]);
-  UniformRows u{std::vector<uint8_t>(rows, 0), std::vector<float>(rows)};
-  const int ry = reach[1], rz = D == 3 ? reach[D - 1] : 0;
+  // Separably: rows whose window along y is flat and equal to them, then
+  // rows whose window along z holds such rows only (the same condition as
+  // the whole window's, at 2 (ry + rz) + 2 looks a row).
   const int nz = D == 3 ? dims[D - 1] : 1;
-  parallelFor(rows, [&](size_t r) {
-    if (!flat[r]) return;
-    const int y = int(r % ny), z = int(r / ny);
-    for (int zz = std::max(z - rz, 0); zz <= std::min(z + rz, nz - 1); ++zz)
-      for (int yy = std::max(y - ry, 0); yy <= std::min(y + ry, int(ny) - 1); ++yy) {
-        const size_t q = size_t(zz) * ny + size_t(yy);
-        if (!flat[q] || bits[q] != bits[r]) return;
+  auto along = [&](const std::vector<uint8_t>& in, int reachRows, bool alongZ) {
+    std::vector<uint8_t> out(rows, 0);
+    parallelFor(rows, [&](size_t r) {
+      if (!in[r]) return;
+      const int k = alongZ ? int(r / ny) : int(r % ny), n = alongZ ? nz : int(ny);
+      const size_t step = alongZ ? ny : 1;
+      for (int j = std::max(k - reachRows, 0); j <= std::min(k + reachRows, n - 1); ++j) {
+        const size_t q = r + (ptrdiff_t(j) - k) * ptrdiff_t(step);
+        if (!in[q] || bits[q] != bits[r]) return;
       }
-    u.skip[r] = 1;
-    u.value[r] = std::bit_cast<float>(bits[r]);
-  }, 64);
+      out[r] = 1;
+    }, 256);
+    return out;
+  };
+  std::vector<uint8_t> skip = along(flat, reach[1], false);
+  if (D == 3) skip = along(skip, reach[D - 1], true);
+  UniformRows u{std::move(skip), std::vector<float>(rows)};
+  for (size_t r = 0; r < rows; ++r)
+    if (u.skip[r]) u.value[r] = std::bit_cast<float>(bits[r]);
   return u;
 }
 
