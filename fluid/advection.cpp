@@ -5,7 +5,6 @@
 #include <cstdint>
 #include <optional>
 #include <cmath>
-#include <cfloat>
 #include <cstring>
 
 #include "core/linear_sampler.h"
@@ -516,35 +515,15 @@ size_t advectField(const Grid<float, D>& src, const Layout<D>& layout, const Mac
   return traced;
 }
 
-namespace {
-
-// max |v|, or infinity where some v is not finite (any order gives the same).
-double maxMagnitude(const std::vector<float>& v) {
-  constexpr size_t kChunk = 1 << 14;
-  std::vector<float> part((v.size() + kChunk - 1) / kChunk);
-  parallelFor(part.size(), [&](size_t k) {
-    float m = 0.0f;
-    bool finite = true;
-    for (size_t i = k * kChunk; i < std::min(v.size(), (k + 1) * kChunk); ++i) {
-      const float a = std::fabs(v[i]);
-      finite &= a <= FLT_MAX;
-      m = a > m ? a : m;
-    }
-    part[k] = finite ? m : HUGE_VALF;
-  });
-  float m = 0.0f;
-  for (float p : part) m = std::max(m, p);
-  return m;
-}
-
-}  // namespace
-
 template <int D>
 std::optional<std::array<int, D>> traceReach(const MacVelocity<D>& u, double dt) {
   std::array<int, D> reach;
   for (int a = 0; a < D; ++a) {
     if (u.periodic()[size_t(a)]) return std::nullopt;
-    const double m = maxMagnitude(u[a].values());
+    const Grid<float, D>& g = u[a];
+    const double m = deterministicMax(g.size(), [&](size_t i) {  // infinite where u is not finite
+      return std::isfinite(g[i]) ? std::abs(double(g[i])) : HUGE_VAL;
+    });
     // |foot - p| <= |dt| / h max|u_a| (the traces interpolate u); the
     // stencil adds a row, and one more covers the positions' rounding.
     const double cells = std::abs(dt) / u.h() * m;

@@ -10,7 +10,6 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
-#include <type_traits>
 
 #include "core/parallel.h"
 #include "core/simd_dispatch.h"
@@ -145,9 +144,6 @@ MF_INLINE void forceCell(const ForceRow<D>& r, int x, int xl, int xh, double den
   for (int a = 0; a < D; ++a) r.f[a][x] = f[a];
 }
 
-template <auto Fn>
-using Kernel = std::integral_constant<decltype(Fn), Fn>;
-
 // A pass's row: its cells x = 0 and n - 1 through the general neighbours,
 // those between through the interior loop (vectorised; AVX2 when the CPU
 // has it).
@@ -240,13 +236,13 @@ void cellForces(const SmokeSettings& s, const std::array<double, 3>& up, bool bu
     }
     for (int a = 0; a < 3; ++a) r.up[a] = up[size_t(a)];
     r.alpha = s.weight, r.beta = s.heat, r.ambient = s.ambient, r.sc = s.vorticity * h;
-    auto run = [&](auto cell) { RowPass<ForceRow<D>, decltype(cell)::value>::run(r, n[0], u.periodic()[0], h, wide); };
+    const bool per = u.periodic()[0];
     if (buoyant && confine)
-      run(Kernel<forceCell<D, true, true>>{});
+      RowPass<ForceRow<D>, forceCell<D, true, true>>::run(r, n[0], per, h, wide);
     else if (buoyant)
-      run(Kernel<forceCell<D, true, false>>{});
+      RowPass<ForceRow<D>, forceCell<D, true, false>>::run(r, n[0], per, h, wide);
     else
-      run(Kernel<forceCell<D, false, true>>{});
+      RowPass<ForceRow<D>, forceCell<D, false, true>>::run(r, n[0], per, h, wide);
   });
 }
 
