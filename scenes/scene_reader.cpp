@@ -77,7 +77,8 @@ void applyOverride(toml::table& root, const std::string& kv, std::map<std::strin
   }
   toml::table* t = cur->as_table();
   if (!t) throw UserError({origin, 1, 1}, key, "the parent of '" + parts.back() + "' is not a table");
-  parsed.get("v")->visit([&](auto&& n) { t->insert_or_assign(parts.back(), n); });
+  // Moved, not copied: a copy drops the nodes' source positions.
+  parsed.get("v")->visit([&](auto&& n) { t->insert_or_assign(parts.back(), std::move(n)); });
   (*locs)[key] = {origin, 1, int(eq) + 2};
 }
 

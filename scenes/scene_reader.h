@@ -30,11 +30,22 @@ class Reader {
   Reader(std::string file, toml::table& root, std::map<std::string, SourceLocation> overrideLocs)
       : file_(std::move(file)), root_(root), overrideLocs_(std::move(overrideLocs)) {}
 
+  // Where key's node n came from: the file, or the --set that gave it or
+  // a table or array around it (at n's column within the value).
   SourceLocation where(const toml::node* n, const std::string& key) const {
-    auto it = overrideLocs_.find(key);
-    if (it != overrideLocs_.end()) return it->second;
+    for (std::string k = key;; k.resize(k.rfind('.'))) {
+      if (auto it = overrideLocs_.find(k); it != overrideLocs_.end()) return withinOverride(it->second, n);
+      if (k.find('.') == std::string::npos) break;
+    }
     if (!n) return {file_, 0, 0};
     return {file_, int(n->source().begin.line), int(n->source().begin.column)};
+  }
+  // applyOverride parses "v = VALUE" and records VALUE's first column.
+  static SourceLocation withinOverride(SourceLocation at, const toml::node* n) {
+    constexpr int kValueColumn = 5;
+    if (n && n->source().path && *n->source().path == at.file && n->source().begin.line == 1)
+      at.column += int(n->source().begin.column) - kValueColumn;
+    return at;
   }
   [[noreturn]] void fail(const toml::node* n, const std::string& key, const std::string& msg,
                          const std::string& hint = {}) const {

@@ -230,6 +230,26 @@ TEST(Cli, MissingFileAndBadOverrideExitTwo) {
   fs::remove_all(dir);
 }
 
+// An error inside a --set value (an element of an array or a table given
+// whole, an expression) points at the column of that element in the value.
+TEST(Cli, AnOverrideErrorPointsAtTheElementWithinTheValue) {
+  auto dir = tempDir("override_column");
+  const std::string scene = writeScene(dir, "s.toml", kSmall).string();
+  struct Case {
+    std::string set, bad, key;
+  };
+  for (const Case& c : {Case{"obstacles=[{shape=\"circle\", center=[0.5, \"q\"], radius=0.1}]", "\"q\"", "obstacles.0.center"},
+                        Case{"obstacles=[{shape=\"circle\", center=[0.5, 0.5], radius=-1}]", "-1", "obstacles.0.radius"},
+                        Case{"fluid.viscosity=-1", "-1", "fluid.viscosity"},
+                        Case{"output.vdb_density=\"speed * nope\"", "nope", "output.vdb_density"}}) {
+    const CommandResult r = runMorphoflow("run " + scene + " --quiet --out " + (dir / "o").string() + " --set '" + c.set + "'");
+    EXPECT_EQ(r.status, 2) << r.output;
+    const std::string at = "--set " + c.set + ":1:" + std::to_string(c.set.find(c.bad) + 1) + ": error: '" + c.key + "'";
+    EXPECT_NE(r.output.find(at), std::string::npos) << "expected " << at << "\n" << r.output;
+  }
+  fs::remove_all(dir);
+}
+
 TEST(Cli, OverridesReachTheSimulationAndRunJsonIsComplete) {
   auto dir = tempDir("run");
   fs::path p = writeScene(dir, "s.toml", kSmall);
