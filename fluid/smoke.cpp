@@ -5,6 +5,9 @@
 #include <algorithm>
 #include <cmath>
 
+#include <fmt/format.h>
+
+#include "core/error.h"
 #include "core/expression.h"
 #include "core/parallel.h"
 
@@ -14,7 +17,13 @@ template <int D>
 Grid<float, D> sourceCover(const SmokeSource& src, double t, const IVec<D>& cells, double h, const Grid<uint8_t, D>& solid) {
   constexpr int kSub = 4;  // samples per cell and axis
   ObstacleSpec region = src.region;
-  for (size_t a = 0; a < src.motion.size(); ++a) region.center[a] = Expression(src.motion[a], {"t"}).evaluate(&t);
+  for (size_t a = 0; a < src.motion.size(); ++a) {
+    region.center[a] = Expression(src.motion[a], {"t"}).evaluate(&t);
+    if (!std::isfinite(region.center[a]))
+      throw NonFiniteError(fmt::format("a source's motion \"{}\" gives the centre {} at t = {:g}", src.motion[a],
+                                       std::isnan(region.center[a]) ? "NaN" : fmt::format("{:g}", region.center[a]), t),
+                           "give sources.N.motion expressions finite over the source's window (start to end)");
+  }
   double size[3] = {0, 0, 0};
   for (int a = 0; a < D; ++a) size[a] = cells[a] * h;
   // The cells an analytic region can reach (images and sdfs: all of them).
@@ -24,8 +33,10 @@ Grid<float, D> sourceCover(const SmokeSource& src, double t, const IVec<D>& cell
     for (int a = 0; a < D; ++a) {
       const double reach = round ? region.radius : region.halfSize[size_t(a)];
       if (region.shape == ObstacleShape::Circle && a == 2) continue;  // a cylinder along z
-      lo[a] = std::clamp(int(std::floor((region.center[size_t(a)] - reach) / h)) - 1, 0, cells[a] - 1);
-      hi[a] = std::clamp(int(std::floor((region.center[size_t(a)] + reach) / h)) + 1, 0, cells[a] - 1);
+      // Clamped as doubles: a centre far outside is no int.
+      auto cell = [&](double x) { return int(std::clamp(std::floor(x / h), -1.0, double(cells[a]))); };
+      lo[a] = std::clamp(cell(region.center[size_t(a)] - reach) - 1, 0, cells[a] - 1);
+      hi[a] = std::clamp(cell(region.center[size_t(a)] + reach) + 1, 0, cells[a] - 1);
     }
   Grid<float, D> c(cells, 0.0f);
   int total = 1;
@@ -49,7 +60,9 @@ template <int D>
 std::vector<Grid<float, D>> sourceCoverage(const std::vector<SmokeSource>& sources, const IVec<D>& cells, double h,
                                            const Grid<uint8_t, D>& solid) {
   std::vector<Grid<float, D>> cover;
-  for (const SmokeSource& src : sources) cover.push_back(sourceCover<D>(src, 0.0, cells, h, solid));
+  // A moving source's cover is computed each step it emits (emitSmoke).
+  for (const SmokeSource& src : sources)
+    cover.push_back(src.motion.empty() ? sourceCover<D>(src, 0.0, cells, h, solid) : Grid<float, D>(cells, 0.0f));
   return cover;
 }
 

@@ -26,7 +26,7 @@ namespace morphoflow {
 // t: the emission integrates to rate x time x the region's volume.
 template <int D>
 Grid<float, D> sourceCover(const SmokeSource& source, double t, const IVec<D>& cells, double h, const Grid<uint8_t, D>& solid);
-// Every source's cover at t = 0 (what a fixed source keeps).
+// Every fixed source's cover (a moving one's: zeros, computed each step it emits).
 template <int D>
 std::vector<Grid<float, D>> sourceCoverage(const std::vector<SmokeSource>& sources, const IVec<D>& cells, double h,
                                            const Grid<uint8_t, D>& solid);

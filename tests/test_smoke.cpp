@@ -9,6 +9,7 @@
 #include <cstring>
 #include <memory>
 
+#include "core/error.h"
 #include "core/simd_dispatch.h"
 #include "fluid/fluid_solver.h"
 #include "fluid/smoke.h"
@@ -219,6 +220,34 @@ TEST(Smoke, AMovingSourceLaysItsSmokeAlongItsPath) {
     m += f.dye()[i];
   }
   EXPECT_NEAR(mx / m, 0.3 + 0.4 * 0.5, 0.005);
+}
+
+// A motion that takes the source far away lays nothing and stays defined;
+// one that is not finite while the source emits stops the run, naming it.
+TEST(Smoke, AMotionFarAwayEmitsNothingAndANonFiniteOneStopsTheRun) {
+  FluidSettings s = closedBox({32, 32});
+  SmokeSource src = ball(2, 0.08);
+  src.density = 2.0;
+  src.motion = {"0.5", "0.5 + 1e30 * (t - 0.01)"};  // out of the box (and past any int) after the first step
+  s.smoke.sources = {src};
+  FluidSolver<2> away(s);
+  away.step(0.02);
+  const double once = total<2>(away.dye(), away.h());
+  EXPECT_NEAR(once, 2.0 * 0.02 * M_PI * 0.08 * 0.08, 0.02 * once) << "the first step's mid-point is inside";
+  for (int i = 0; i < 5; ++i) away.step(0.02);
+  EXPECT_EQ(total<2>(away.dye(), away.h()), once);
+  for (const char* bad : {"1 / (t - 0.05)", "sqrt(t - 0.1)"}) {  // inf at t = 0.05 (mid-step), NaN before t = 0.1
+    src.motion = {"0.5", bad};
+    s.smoke.sources = {src};
+    FluidSolver<2> f(s);
+    try {
+      for (int i = 0; i < 3; ++i) f.step(0.1);
+      ADD_FAILURE() << bad << ": no error";
+    } catch (const NonFiniteError& e) {
+      EXPECT_NE(std::string(e.what()).find(bad), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("t = 0.05"), std::string::npos) << e.what();
+    }
+  }
 }
 
 namespace {
