@@ -1,7 +1,8 @@
 // [[obstacles]]: circles, spheres, boxes and image or signed-distance shapes.
-#include "scenes/scene_reader.h"
+#include <fmt/format.h>
 
 #include "render/image_io.h"
+#include "scenes/scene_reader.h"
 
 namespace morphoflow {
 
@@ -28,7 +29,7 @@ ObstacleSpec parseRegion(SceneContext& c, const toml::table* o, const std::strin
   centre = r.numbers(o, p, "center", centre, size_t(D), size_t(D), -1e9, 1e9, false, &cn);
   for (int a = 0; a < D; ++a) {
     if (centre[size_t(a)] < 0 || centre[size_t(a)] > size[size_t(a)])
-      r.fail(cn, p + "center", "the centre lies outside the domain", "domain.size is " + std::to_string(size[size_t(a)]) + " along axis " + std::to_string(a));
+      r.fail(cn, p + "center", "the centre lies outside the domain", fmt::format("domain.size is {:g} along axis {}", size[size_t(a)], a));
     spec.center[size_t(a)] = centre[size_t(a)];
   }
   if (spec.shape == ObstacleShape::Circle || spec.shape == ObstacleShape::Sphere) {

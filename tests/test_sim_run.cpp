@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "core/expression.h"
 #include "core/host_copy.h"
 #include "core/sampling.h"
 #include "gpu/gl_context.h"
@@ -69,6 +70,20 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> kEveryKind =
 };
 
 }  // namespace
+
+// A number where an expression may stand (a given velocity's component, a
+// source's motion) keeps every digit.
+TEST(SceneLoad, ANumberGivenForAnExpressionKeepsEveryDigit) {
+  const std::string base = "[grid]\nresolution = [16, 16]\n[time]\ndt = 0.01\nsteps = 2\n";
+  const Scene given = parseScene(base + "[rd]\nmodel = \"gray-scott\"\n[velocity]\nfield = [0.123456789, 1e-7]\n", "v.toml");
+  const Scene smoke = parseScene(base + "[fluid]\nviscosity = 0.0\n[[sources]]\nshape = \"circle\"\ncenter = [0.5, 0.5]\n"
+                                        "radius = 0.1\ndensity = 1.0\nmotion = [0.123456789, 0.5]\n", "s.toml");
+  const double at[4] = {0.3, 0.7, 0.0, 0.0};
+  ASSERT_EQ(given.velocity.field.size(), 2u);
+  EXPECT_EQ(Expression(given.velocity.field[0], {"x", "y", "z", "t"}).evaluate(at), 0.123456789);
+  EXPECT_EQ(Expression(given.velocity.field[1], {"x", "y", "z", "t"}).evaluate(at), 1e-7);
+  EXPECT_EQ(Expression(smoke.fluid.smoke.sources.at(0).motion.at(0), {"t"}).evaluate(at), 0.123456789);
+}
 
 TEST(SimulationFactory, BackendNamesAreTheCommandLinesAndOthersAreRefused) {
   EXPECT_EQ(backendNamed("tbb"), Backend::TBB);
