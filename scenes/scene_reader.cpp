@@ -2,6 +2,8 @@
 
 #include <sstream>
 
+#include <fmt/format.h>
+
 #include "scenes/scene_loader.h"
 
 namespace morphoflow {
@@ -37,7 +39,7 @@ std::string describe(const toml::node& n) {
   }
 }
 
-// Reads typed values out of the TOML tree, remembering which keys each table
+std::string numberText(double v) { return fmt::format("{}", v); }
 
 // Applies one --set key.path=value override; value is TOML.
 void applyOverride(toml::table& root, const std::string& kv, std::map<std::string, SourceLocation>* locs) {

@@ -24,6 +24,9 @@ std::string join(const std::vector<std::string>& v, const std::string& sep = ", 
 std::string nearest(const std::string& word, const std::vector<std::string>& choices);
 // "a string", "an integer", ...: what a node holds, for messages.
 std::string describe(const toml::node& n);
+// A number given where an expression may stand, as an expression's text:
+// the shortest that reads back as the same double.
+std::string numberText(double v);
 
 class Reader {
  public:
@@ -156,7 +159,7 @@ class Reader {
     f.where = where(n, full);
     f.key = full;
     if (n->is_string() || n->is_number()) {
-      f.field.expression = n->is_string() ? n->value<std::string>().value() : std::to_string(n->value<double>().value());
+      f.field.expression = n->is_string() ? n->value<std::string>().value() : numberText(n->value<double>().value());
       try {
         compileSpatialField(f.field.expression);
       } catch (const ExpressionError& e) {

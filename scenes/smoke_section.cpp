@@ -24,7 +24,7 @@ std::vector<std::string> parseMotion(SceneContext& c, const toml::table* t, cons
     const toml::node* e = arr->get(q);
     const std::string key = p + "motion." + std::to_string(q);
     if (!e->is_string() && !e->is_number()) r.fail(e, key, "expected an expression string, found " + describe(*e));
-    const std::string text = e->is_string() ? e->value<std::string>().value() : fmt::format("{}", e->value<double>().value());
+    const std::string text = e->is_string() ? e->value<std::string>().value() : numberText(e->value<double>().value());
     try {
       Expression(text, {"t"});
     } catch (const ExpressionError& err) {

@@ -3,8 +3,6 @@
 // whose frames are found and whose first frame is read and checked here.
 #include <array>
 
-#include <fmt/format.h>
-
 #include "coupling/given_velocity.h"
 #include "scenes/scene_reader.h"
 
@@ -71,7 +69,7 @@ void parseVelocity(SceneContext& c, Scene* sp) {
       const toml::node* e = arr->get(q);
       const std::string key = p + "field." + std::to_string(q);
       if (!e->is_string() && !e->is_number()) r.fail(e, key, "expected an expression string, found " + describe(*e));
-      const std::string text = e->is_string() ? e->value<std::string>().value() : fmt::format("{}", e->value<double>().value());  // exact
+      const std::string text = e->is_string() ? e->value<std::string>().value() : numberText(e->value<double>().value());
       try {
         Expression(text, ExpressionVelocity<3>::variables());
       } catch (const ExpressionError& err) {

@@ -75,7 +75,8 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> kEveryKind =
 // source's motion) keeps every digit.
 TEST(SceneLoad, ANumberGivenForAnExpressionKeepsEveryDigit) {
   const std::string base = "[grid]\nresolution = [16, 16]\n[time]\ndt = 0.01\nsteps = 2\n";
-  const Scene given = parseScene(base + "[rd]\nmodel = \"gray-scott\"\n[velocity]\nfield = [0.123456789, 1e-7]\n", "v.toml");
+  const Scene given = parseScene(base + "[rd]\nmodel = \"gray-scott\"\n[rd.maps]\nF = 0.0123456789\n"
+                                        "[velocity]\nfield = [0.123456789, 1e-7]\n", "v.toml");
   const Scene smoke = parseScene(base + "[fluid]\nviscosity = 0.0\n[[sources]]\nshape = \"circle\"\ncenter = [0.5, 0.5]\n"
                                         "radius = 0.1\ndensity = 1.0\nmotion = [0.123456789, 0.5]\n", "s.toml");
   const double at[4] = {0.3, 0.7, 0.0, 0.0};
@@ -83,6 +84,8 @@ TEST(SceneLoad, ANumberGivenForAnExpressionKeepsEveryDigit) {
   EXPECT_EQ(Expression(given.velocity.field[0], {"x", "y", "z", "t"}).evaluate(at), 0.123456789);
   EXPECT_EQ(Expression(given.velocity.field[1], {"x", "y", "z", "t"}).evaluate(at), 1e-7);
   EXPECT_EQ(Expression(smoke.fluid.smoke.sources.at(0).motion.at(0), {"t"}).evaluate(at), 0.123456789);
+  ASSERT_EQ(given.rd.parameterMaps.size(), 1u);
+  EXPECT_EQ(Expression(given.rd.parameterMaps[0].second.field.expression, {"x", "y", "z", "t"}).evaluate(at), 0.0123456789);
 }
 
 TEST(SimulationFactory, BackendNamesAreTheCommandLinesAndOthersAreRefused) {
