@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -114,7 +115,8 @@ std::vector<Grid<float, D>> VdbSink<D>::densityField(const Simulation<D>& sim) c
       }
     }
     const double d = e.evaluate(values.data());
-    out[i] = std::isfinite(d) ? float(d) : 0.0f;  // (a division by a zero field: no density there)
+    // Not finite (a division by a zero field) or past a float: no density there.
+    out[i] = std::abs(d) <= double(std::numeric_limits<float>::max()) ? float(d) : 0.0f;
   });
   return {out};
 }

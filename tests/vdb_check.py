@@ -216,5 +216,13 @@ dens, v = dense(by["density"], (48, 80, 48)), dense(by["v"], (48, 80, 48))
 check(np.all(dens[v == 0] == 0) and dens.max() > 0 and dens.min() >= 0, "smoke pattern: the density is smoke times v")
 check(counts["u"] < 0.5 * 48 * 80 * 48, f"smoke pattern: the species are sparse ({counts['u']})")
 
+# A density expression past a float is 0 there (as a non-finite one is), never inf.
+do = run("smoke_overflow", "vfx/plume_3d.toml", ["grid.resolution=[12,20,12]", "time.duration=0.3", "output.every=30",
+                                               "output.images=false", 'output.vdb_density="dye * 1e300"'])
+last = sorted(x for x in os.listdir(os.path.join(do, "vdb")) if x.endswith(".vdb"))[-1]
+d = vdb.read(os.path.join(do, "vdb", last), "density")
+vals = np.array([v.value for v in d.citerOnValues()], dtype=np.float64)
+check(vals.size > 0 and np.all(vals == 0), f"smoke overflow: a density past a float is 0 ({vals.size} active, {np.unique(vals)[:4]})")
+
 print(f"vdb_check: {'FAILED' if failures else 'ok'} ({len(failures)} failures)")
 sys.exit(1 if failures else 0)
