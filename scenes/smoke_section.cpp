@@ -85,19 +85,9 @@ void parseSmoke(SceneContext& c, Scene* s) {
   m.vorticity = r.number(t, "smoke.", "vorticity", 0.0, 0.0, 1e6);
   m.dissipation = r.number(t, "smoke.", "dissipation", 0.0, 0.0, 1e9);
   m.cooling = r.number(t, "smoke.", "cooling", 0.0, 0.0, 1e9);
-  if (!sources) return;
-  // The run ends by its duration, or by steps x dt at the latest (a CFL limit shortens steps).
-  const double runEnd = s->time.duration > 0 ? s->time.duration : double(s->time.steps) * s->time.dt;
-  for (size_t i = 0; i < sources->size(); ++i) {
-    const std::string p = "sources." + std::to_string(i) + ".";
-    const toml::table* st = sources->get(i)->as_table();
-    m.sources.push_back(parseSource(c, st, p));
-    if (m.sources.back().start >= runEnd)
-      r.fail(r.node(st, p, "start"), p + "start",
-             fmt::format("the source starts emitting at t = {:g}, when the run has ended (t = {:g}): it would emit nothing",
-                         m.sources.back().start, runEnd),
-             "give start before the run's end, or a longer time.duration");
-  }
+  if (sources)
+    for (size_t i = 0; i < sources->size(); ++i)
+      m.sources.push_back(parseSource(c, sources->get(i)->as_table(), "sources." + std::to_string(i) + "."));
 }
 
 }  // namespace morphoflow
