@@ -55,6 +55,7 @@ class Driver {
     else removeEarlierRun(out_, safeFileStem(scene_.name));
     sinks_ = makeOutputSinks<D>(out_, scene_, [] { return StopSignals::received() != 0; });
     if (checkpoint_) restoreSinks();
+    warnOfIdleSources();
     try {
       return loop();
     } catch (const NonFiniteError& e) {
@@ -68,6 +69,18 @@ class Driver {
   }
 
  private:
+  // A source whose window opens when this run has ended (a short preview
+  // of a longer shot) emits nothing here: said, not refused.
+  void warnOfIdleSources() {
+    const double end = scene_.time.duration > 0 ? scene_.time.duration : double(scene_.time.steps) * scene_.time.dt;
+    const std::vector<SmokeSource>& sources = scene_.fluid.smoke.sources;
+    for (size_t q = 0; q < sources.size(); ++q)
+      if (sources[q].start >= end)
+        log_.warn(fmt::format("warning: sources.{} starts emitting at t = {:g}, when this run has ended (t = {:g}): "
+                              "it emits nothing here",
+                              q, sources[q].start, end));
+  }
+
   int loop() {
     const long stepsEstimate = scene_.hasFluid ? scene_.totalSteps() : runTime(scene_).steps;
     const double endTime = scene_.time.steps > 0 ? 0.0 : scene_.time.duration;

@@ -112,6 +112,23 @@ TEST(SmokeScenes, BadSourcesAndSmokeWithoutAFluidAreLocatedErrors) {
   fs::remove_all(dir);
 }
 
+// A source that opens after a short run has ended (a preview of a longer
+// shot) runs, and the run says that it emitted nothing.
+TEST(SmokeScenes, ASourceThatOpensAfterTheRunIsAWarning) {
+  const fs::path dir = tempDir("smoke_late");
+  std::string source = kSource;
+  source.replace(source.find("radius = 0.08"), 13, "radius = 0.08\nstart = 0.5");
+  const fs::path scene = write(dir / "late.toml", std::string(kPlume) + source);
+  CommandResult r = runMorphoflow("run " + scene.string() + " --quiet --out " + (dir / "o").string());
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("warning: sources.0 starts emitting at t = 0.5, when this run has ended (t = 0.06)"),
+            std::string::npos) << r.output;
+  r = runMorphoflow("run " + scene.string() + " --set sources.0.start=0.05 --quiet --out " + (dir / "o").string());
+  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(r.output.find("warning"), std::string::npos) << r.output;
+  fs::remove_all(dir);
+}
+
 // The GPU runs smoke and the pattern on it (their parity:
 // GpuFluid.SmokeMatchesTheCpu, Gpu.PatternedPlumesMatchTheCpu).
 TEST(SmokeScenes, TheGpuBackendRunsSmokeAndThePatternOnIt) {
