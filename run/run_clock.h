@@ -34,6 +34,9 @@ class RunClock {
 
   // The steps still to run from step `step` on (by the step count alone).
   long stepsLeft(long step) const { return steps_ - step; }
+  // When the run ends at the latest: its duration, or its steps of time.dt
+  // (a CFL limit shortens them).
+  double latestEnd() const { return time_.steps > 0 ? double(time_.steps) * time_.dt : endTime_; }
   // Whether every step takes time.dt (a step count, no CFL limit).
   bool fixedDt() const { return time_.steps > 0 && time_.cfl <= 0; }
 

@@ -72,7 +72,7 @@ class Driver {
   // A source whose window opens when this run has ended (a short preview
   // of a longer shot) emits nothing here: said, not refused.
   void warnOfIdleSources() {
-    const double end = scene_.time.duration > 0 ? scene_.time.duration : double(scene_.time.steps) * scene_.time.dt;
+    const double end = clock_.latestEnd();
     const std::vector<SmokeSource>& sources = scene_.fluid.smoke.sources;
     for (size_t q = 0; q < sources.size(); ++q)
       if (sources[q].start >= end)
