@@ -17,6 +17,10 @@
 #define MORPHOFLOW_AVX2_KERNELS 0
 #endif
 
+// A helper of a wide kernel, always inlined into it, so that inside a
+// target("avx2") kernel it compiles for AVX2 too.
+#define MF_INLINE __attribute__((always_inline)) inline
+
 namespace morphoflow {
 
 // Eight float lanes (GCC vector extensions, as core/simd4.h's four): one

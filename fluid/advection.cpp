@@ -23,7 +23,6 @@ namespace {
 // periodic domains take the scalar path. The arithmetic is the scalar
 // path's, operation for operation, so every path gives bitwise the same
 // fields.
-#define MF_INLINE __attribute__((always_inline)) inline
 // vf8 by value is a different psABI with and without AVX; these helpers are
 // internal and always inlined, so no call ever passes one.
 #pragma GCC diagnostic ignored "-Wpsabi"

@@ -19,8 +19,6 @@ namespace morphoflow {
 
 namespace {
 
-#define MF_INLINE __attribute__((always_inline)) inline
-
 // The neighbours of coordinate k along an axis of n cells: wrapped on a
 // periodic axis, k itself past a wall (one-sided differences there); den is
 // the distance a central difference divides by, span h (1 where the span is

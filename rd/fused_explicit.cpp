@@ -19,8 +19,6 @@ namespace morphoflow {
 
 namespace {
 
-#define MF_INLINE __attribute__((always_inline)) inline
-
 typedef float vf4x __attribute__((vector_size(16)));
 typedef float vf8x __attribute__((vector_size(32)));
 typedef float vf16x __attribute__((vector_size(64)));  // one AVX-512 register (used in avx512 targets only)
