@@ -12,21 +12,17 @@
 namespace morphoflow {
 
 namespace {
-GpuGate* entered = nullptr;
 constexpr size_t kStateBytes = 8 * sizeof(uint32_t) + 2 * sizeof(double);
 }  // namespace
 
 GpuGate::GpuGate() : state_(kStateBytes) { resetTally(); }
 
-GpuGate* GpuGate::current() { return entered; }
-
-void GpuGate::enter() { entered = this; }
-void GpuGate::leave() { entered = nullptr; }
+void GpuGate::enter() { routeDispatches(this); }
+void GpuGate::leave() { routeDispatches(nullptr); }
 
 void GpuGate::run(const char* mode, const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations,
                   const Finals& finals) {
-  GpuGate* was = entered;
-  entered = nullptr;  // the gate's own kernel is not gated
+  DispatchRoute* was = routeDispatches(nullptr);  // the gate's own kernel is not gated
   const ComputeProgram& p = useKernel("gate.comp", std::string("#define ") + mode);
   setTestUniforms(slots, tolerance, maxIterations);
   glUniform2i(p.uniform("finals"), finals.slots[0], finals.slots[1]);
@@ -39,7 +35,7 @@ void GpuGate::run(const char* mode, const GpuBuffer& scalars, Slots slots, doubl
   glDispatchCompute(1, 1, 1);
   countDispatch();
   glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_COMMAND_BARRIER_BIT);
-  entered = was;
+  routeDispatches(was);
 }
 
 void GpuGate::setTestUniforms(Slots slots, double tolerance, int maxIterations) const {

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "gpu/gpu_buffer.h"
+#include "gpu/gpu_kernels.h"
 
 namespace morphoflow {
 
@@ -33,7 +34,7 @@ struct GateFinals {
   unsigned groups = 0;
 };
 
-class GpuGate {
+class GpuGate final : public DispatchRoute {
  public:
   // The scalar slots of the solve's reduction buffer the kernel reads.
   struct Slots {
@@ -65,10 +66,8 @@ class GpuGate {
   // Dispatches between enter() and leave() are gated.
   void enter();
   void leave();
-  // The gate entered now, or null.
-  static GpuGate* current();
-  // A gated dispatch of gx x gy groups (gpu_kernels.cpp routes dispatches here).
-  void dispatch(unsigned gx, unsigned gy);
+  // A gated dispatch of gx x gy groups (dispatchGroups' route while entered).
+  void dispatch(unsigned gx, unsigned gy) override;
   // Whether the solve is still going (one host wait).
   bool going() const;
   Tally read() const;  // one host wait

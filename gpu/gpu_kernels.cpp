@@ -2,13 +2,13 @@
 
 #include <map>
 #include <memory>
+#include <utility>
 
 #include <epoxy/gl.h>
 
 #include "gpu/compute_program.h"
 #include "gpu/gl_context.h"
 #include "gpu/gpu_counts.h"
-#include "gpu/gpu_gate.h"
 #include "gpu/shader_source.h"
 
 namespace morphoflow {
@@ -46,7 +46,10 @@ const ComputeProgram& useKernel(const std::string& shader, const std::string& de
 
 namespace {
 double traffic = 0.0;
-}
+DispatchRoute* route = nullptr;
+}  // namespace
+
+DispatchRoute* routeDispatches(DispatchRoute* to) { return std::exchange(route, to); }
 
 void countGpuTraffic(double bytes) { traffic += bytes; }
 double gpuTrafficBytes() { return traffic; }
@@ -61,7 +64,7 @@ void dispatchFlat(size_t samples, double bytes) {
 }
 
 void dispatchGroups(unsigned gx, unsigned gy) {
-  if (GpuGate* gate = GpuGate::current()) return gate->dispatch(gx, gy);
+  if (route) return route->dispatch(gx, gy);
   glDispatchCompute(gx, gy, 1);
   countDispatch();
 }

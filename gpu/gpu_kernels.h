@@ -17,8 +17,19 @@ const ComputeProgram& useKernel(const std::string& shader, const std::string& de
 // must read or write `bytes` of the buffers at least once (the traffic model
 // the benchmarks divide by time: a lower bound of the memory traffic).
 void dispatchFlat(size_t samples, double bytes);
-// Dispatches gx x gy groups of the current kernel: indirect, through the
-// solve's gate, while one is entered (gpu_gate.h).
+// Where dispatches go while it is set: a solve's gate (gpu_gate.h) makes
+// every dispatch indirect.
+class DispatchRoute {
+ public:
+  virtual void dispatch(unsigned gx, unsigned gy) = 0;
+
+ protected:
+  ~DispatchRoute() = default;
+};
+// Sets the route dispatchGroups takes (null: glDispatchCompute); returns the
+// one set before.
+DispatchRoute* routeDispatches(DispatchRoute* route);
+// Dispatches gx x gy groups of the current kernel, through the route if one is set.
 void dispatchGroups(unsigned gx, unsigned gy);
 // Counts dispatched traffic (dispatchFlat's, and kernels that call it directly).
 void countGpuTraffic(double bytes);
