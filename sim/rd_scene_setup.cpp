@@ -57,28 +57,30 @@ void initialState(const Scene& scene, RDSolver<D>* rd) {
   }
 }
 
-// The scene's parameter maps, perturbations and fixed regions, sampled on rd's grid.
+// Parameter maps, then a Gaussian perturbation by a percentage on top (seed 004 sec. 3.1).
 template <int D>
-void applyScene(const Scene& scene, RDSolver<D>* rd) {
-  const IVec<D> n = rd->cells();
-  const uint64_t seed = scene.seed;
-  // Parameter maps, then a Gaussian perturbation by a percentage on top (seed 004 sec. 3.1).
+void applyParameterFields(const Scene& scene, RDSolver<D>* rd) {
   const size_t cells = rd->field(0).size();
   std::vector<std::vector<double>> params(rd->model().info().parameters.size());
-  for (const auto& [k, f] : scene.rd.parameterMaps) params[size_t(k)] = sampleSpatialField<D>(f.field, n);
+  for (const auto& [k, f] : scene.rd.parameterMaps) params[size_t(k)] = sampleSpatialField<D>(f.field, rd->cells());
   for (auto [k, percent] : scene.rd.perturb) {
     std::vector<double>& f = params[size_t(k)];
     if (f.empty()) f.assign(cells, rd->parameter(k));
-    for (size_t i = 0; i < cells; ++i) f[i] *= 1.0 + 0.01 * percent * gaussian(seed, 200 + uint64_t(k), i);
+    for (size_t i = 0; i < cells; ++i) f[i] *= 1.0 + 0.01 * percent * gaussian(scene.seed, 200 + uint64_t(k), i);
   }
   for (size_t k = 0; k < params.size(); ++k)
     if (!params[k].empty()) rd->setParameterField(int(k), std::move(params[k]));
-  // Brush strokes, their direction extended to every cell (Kim & Lin sec. 6).
-  // Each stroke must cover a cell; the direction is painted only where it steers something.
-  const bool periodic = rd->settings().boundary == RDBoundary::Periodic;
+}
+
+// Brush strokes, their direction extended to every cell (Kim & Lin sec. 6).
+// Each stroke must cover a cell; the direction is painted only where it
+// steers something (empty otherwise).
+template <int D>
+PaintedStrokes<D> paintSceneStrokes(const Scene& scene, const RDSolver<D>& rd) {
+  const bool periodic = rd.settings().boundary == RDBoundary::Periodic;
   for (const RDStroke& s : scene.rd.strokes) {
     try {
-      strokeCoverage<D>(s.stroke, n, rd->settings().size, periodic);
+      strokeCoverage<D>(s.stroke, rd.cells(), rd.settings().size, periodic);
     } catch (const std::invalid_argument&) {
       throw UserError(s.where, s.key, "the stroke covers no cell of the grid",
                       s.stroke.isImage() ? "an image stroke covers the cells brighter than its range's middle: this image has none"
@@ -87,67 +89,70 @@ void applyScene(const Scene& scene, RDSolver<D>* rd) {
   }
   const bool steers = (scene.rd.anisotropy.enabled && scene.rd.anisotropy.thetaFromStrokes) ||
                       (scene.rd.lobes.enabled && scene.rd.lobes.theta0FromStrokes);
-  PaintedStrokes<D> painted;
-  if (steers) {
-    std::vector<BrushStroke> strokes;
-    for (const RDStroke& s : scene.rd.strokes) strokes.push_back(s.stroke);
-    try {
-      painted = paintStrokes<D>(strokes, n, rd->settings().size, periodic);
-    } catch (const std::invalid_argument&) {  // every stroke an image without edges
-      const RDStroke& first = scene.rd.strokes.front();
-      throw UserError(first.where, first.key, "the strokes give no direction: an image stroke's direction comes from its edges, "
-                                              "and these images are uniform where they cover",
-                      "add a polyline stroke, use an image with edges, or give the direction another way");
+  if (!steers) return {};
+  std::vector<BrushStroke> strokes;
+  for (const RDStroke& s : scene.rd.strokes) strokes.push_back(s.stroke);
+  try {
+    return paintStrokes<D>(strokes, rd.cells(), rd.settings().size, periodic);
+  } catch (const std::invalid_argument&) {  // every stroke an image without edges
+    const RDStroke& first = scene.rd.strokes.front();
+    throw UserError(first.where, first.key, "the strokes give no direction: an image stroke's direction comes from its edges, "
+                                            "and these images are uniform where they cover",
+                    "add a polyline stroke, use an image with edges, or give the direction another way");
+  }
+}
+
+// Inhomogeneous anisotropic diffusion (seed 004 eq. 11-19).
+template <int D>
+void applyAnisotropy(const RDAnisotropy& an, const PaintedStrokes<D>& painted, RDSolver<D>* rd) {
+  const IVec<D> n = rd->cells();
+  const size_t cells = rd->field(0).size();
+  DiffusionTensorSpec<D> spec;
+  spec.lambda1 = sampleSpatialField<D>(an.lambda1.field, n);
+  spec.lambda2 = sampleSpatialField<D>(an.lambda2.field, n);
+  if (an.directionFromVelocity) {  // isotropic until the run sets a = u / |u| (GivenFlowSimulation)
+    for (int a = 0; a < D; ++a) spec.direction[size_t(a)].assign(cells, 0.0);
+  } else if (an.direction.empty()) {  // a = (cos theta, sin theta, 0)   (eq. 12)
+    std::vector<double> theta = an.thetaFromStrokes ? painted.angle : sampleSpatialField<D>(an.theta.field, n);
+    if (an.thetaFromStrokes)
+      for (double& t : theta) t += an.strokeAngle;
+    for (int a = 0; a < D; ++a) spec.direction[size_t(a)].assign(cells, 0.0);
+    for (size_t i = 0; i < cells; ++i) {
+      spec.direction[0][i] = std::cos(theta[i]);
+      spec.direction[1][i] = std::sin(theta[i]);
     }
+  } else {
+    for (int a = 0; a < D; ++a) spec.direction[size_t(a)] = sampleSpatialField<D>(an.direction[size_t(a)].field, n);
   }
-  // Inhomogeneous anisotropic diffusion (seed 004 eq. 11-19).
-  if (const RDAnisotropy& an = scene.rd.anisotropy; an.enabled) {
-    DiffusionTensorSpec<D> spec;
-    spec.lambda1 = sampleSpatialField<D>(an.lambda1.field, n);
-    spec.lambda2 = sampleSpatialField<D>(an.lambda2.field, n);
-    if (an.directionFromVelocity) {  // isotropic until the run sets a = u / |u| (GivenFlowSimulation)
-      for (int a = 0; a < D; ++a) spec.direction[size_t(a)].assign(cells, 0.0);
-    } else if (an.direction.empty()) {  // a = (cos theta, sin theta, 0)   (eq. 12)
-      std::vector<double> theta = an.thetaFromStrokes ? painted.angle : sampleSpatialField<D>(an.theta.field, n);
-      if (an.thetaFromStrokes)
-        for (double& t : theta) t += an.strokeAngle;
-      for (int a = 0; a < D; ++a) spec.direction[size_t(a)].assign(cells, 0.0);
-      for (size_t i = 0; i < cells; ++i) {
-        spec.direction[0][i] = std::cos(theta[i]);
-        spec.direction[1][i] = std::sin(theta[i]);
-      }
-    } else {
-      for (int a = 0; a < D; ++a) spec.direction[size_t(a)] = sampleSpatialField<D>(an.direction[size_t(a)].field, n);
-    }
-    spec.species = an.species;
-    spec.shape = an.shape;
-    spec.shapeSpecies = an.shapeSpecies;
-    rd->setDiffusionTensor(std::move(spec));
+  spec.species = an.species;
+  spec.shape = an.shape;
+  spec.shapeSpecies = an.shapeSpecies;
+  rd->setDiffusionTensor(std::move(spec));
+}
+
+// Kim & Lin's cosine lobes (seed 001 eq. 14-17).
+template <int D>
+void applyCosineLobes(const RDCosineLobes& lb, const PaintedStrokes<D>& painted, RDSolver<D>* rd) {
+  CosineLobeSpec spec;
+  spec.speeds = lb.speeds;
+  spec.witkinKass = lb.witkinKass;
+  if (lb.theta0FromStrokes) {  // lobe 1 (centred at phi = theta + theta0 = 0) along the stroke, turned by strokeAngle
+    spec.theta0.resize(rd->field(0).size());
+    for (size_t i = 0; i < spec.theta0.size(); ++i) spec.theta0[i] = -(painted.angle[i] + lb.strokeAngle);
+  } else {
+    spec.theta0 = sampleSpatialField<D>(lb.theta0.field, rd->cells());
   }
-  // Kim & Lin's cosine lobes (seed 001 eq. 14-17).
-  if (const RDCosineLobes& lb = scene.rd.lobes; lb.enabled) {
-    CosineLobeSpec spec;
-    spec.speeds = lb.speeds;
-    spec.witkinKass = lb.witkinKass;
-    if (lb.theta0FromStrokes) {  // lobe 1 (centred at phi = theta + theta0 = 0) along the stroke, turned by strokeAngle
-      spec.theta0.resize(cells);
-      for (size_t i = 0; i < cells; ++i) spec.theta0[i] = -(painted.angle[i] + lb.strokeAngle);
-    } else {
-      spec.theta0 = sampleSpatialField<D>(lb.theta0.field, n);
-    }
-    spec.species = lb.species;
-    rd->setCosineLobes(std::move(spec));
-  }
-  // McGraw's generalized diffusion (seed 000), one 5 x 5 operator on this grid.
-  if (const RDGeneralized& g = scene.rd.generalized; g.enabled) {
-    if constexpr (D == 2)
-      rd->setGeneralizedDiffusion(
-          std::make_shared<const GeneralizedDiffusion>(g.tensors, n[0], n[1], rd->h(),
-                                                       g.savitzkyGolaySecond ? SecondDerivatives::SavitzkyGolay
-                                                                             : SecondDerivatives::CentralDifferences),
-          g.species);
-  }
-  // Fixed regions and the chemical strokes deposit: held at their values from the start (seed 004 fig. 20, seed 001 fig. 3).
+  spec.species = lb.species;
+  rd->setCosineLobes(std::move(spec));
+}
+
+// Fixed regions and the chemical strokes' deposit: held at their values from
+// the start (seed 004 fig. 20, seed 001 fig. 3).
+template <int D>
+void applyFixedCells(const Scene& scene, RDSolver<D>* rd) {
+  if (scene.rd.fixed.empty() && !scene.rd.strokesDeposit()) return;
+  const IVec<D> n = rd->cells();
+  const size_t cells = rd->field(0).size();
   const size_t ns = size_t(rd->species());
   std::vector<std::vector<uint8_t>> mask(ns);
   std::vector<std::vector<double>> values(ns);
@@ -167,13 +172,32 @@ void applyScene(const Scene& scene, RDSolver<D>* rd) {
     const std::vector<double> inside = sampleSpatialField<D>(fr.where.field, n);
     hold(fr.species, fr.values, [&](size_t i) { return inside[i] != 0.0; });
   }
+  const bool periodic = rd->settings().boundary == RDBoundary::Periodic;
   for (const RDStroke& s : scene.rd.strokes) {
     if (s.species.empty()) continue;
     const std::vector<uint8_t> under = strokeCoverage<D>(s.stroke, n, rd->settings().size, periodic);
     hold(s.species, s.values, [&](size_t i) { return under[i] != 0; });
   }
-  if (!scene.rd.fixed.empty() || scene.rd.strokesDeposit())
-    rd->setFixedCells(std::move(mask), std::move(values));
+  rd->setFixedCells(std::move(mask), std::move(values));
+}
+
+// The scene's parameter maps, perturbations, anisotropy and fixed regions, sampled on rd's grid.
+template <int D>
+void applyScene(const Scene& scene, RDSolver<D>* rd) {
+  applyParameterFields(scene, rd);
+  const PaintedStrokes<D> painted = paintSceneStrokes(scene, *rd);
+  if (scene.rd.anisotropy.enabled) applyAnisotropy(scene.rd.anisotropy, painted, rd);
+  if (scene.rd.lobes.enabled) applyCosineLobes(scene.rd.lobes, painted, rd);
+  // McGraw's generalized diffusion (seed 000), one 5 x 5 operator on this grid.
+  if (const RDGeneralized& g = scene.rd.generalized; g.enabled) {
+    if constexpr (D == 2)
+      rd->setGeneralizedDiffusion(
+          std::make_shared<const GeneralizedDiffusion>(g.tensors, rd->cells()[0], rd->cells()[1], rd->h(),
+                                                       g.savitzkyGolaySecond ? SecondDerivatives::SavitzkyGolay
+                                                                             : SecondDerivatives::CentralDifferences),
+          g.species);
+  }
+  applyFixedCells(scene, rd);
 }
 
 std::string rdStage(const RDSettings& s) {
