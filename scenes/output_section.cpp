@@ -11,6 +11,30 @@ namespace morphoflow {
 
 namespace {
 
+// output.vdb_density: a field's name, or an expression of fields (e.g. "dye *
+// v / 0.3": the smoke with the pattern cut into it), compiled here so that an
+// error names its column.
+std::string parseVdbDensity(Reader& r, const toml::table* out, const std::string& byDefault,
+                            const std::vector<std::string>& fields) {
+  std::string density = r.string(out, "output.", "vdb_density", byDefault);
+  const bool name = !density.empty() && std::all_of(density.begin(), density.end(), [](char ch) {
+    return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
+  });
+  if (name)  // a single name must be a field's (the nearest is suggested)
+    return r.string(out, "output.", "vdb_density", byDefault, fields);
+  const toml::node* dn = r.node(out, "output.", "vdb_density");
+  try {
+    if (Expression(density, fields).constant())
+      r.fail(dn, "output.vdb_density", "a constant density fills the box", "name a field, or an expression of fields");
+  } catch (const ExpressionError& e) {
+    SourceLocation at = r.where(dn, "output.vdb_density");
+    if (at.line > 0) at.column += 1 + int(e.column());
+    throw UserError(at, "output.vdb_density", std::string("neither a field nor an expression of fields: ") + e.what(),
+                    "the fields are " + join(fields));
+  }
+  return density;
+}
+
 // output.vdb and its options: every named field must be one the scene has.
 void parseVdbOutput(SceneContext& c, const toml::table* out, Scene& s) {
   Reader& r = c.r;
@@ -24,27 +48,7 @@ void parseVdbOutput(SceneContext& c, const toml::table* out, Scene& s) {
   if (smoke) fluidScalars.push_back("temperature");
   std::vector<std::string> fields = species;
   if (s.hasFluid) fields.insert(fields.end(), fluidScalars.begin(), fluidScalars.end());
-  // A field's name, or an expression of fields (e.g. "dye * v / 0.3": the
-  // smoke with the pattern cut into it), compiled here so that an error
-  // names its column.
-  o.vdbDensity = r.string(out, "output.", "vdb_density", smoke ? "dye" : o.field);
-  const bool name = !o.vdbDensity.empty() && std::all_of(o.vdbDensity.begin(), o.vdbDensity.end(), [](char ch) {
-    return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_';
-  });
-  if (name) {  // a single name must be a field's (the nearest is suggested)
-    o.vdbDensity = r.string(out, "output.", "vdb_density", smoke ? "dye" : o.field, fields);
-  } else {
-    const toml::node* dn = r.node(out, "output.", "vdb_density");
-    try {
-      if (Expression(o.vdbDensity, fields).constant())
-        r.fail(dn, "output.vdb_density", "a constant density fills the box", "name a field, or an expression of fields");
-    } catch (const ExpressionError& e) {
-      SourceLocation at = r.where(dn, "output.vdb_density");
-      if (at.line > 0) at.column += 1 + int(e.column());
-      throw UserError(at, "output.vdb_density", std::string("neither a field nor an expression of fields: ") + e.what(),
-                      "the fields are " + join(fields));
-    }
-  }
+  o.vdbDensity = parseVdbDensity(r, out, smoke ? "dye" : o.field, fields);
   if (const toml::node* vf = r.node(out, "output.", "vdb_fields")) {
     const toml::array* arr = vf->as_array();
     if (!arr) r.fail(vf, "output.vdb_fields", "expected an array of field names, e.g. [\"speed\", \"vorticity\"]");
@@ -79,14 +83,64 @@ void parseVdbOutput(SceneContext& c, const toml::table* out, Scene& s) {
         r.fail(n, std::string("output.") + k, "only applies with output.vdb = true", "add output.vdb = true or drop it");
 }
 
+// The frames' palette: output.colormap or output.gradient, and output.range.
+void parsePalette(const SceneContext& c, const toml::table* out, OutputSettings& o) {
+  Reader& r = c.r;
+  o.colormap = r.string(out, "output.", "colormap", o.field == "vorticity" ? "coolwarm" : "viridis", colormapNames());
+  if (o.colormap == kTwoSpeciesPalette && c.species.size() < 2)
+    r.fail(r.node(out, "output.", "colormap"), "output.colormap",
+           std::string(kTwoSpeciesPalette) + " shows two reaction-diffusion species (the first in red, the second in green)",
+           "use it with an [rd] model of two or more species, or pick a scalar palette");
+  if (const toml::node* g = r.node(out, "output.", "gradient")) {
+    const toml::array* arr = g->as_array();
+    if (!arr || arr->size() < 2)
+      r.fail(g, "output.gradient", "expected an array of two or more colours, e.g. [\"#000000\", \"#ff8800\", \"#ffffff\"]");
+    for (const toml::node& e : *arr) {
+      Rgb8 colour;
+      auto text = e.value<std::string>();
+      if (!text || !parseHexColour(*text, &colour))
+        r.fail(&e, "output.gradient", "expected a colour as \"#rrggbb\"", "e.g. \"#ff8800\" for orange");
+      o.gradient.push_back(colour);
+    }
+  }
+  const toml::node* rangeNode = nullptr;
+  std::vector<double> range = r.numbers(out, "output.", "range", {}, 2, 2, -1e30, 1e30, false, &rangeNode);
+  if (!range.empty()) {
+    if (!(range[0] < range[1])) r.fail(rangeNode, "output.range", "expected [low, high] with low < high");
+    o.autoRange = false;
+    o.range[0] = range[0];
+    o.range[1] = range[1];
+  }
+}
+
+// How frames show the field: the 3D view, the image size, the slice, and
+// 2D normal and height maps.
+void parseView(const SceneContext& c, const toml::table* out, OutputSettings& o) {
+  Reader& r = c.r;
+  const int D = c.D;
+  // 3D frames show the whole volume by default; a 2D field is its own slice.
+  const toml::node* viewNode = r.node(out, "output.", "view");
+  o.view = r.string(out, "output.", "view", D == 3 ? "volume" : "slice", {"volume", "slice"});
+  if (D == 2 && o.view == "volume")
+    r.fail(viewNode, "output.view", "a 2D scene's frames show its field itself; \"volume\" is for 3D scenes",
+           "drop output.view, or set it to \"slice\"");
+  o.imageSize = int(r.integer(out, "output.", "image_size", 512, 16, 8192));
+  o.slice = int(r.integer(out, "output.", "slice", -1, -1, D == 3 ? long(c.res[2]) - 1 : -1));
+  // Normal and height maps of the shown field (seed 000 fig. 7).
+  const toml::node* nm = r.node(out, "output.", "normal_map");
+  o.normalMap = r.boolean(out, "output.", "normal_map", false);
+  if (o.normalMap && D == 3)
+    r.fail(nm, "output.normal_map", "normal maps are of 2D patterns read as height fields; this scene is 3D",
+           "drop output.normal_map, or run the pattern in 2D");
+  o.normalStrength = r.number(out, "output.", "normal_strength", 4.0, 0.0, 1e6, true);
+}
+
 }  // namespace
 
 void parseOutput(SceneContext& c, Scene* sp) {
   Reader& r = c.r;
   toml::table& root = c.root;
   Scene& s = *sp;
-  const int D = c.D;
-  const std::vector<double>& res = c.res;
   const std::vector<std::string>& species = c.species;
   const toml::table* out = r.table(root, "", "output");
   s.output.every = int(r.integer(out, "output.", "every", 10, 1, 1'000'000'000));
@@ -112,47 +166,8 @@ void parseOutput(SceneContext& c, Scene* sp) {
   else
     s.output.field = r.string(out, "output.", "field", smoke ? "dye" : "vorticity", fluidFields);
   parseVdbOutput(c, out, s);
-  s.output.colormap = r.string(out, "output.", "colormap", s.output.field == "vorticity" ? "coolwarm" : "viridis",
-                               colormapNames());
-  if (s.output.colormap == kTwoSpeciesPalette && species.size() < 2)
-    r.fail(r.node(out, "output.", "colormap"), "output.colormap",
-           std::string(kTwoSpeciesPalette) + " shows two reaction-diffusion species (the first in red, the second in green)",
-           "use it with an [rd] model of two or more species, or pick a scalar palette");
-  if (const toml::node* g = r.node(out, "output.", "gradient")) {
-    const toml::array* arr = g->as_array();
-    if (!arr || arr->size() < 2)
-      r.fail(g, "output.gradient", "expected an array of two or more colours, e.g. [\"#000000\", \"#ff8800\", \"#ffffff\"]");
-    for (const toml::node& e : *arr) {
-      Rgb8 c;
-      auto text = e.value<std::string>();
-      if (!text || !parseHexColour(*text, &c))
-        r.fail(&e, "output.gradient", "expected a colour as \"#rrggbb\"", "e.g. \"#ff8800\" for orange");
-      s.output.gradient.push_back(c);
-    }
-  }
-  const toml::node* rangeNode = nullptr;
-  std::vector<double> range = r.numbers(out, "output.", "range", {}, 2, 2, -1e30, 1e30, false, &rangeNode);
-  if (!range.empty()) {
-    if (!(range[0] < range[1])) r.fail(rangeNode, "output.range", "expected [low, high] with low < high");
-    s.output.autoRange = false;
-    s.output.range[0] = range[0];
-    s.output.range[1] = range[1];
-  }
-  // 3D frames show the whole volume by default; a 2D field is its own slice.
-  const toml::node* viewNode = r.node(out, "output.", "view");
-  s.output.view = r.string(out, "output.", "view", D == 3 ? "volume" : "slice", {"volume", "slice"});
-  if (D == 2 && s.output.view == "volume")
-    r.fail(viewNode, "output.view", "a 2D scene's frames show its field itself; \"volume\" is for 3D scenes",
-           "drop output.view, or set it to \"slice\"");
-  s.output.imageSize = int(r.integer(out, "output.", "image_size", 512, 16, 8192));
-  s.output.slice = int(r.integer(out, "output.", "slice", -1, -1, D == 3 ? long(res[2]) - 1 : -1));
-  // Normal and height maps of the shown field (seed 000 fig. 7).
-  const toml::node* nm = r.node(out, "output.", "normal_map");
-  s.output.normalMap = r.boolean(out, "output.", "normal_map", false);
-  if (s.output.normalMap && D == 3)
-    r.fail(nm, "output.normal_map", "normal maps are of 2D patterns read as height fields; this scene is 3D",
-           "drop output.normal_map, or run the pattern in 2D");
-  s.output.normalStrength = r.number(out, "output.", "normal_strength", 4.0, 0.0, 1e6, true);
+  parsePalette(c, out, s.output);
+  parseView(c, out, s.output);
 }
 
 }  // namespace morphoflow
