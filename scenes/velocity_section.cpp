@@ -26,6 +26,60 @@ void checkFirstFrame(const std::vector<VelocityFrame>& frames, const Scene& s) {
   seq.sample(frames.front().time, &u);
 }
 
+// velocity.field: one expression per axis in x, y, z (domain units) and t.
+void parseVelocityField(SceneContext& c, const toml::node* fn, VelocityScene& V) {
+  Reader& r = c.r;
+  const std::string p = "velocity.";
+  const std::string axes = c.D == 2 ? "two" : "three";
+  V.where = r.where(fn, p + "field");
+  V.key = p + "field";
+  const toml::array* arr = fn->as_array();
+  if (!arr || arr->size() != size_t(c.D))
+    r.fail(fn, p + "field",
+           "expected " + axes + " expressions, one per axis, in x, y" + (c.D == 3 ? ", z" : "") + " (domain units) and t" +
+               (arr ? ", found " + std::to_string(arr->size()) : ""),
+           c.D == 2 ? "e.g. field = [\"-(y - 0.5)\", \"x - 0.5\"] (a rigid rotation about the centre of a unit domain)" : "");
+  for (size_t q = 0; q < arr->size(); ++q) {
+    const toml::node* e = arr->get(q);
+    const std::string key = p + "field." + std::to_string(q);
+    if (!e->is_string() && !e->is_number()) r.fail(e, key, "expected an expression string, found " + describe(*e));
+    const std::string text = e->is_string() ? e->value<std::string>().value() : numberText(e->value<double>().value());
+    try {
+      Expression(text, ExpressionVelocity<3>::variables());
+    } catch (const ExpressionError& err) {
+      SourceLocation at = r.where(e, key);
+      if (at.line > 0 && e->is_string()) at.column += 1 + int(err.column());
+      throw UserError(at, key, std::string("in the velocity expression: ") + err.what(),
+                      "the variables are x, y, z (domain units) and t");
+    }
+    V.field.push_back(text);
+  }
+}
+
+// velocity.vdb: a sequence of volumes, each frame noted as an input and the
+// first checked against the scene's domain.
+void parseVelocityVdb(SceneContext& c, const toml::table* vt, const toml::node* vn, Scene& s) {
+  Reader& r = c.r;
+  const std::string p = "velocity.";
+  VelocityScene& V = s.velocity;
+  V.where = r.where(vn, p + "vdb");
+  V.key = p + "vdb";
+  const std::string file = r.string(vt, p, "vdb", "");
+  std::filesystem::path fp(file);
+  if (fp.is_relative()) fp = c.sceneDir / fp;
+  V.vdb = fp.string();
+  try {
+    const std::vector<VelocityFrame> frames = findVelocityFrames(V.vdb, V.frameTime);
+    for (const VelocityFrame& f : frames) r.noteInput(f.path, vn, p + "vdb");
+    if (c.D == 2) checkFirstFrame<2>(frames, s);
+    else checkFirstFrame<3>(frames, s);
+  } catch (const VelocityFileError& e) {
+    r.fail(vn, p + "vdb", e.path() + ": " + e.what(),
+           "give a sequence of .vdb files with a Vec3 grid 'vel' over the scene's domain, e.g. written by "
+           "`morphoflow run` with output.vdb = true");
+  }
+}
+
 }  // namespace
 
 void parseVelocity(SceneContext& c, Scene* sp) {
@@ -55,51 +109,9 @@ void parseVelocity(SceneContext& c, Scene* sp) {
   if (!fn && !vn && !V.python)
     r.fail(vt, p + "field",
            "[velocity] needs field = [\"u(x, y, t)\", \"v(x, y, t)\"], vdb = \"path/name.####.vdb\" or python = true");
-  const std::string axes = c.D == 2 ? "two" : "three";
-  if (fn) {
-    V.where = r.where(fn, p + "field");
-    V.key = p + "field";
-    const toml::array* arr = fn->as_array();
-    if (!arr || arr->size() != size_t(c.D))
-      r.fail(fn, p + "field",
-             "expected " + axes + " expressions, one per axis, in x, y" + (c.D == 3 ? ", z" : "") + " (domain units) and t" +
-                 (arr ? ", found " + std::to_string(arr->size()) : ""),
-             c.D == 2 ? "e.g. field = [\"-(y - 0.5)\", \"x - 0.5\"] (a rigid rotation about the centre of a unit domain)" : "");
-    for (size_t q = 0; q < arr->size(); ++q) {
-      const toml::node* e = arr->get(q);
-      const std::string key = p + "field." + std::to_string(q);
-      if (!e->is_string() && !e->is_number()) r.fail(e, key, "expected an expression string, found " + describe(*e));
-      const std::string text = e->is_string() ? e->value<std::string>().value() : numberText(e->value<double>().value());
-      try {
-        Expression(text, ExpressionVelocity<3>::variables());
-      } catch (const ExpressionError& err) {
-        SourceLocation at = r.where(e, key);
-        if (at.line > 0 && e->is_string()) at.column += 1 + int(err.column());
-        throw UserError(at, key, std::string("in the velocity expression: ") + err.what(),
-                        "the variables are x, y, z (domain units) and t");
-      }
-      V.field.push_back(text);
-    }
-  }
+  if (fn) parseVelocityField(c, fn, V);
   V.frameTime = r.number(vt, p, "frame_time", 0.0, 0.0, 1e12);
-  if (vn) {
-    V.where = r.where(vn, p + "vdb");
-    V.key = p + "vdb";
-    const std::string file = r.string(vt, p, "vdb", "");
-    std::filesystem::path fp(file);
-    if (fp.is_relative()) fp = c.sceneDir / fp;
-    V.vdb = fp.string();
-    try {
-      const std::vector<VelocityFrame> frames = findVelocityFrames(V.vdb, V.frameTime);
-      for (const VelocityFrame& f : frames) r.noteInput(f.path, vn, p + "vdb");
-      if (c.D == 2) checkFirstFrame<2>(frames, s);
-      else checkFirstFrame<3>(frames, s);
-    } catch (const VelocityFileError& e) {
-      r.fail(vn, p + "vdb", e.path() + ": " + e.what(),
-             "give a sequence of .vdb files with a Vec3 grid 'vel' over the scene's domain, e.g. written by "
-             "`morphoflow run` with output.vdb = true");
-    }
-  }
+  if (vn) parseVelocityVdb(c, vt, vn, s);
   const toml::node* rn = nullptr;
   const std::vector<double> range = r.numbers(vt, p, "speed_range", {0.0, 1.0}, 2, 2, -1e12, 1e12, false, &rn);
   V.speedRange[0] = range[0];
