@@ -1,7 +1,7 @@
 // The pattern on the smoke: a layer that reacts only where there is smoke.
 // Each backend applies the same two operations after its coupled step:
 //   blend: species x towards a source's chemicals v by its cover c of the
-//          cell, x = (1 - c) x + c v (kernels/smoke.inc coverBlend);
+//          cell, x = (1 - c) x + c v (kernels/smoke_physics.inc coverBlend);
 //   mask:  where the smoke, linearly interpolated at the layer cell's centre,
 //          is at most the threshold, the species take their rest values.
 // The mask's interpolation taps are separable (each axis' depends on the

@@ -18,7 +18,7 @@ namespace morphoflow {
 
 // The per-cell formulas, shared with the GPU (kernels/README.md).
 #define SMOKE_FN(name) inline double name
-#include "kernels/smoke.inc"
+#include "kernels/smoke_physics.inc"
 #undef SMOKE_FN
 
 // A source's covered fraction of every cell (4^D samples a cell), solid

@@ -1,5 +1,5 @@
 // The smoke stages of the fluid step (fluid/smoke.cpp; Fedkiw, Stam & Jensen
-// 2001), one MODE each, the formulas from kernels/smoke.inc. The MAC
+// 2001), one MODE each, the formulas from kernels/smoke_physics.inc. The MAC
 // velocity is one buffer, component a at velOff[a] with dims cells + e_a;
 // the cell-centred work vectors hold component c at c * n.
 // MODE_EMIT        smoke += dRho c, T += dT c (c: the source's cover of the cell)
@@ -24,7 +24,7 @@ uniform double dRho, dT, value, alpha, beta, ambient, s, h, dt, keepRho, keepT;
 uniform dvec3 up;
 
 #define SMOKE_FN(name) double name
-#include "smoke.inc"
+#include "smoke_physics.inc"
 
 ivec3 faceDims() { ivec3 d = cells; d[axis] += 1; return d; }
 

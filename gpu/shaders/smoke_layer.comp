@@ -15,7 +15,7 @@ uniform double values[N];
 uniform double threshold;
 
 #define SMOKE_FN(name) double name
-#include "smoke.inc"
+#include "smoke_physics.inc"
 
 void main() {
   const int i = flatIndex();
