@@ -1,10 +1,14 @@
 #include "render/isolated_read.h"
 
+#include <poll.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdint>
@@ -36,14 +40,37 @@ bool writeAll(int fd, const char* p, size_t n) {
   return true;
 }
 
+// The child's whole answer from `fd` within `wallSeconds`: false when the
+// time ran out first (the child may be blocked, using no processor time).
+bool readAll(int fd, double wallSeconds, std::string* got) {
+  using Clock = std::chrono::steady_clock;
+  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(wallSeconds));
+  char buf[1 << 16];
+  for (;;) {
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+    if (left <= 0) return false;
+    pollfd p{fd, POLLIN, 0};
+    const int ready = ::poll(&p, 1, int(std::min<long long>(left, 60000)));
+    if (ready < 0 && errno != EINTR) return true;  // the pipe is unusable: the answer is what came
+    if (ready <= 0) continue;
+    const ssize_t r = ::read(fd, buf, sizeof buf);
+    if (r < 0 && errno == EINTR) continue;
+    if (r <= 0) return true;
+    got->append(buf, size_t(r));
+  }
+}
+
 }  // namespace
 
-bool runIsolated(const std::function<std::string()>& work, double cpuSeconds, std::string* result, std::string* error) {
+bool runIsolated(const std::function<std::string()>& work, const ReaderLimits& limits, std::string* result,
+                 std::string* error) {
+  const double cpuSeconds = limits.cpuSeconds;
   int fds[2];
   if (::pipe(fds) != 0) {
     *error = std::string("cannot make a pipe for the reader: ") + std::strerror(errno);
     return false;
   }
+  const pid_t parent = ::getpid();
   const pid_t pid = ::fork();
   if (pid < 0) {
     ::close(fds[0]), ::close(fds[1]);
@@ -53,6 +80,10 @@ bool runIsolated(const std::function<std::string()>& work, double cpuSeconds, st
   if (pid == 0) {  // the child: the work, its length and bytes, and out without running exit handlers
     ::close(fds[0]);
     dieAlone();
+    // The reader ends with the process that waits for it (no reader left
+    // behind, blocked, when a run is killed).
+    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+    if (::getppid() != parent) ::_exit(5);
     const rlim_t cpu = rlim_t(std::ceil(cpuSeconds));
     const rlimit limit{cpu, cpu + 1};  // SIGXCPU at the soft limit, SIGKILL at the hard one
     ::setrlimit(RLIMIT_CPU, &limit);
@@ -70,16 +101,16 @@ bool runIsolated(const std::function<std::string()>& work, double cpuSeconds, st
   }
   ::close(fds[1]);
   std::string got;
-  char buf[1 << 16];
-  for (;;) {
-    const ssize_t r = ::read(fds[0], buf, sizeof buf);
-    if (r < 0 && errno == EINTR) continue;
-    if (r <= 0) break;
-    got.append(buf, size_t(r));
-  }
+  const bool answered = readAll(fds[0], limits.wallSeconds, &got);
   ::close(fds[0]);
+  if (!answered) ::kill(pid, SIGKILL);
   int status = 0;
   while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (!answered) {
+    *error = "the file's reader did not finish within " + std::to_string(long(std::ceil(limits.wallSeconds))) +
+             " s (it was waiting, not reading: a file system that does not answer, or a damaged file)";
+    return false;
   }
   uint64_t n = 0;
   if (WIFSIGNALED(status) && (WTERMSIG(status) == SIGXCPU || WTERMSIG(status) == SIGKILL)) {

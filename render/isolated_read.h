@@ -12,9 +12,20 @@
 
 namespace morphoflow {
 
+// How long the child may take: `cpuSeconds` of processor time (a damaged
+// file can send the reader round a loop for minutes) and `wallSeconds` in
+// all (a child that waits, using no processor time, is stopped too).
+struct ReaderLimits {
+  double cpuSeconds = 10.0;
+  double wallSeconds = 60.0;
+};
+// The limits for a reader that may use `cpuSeconds`: ten times as long and a
+// minute in all, for a busy machine and a slow file system.
+inline ReaderLimits readerLimits(double cpuSeconds) { return {cpuSeconds, 60.0 + 10.0 * cpuSeconds}; }
+
 // True and *result the child's bytes; false and *error what became of it.
-// The child may use `cpuSeconds` of processor time (a damaged file can also
-// send the reader round a loop for minutes).
-bool runIsolated(const std::function<std::string()>& work, double cpuSeconds, std::string* result, std::string* error);
+// The child is killed when this process ends.
+bool runIsolated(const std::function<std::string()>& work, const ReaderLimits& limits, std::string* result,
+                 std::string* error);
 
 }  // namespace morphoflow

@@ -235,7 +235,7 @@ bool readVdbTime(const std::string& path, double* time, bool* has, std::string* 
               return std::string("E") + e.what();
             }
           },
-          10.0, &answer, error))
+          readerLimits(10.0), &answer, error))
     return false;
   if (answer.empty() || answer[0] == 'E') {
     *error = answer.empty() ? std::string("the file is damaged: its reader gave no answer") : answer.substr(1);
@@ -404,7 +404,7 @@ bool readVdbVelocity(const std::string& path, VelocityVolume* out, std::string* 
             const bool ok = readVelocityHere(path, &v, &err);
             return encodeAnswer(ok, v, err);
           },
-          seconds, &answer, error))
+          readerLimits(seconds), &answer, error))
     return false;
   try {
     return decodeAnswer(answer, out, error);
