@@ -16,6 +16,7 @@
 #include <string_view>
 
 #include "core/error.h"
+#include "core/parallel.h"
 
 namespace morphoflow::fuzz {
 
@@ -67,6 +68,13 @@ void expectUserErrorsOnly(F&& f) {
     std::abort();
   }
 }
+
+// Keeps the target on one thread. A file's reader child
+// (render/isolated_read.h) forked while a TBB worker held the allocator's
+// lock of clang 14's ASan, which has no fork handler, waits for it for good
+// (stopped at its wall-clock limit, a timeout to the fuzzer); glibc's malloc
+// takes its locks across a fork, so the program itself does not.
+inline void runOnOneThread() { static const ThreadLimit one(1); }
 
 // Calls write(dir) when MORPHOFLOW_FUZZ_SEEDS names a folder, then exits.
 template <class F>

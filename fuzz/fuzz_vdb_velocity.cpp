@@ -97,6 +97,7 @@ void writeSeeds(const fs::path& dir) {
 
 extern "C" int LLVMFuzzerInitialize(int*, char***) {
   fuzz::writeSeedsIfAsked(writeSeeds);
+  fuzz::runOnOneThread();
   return 0;
 }
 
