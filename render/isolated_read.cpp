@@ -109,7 +109,7 @@ bool runIsolated(const std::function<std::string()>& work, const ReaderLimits& l
   }
   if (!answered) {
     *error = "the file's reader did not finish within " + std::to_string(long(std::ceil(limits.wallSeconds))) +
-             " s (it was waiting, not reading: a file system that does not answer, or a damaged file)";
+             " s: the file system did not answer, or the reader is stuck";
     return false;
   }
   uint64_t n = 0;
