@@ -17,6 +17,11 @@ constexpr size_t kStateBytes = 8 * sizeof(uint32_t) + 2 * sizeof(double);
 
 GpuGate::GpuGate() : state_(kStateBytes) { resetTally(); }
 
+GpuGate::~GpuGate() {
+  DispatchRoute* now = routeDispatches(nullptr);
+  if (now != this) routeDispatches(now);
+}
+
 void GpuGate::enter() { routeDispatches(this); }
 void GpuGate::leave() { routeDispatches(nullptr); }
 

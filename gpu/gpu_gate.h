@@ -50,6 +50,9 @@ class GpuGate final : public DispatchRoute {
   };
 
   GpuGate();
+  ~GpuGate();  // no longer the route, if a solve that entered it was cut short
+  GpuGate(const GpuGate&) = delete;
+  GpuGate& operator=(const GpuGate&) = delete;
   // Before the first iteration: go while ||r|| / ||b|| > tolerance (and b != 0); 0 iterations.
   void start(const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations, const Finals& finals = {});
   // After an iteration: counts it while going, and goes on while p.Ap > 0,
