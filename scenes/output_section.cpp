@@ -103,10 +103,7 @@ void parsePalette(const SceneContext& c, const toml::table* out, OutputSettings&
       o.gradient.push_back(colour);
     }
   }
-  const toml::node* rangeNode = nullptr;
-  std::vector<double> range = r.numbers(out, "output.", "range", {}, 2, 2, -1e30, 1e30, false, &rangeNode);
-  if (!range.empty()) {
-    if (!(range[0] < range[1])) r.fail(rangeNode, "output.range", "expected [low, high] with low < high");
+  if (const std::vector<double> range = interval(r, out, "output.", "range", 1e30); !range.empty()) {
     o.autoRange = false;
     o.range[0] = range[0];
     o.range[1] = range[1];

@@ -117,10 +117,7 @@ void parseInitial(const RDTable& t, RDScene& R) {
     I.noise.assign(n, r.number(it, "rd.initial.", "noise", 0.0, 0, 1e12));
   else
     I.noise = r.numbers(it, "rd.initial.", "noise", std::vector<double>(n, 0.0), n, n, 0, 1e12);
-  const toml::node* rn = nullptr;
-  std::vector<double> range = r.numbers(it, "rd.initial.", "random_range", {}, 2, 2, -1e12, 1e12, false, &rn);
-  if (!range.empty()) {
-    if (!(range[0] < range[1])) r.fail(rn, "rd.initial.random_range", "expected [low, high] with low < high");
+  if (const std::vector<double> range = interval(r, it, "rd.initial.", "random_range", 1e12); !range.empty()) {
     I.randomRange = true;
     I.range[0] = range[0];
     I.range[1] = range[1];

@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "core/expression.h"
 #include "scenes/scene_loader.h"
 
 namespace morphoflow {
@@ -96,6 +97,35 @@ std::vector<int> speciesIndices(Reader& r, const toml::node* n, const std::strin
     out.push_back(int(f - species.begin()));
   }
   return out;
+}
+
+std::vector<std::string> expressionList(Reader& r, const toml::array& arr, const std::string& prefix,
+                                        const std::vector<std::string>& vars, const std::string& what,
+                                        const std::string& help) {
+  std::vector<std::string> texts;
+  for (size_t q = 0; q < arr.size(); ++q) {
+    const toml::node* e = arr.get(q);
+    const std::string key = prefix + "." + std::to_string(q);
+    if (!e->is_string() && !e->is_number()) r.fail(e, key, "expected an expression string, found " + describe(*e));
+    const std::string text = e->is_string() ? e->value<std::string>().value() : numberText(e->value<double>().value());
+    try {
+      Expression(text, vars);
+    } catch (const ExpressionError& err) {
+      SourceLocation at = r.where(e, key);
+      if (at.line > 0 && e->is_string()) at.column += 1 + int(err.column());
+      throw UserError(at, key, "in the " + what + " expression: " + err.what(), help);
+    }
+    texts.push_back(text);
+  }
+  return texts;
+}
+
+std::vector<double> interval(Reader& r, const toml::table* t, const std::string& prefix, const std::string& key,
+                             double bound) {
+  const toml::node* n = nullptr;
+  std::vector<double> range = r.numbers(t, prefix, key, {}, 2, 2, -bound, bound, false, &n);
+  if (!range.empty() && !(range[0] < range[1])) r.fail(n, prefix + key, "expected [low, high] with low < high");
+  return range;
 }
 
 }  // namespace morphoflow

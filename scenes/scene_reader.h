@@ -211,6 +211,18 @@ class Reader {
 std::vector<int> speciesIndices(Reader& r, const toml::node* n, const std::string& key,
                                 const std::vector<std::string>& species, const std::string& model, bool allowEmpty);
 
+// The elements of `arr` as expressions in `vars` (a string, or a number as
+// its text), each compiled here so that an error names its key (prefix.N)
+// and column: "in the WHAT expression: ...", then `help`.
+std::vector<std::string> expressionList(Reader& r, const toml::array& arr, const std::string& prefix,
+                                        const std::vector<std::string>& vars, const std::string& what,
+                                        const std::string& help);
+
+// prefix+key as [low, high] with low < high, each within +-bound: empty
+// when the key is absent.
+std::vector<double> interval(Reader& r, const toml::table* t, const std::string& prefix, const std::string& key,
+                             double bound);
+
 // Applies one --set key.path=value override (the value in TOML syntax) and
 // remembers where it came from, for messages.
 void applyOverride(toml::table& root, const std::string& kv, std::map<std::string, SourceLocation>* locs);

@@ -2,7 +2,6 @@
 // heat and velocity, where and when): fluid/smoke_settings.h.
 #include <fmt/format.h>
 
-#include "core/expression.h"
 #include "scenes/scene_reader.h"
 
 namespace morphoflow {
@@ -19,22 +18,7 @@ std::vector<std::string> parseMotion(SceneContext& c, const toml::table* t, cons
   if (!arr || arr->size() != size_t(c.D))
     r.fail(n, p + "motion", fmt::format("expected {} expressions in t, the centre per axis", c.D),
            c.D == 2 ? "e.g. motion = [\"0.5 + 0.2 * sin(t)\", \"0.2\"]" : "");
-  std::vector<std::string> texts;
-  for (size_t q = 0; q < arr->size(); ++q) {
-    const toml::node* e = arr->get(q);
-    const std::string key = p + "motion." + std::to_string(q);
-    if (!e->is_string() && !e->is_number()) r.fail(e, key, "expected an expression string, found " + describe(*e));
-    const std::string text = e->is_string() ? e->value<std::string>().value() : numberText(e->value<double>().value());
-    try {
-      Expression(text, {"t"});
-    } catch (const ExpressionError& err) {
-      SourceLocation at = r.where(e, key);
-      if (at.line > 0 && e->is_string()) at.column += 1 + int(err.column());
-      throw UserError(at, key, std::string("in the motion expression: ") + err.what(), "the variable is t");
-    }
-    texts.push_back(text);
-  }
-  return texts;
+  return expressionList(r, *arr, p + "motion", {"t"}, "motion", "the variable is t");
 }
 
 SmokeSource parseSource(SceneContext& c, const toml::table* t, const std::string& p) {

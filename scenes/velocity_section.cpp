@@ -39,21 +39,8 @@ void parseVelocityField(SceneContext& c, const toml::node* fn, VelocityScene& V)
            "expected " + axes + " expressions, one per axis, in x, y" + (c.D == 3 ? ", z" : "") + " (domain units) and t" +
                (arr ? ", found " + std::to_string(arr->size()) : ""),
            c.D == 2 ? "e.g. field = [\"-(y - 0.5)\", \"x - 0.5\"] (a rigid rotation about the centre of a unit domain)" : "");
-  for (size_t q = 0; q < arr->size(); ++q) {
-    const toml::node* e = arr->get(q);
-    const std::string key = p + "field." + std::to_string(q);
-    if (!e->is_string() && !e->is_number()) r.fail(e, key, "expected an expression string, found " + describe(*e));
-    const std::string text = e->is_string() ? e->value<std::string>().value() : numberText(e->value<double>().value());
-    try {
-      Expression(text, ExpressionVelocity<3>::variables());
-    } catch (const ExpressionError& err) {
-      SourceLocation at = r.where(e, key);
-      if (at.line > 0 && e->is_string()) at.column += 1 + int(err.column());
-      throw UserError(at, key, std::string("in the velocity expression: ") + err.what(),
-                      "the variables are x, y, z (domain units) and t");
-    }
-    V.field.push_back(text);
-  }
+  V.field = expressionList(r, *arr, p + "field", ExpressionVelocity<3>::variables(), "velocity",
+                           "the variables are x, y, z (domain units) and t");
 }
 
 // velocity.vdb: a sequence of volumes, each frame noted as an input and the
