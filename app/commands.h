@@ -24,5 +24,6 @@ void addBatchCommands(CLI::App& app, Commands* commands);      // batch, sweep, 
 void addInspectCommands(CLI::App& app, Commands* commands);    // validate, info, list (inspect_commands.cpp)
 void addBenchCommand(CLI::App& app, Commands* commands);       // bench (bench_command.cpp)
 void addTextureCommands(CLI::App& app, Commands* commands);    // analyze, plot, texton (texture_commands.cpp)
+void addStudioCommand(CLI::App& app, Commands* commands);      // studio (studio_command.cpp)
 
 }  // namespace morphoflow

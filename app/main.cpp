@@ -27,6 +27,7 @@ int main(int argc, char** argv) {
   addBatchCommands(app, &commands);
   addInspectCommands(app, &commands);
   addBenchCommand(app, &commands);
+  addStudioCommand(app, &commands);
   addTextureCommands(app, &commands);
 
   try {

@@ -20,9 +20,13 @@ class UserError : public std::runtime_error {
   UserError(SourceLocation where, std::string key, std::string message, std::string hint = {})
       : std::runtime_error(format(where, key, message, hint)),
         where_(std::move(where)),
-        key_(std::move(key)) {}
+        key_(std::move(key)),
+        message_(std::move(message)),
+        hint_(std::move(hint)) {}
   const SourceLocation& where() const { return where_; }
   const std::string& key() const { return key_; }
+  const std::string& message() const { return message_; }
+  const std::string& hint() const { return hint_; }
 
  private:
   static std::string format(const SourceLocation& w, const std::string& key, const std::string& msg,
@@ -37,7 +41,7 @@ class UserError : public std::runtime_error {
     return s.str();
   }
   SourceLocation where_;
-  std::string key_;
+  std::string key_, message_, hint_;
 };
 
 // A field turned NaN, infinite or too large for a float: the run stops

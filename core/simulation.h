@@ -52,7 +52,7 @@ class Simulation {
   // Sets a field from values on its grid (field()'s shape): a species, the
   // dye (the smoke) or the temperature; throws UserError (key "set_field")
   // for a field computed from the state (speed, vorticity, ...) or one this
-  // simulation lacks.
+  // simulation lacks. A NaN leaves its cell as it is (a brush's footprint).
   virtual void setField(const std::string& name, const Grid<float, D>& values) {
     throw UserError({"set_field", 0, 0}, "", "the field '" + name + "' cannot be set",
                     "set_field takes a species, dye or temperature");

@@ -79,6 +79,7 @@ void parseObstacles(SceneContext& c, Scene* s) {
       spec.boundary = c.r.string(o, p, "boundary", "cut", {"cut", "voxel"}) == "voxel" ? ObstacleBoundary::Voxel
                                                                                     : ObstacleBoundary::Cut;
       s->fluid.obstacles.push_back(std::move(spec));
+      s->timeline.obstacles.push_back(parseWindow(c.r, o, p));
     }
 }
 

@@ -71,6 +71,7 @@ void parseStrokes(SceneContext& c, const toml::table& rdt, RDScene* out) {
       if (!bright) r.fail(img, p + "image", "the image has no stroke: no pixel is brighter than half", "strokes are light on dark");
     }
     s.stroke.width = r.number(t, p, "width", 0.0, 0.0, 1e12);
+    s.start = r.number(t, p, "start", 0.0, 0.0, 1e12);
     if (const toml::node* sp = r.node(t, p, "species")) {
       s.species = speciesIndices(r, sp, p + "species", c.species, out->settings.model, false);
     } else if (r.node(t, p, "values")) {

@@ -4,6 +4,7 @@
 
 #include <array>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,7 @@
 #include "rd/brush_strokes.h"
 #include "rd/generalized_diffusion.h"
 #include "rd/rd_settings.h"
+#include "scenes/timeline.h"
 
 namespace morphoflow {
 
@@ -147,6 +149,7 @@ struct RDStroke {
   std::vector<double> values;         // one per deposited species
   SourceLocation where;
   std::string key;
+  double start = 0.0;                 // when it is painted (the scene's timeline)
 };
 
 struct RDScene {
@@ -217,6 +220,14 @@ struct SceneInput {
   std::string key;
 };
 
+// A numeric key as the reader checked it: its range and its value(s).
+struct KeyRange {
+  double lo = 0.0, hi = 0.0;
+  bool loOpen = false;
+  bool array = false;
+  std::vector<double> values;  // one, or an array's
+};
+
 struct Scene {
   std::string path;                // the file it came from
   std::vector<SceneInput> inputs;  // the files it reads
@@ -234,6 +245,8 @@ struct Scene {
   VelocityScene velocity;
   double reynolds = 0.0;           // resolved Re = U L / nu
   std::string resolvedJson;        // the scene as resolved (JSON text), for run.json
+  SceneTimeline timeline;          // what changes during the run (keyframes, deposits, timed elements)
+  std::map<std::string, KeyRange> numericKeys;  // every numeric key read, with its range (the studio's controls)
   long totalSteps() const;         // resolved from steps or duration/dt
 };
 

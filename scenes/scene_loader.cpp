@@ -73,19 +73,10 @@ std::string readSceneText(const std::string& path) {
   return text;
 }
 
-Scene parseScene(const std::string& text, const std::string& path, const std::vector<std::string>& overrides) {
-  if (text.size() > kMaxSceneBytes)
-    throw UserError({path, 0, 0}, "", "the scene is larger than " + std::to_string(kMaxSceneBytes >> 20) + " MiB");
-  toml::table root;
-  try {
-    root = toml::parse(text, path);
-  } catch (const toml::parse_error& e) {
-    throw UserError({path, int(e.source().begin.line), int(e.source().begin.column)}, "",
-                    "not valid TOML: " + std::string(e.description()));
-  }
-  std::map<std::string, SourceLocation> overrideLocs;
-  for (const std::string& kv : overrides) applyOverride(root, kv, &overrideLocs);
+namespace {
 
+// The sections of a tree (overrides applied, keyframes replaced by a value).
+Scene parseTree(toml::table& root, const std::string& path, const std::map<std::string, SourceLocation>& overrideLocs) {
   Reader r(path, root, overrideLocs);
   Scene s;
   s.path = path;
@@ -106,11 +97,62 @@ Scene parseScene(const std::string& text, const std::string& path, const std::ve
   parseSmoke(c, &s);
   parseCoupling(c, &s);
   parseOutput(c, &s);
+  parseDeposits(c, &s);
   checkBackTraces(c, s);
   checkUntilSteady(c, s);
   s.inputs = r.inputs();
+  s.numericKeys = r.numericKeys();
+  for (const RDStroke& st : s.rd.strokes) s.timeline.strokeStarts.push_back(st.start);
 
   r.checkUnknown(root, "");
+  return s;
+}
+
+// Every keyframe's value goes through the checks a value in the file does:
+// the scene is read with it in place, an error named at the key's value.
+void checkKeyframeValues(const toml::table& root, const std::string& path,
+                         const std::map<std::string, SourceLocation>& overrideLocs, const std::vector<KeyedValue>& keyed) {
+  for (const KeyedValue& k : keyed)
+    for (size_t i = 1; i < k.times.size(); ++i) {
+      toml::table copy = root;
+      std::map<std::string, SourceLocation> ignored;
+      KeyedValue one = k;
+      one.times = {0.0};
+      one.values = {k.values[i]};
+      applyOverride(copy, k.key + "=" + one.textAt(0.0), &ignored);
+      try {
+        parseTree(copy, path, overrideLocs);
+      } catch (const UserError& e) {
+        throw UserError(k.places[i], k.key, fmt::format("at t = {:g}: {}", k.times[i], e.message()), e.hint());
+      }
+    }
+}
+
+}  // namespace
+
+Scene parseScene(const std::string& text, const std::string& path, const std::vector<std::string>& overrides) {
+  if (text.size() > kMaxSceneBytes)
+    throw UserError({path, 0, 0}, "", "the scene is larger than " + std::to_string(kMaxSceneBytes >> 20) + " MiB");
+  toml::table root;
+  try {
+    root = toml::parse(text, path);
+  } catch (const toml::parse_error& e) {
+    throw UserError({path, int(e.source().begin.line), int(e.source().begin.column)}, "",
+                    "not valid TOML: " + std::string(e.description()));
+  }
+  std::map<std::string, SourceLocation> overrideLocs;
+  for (const std::string& kv : overrides) applyOverride(root, kv, &overrideLocs);
+  toml::table resolved = root;  // keyframes and all, for run.json and the settings hash
+
+  Reader keys(path, root, overrideLocs);
+  std::vector<KeyedValue> keyed = extractKeyframes(keys, root);
+  checkKeyframeValues(root, path, overrideLocs, keyed);
+  Scene s = parseTree(root, path, overrideLocs);
+  s.timeline.keyed = std::move(keyed);
+  if (!s.timeline.empty()) {
+    s.timeline.text = text;
+    s.timeline.overrides = overrides;
+  }
 
   // The files it reads, by size and modification time: a changed input
   // changes the settings hash (a batch --resume runs the scene again).
@@ -122,12 +164,29 @@ Scene parseScene(const std::string& text, const std::string& path, const std::ve
       const auto time = std::filesystem::last_write_time(in.path, ec).time_since_epoch().count();
       stamps.insert_or_assign(in.path, fmt::format("{} bytes, modified {}", ec ? 0 : size, ec ? 0 : time));
     }
-    root.insert_or_assign("inputs", std::move(stamps));
+    resolved.insert_or_assign("inputs", std::move(stamps));
   }
   // The scene as resolved, for run.json.
   std::ostringstream json;
-  json << toml::json_formatter{root};
+  json << toml::json_formatter{resolved};
   s.resolvedJson = json.str();
+  return s;
+}
+
+Scene sceneAt(const Scene& scene, double t) {
+  const SceneTimeline& tl = scene.timeline;
+  if (tl.empty()) return scene;
+  Scene s = parseScene(tl.text, scene.path, tl.overridesAt(t));
+  std::vector<ObstacleSpec> obstacles;
+  for (size_t q = 0; q < s.fluid.obstacles.size(); ++q)
+    if (tl.obstacles[q].contains(t)) obstacles.push_back(s.fluid.obstacles[q]);
+  s.fluid.obstacles = std::move(obstacles);
+  std::vector<RDStroke> strokes;
+  for (const RDStroke& st : s.rd.strokes)
+    if (st.start <= t) strokes.push_back(st);
+  s.rd.strokes = std::move(strokes);
+  s.timeline = SceneTimeline();
+  s.resolvedJson = scene.resolvedJson;
   return s;
 }
 

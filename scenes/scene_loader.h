@@ -24,6 +24,10 @@ constexpr uintmax_t kMaxSceneBytes = 4u << 20;
 std::string readSceneText(const std::string& path);
 Scene parseScene(const std::string& text, const std::string& path, const std::vector<std::string>& overrides = {});
 
+// The scene as it stands at time t of its timeline (scenes/timeline.h):
+// keyed values at t, the obstacles and strokes that exist then; no timeline.
+Scene sceneAt(const Scene& scene, double t);
+
 // Levenshtein distance, for "did you mean" suggestions.
 int editDistance(const std::string& a, const std::string& b);
 

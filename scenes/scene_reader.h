@@ -72,8 +72,9 @@ class Reader {
   double number(const toml::table* t, const std::string& prefix, const std::string& key, double def,
                 double lo, double hi, bool loOpen = false) {
     const toml::node* n = node(t, prefix, key);
-    if (!n) return def;
-    return checkNumber(n, prefix + key, lo, hi, loOpen);
+    const double v = n ? checkNumber(n, prefix + key, lo, hi, loOpen) : def;
+    numeric_[prefix + key] = {lo, hi, loOpen, false, {v}};
+    return v;
   }
   double checkNumber(const toml::node* n, const std::string& full, double lo, double hi, bool loOpen) {
     if (!n->is_number()) fail(n, full, "expected a number, found " + describe(*n));
@@ -121,6 +122,7 @@ class Reader {
                               bool loOpen = false, const toml::node** out = nullptr) {
     const toml::node* n = node(t, prefix, key);
     if (out) *out = n;
+    numeric_[prefix + key] = {lo, hi, loOpen, true, def};
     if (!n) return def;
     const std::string full = prefix + key;
     const toml::array* arr = n->as_array();
@@ -131,6 +133,7 @@ class Reader {
                " numbers, found " + std::to_string(arr->size()));
     std::vector<double> v;
     for (const toml::node& e : *arr) v.push_back(checkNumber(&e, full, lo, hi, loOpen));
+    numeric_[full].values = v;
     return v;
   }
 
@@ -198,6 +201,8 @@ class Reader {
     inputs_.push_back({path.string(), where(n, key), key});
   }
   const std::vector<SceneInput>& inputs() const { return inputs_; }
+  // Every number and array of numbers asked for, with its range and value.
+  const std::map<std::string, KeyRange>& numericKeys() const { return numeric_; }
 
  private:
   std::string file_;
@@ -205,6 +210,7 @@ class Reader {
   std::map<std::string, SourceLocation> overrideLocs_;
   std::map<const toml::table*, std::set<std::string>> known_;
   std::vector<SceneInput> inputs_;
+  std::map<std::string, KeyRange> numeric_;
 };
 
 // An array of species names of `model` (one of `species`), as indices.
@@ -266,5 +272,11 @@ void parseGeneralized(SceneContext& c, const toml::table& rd, Scene* s);  // [rd
 void parseVelocity(SceneContext& c, Scene* s);    // [velocity] (after [rd])
 void parseCoupling(SceneContext& c, Scene* s);    // [coupling]
 void parseOutput(SceneContext& c, Scene* s);      // [output]
+void parseDeposits(SceneContext& c, Scene* s);    // [[deposits]] (after [rd] and [smoke])
+
+// The timeline (scenes/timeline.h): every keyframed key of the tree, checked
+// and replaced by its first value; an element's [start, end) (keys p+start, p+end).
+std::vector<KeyedValue> extractKeyframes(Reader& r, toml::table& root);
+TimeWindow parseWindow(Reader& r, const toml::table* t, const std::string& p);
 
 }  // namespace morphoflow

@@ -260,7 +260,8 @@ bool setFluidField(FluidSolver<D>* fluid, const std::string& name, const Grid<fl
   Grid<float, D>& g = temperature ? fluid->temperature() : fluid->dye();
   if (values.dims() != g.dims())
     throw UserError({"set_field", 0, 0}, "", "the values of '" + name + "' are not on its grid", "give field()'s shape");
-  g.values() = values.values();
+  for (size_t i = 0; i < g.size(); ++i)
+    if (!std::isnan(values[i])) g[i] = values[i];  // (NaN: the cell keeps its value)
   return true;
 }
 

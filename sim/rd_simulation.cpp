@@ -1,5 +1,7 @@
 #include "sim/rd_simulation.h"
 
+#include <cmath>
+
 #include <algorithm>
 #include <stdexcept>
 
@@ -25,7 +27,8 @@ bool setSpeciesField(RDSolver<D>* rd, const std::string& name, const Grid<float,
   Grid<double, D>& g = rd->field(int(it - names.begin()));
   if (values.dims() != g.dims())
     throw UserError({"set_field", 0, 0}, "", "the values of '" + name + "' are not on its grid", "give field()'s shape");
-  for (size_t i = 0; i < g.size(); ++i) g[i] = double(values[i]);
+  for (size_t i = 0; i < g.size(); ++i)
+    if (!std::isnan(values[i])) g[i] = double(values[i]);  // (NaN: the cell keeps its value)
   return true;
 }
 

@@ -11,14 +11,22 @@
 #include "scenes/scene.h"
 #include "sim/backend.h"
 #include "sim/steppers.h"
+#include "sim/timeline_simulation.h"
 
 namespace morphoflow {
 
 // The scene's simulation on the backend (checkBackend said it can): say
-// takes the simulations' messages, warn their warnings.
+// takes the simulations' messages, warn their warnings. A scene with a
+// timeline (scenes/timeline.h) runs in a TimelineSimulation.
 template <int D>
 std::unique_ptr<Simulation<D>> makeSimulation(const Scene& scene, Backend backend,
                                               const std::function<void(const std::string&)>& say,
                                               const std::function<void(const std::string&)>& warn);
+
+// Always a TimelineSimulation (the studio extends its timeline as it runs).
+template <int D>
+std::unique_ptr<TimelineSimulation<D>> makeTimelineSimulation(const Scene& scene, Backend backend,
+                                                              const std::function<void(const std::string&)>& say,
+                                                              const std::function<void(const std::string&)>& warn);
 
 }  // namespace morphoflow
