@@ -1,5 +1,6 @@
 #include "studio/studio_server.h"
 
+#include <array>
 #include <atomic>
 #include <filesystem>
 #include <fstream>
@@ -305,6 +306,17 @@ struct StudioServer::Impl {
     }
   }
 
+  // After refusing a request whose body is still arriving: stop sending, then
+  // read and drop what the client is still writing (for 2 s at most), so the
+  // close does not reset the connection before the client reads the answer.
+  static awaitable<void> lingeringClose(beast::tcp_stream& stream) {
+    beast::error_code ec;
+    stream.socket().shutdown(tcp::socket::shutdown_send, ec);
+    stream.expires_after(std::chrono::seconds(2));
+    std::array<char, 64 * 1024> sink;
+    while (!ec) co_await stream.async_read_some(asio::buffer(sink), asio::redirect_error(use_awaitable, ec));
+  }
+
   awaitable<void> connection(tcp::socket socket) {
     struct Count {
       std::atomic<size_t>& n;
@@ -325,6 +337,7 @@ struct StudioServer::Impl {
         r.keep_alive(false);
         r.prepare_payload();
         co_await http::async_write(stream, r, asio::redirect_error(use_awaitable, ec));
+        co_await lingeringClose(stream);
         co_return;
       }
       if (ec) co_return;
