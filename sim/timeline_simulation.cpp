@@ -43,6 +43,7 @@ void TimelineSimulation<D>::rebuildAt(double t) {
   inner_ = std::move(next);  // (before built_: the old simulation refers to the old scene)
   built_ = std::move(scene);
   builtAt_ = t;
+  stale_ = false;
   signature_ = signatureAt(t);
 }
 
@@ -66,11 +67,16 @@ void TimelineSimulation<D>::deposit(const Deposit& d) {
 }
 
 template <int D>
-void TimelineSimulation<D>::step(double dt) {
+void TimelineSimulation<D>::prepare(double dt) {
   const double t = inner_->time(), te = t + 1e-6 * dt;  // (scenes/timeline.h, dueAt)
-  if (signatureAt(te) != signature_) rebuildAt(te);
+  if (stale_ || signatureAt(te) != signature_) rebuildAt(te);
   const std::vector<Deposit>& deposits = scene_->timeline.deposits;
   for (; deposited_ < deposits.size() && dueAt(deposits[deposited_].time, t, dt); ++deposited_) deposit(deposits[deposited_]);
+}
+
+template <int D>
+void TimelineSimulation<D>::step(double dt) {
+  prepare(dt);
   inner_->step(dt);
 }
 
@@ -115,6 +121,9 @@ void TimelineSimulation<D>::report(nlohmann::json* run) const {
 template <int D>
 void TimelineSimulation<D>::retarget(const Scene& scene) {
   scene_ = std::make_shared<const Scene>(scene);
+  // Built for the coming step already (`prepare`): the edit, made at the
+  // current time, is not in what was built, so the next `prepare` builds again.
+  stale_ = builtAt_ >= inner_->time();
   signature_ = signatureAt(builtAt_);
 }
 

@@ -48,6 +48,10 @@ class TimelineSimulation : public Simulation<D> {
   // The studio: the same scene with a timeline that only adds to this one
   // at the current time or later. Takes effect at the next step.
   void retarget(const Scene& scene);
+  // What the scene changes before the step of `dt` from the current time
+  // (a rebuild, the deposits due), done now; `step` does it first. Lets the
+  // studio show an edit made while paused without taking a step.
+  void prepare(double dt);
   // The scene the running simulation was built from (the timeline's at the last change).
   const Scene& current() const { return *built_; }
   // How many times the simulation was built again.
@@ -64,6 +68,7 @@ class TimelineSimulation : public Simulation<D> {
   std::unique_ptr<Simulation<D>> inner_;
   double builtAt_ = 0.0;
   std::vector<double> signature_;
+  bool stale_ = false;  // what was built lacks an edit made since (retarget)
   size_t deposited_ = 0;                // deposits applied
   long rebuilds_ = 0;
 };

@@ -99,18 +99,21 @@ struct StudioServer::Impl {
   unsigned short port = 0;
   mutable std::mutex mutex;
   std::shared_ptr<StudioSession> session;
-  std::set<std::shared_ptr<asio::steady_timer>> wakeups;  // one per WebSocket client (I/O thread only)
+  struct Watcher;
+  std::set<Watcher*> watchers;  // the WebSocket clients (I/O thread only)
   std::atomic<long> sent{0};
   std::atomic<size_t> clients{0}, connections{0};
   std::atomic<bool> wakePending{false};
 
-  // Every frame wakes each client's writer (at most one wake-up queued).
+  // Every frame wakes the writers of the clients that took their last frame
+  // (at most one wake-up queued; a client still busy with a frame costs nothing).
   void listen(const std::shared_ptr<StudioSession>& s) {
     s->onFrame([this] {
       if (wakePending.exchange(true)) return;
       asio::post(ioc, [this] {
         wakePending = false;
-        for (const auto& t : wakeups) t->cancel();
+        for (Watcher* w : watchers)
+          if (w->ready) w->wake.cancel();
       });
     });
   }
@@ -243,14 +246,14 @@ struct StudioServer::Impl {
   // slow client skips frames and nothing queues for it, here or in the kernel.
   struct Watcher {
     explicit Watcher(websocket::stream<beast::tcp_stream> s, asio::io_context& ioc)
-        : ws(std::move(s)), wake(std::make_shared<asio::steady_timer>(ioc)) {}
+        : ws(std::move(s)), wake(ioc) {}
     websocket::stream<beast::tcp_stream> ws;
-    std::shared_ptr<asio::steady_timer> wake;
+    asio::steady_timer wake;
     bool ready = true, done = false;
   };
 
   awaitable<void> frames(Watcher& w) {
-    wakeups.insert(w.wake);
+    watchers.insert(&w);
     std::shared_ptr<const std::string> last;
     beast::error_code ec;
     while (!w.done) {
@@ -265,10 +268,10 @@ struct StudioServer::Impl {
         ++sent;
         continue;
       }
-      w.wake->expires_after(std::chrono::seconds(1));
-      co_await w.wake->async_wait(asio::redirect_error(use_awaitable, ec));
+      w.wake.expires_after(std::chrono::seconds(1));
+      co_await w.wake.async_wait(asio::redirect_error(use_awaitable, ec));
     }
-    wakeups.erase(w.wake);
+    watchers.erase(&w);
   }
 
   awaitable<void> websocketClient(beast::tcp_stream stream, Request req) {
@@ -290,10 +293,10 @@ struct StudioServer::Impl {
         co_await w.ws.async_read(in, asio::redirect_error(use_awaitable, rec));
         if (rec) break;
         w.ready = true;
-        w.wake->cancel();
+        w.wake.cancel();
       }
       w.done = true;
-      w.wake->cancel();
+      w.wake.cancel();
       readerDone = true;
     }, asio::detached);
     co_await frames(w);

@@ -344,7 +344,12 @@ nlohmann::json StudioSession::adopt(EditLog&& edited) {
     build();
     publish();
   } else {
-    with([&](auto& sim) { sim.retarget(log_.scene()); });
+    // Shown now, as the next step would start from it (a paused run shows a deposit at once).
+    with([&](auto& sim) {
+      sim.retarget(log_.scene());
+      sim.prepare(RunClock(runTime(*clockScene_)).dt(sim));
+    });
+    publish();
   }
   nlohmann::json j = where();
   j["ok"] = true;
