@@ -203,10 +203,13 @@ void EditLog::paint(const nlohmann::json& edit, double t) {
     const auto [name, idx] = target(edit, scene_);
     toml::array& a = arrayOf(tree, name);
     toml::table& old = *a.get(idx)->as_table();
+    // An element that starts now (at the scene's start, or added at this
+    // time) changes in place: it never existed elsewhere.
+    const bool startsNow = old["start"].value_or(0.0) == t;
     if (kind == "move") {
       toml::table moved = old;
       insertJson(moved, "center", edit.value("center", nlohmann::json()));
-      if (t == 0.0) {
+      if (startsNow) {
         old = std::move(moved);
       } else {
         moved.erase("end");
@@ -215,7 +218,7 @@ void EditLog::paint(const nlohmann::json& edit, double t) {
         old.insert_or_assign("end", t);
         a.push_back(std::move(moved));
       }
-    } else if (t == 0.0) {
+    } else if (startsNow) {
       a.erase(a.begin() + std::ptrdiff_t(idx));
     } else {
       old.insert_or_assign("end", t);

@@ -63,22 +63,27 @@ std::string percentDecoded(std::string_view s) {
   return out;
 }
 
-// A target's path and its query's value for `name` ("" when absent).
-std::string_view pathOf(std::string_view target) { return target.substr(0, target.find('?')); }
-std::string queryValue(std::string_view target, std::string_view name) {
-  const size_t q = target.find('?');
-  if (q == std::string_view::npos) return {};
-  std::string_view rest = target.substr(q + 1);
-  while (!rest.empty()) {
-    const size_t amp = rest.find('&');
-    const std::string_view pair = rest.substr(0, amp);
+// The value for `name` in a list of name=value pairs ("" when absent).
+std::string listValue(std::string_view list, char separator, std::string_view name) {
+  while (!list.empty()) {
+    const size_t end = list.find(separator);
+    std::string_view pair = list.substr(0, end);
+    while (!pair.empty() && pair.front() == ' ') pair.remove_prefix(1);
     const size_t eq = pair.find('=');
-    if (pair.substr(0, eq) == name) return eq == std::string_view::npos ? std::string() : percentDecoded(pair.substr(eq + 1));
-    if (amp == std::string_view::npos) break;
-    rest = rest.substr(amp + 1);
+    if (pair.substr(0, eq) == name) return eq == std::string_view::npos ? std::string() : std::string(pair.substr(eq + 1));
+    if (end == std::string_view::npos) break;
+    list = list.substr(end + 1);
   }
   return {};
 }
+
+// A target's path, its query's value for `name`, a Cookie header's value for `name`.
+std::string_view pathOf(std::string_view target) { return target.substr(0, target.find('?')); }
+std::string queryValue(std::string_view target, std::string_view name) {
+  const size_t q = target.find('?');
+  return q == std::string_view::npos ? std::string() : percentDecoded(listValue(target.substr(q + 1), '&', name));
+}
+std::string cookieValue(std::string_view header, std::string_view name) { return listValue(header, ';', name); }
 
 std::string_view sv(beast::string_view s) { return {s.data(), s.size()}; }
 
@@ -150,12 +155,18 @@ struct StudioServer::Impl {
     std::string token = queryValue(sv(req.target()), "token");
     const std::string_view auth = sv(req[http::field::authorization]);
     if (token.empty() && auth.substr(0, 7) == "Bearer ") token = std::string(auth.substr(7));
+    if (token.empty()) token = cookieValue(sv(req[http::field::cookie]), cookieName());
     if (!sameSecret(token, options.token))
       return refuse(http::status::unauthorized,
                     "unauthorized: open the address with ?token= that `morphoflow studio` printed, or send "
                     "Authorization: Bearer TOKEN");
     return std::nullopt;
   }
+
+  // The page's cookie: set when the page is opened with the token, so that a
+  // reload (the address no longer shows the token) is let in. Strict
+  // same-site: another site's page never sends it.
+  std::string cookieName() const { return "morphoflow-studio-" + std::to_string(port); }
 
   static Response reply(const Request& req, http::status status, std::string body, const std::string& type) {
     Response r{status, req.version()};
@@ -205,7 +216,9 @@ struct StudioServer::Impl {
     const bool get = req.method() == http::verb::get, post = req.method() == http::verb::post;
     if (path == "/" || path == "/index.html") {
       if (!get) return error(req, http::status::method_not_allowed, "the page is GET /");
-      return reply(req, http::status::ok, std::string(kStudioPage), "text/html; charset=utf-8");
+      Response page = reply(req, http::status::ok, std::string(kStudioPage), "text/html; charset=utf-8");
+      page.set(http::field::set_cookie, cookieName() + "=" + options.token + "; Path=/; HttpOnly; SameSite=Strict");
+      return page;
     }
     if (path.rfind("/api/", 0) != 0) return error(req, http::status::not_found, "no such page: " + path);
     nlohmann::json body;
@@ -215,9 +228,10 @@ struct StudioServer::Impl {
     }
     const std::string call = path.substr(5);
     try {
-      if (call == "scenes" && get) return json(req, {{"scenes", shippedScenes()}});
-      if (call == "open" && post) return open(req, body);
       const std::shared_ptr<StudioSession> s = current();
+      if (call == "scenes" && get)
+        return json(req, {{"scenes", shippedScenes()}, {"open", s ? s->state()["scene"] : nlohmann::json()}});
+      if (call == "open" && post) return open(req, body);
       if (!s) return error(req, http::status::conflict, "no scene is open: POST /api/open {\"scene\": NAME} (GET /api/scenes)");
       if (call == "state" && get) return json(req, s->state());
       if (call == "scene" && get) return reply(req, http::status::ok, s->sceneText(), "application/toml; charset=utf-8");

@@ -190,6 +190,7 @@ TEST(Studio, TheSavedSceneReplaysTheSessionBitForBit) {
   s.paint({{"kind", "deposit"}, {"field", "v"}, {"center", {0.6, 0.6}}, {"radius", 0.1}, {"value", 0.4}});
   stepTo(s, 9);
   s.paint({{"kind", "obstacle"}, {"shape", "box"}, {"center", {0.7, 0.4}}, {"size", {0.1, 0.2}}});
+  s.paint({{"kind", "move"}, {"target", "obstacles.1"}, {"center", {0.72, 0.45}}});  // moved as it is added: in place
   stepTo(s, 11);
   s.paint({{"kind", "move"}, {"target", "obstacles.0"}, {"center", {0.25, 0.7}}});
   s.set({{"smoke.vorticity", 0.5}, {"sources.0.density", 2.0}});
