@@ -17,6 +17,7 @@
 #include "core/parallel.h"
 #include "core/state_archive.h"
 #include "python/py_simulation.h"
+#include "python/py_studio.h"
 #include "scenes/scene_loader.h"
 
 namespace py = pybind11;
@@ -180,4 +181,5 @@ PYBIND11_MODULE(morphoflow, m) {
         py::arg("resume") = false, py::arg("quiet") = true,
         "Varies a scene's keys as `morphoflow sweep` does (vary=['rd.parameters.F=0.02:0.05:4']); returns "
         "{'status', 'summary'}.");
+  bindStudio(m, executable);
 }
