@@ -1,4 +1,4 @@
-// `morphoflow bench SUITE`: the benchmark suites (bench/) and the memory benchmark (run/).
+// `morphoflow bench SUITE`: the benchmark suites (bench/), the memory benchmark (run/) and the studio's (studio/).
 #include <memory>
 
 #include <CLI/CLI.hpp>
@@ -6,14 +6,19 @@
 #include "app/commands.h"
 #include "bench/bench_command.h"
 #include "run/memory_bench.h"
+#include "studio/studio_bench.h"
 
 namespace morphoflow {
 
 void addBenchCommand(CLI::App& app, Commands* commands) {
   auto a = std::make_shared<BenchArguments>();
-  CLI::App* cmd = addBenchSubcommand(app, a.get(), std::string(benchSuiteNames()) + ", memory");
+  CLI::App* cmd = addBenchSubcommand(app, a.get(), std::string(benchSuiteNames()) + ", memory, studio");
   commands->add(cmd, [a] {
     return runBench(*a, [](const BenchArguments& b) {
+      if (b.suite == "studio" && b.bench.backend != "gpu") {
+        runStudioBench(MORPHOFLOW_SCENE_DIR, b.bench.minSeconds, b.bench.json);
+        return 0;
+      }
       if (b.suite != "memory" || b.bench.backend == "gpu") return -1;
       return runMemoryBench(b.bench) ? 0 : 1;
     });
