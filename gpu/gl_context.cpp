@@ -104,7 +104,25 @@ void GLAPIENTRY debugMessage(GLenum, GLenum type, GLuint, GLenum severity, GLsiz
 
 GlContext& GlContext::instance() {
   static GlContext context;
+  context.makeCurrent();
   return context;
+}
+
+void GlContext::makeCurrent() {
+  if (holder_.load() == std::this_thread::get_id()) return;
+  std::lock_guard<std::mutex> lk(mutex_);
+  if (holder_.load() != std::thread::id())
+    throw GpuError("the GPU's context is current on another thread: one thread at a time uses the GPU");
+  if (!eglMakeCurrent(egl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, egl_->context))
+    throw GpuError("eglMakeCurrent failed on this thread (EGL error " + std::to_string(eglGetError()) + ")");
+  holder_ = std::this_thread::get_id();
+}
+
+void GlContext::release() {
+  std::lock_guard<std::mutex> lk(mutex_);
+  if (holder_.load() != std::this_thread::get_id()) return;
+  eglMakeCurrent(egl_->display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+  holder_ = std::thread::id();
 }
 
 GlContext::GlContext() : egl_(std::make_unique<Egl>()) {
@@ -126,6 +144,7 @@ GlContext::GlContext() : egl_(std::make_unique<Egl>()) {
     throw GpuUnavailable("no OpenGL 4.3 core context: neither an EGL device nor Mesa's surfaceless platform offers one "
                          "(install libegl-mesa0 and libgl1-mesa-dri for llvmpipe)");
   if (epoxy_gl_version() < 43) throw GpuUnavailable(fmt::format("OpenGL {:.1f} only; compute shaders need 4.3", epoxy_gl_version() / 10.0));
+  holder_ = std::this_thread::get_id();  // (makeContext made it current here)
   renderer_ = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
   version_ = reinterpret_cast<const char*>(glGetString(GL_VERSION));
 #ifndef NDEBUG

@@ -1,14 +1,17 @@
 // A headless OpenGL 4.3+ core context through EGL, with no window and no X
 // server: the EGL device platform first (a hardware GPU; on NVIDIA the
 // device that reports EGL_CUDA_DEVICE_NV), then Mesa's surfaceless platform
-// (llvmpipe when there is no GPU). One context per process, made current on
-// the thread that created it.
+// (llvmpipe when there is no GPU). One context per process, current on one
+// thread at a time: the thread that last called instance().
 #pragma once
 
+#include <atomic>
 #include <cstddef>
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <thread>
+#include <mutex>
 
 #include <nlohmann/json.hpp>
 
@@ -28,8 +31,13 @@ class GpuError : public std::runtime_error {
 
 class GlContext {
  public:
-  // The process's context, created on first use; throws GpuUnavailable.
+  // The process's context, created on first use (throws GpuUnavailable) and
+  // made current on the calling thread (throws GpuError while another thread
+  // holds it: one thread at a time uses the GPU).
   static GlContext& instance();
+  // Lets go of the context on the calling thread, so that another thread's
+  // instance() may take it (the studio steps on a thread of its own).
+  void release();
   GlContext(const GlContext&) = delete;
   GlContext& operator=(const GlContext&) = delete;
   ~GlContext();
@@ -50,7 +58,11 @@ class GlContext {
   struct Egl;  // the display and context (gl_context.cpp)
 
  private:
+  void makeCurrent();
+
   std::unique_ptr<Egl> egl_;
+  std::mutex mutex_;
+  std::atomic<std::thread::id> holder_{};  // the thread it is current on (none: released)
   std::string renderer_, version_, platform_;
 };
 

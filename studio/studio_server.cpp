@@ -201,7 +201,9 @@ struct StudioServer::Impl {
     if (std::find(names.begin(), names.end(), name) == names.end())
       return error(req, http::status::bad_request, "no shipped scene '" + name + "' (GET /api/scenes lists them)");
     const std::string path = (std::filesystem::path(sceneDir) / name).string();
-    auto s = std::make_shared<StudioSession>(readSceneText(path), path, studio);
+    const std::string text = readSceneText(path);
+    if (const std::shared_ptr<StudioSession> old = current()) old->close();  // (one GPU simulation at a time)
+    auto s = std::make_shared<StudioSession>(text, path, studio);
     listen(s);
     {
       std::lock_guard<std::mutex> lk(mutex);

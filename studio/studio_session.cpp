@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "core/parallel.h"
+#include "gpu/gl_context.h"
 #include "run/memory_estimate.h"
 #include "run/run_clock.h"
 #include "sim/simulation_factory.h"
@@ -46,19 +47,30 @@ StudioSession::StudioSession(const std::string& text, const std::string& path, c
   checkBackend(s, backendNamed(options.backend));
   checkRunFits(s);
   dimension_ = s.dimension;
+  // The simulation's thread uses the GPU: the context it took here is let go.
+  if (backendNamed(options.backend) == Backend::Gpu) GlContext::instance().release();
   std::promise<void> ready;
   std::future<void> built = ready.get_future();
   thread_ = std::thread([this, &ready] {
     ThreadLimit limit(options_.backend == "serial" ? 1 : options_.threads);
+    // The simulation goes on this thread (GPU objects are freed where the
+    // context is current), which then lets the GPU's context go.
+    auto finish = [this] {
+      s2_.reset();
+      s3_.reset();
+      if (backendNamed(options_.backend) == Backend::Gpu) GlContext::instance().release();
+    };
     try {
-      build();  // (on this thread: a GPU context is current where it was made)
+      build();  // (on this thread: the GPU's context is made current here)
       publish();
       ready.set_value();
     } catch (...) {
+      finish();
       ready.set_exception(std::current_exception());
       return;
     }
     loop();
+    finish();
   });
   try {
     built.get();
@@ -68,13 +80,19 @@ StudioSession::StudioSession(const std::string& text, const std::string& path, c
   }
 }
 
-StudioSession::~StudioSession() {
+StudioSession::~StudioSession() { close(); }
+
+void StudioSession::close() {
   {
     std::lock_guard<std::mutex> lk(mutex_);
     stop_ = true;
   }
   wake_.notify_all();
-  if (thread_.joinable()) thread_.join();
+  if (thread_.joinable()) {
+    thread_.join();
+    // The GPU's context back on this thread (the process's cached programs are freed on it at exit).
+    if (backendNamed(options_.backend) == Backend::Gpu) GlContext::instance();
+  }
   if (render_) render_->signal(SIGTERM);
 }
 
@@ -106,6 +124,7 @@ R StudioSession::onSimThread(std::function<R()> task) {
   std::future<R> result = job.get_future();
   {
     std::lock_guard<std::mutex> lk(mutex_);
+    if (stop_) throw UserError(kStudio, "", "this scene was closed", "reload the page");
     tasks_.push_back([&job] { job(); });
   }
   wake_.notify_all();

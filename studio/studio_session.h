@@ -36,6 +36,9 @@ class StudioSession {
   // Throws UserError when the scene does not read or cannot run on the backend.
   StudioSession(const std::string& text, const std::string& path, const StudioOptions& options);
   ~StudioSession();
+  // Stops the simulation and frees it (the GPU's context let go) now, though
+  // a frame in flight may still hold the session.
+  void close();
   StudioSession(const StudioSession&) = delete;
   StudioSession& operator=(const StudioSession&) = delete;
 
