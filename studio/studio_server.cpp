@@ -109,6 +109,7 @@ struct StudioServer::Impl {
   std::atomic<long> sent{0};
   std::atomic<size_t> clients{0}, connections{0};
   std::atomic<bool> wakePending{false};
+  std::atomic<long> wanting{0};  // clients that took their last frame (each wants the next)
 
   // Every frame wakes the writers of the clients that took their last frame
   // (at most one wake-up queued; a client still busy with a frame costs nothing).
@@ -120,7 +121,7 @@ struct StudioServer::Impl {
         for (Watcher* w : watchers)
           if (w->ready) w->wake.cancel();
       });
-    });
+    }, [this] { return wanting > 0; });
   }
 
   std::shared_ptr<StudioSession> current() const {
@@ -270,6 +271,7 @@ struct StudioServer::Impl {
 
   awaitable<void> frames(Watcher& w) {
     watchers.insert(&w);
+    ++wanting;  // (a new client wants a frame: w.ready)
     std::shared_ptr<const std::string> last;
     beast::error_code ec;
     while (!w.done) {
@@ -277,6 +279,7 @@ struct StudioServer::Impl {
       std::shared_ptr<const std::string> f = s ? s->frame() : nullptr;
       if (w.ready && f && f != last) {
         w.ready = false;
+        --wanting;
         w.ws.binary(true);
         co_await w.ws.async_write(asio::buffer(*f), asio::redirect_error(use_awaitable, ec));
         if (ec) break;
@@ -287,7 +290,10 @@ struct StudioServer::Impl {
       w.wake.expires_after(std::chrono::seconds(1));
       co_await w.wake.async_wait(asio::redirect_error(use_awaitable, ec));
     }
+    w.done = true;  // (the reader counts no more answers)
     watchers.erase(&w);
+    if (w.ready) --wanting;
+    w.ready = false;
   }
 
   awaitable<void> websocketClient(beast::tcp_stream stream, Request req) {
@@ -301,13 +307,14 @@ struct StudioServer::Impl {
     ++clients;
     // The reader: each message says the client took a frame; a close or an error ends both.
     bool readerDone = false;
-    asio::co_spawn(ioc, [&w, &readerDone]() -> awaitable<void> {
+    asio::co_spawn(ioc, [this, &w, &readerDone]() -> awaitable<void> {
       beast::flat_buffer in;
       beast::error_code rec;
       for (;;) {
         in.consume(in.size());
         co_await w.ws.async_read(in, asio::redirect_error(use_awaitable, rec));
         if (rec) break;
+        if (!w.ready && !w.done) ++wanting;
         w.ready = true;
         w.wake.cancel();
       }

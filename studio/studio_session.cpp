@@ -195,8 +195,10 @@ void StudioSession::stepOnce() {
   {
     std::lock_guard<std::mutex> lk(mutex_);
     with([&](auto& sim) { time_ = sim.time(), steps_ = sim.steps(); });
-    due = ++sinceFrame_ >= stepsPerFrame_ || (!running_ && stepsToDo_ == 0);
-    if (due) sinceFrame_ = 0;
+    const bool paused = !running_ && stepsToDo_ == 0;
+    const bool shown = !wanted_ || (wanted_() && Clock::now() - lastFrame_ >= std::chrono::microseconds(16667));
+    due = (++sinceFrame_ >= stepsPerFrame_ && shown) || paused;
+    if (due) sinceFrame_ = 0, lastFrame_ = Clock::now();
   }
   if (due) publish();
 }
@@ -237,9 +239,10 @@ std::shared_ptr<const std::string> StudioSession::frame() const {
   return frame_;
 }
 
-void StudioSession::onFrame(std::function<void()> listener) {
+void StudioSession::onFrame(std::function<void()> listener, std::function<bool()> wanted) {
   std::lock_guard<std::mutex> lk(mutex_);
   listener_ = std::move(listener);
+  wanted_ = std::move(wanted);
 }
 
 nlohmann::json StudioSession::state() const {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <deque>
 #include <functional>
@@ -64,7 +65,10 @@ class StudioSession {
   // The newest frame (null before the first).
   std::shared_ptr<const std::string> frame() const;
   // Called on the simulation's thread after each new frame.
-  void onFrame(std::function<void()> listener);
+  // `wanted` says whether any client waits for a frame: while running, a
+  // frame is made only then (at most 60 a second), so that watching costs
+  // the simulation no more than what is shown.
+  void onFrame(std::function<void()> listener, std::function<bool()> wanted = {});
   long framesPublished() const { return framesPublished_; }
   int dimension() const { return dimension_; }
 
@@ -97,6 +101,8 @@ class StudioSession {
   long steps_ = 0;
   std::shared_ptr<const std::string> frame_;
   std::function<void()> listener_;
+  std::function<bool()> wanted_;
+  std::chrono::steady_clock::time_point lastFrame_{};
   std::atomic<long> framesPublished_{0};
   std::optional<ChildProcess> render_;
   std::string renderOut_;

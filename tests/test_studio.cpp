@@ -379,8 +379,8 @@ TEST(StudioServer, BadCallsGetAMessageAndTheSimulationGoesOn) {
                    0.061);
 }
 
-// A client that reads one frame in 200 ms while the simulation publishes
-// many: it gets the newest each time (steps skipped), the server holds no queue.
+// A client that reads one frame in 200 ms while the simulation steps
+// many times: it gets the newest each time (steps skipped), nothing queues.
 TEST(StudioServer, ASlowClientGetsTheNewestFrameAndFramesAreDropped) {
   Served s;
   s.call(http::verb::post, "/api/control", R"({"action":"play"})");
@@ -403,8 +403,8 @@ TEST(StudioServer, ASlowClientGetsTheNewestFrameAndFramesAreDropped) {
     ws.write(boost::asio::buffer(std::string("next")));
   }
   for (size_t k = 1; k < steps.size(); ++k) EXPECT_GT(steps[k], steps[k - 1] + 1) << "frames were not dropped";
-  const long published = s.server.session()->framesPublished();
-  EXPECT_GT(published, 3 * s.server.framesSent());
+  // Frames are made only for a client that waits for one: no more than were sent, and a few.
+  EXPECT_LE(s.server.session()->framesPublished(), s.server.framesSent() + 2);
   EXPECT_LE(s.server.framesSent(), 6);  // the five taken, and the one sent after the last answer
   ws.close(websocket::close_code::normal);
 }
