@@ -35,7 +35,9 @@ std::string expandIncludes(const std::string& text) {
 }  // namespace
 
 const ComputeProgram& useKernel(const std::string& shader, const std::string& defines) {
-  static std::map<std::string, std::unique_ptr<ComputeProgram>> programs;
+  // Kept to the process's end and never freed (no GL call at exit, when the
+  // context may be current on no thread).
+  static auto& programs = *new std::map<std::string, std::unique_ptr<ComputeProgram>>;
   const std::string key = shader + "\n" + defines;
   auto it = programs.find(key);
   if (it == programs.end())

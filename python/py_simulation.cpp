@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/parallel.h"
+#include "gpu/gl_context.h"
 #include "run/checkpoint.h"
 #include "run/memory_estimate.h"
 #include "run/run_clock.h"
@@ -63,7 +64,42 @@ PySimulation::PySimulation(const PyScene& scene, const std::string& backend, int
     throw py::value_error("backend must be 'tbb', 'serial' or 'gpu', not '" + backend + "'");
   if (threads < 0) throw py::value_error("threads must be 0 (every core) or more");
   backend_ = backendNamed(backend);
+  Call call(*this, "Simulation");
   make();
+}
+
+PySimulation::Call::Call(const PySimulation& sim, const char* what) : sim_(const_cast<PySimulation&>(sim)) {
+  {
+    std::lock_guard<std::mutex> lk(sim_.calls_->mutex);
+    if (sim_.calls_->busy)
+      throw std::runtime_error(std::string("this Simulation is in ") + sim_.calls_->busy + "() (on another thread, or this is " +
+                               "a callback of that call): one call at a time");
+    sim_.calls_->busy = what;
+  }
+  if (sim_.backend_ != Backend::Gpu) return;
+  try {
+    GlContext::instance();  // (current on this thread; a GpuError while another thread uses the GPU)
+  } catch (...) {
+    std::lock_guard<std::mutex> lk(sim_.calls_->mutex);
+    sim_.calls_->busy = nullptr;
+    throw;
+  }
+}
+
+PySimulation::Call::~Call() {
+  std::lock_guard<std::mutex> lk(sim_.calls_->mutex);
+  if (sim_.calls_->closeAfter) sim_.free();
+  if (sim_.backend_ == Backend::Gpu) GlContext::instance().release();
+  sim_.calls_->busy = nullptr;
+}
+
+// The simulation's memory, freed on this thread (a GPU's with the context current here).
+void PySimulation::free() {
+  s2_.reset();
+  s3_.reset();
+  velocity2_ = nullptr;
+  velocity3_ = nullptr;
+  calls_->closeAfter = false;
 }
 
 void PySimulation::make() {
@@ -85,6 +121,7 @@ auto PySimulation::with(F&& f) const {
 }
 
 void PySimulation::step(long n) {
+  Call call(*this, "step");
   if (n < 0) throw py::value_error("step takes n >= 0");
   const TimeSettings t = runTime(*scene_.scene);
   with([&](auto& sim) {
@@ -102,16 +139,24 @@ void PySimulation::step(long n) {
 }
 
 double PySimulation::time() const {
+  Call call(*this, "time");
   return with([](auto& sim) { return sim.time(); });
 }
 long PySimulation::steps() const {
+  Call call(*this, "steps");
   return with([](auto& sim) { return sim.steps(); });
 }
 std::vector<std::string> PySimulation::fieldNames() const {
+  Call call(*this, "field_names");
   return with([](auto& sim) { return sim.fieldNames(); });
 }
 
 py::array_t<float> PySimulation::field(const std::string& name) const {
+  Call call(*this, "field");
+  return fieldOf(name);
+}
+
+py::array_t<float> PySimulation::fieldOf(const std::string& name) const {
   return with([&](auto& sim) {
     const std::vector<std::string> names = sim.fieldNames();
     if (std::find(names.begin(), names.end(), name) == names.end()) {
@@ -124,11 +169,12 @@ py::array_t<float> PySimulation::field(const std::string& name) const {
 }
 
 void PySimulation::setField(const std::string& name, const py::object& values) {
+  Call call(*this, "set_field");
   if (!py::isinstance<py::array>(values)) throw py::type_error("set_field takes a numpy array of float32");
   const py::array a = values.cast<py::array>();
   if (!a.dtype().is(py::dtype::of<float>()))
     throw py::type_error("set_field takes float32 values, not " + std::string(py::str(a.dtype())) + " (astype(numpy.float32))");
-  const py::array_t<float> now = field(name);
+  const py::array_t<float> now = fieldOf(name);
   std::vector<py::ssize_t> want(now.shape(), now.shape() + now.ndim()), got(a.shape(), a.shape() + a.ndim());
   if (want != got) throw py::value_error("the values of '" + name + "' have the shape " + shapeText(got) + ", not " + shapeText(want));
   const py::array_t<float, py::array::c_style> c(a);
@@ -147,6 +193,7 @@ void PySimulation::setField(const std::string& name, const py::object& values) {
 }
 
 void PySimulation::setVelocity(py::object velocity) {
+  Call call(*this, "set_velocity");
   with([&](auto& sim) {
     constexpr int D = std::remove_reference_t<decltype(sim)>::kDimension;
     PythonVelocity<D>* source = nullptr;
@@ -173,6 +220,7 @@ void PySimulation::setVelocity(py::object velocity) {
 }
 
 void PySimulation::save(const std::string& path) const {
+  Call call(*this, "save");
   const Scene& s = *scene_.scene;
   with([&](auto& sim) {
     const nlohmann::json header = {
@@ -201,15 +249,19 @@ PySimulation PySimulation::load(const std::string& path, const std::string& back
   if (sceneHash(*scene.scene) != h.value("scene_hash", ""))
     throw py::value_error(path + ": the scene reads files that changed since the checkpoint was written");
   PySimulation sim(scene, backend, threads);
-  const StateReader state(std::move(c.state));
-  sim.with([&](auto& s) {
-    s.load(state);
-    return 0;
-  });
+  {
+    Call call(sim, "load");
+    const StateReader state(std::move(c.state));
+    sim.with([&](auto& s) {
+      s.load(state);
+      return 0;
+    });
+  }
   return sim;
 }
 
 py::dict PySimulation::run(const std::string& out, const py::object& progress, bool resume, bool quiet) {
+  Call call(*this, "run");
   RunOptions opt;
   opt.scene = scene_.path;
   opt.out = out;
@@ -240,10 +292,26 @@ py::dict PySimulation::run(const std::string& out, const py::object& progress, b
 }
 
 void PySimulation::close() {
-  s2_.reset();
-  s3_.reset();
-  velocity2_ = nullptr;
-  velocity3_ = nullptr;
+  {
+    std::lock_guard<std::mutex> lk(calls_->mutex);
+    if (calls_->busy) {
+      calls_->closeAfter = true;
+      return;
+    }
+  }
+  Call call(*this, "close");
+  free();
+}
+
+PySimulation::~PySimulation() {
+  if (!calls_ || (!s2_ && !s3_)) return;  // (moved from, or closed)
+  try {
+    Call call(*this, "close");
+    free();
+  } catch (const std::exception&) {  // the GPU in use on another thread: its memory is left to the process's end
+    (void)s2_.release();
+    (void)s3_.release();
+  }
 }
 
 }  // namespace morphoflow
