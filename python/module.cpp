@@ -7,7 +7,11 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cstdlib>
+
+#include <fmt/format.h>
 #include <fstream>
 #include <memory>
 
@@ -31,7 +35,11 @@ std::string tomlValue(const py::handle& v) {
   if (py::isinstance<py::int_>(v) || py::isinstance<py::float_>(v)) return py::str(py::repr(v));
   if (py::isinstance<py::str>(v)) {
     std::string s = "\"";
-    for (char c : v.cast<std::string>()) s += c == '"' ? "\\\"" : c == '\\' ? "\\\\" : std::string(1, c);
+    for (char c : v.cast<std::string>()) {
+      if (c == '"' || c == '\\') s += std::string("\\") + c;
+      else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) s += fmt::format("\\u{:04X}", static_cast<unsigned char>(c));
+      else s += c;
+    }
     return s + "\"";
   }
   if (py::isinstance<py::list>(v) || py::isinstance<py::tuple>(v)) {
@@ -48,7 +56,14 @@ std::vector<std::string> overrides(const py::object& set) {
   std::vector<std::string> out;
   if (set.is_none()) return out;
   if (!py::isinstance<py::dict>(set)) throw py::type_error("set= takes a dict of dotted keys to values");
-  for (const auto& [key, value] : set.cast<py::dict>()) out.push_back(py::str(key).cast<std::string>() + "=" + tomlValue(value));
+  for (const auto& [key, value] : set.cast<py::dict>()) {
+    const std::string k = py::str(key).cast<std::string>();
+    // A dotted key of bare names (what --set takes): '=', spaces or a newline would set another key.
+    const bool bare = !k.empty() && k.front() != '.' && k.back() != '.' && k.find("..") == std::string::npos &&
+                      std::all_of(k.begin(), k.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.'; });
+    if (!bare) throw py::value_error("set= takes dotted keys of letters, digits, '_' and '-' (as 'fluid.reynolds'), not '" + k + "'");
+    out.push_back(k + "=" + tomlValue(value));
+  }
   return out;
 }
 
@@ -63,6 +78,10 @@ PyScene sceneFrom(std::string text, std::string path, std::vector<std::string> s
 
 // The summary a batch or sweep wrote into `out`, with its exit status.
 py::dict batchResult(int status, const std::string& out) {
+  if (status == 130 || status == 143) {  // Ctrl-C (or SIGTERM): the runs checkpointed; resume=True goes on
+    PyErr_SetString(PyExc_KeyboardInterrupt, ("the batch in " + out + " stopped; its runs checkpointed (resume=True goes on)").c_str());
+    throw py::error_already_set();
+  }
   py::dict r;
   r["status"] = status;
   std::ifstream in(summaryPath(out, ""));
@@ -78,6 +97,8 @@ std::string executable() {
 }
 
 BatchOptions batchOptions(const std::string& out, int jobs, const py::object& set, bool keepGoing, bool resume, bool quiet) {
+  if (jobs < 1 || jobs > 256) throw py::value_error("jobs must be in [1, 256] (as --jobs), not " + std::to_string(jobs));
+  if (out.empty()) throw py::value_error("out must name a folder, not ''");
   BatchOptions o;
   o.out = out;
   o.jobs = jobs;
