@@ -77,6 +77,7 @@ class Watcher {
  public:
   Watcher(unsigned short port, const std::string& token) : ws_(ioc_) {
     ws_.next_layer().connect({boost::asio::ip::make_address("127.0.0.1"), port});
+    ws_.next_layer().set_option(tcp::no_delay(true));  // (as browsers do)
     ws_.handshake("127.0.0.1:" + std::to_string(port), "/ws?token=" + token);
     thread_ = std::thread([this] {
       beast::error_code ec;

@@ -401,6 +401,7 @@ struct StudioServer::Impl {
         continue;
       }
       ++connections;
+      socket.set_option(tcp::no_delay(true), ec);  // (a frame's last segment is not held back for an acknowledgement)
       asio::co_spawn(ioc, connection(std::move(socket)), asio::detached);
     }
   }

@@ -205,14 +205,20 @@ void StudioSession::stepOnce() {
 
 void StudioSession::publish() {
   std::string field;
+  bool running = false;
   {
     std::lock_guard<std::mutex> lk(mutex_);
-    field = field_;
+    field = field_, running = running_;
   }
   std::string bytes;
   try {
     bytes = with([&](auto& sim) {
-      sim.checkFinite(fmt::format("at step {}", sim.steps()));
+      // Every field checked for NaN and infinity when paused and at most 4
+      // times a second while running (a frame in between shows them as 0).
+      if (!running || Clock::now() - lastCheck_ >= std::chrono::milliseconds(250)) {
+        sim.checkFinite(fmt::format("at step {}", sim.steps()));
+        lastCheck_ = Clock::now();
+      }
       const OutputSettings& out = clockScene_->output;
       const bool autoRange = field != out.field || out.autoRange;
       const nlohmann::json meta = {{"field", field}, {"t", sim.time()}, {"step", sim.steps()}, {"dimension", dimension_}};

@@ -102,7 +102,7 @@ class StudioSession {
   std::shared_ptr<const std::string> frame_;
   std::function<void()> listener_;
   std::function<bool()> wanted_;
-  std::chrono::steady_clock::time_point lastFrame_{};
+  std::chrono::steady_clock::time_point lastFrame_{}, lastCheck_{};
   std::atomic<long> framesPublished_{0};
   std::optional<ChildProcess> render_;
   std::string renderOut_;
