@@ -130,7 +130,7 @@ nlohmann::json post(unsigned short port, const std::string& token, const std::st
 
 struct Row {
   std::string name;
-  double alone = 0, watched = 0, framesPerSecond = 0, frameBytes = 0, latencyMedian = 0, latencyMax = 0;
+  double alone = 0, watched = 0, framesPerSecond = 0, frameBytes = 0, frameMs = 0, latencyMedian = 0, latencyMax = 0;
 };
 
 Row measure(const std::string& name, const std::string& text, const std::string& path, double seconds, bool latency) {
@@ -154,6 +154,7 @@ Row measure(const std::string& name, const std::string& text, const std::string&
   }
   row.alone = median(alone), row.watched = median(watched), row.framesPerSecond = median(fps);
   row.frameBytes = double(server.session()->frame()->size());
+  row.frameMs = server.session()->state()["frame_ms"].get<double>();
   if (latency) {  // a deposit posted while running, to the first frame computed after it
     post(server.port(), server.token(), "/api/control", {{"action", "play"}});
     std::vector<double> ms;
@@ -181,16 +182,16 @@ void runStudioBench(const std::string& sceneDir, double seconds, const std::stri
   const std::vector<Row> rows = {
       measure("2D 128^2 fluid, 256^2 chemicals", sceneText(cavity, 2, 128, 256), cavity, seconds, true),
       measure("3D 64^3 fluid, 64^3 chemicals", sceneText(cavity3, 3, 64, 64), cavity3, seconds, false)};
-  fmt::print("{:<34} {:>12} {:>12} {:>9} {:>10} {:>11} {:>18}\n", "case", "alone/s", "studio/s", "cost", "frames/s",
-             "frame KiB", "edit to frame ms");
+  fmt::print("{:<34} {:>10} {:>10} {:>7} {:>9} {:>9} {:>9} {:>18}\n", "case", "alone/s", "studio/s", "cost", "frames/s",
+             "frame KiB", "frame ms", "edit to frame ms");
   nlohmann::json out = nlohmann::json::array();
   for (const Row& r : rows) {
     const double cost = r.alone / r.watched - 1.0;  // the extra time a step takes in the studio
-    fmt::print("{:<34} {:>12.1f} {:>12.1f} {:>8.1f}% {:>10.1f} {:>11.1f} {:>18}\n", r.name, r.alone, r.watched, 100 * cost,
-               r.framesPerSecond, r.frameBytes / 1024,
+    fmt::print("{:<34} {:>10.1f} {:>10.1f} {:>6.1f}% {:>9.1f} {:>9.1f} {:>9.2f} {:>18}\n", r.name, r.alone, r.watched, 100 * cost,
+               r.framesPerSecond, r.frameBytes / 1024, r.frameMs,
                r.latencyMedian > 0 ? fmt::format("{:.1f} (max {:.1f})", r.latencyMedian, r.latencyMax) : std::string("-"));
     out.push_back({{"case", r.name}, {"steps_per_second_alone", r.alone}, {"steps_per_second_studio", r.watched},
-                   {"cost", cost}, {"frames_per_second", r.framesPerSecond}, {"frame_bytes", r.frameBytes},
+                   {"cost", cost}, {"frames_per_second", r.framesPerSecond}, {"frame_bytes", r.frameBytes}, {"frame_ms", r.frameMs},
                    {"edit_to_frame_ms_median", r.latencyMedian}, {"edit_to_frame_ms_max", r.latencyMax}});
   }
   if (!json.empty()) std::ofstream(json) << nlohmann::json{{"suite", "studio"}, {"threads", hardwareThreads()}, {"cases", out}}.dump(2) << "\n";

@@ -211,6 +211,7 @@ void StudioSession::publish() {
     field = field_, running = running_;
   }
   std::string bytes;
+  const Clock::time_point start = Clock::now();
   try {
     bytes = with([&](auto& sim) {
       // Every field checked for NaN and infinity when paused and at most 4
@@ -234,6 +235,7 @@ void StudioSession::publish() {
   {
     std::lock_guard<std::mutex> lk(mutex_);
     frame_ = std::make_shared<const std::string>(std::move(bytes));
+    frameSeconds_ += std::chrono::duration<double>(Clock::now() - start).count();
     listener = listener_;
   }
   ++framesPublished_;
@@ -257,7 +259,8 @@ nlohmann::json StudioSession::state() const {
   nlohmann::json j = {{"scene", s.name},        {"path", log_.path()},   {"dimension", dimension_},
                       {"t", time_},             {"steps", steps_},       {"running", running_},
                       {"steps_per_second", stepsPerSecond_}, {"field", field_}, {"steps_per_frame", stepsPerFrame_},
-                      {"frames", framesPublished_.load()}};
+                      {"frames", framesPublished_.load()},
+                      {"frame_ms", framesPublished_ > 0 ? 1e3 * frameSeconds_ / double(framesPublished_) : 0.0}};
   j["domain"] = s.fluid.size;
   j["fields"] = with([](auto& sim) { return sim.fieldNames(); });
   j["species"] = with([](auto& sim) { return sim.species(); });

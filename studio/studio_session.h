@@ -104,6 +104,7 @@ class StudioSession {
   std::function<bool()> wanted_;
   std::chrono::steady_clock::time_point lastFrame_{}, lastCheck_{};
   std::atomic<long> framesPublished_{0};
+  double frameSeconds_ = 0.0;  // the simulation thread's time making frames (under mutex_)
   std::optional<ChildProcess> render_;
   std::string renderOut_;
   long renderFrames_ = 0;
