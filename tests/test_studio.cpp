@@ -3,10 +3,12 @@
 // saved scene reproduces the session bit for bit, and the web server's
 // refusals, limits and frame dropping over real sockets (Boost.Beast clients).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstring>
+#include <fstream>
 #include <thread>
 
 #include <boost/asio.hpp>
@@ -410,11 +412,20 @@ TEST(StudioServer, ASlowClientGetsTheNewestFrameAndFramesAreDropped) {
 }
 
 // 50 clients connect, each takes a frame and stops reading: the server holds
-// them, sends them nothing more and makes no frame for them while the run goes
-// on (the simulation spends nothing on them); they leave and it holds none.
+// them in bounded memory, sends them nothing more and makes no frame for them
+// while the run goes on (the simulation spends nothing on them); they leave
+// and it holds none.
 TEST(StudioServer, FiftyClientsWatchAndLeave) {
   Served s;
   s.call(http::verb::post, "/api/control", R"({"action":"play"})");
+  auto residentMiB = [] {  // this process's resident memory
+    std::ifstream statm("/proc/self/statm");
+    long pages = 0, resident = 0;
+    statm >> pages >> resident;
+    return double(resident) * double(sysconf(_SC_PAGESIZE)) / (1 << 20);
+  };
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  const double before = residentMiB();
   boost::asio::io_context ioc;
   std::vector<std::unique_ptr<websocket::stream<tcp::socket>>> clients;
   for (int k = 0; k < 50; ++k) {
@@ -434,6 +445,7 @@ TEST(StudioServer, FiftyClientsWatchAndLeave) {
   EXPECT_GT(s.server.session()->state()["steps"].get<long>(), steps + 10);
   EXPECT_EQ(s.server.session()->framesPublished(), published);
   EXPECT_EQ(s.server.framesSent(), sent);
+  EXPECT_LT(residentMiB() - before, 32.0) << "50 clients made the process grow by that many MiB";
   for (auto& c : clients) c->next_layer().close();
   clients.clear();
   for (int k = 0; k < 200 && s.server.clients() > 0; ++k) std::this_thread::sleep_for(std::chrono::milliseconds(10));
