@@ -99,6 +99,7 @@ void writeFileAtomically(const fs::path& path, std::string_view bytes) {
 }
 
 void createOutputFolder(const fs::path& dir) {
+  if (dir.empty()) throw OutputError("--out", "names no folder (it is empty)", "give --out DIR");
   std::error_code ec;
   const fs::path abs = fs::weakly_canonical(fs::absolute(dir, ec), ec);
   for (const char* system : {"/proc", "/sys", "/dev"}) {

@@ -45,10 +45,10 @@ void checkFrames(const Scene& scene, const RunOptions& opt) {
 void checkInputsOutside(const Scene& scene, const std::string& out) {
   namespace fs = std::filesystem;
   std::error_code ec;
-  const fs::path folder = fs::weakly_canonical(fs::absolute(out), ec);
+  const fs::path folder = fs::weakly_canonical(fs::absolute(out, ec), ec);
   if (ec) return;
   for (const SceneInput& in : scene.inputs) {
-    const fs::path file = fs::weakly_canonical(fs::absolute(in.path), ec);
+    const fs::path file = fs::weakly_canonical(fs::absolute(in.path, ec), ec);
     if (ec) continue;
     const auto [f, o] = std::mismatch(file.begin(), file.end(), folder.begin(), folder.end());
     if (o == folder.end())

@@ -91,6 +91,13 @@ TEST(OutputSafety, AnOutThatCannotHoldARunIsExitTwoNamingIt) {
     EXPECT_EQ(r.output.find("internal error"), std::string::npos) << r.output;
   }
   EXPECT_EQ(fs::file_size(dir / "a_file"), 12u);  // untouched
+  // An empty --out names no folder: exit 2 saying so, for run and batch.
+  for (const std::string& command : {"run " + kScene + kSmall + " --out ''", "batch " + kScene + kSmall + " --out ''"}) {
+    CommandResult r = runMorphoflow(command);
+    EXPECT_EQ(r.status, 2) << command << ": " << r.output;
+    EXPECT_NE(r.output.find("--out"), std::string::npos) << r.output;
+    EXPECT_EQ(r.output.find("internal error"), std::string::npos) << r.output;
+  }
   fs::remove_all(dir);
 }
 
