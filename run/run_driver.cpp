@@ -132,6 +132,11 @@ class Driver {
     if (steady_->steady())
       log_.say(fmt::format("steady at t = {:.5g} (step {}): the velocity changes by {:.3g} per unit time, below "
                            "time.until_steady = {:g}", sim_.time(), sim_.steps(), steady_->change(), tol));
+    else if (!steady_->checked())
+      log_.warn(fmt::format("warning: steadiness not measured: it is measured at each frame, every {} steps "
+                            "(output.every), and the run ended at step {} before the first; give output.every <= {} "
+                            "to measure it (time.until_steady = {:g})",
+                            schedule_.every(), sim_.steps(), std::max(1L, sim_.steps()), tol));
     else
       log_.warn(fmt::format("warning: not steady by t = {:.5g}: the velocity still changes by {:.3g} per unit time "
                             "(time.until_steady = {:g}); give a longer time.duration (or time.steps) to run on",
@@ -143,6 +148,9 @@ class Driver {
   nlohmann::json steadyRecord() const {
     nlohmann::json s = {{"tolerance", steady_->tolerance()}, {"steady", steady_->steady()}};
     s["relative_change_per_time"] = steady_->checked() ? nlohmann::json(steady_->change()) : nlohmann::json(nullptr);
+    if (!steady_->checked())
+      s["not_measured_because"] = fmt::format("output.every ({} steps) is longer than the run ({} steps)", schedule_.every(),
+                                              sim_.steps());
     s["stopped_because"] = steady_->steady()                  ? "steady"
                            : schedule_.pastLast(sim_.steps()) ? "--frames"
                            : scene_.time.steps > 0            ? "time.steps"

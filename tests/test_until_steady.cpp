@@ -70,6 +70,23 @@ TEST(UntilSteady, ACappedRunSaysItIsNotSteadyAndWhatStoppedIt) {
   fs::remove_all(dir);
 }
 
+// No frame within the run, so no measurement: said as such (not "changes by
+// inf"), with the output.every that would measure it, and why in run.json.
+TEST(UntilSteady, ARunWithNoFrameToMeasureAtSaysSo) {
+  const fs::path dir = tempDir("until_steady_unmeasured");
+  CommandResult r = runMorphoflow("run " + sceneFile("lid_driven_cavity.toml") +
+                                  " --set grid.resolution=[16,16] --set output.images=false --set time.until_steady=1e-3"
+                                  " --set time.duration=0.5 --set output.every=1000 --out " + (dir / "o").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  EXPECT_NE(r.output.find("steadiness not measured"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("give output.every <= 50"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("inf"), std::string::npos) << r.output;
+  const nlohmann::json s = runJson(dir / "o")["until_steady"];
+  EXPECT_TRUE(s["relative_change_per_time"].is_null());
+  EXPECT_EQ(s["not_measured_because"], "output.every (1000 steps) is longer than the run (50 steps)");
+  fs::remove_all(dir);
+}
+
 TEST(UntilSteady, IsRefusedWithoutAFluidAndOutOfRange) {
   const fs::path dir = tempDir("until_steady_bad");
   const std::string rd = "[grid]\nresolution = [16, 16]\n[time]\ndt = 0.5\nuntil_steady = 1e-4\n[rd]\nmodel = \"gray-scott\"\n";
