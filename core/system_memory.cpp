@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cstdio>
 #include <fstream>
+#include <string>
+#include <utility>
+
+#include <sys/resource.h>
 
 namespace morphoflow {
 
@@ -27,9 +31,36 @@ uintmax_t cgroupRoom() {
   return limit > c ? limit - c : 0;
 }
 
+// This process's status line `key` ("VmSize:", "VmData:") in bytes.
+uintmax_t statusBytes(const std::string& key) {
+  std::ifstream in("/proc/self/status");
+  std::string k;
+  while (in >> k) {
+    if (k == key) {
+      uintmax_t kb = 0;
+      in >> kb;
+      return kb * 1024;
+    }
+    in.ignore(1 << 12, '\n');
+  }
+  return 0;
+}
+
+// What ulimit -v (RLIMIT_AS) and ulimit -d (RLIMIT_DATA) leave this process.
+uintmax_t rlimitRoom() {
+  uintmax_t room = UINTMAX_MAX;
+  for (const auto& [resource, key] : {std::pair{RLIMIT_AS, "VmSize:"}, std::pair{RLIMIT_DATA, "VmData:"}}) {
+    rlimit r{};
+    if (getrlimit(resource, &r) != 0 || r.rlim_cur == RLIM_INFINITY) continue;
+    const uintmax_t used = statusBytes(key), limit = r.rlim_cur;
+    room = std::min(room, limit > used ? limit - used : uintmax_t(0));
+  }
+  return room;
+}
+
 }  // namespace
 
-uintmax_t availableBytes() { return std::min(meminfoAvailable(), cgroupRoom()); }
+uintmax_t availableBytes() { return std::min({meminfoAvailable(), cgroupRoom(), rlimitRoom()}); }
 
 std::string humanBytes(uintmax_t b) {
   char text[32];

@@ -89,6 +89,7 @@ class Driver {
     while (clock_.running(sim_.steps(), sim_.time()) && !schedule_.pastLast(sim_.steps())) {
       if (StopSignals::received()) return stop();
       lastDt_ = clock_.dt(sim_);
+      checkStepsLeft();
       sim_.advance(lastDt_, stepsNow());
       const long f = frame();
       const bool steady = f > 0 && steady_ && steady_->check(sim_);
@@ -125,6 +126,20 @@ class Driver {
     const long together = sim_.stepsTogether(), step = sim_.steps();
     if (together <= 1 || !clock_.fixedDt()) return 1;
     return std::min({together, schedule_.every() - step % schedule_.every(), clock_.stepsLeft(step)});
+  }
+
+  // A CFL limit sets dt as the run goes: refused once the duration left
+  // would take more steps than any run may (TimeSettings::kMaxSteps).
+  void checkStepsLeft() const {
+    if (scene_.time.cfl <= 0 || scene_.time.steps > 0) return;
+    const double left = (scene_.time.duration - sim_.time()) / lastDt_;
+    if (double(sim_.steps()) + left <= double(TimeSettings::kMaxSteps)) return;
+    throw UserError({scene_.path, 0, 0}, "time.cfl",
+                    fmt::format("at step {} (t = {:.5g}) the CFL limit {:g} gives dt = {:.3g}: the {:.3g} time units left "
+                                "would take {:.3g} steps, more than {}",
+                                sim_.steps(), sim_.time(), scene_.time.cfl, lastDt_, scene_.time.duration - sim_.time(), left,
+                                TimeSettings::kMaxSteps),
+                    "raise time.cfl or shorten time.duration");
   }
 
   void sayHowSteady() {

@@ -31,6 +31,9 @@ struct TimeSettings {
   static constexpr double kEndTolerance = 1e-12;
   // The duration of a run until steady that gives neither steps nor duration.
   static constexpr double kSteadyCap = 1000.0;
+  // The most steps a run may take (a step count, a duration over dt, or a
+  // CFL limit's steps: run/run_driver.cpp).
+  static constexpr long kMaxSteps = 100'000'000;
 };
 
 struct OutputSettings {

@@ -6,7 +6,7 @@
 
 namespace morphoflow {
 
-constexpr long kMaxSteps = 100'000'000;
+constexpr long kMaxSteps = TimeSettings::kMaxSteps;
 
 void parseTime(SceneContext& c, Scene* sp) {
   Reader& r = c.r;

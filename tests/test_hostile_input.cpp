@@ -113,6 +113,24 @@ TEST(HostileInput, QuantitiesThatSizeWorkAreBoundedBeforeUse) {
                                   " --set 'time={dt=1e-300,duration=1e9}'");
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("steps, more than 100000000"), std::string::npos) << r.output;
+  // a CFL limit whose steps would never end: refused at the step it sets dt, naming time.cfl
+  r = runMorphoflow("run " + fluid + o + " --set 'time={dt=0.01,duration=1.0,cfl=1e-12}'");
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("'time.cfl'"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("more than 100000000"), std::string::npos) << r.output;
+  // memory that ulimit -v does not give: refused before allocating, with what is available
+  std::string out;
+  {
+    const std::string cmd = "ulimit -v 1200000; " + std::string(MORPHOFLOW_BINARY) + " run " + sceneFile("coupled/cavity_gray_scott_3d.toml") +
+                            " --set time.steps=2" + o + " 2>&1";
+    FILE* p = popen(cmd.c_str(), "r");
+    char buf[4096];
+    for (size_t n; p && (n = fread(buf, 1, sizeof buf, p)) > 0;) out.append(buf, n);
+    const int st = p ? pclose(p) : -1;
+    EXPECT_EQ(WIFEXITED(st) ? WEXITSTATUS(st) : -1, 2) << out;
+  }
+  EXPECT_NE(out.find("this run needs about 1.92 GiB of memory, and"), std::string::npos) << out;
+  EXPECT_EQ(out.find("internal error"), std::string::npos) << out;
   // a viscosity from a tiny Reynolds number
   expectUserError("run " + fluid + " --quiet --set fluid.reynolds=1e-300 --out " + (dir / "o").string(), "fluid.reynolds");
   // cells so small that back-traces lose all precision, and back-traces a million cells long
