@@ -2,10 +2,12 @@
 
 #include "core/error.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "sim/steppers.h"
 #include "core/parallel.h"
@@ -231,6 +233,9 @@ void checkFluidLeft(const Scene& scene, const FluidSolver<D>& fluid) {
 }
 
 template <int D>
+void checkFluidBounded(const FluidSolver<D>& fluid, const std::string& where);
+
+template <int D>
 void checkFluidFinite(const FluidSolver<D>& fluid, const std::string& where) {
   auto finite = [](const Grid<float, D>& g) {
     for (float v : g.values())
@@ -245,6 +250,44 @@ void checkFluidFinite(const FluidSolver<D>& fluid, const std::string& where) {
   if (fluid.hasDye() && !finite(fluid.dye()))
     throw NonFiniteError(fmt::format("the simulation diverged {} in the fluid step: the dye is not finite", where),
                          "use a smaller time.dt or set time.cfl");
+  checkFluidBounded<D>(fluid, where);
+}
+
+// A run that blew up while staying finite: a speed of more than 1000 domain
+// lengths per unit time and 1000 times the fastest speed the scene gives
+// (walls, inflow, sources), which no scene means. The hint names the forces
+// the scene sets, the likeliest causes.
+template <int D>
+void checkFluidBounded(const FluidSolver<D>& fluid, const std::string& where) {
+  const FluidSettings& f = fluid.settings();
+  double given = 0.0;
+  for (const DomainSide& side : f.boundaries.sides) {
+    for (double w : side.wallVelocity) given = std::max(given, std::abs(w));
+    if (side.kind == BoundaryKind::Inflow) given = std::max(given, 1.5 * std::abs(f.boundaries.inflowMeanVelocity));
+  }
+  for (const SmokeSource& src : f.smoke.sources)
+    for (double v : src.velocity) given = std::max(given, std::abs(v));
+  const double length = *std::max_element(f.size.begin(), f.size.end()), bound = 1e3 * std::max(length, given);
+  double top = 0.0;
+  for (int a = 0; a < D; ++a)
+    for (float v : fluid.velocity()[a].values()) top = std::max(top, double(std::abs(v)));
+  if (top <= bound) return;
+  std::vector<std::string> forces;
+  auto say = [&](const char* key, double v) {
+    if (v != 0.0) forces.push_back(fmt::format("{} = {:g}", key, v));
+  };
+  say("smoke.vorticity", f.smoke.vorticity);
+  say("smoke.buoyancy", f.smoke.heat);
+  say("smoke.weight", f.smoke.weight);
+  say("fluid.buoyancy", f.buoyancy);
+  for (int a = 0; a < D; ++a) say(a == 0 ? "fluid.force[0]" : a == 1 ? "fluid.force[1]" : "fluid.force[2]", f.force[size_t(a)]);
+  throw NonFiniteError(
+      fmt::format("the simulation blew up {} in the fluid step: the speed reached {:.3g}, more than 1000 domain lengths "
+                  "and 1000 times the scene's speeds ({:g} in all) per unit time",
+                  where, top, bound),
+      forces.empty() ? std::string("use a smaller time.dt or set time.cfl, and check the boundary speeds")
+                     : fmt::format("the forces set, the likeliest causes: {}; lower them, or use a smaller time.dt",
+                                   fmt::join(forces, ", ")));
 }
 
 template void checkFluidFinite<2>(const FluidSolver<2>&, const std::string&);

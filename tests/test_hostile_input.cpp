@@ -216,6 +216,32 @@ TEST(HostileInput, ADivergingRunStopsNamingTheStepAndStageAndKeepsItsFrames) {
   fs::remove_all(dir);
 }
 
+// A run that blows up while staying finite (a speed past 1000 domain lengths
+// and 1000 times the scene's own speeds per unit time) stops as a diverged
+// one does: exit 2 naming the stage and the forces set, its frames kept.
+TEST(HostileInput, ARunThatBlowsUpWhileFiniteStopsNamingTheForces) {
+  const fs::path dir = tempDir("hostile_blowup");
+  for (const auto& [scene, sets, key] :
+       {std::tuple{sceneFile("vfx/plume_3d.toml"), std::string(" --set grid.resolution=[12,20,12] --set smoke.vorticity=1e6"),
+                   std::string("smoke.vorticity = 1e+06")},
+        std::tuple{sceneFile("vfx/plume_2d.toml"), std::string(" --set grid.resolution=[32,48] --set smoke.buoyancy=1e9"),
+                   std::string("smoke.buoyancy = 1e+09")},
+        std::tuple{sceneFile("vfx/plume_2d.toml"), std::string(" --set grid.resolution=[32,48] --set smoke.weight=-1e9"),
+                   std::string("smoke.weight = -1e+09")}}) {
+    const fs::path out = dir / "o";
+    fs::remove_all(out);
+    CommandResult r = runMorphoflow("run " + scene + sets + " --quiet --set time.duration=0.5 --set output.every=2 --out " +
+                                    out.string());
+    ASSERT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find("blew up"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("in the fluid step"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(key), std::string::npos) << r.output;
+    std::ifstream in(out / "run.json");
+    EXPECT_EQ(nlohmann::json::parse(in)["exit_state"], "diverged");
+  }
+  fs::remove_all(dir);
+}
+
 // Every numeric option is range-checked where it is parsed: infinities, NaN,
 // values far beyond what the option can use, signs and empty tokens are exit
 // 2 naming the option, before anything runs or is written.
