@@ -110,6 +110,7 @@ class Driver {
     const nlohmann::json j = record("completed");
     if (j.contains("video") && !j["video"]["written"].get<bool>())
       log_.warn("warning: " + j["video"]["warning"].get<std::string>());
+    if (j.contains("vdb_half_warning")) log_.warn("warning: " + j["vdb_half_warning"].get<std::string>());
     if (steady_) sayHowSteady();
     log_.say(fmt::format("done: {} steps, t = {:.5g}, {:.2f} s wall, {} frames -> {}", sim_.steps(), sim_.time(),
                          wallSeconds(), j["frames_written"].get<int>(), out_.string()));

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include "run/output_kinds.h"
 #include "run/scene_hash.h"
@@ -168,10 +169,29 @@ VolumeOptions::ActiveMask VdbSink<D>::smokeMask(const Simulation<D>& sim, const 
   return m;
 }
 
+namespace {
+
+// output.vdb_half: a value beyond half's range (65504) would be read back as
+// infinity; it is written at the limit instead, and counted per grid.
+void clampToHalf(std::vector<VolumeGrid>* grids, std::map<std::string, uintmax_t>* clamped) {
+  constexpr float kHalfMax = 65504.0f;
+  for (VolumeGrid& g : *grids) {
+    if (g.kind == VolumeGrid::Kind::LevelSet) continue;
+    uintmax_t n = 0;
+    for (std::vector<float>& c : g.values)
+      for (float& v : c)
+        if (std::abs(v) > kHalfMax) v = std::copysign(kHalfMax, v), ++n;
+    if (n > 0) (*clamped)[g.name] += n;
+  }
+}
+
+}  // namespace
+
 template <int D>
 void VdbSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
   const OutputSettings& o = scene_.output;
-  const std::vector<VolumeGrid> g = grids(sim);
+  std::vector<VolumeGrid> g = grids(sim);
+  if (o.vdbHalf) clampToHalf(&g, &clamped_);
   VolumeMetadata meta;
   meta.frame = at.frame;
   meta.step = at.step;
@@ -207,11 +227,20 @@ void VdbSink<D>::report(nlohmann::json* j) const {
   (*j)["vdb_written"] = written_;
   addBytes(j, "vdb", bytes_);
   if (scene_.output.nanovdb) addBytes(j, "nanovdb", nanoBytes_);
+  if (!clamped_.empty()) {
+    std::vector<std::string> parts;
+    for (const auto& [name, n] : clamped_) parts.push_back(fmt::format("'{}' {} voxels", name, n));
+    (*j)["vdb_half_clamped"] = clamped_;
+    (*j)["vdb_half_warning"] =
+        fmt::format("output.vdb_half: values beyond half's range (65504) were written as +-65504: {} (over all frames; "
+                    "set output.vdb_half = false to keep them)",
+                    fmt::join(parts, ", "));
+  }
 }
 
 template <int D>
 nlohmann::json VdbSink<D>::state() const {
-  return {{"written", written_}, {"bytes", bytes_}, {"nano_bytes", nanoBytes_}};
+  return {{"written", written_}, {"bytes", bytes_}, {"nano_bytes", nanoBytes_}, {"clamped", clamped_}};
 }
 
 // Blender loads a numbered sequence as one animated volume from its first file.
@@ -230,6 +259,10 @@ void VdbSink<D>::restore(const nlohmann::json& s) {
   written_ = stateCount<int>(s, "written");
   bytes_ = stateCount<uintmax_t>(s, "bytes");
   nanoBytes_ = stateCount<uintmax_t>(s, "nano_bytes");
+  clamped_.clear();
+  if (s.contains("clamped") && s["clamped"].is_object())
+    for (const auto& [name, n] : s["clamped"].items())
+      if (n.is_number_unsigned()) clamped_[name] = n.template get<uintmax_t>();
 }
 
 template class VdbSink<2>;

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <filesystem>
+#include <map>
 #include <string>
 
 #include "run/output_sinks.h"
@@ -38,6 +39,7 @@ class VdbSink : public OutputSink<D> {
   const std::string hash_;  // the scene's settings hash, for the metadata
   int written_ = 0;
   uintmax_t bytes_ = 0, nanoBytes_ = 0;
+  std::map<std::string, uintmax_t> clamped_;  // output.vdb_half: voxels per grid beyond half's range, written at its limit
 };
 
 }  // namespace morphoflow

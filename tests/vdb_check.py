@@ -224,5 +224,23 @@ d = vdb.read(os.path.join(do, "vdb", last), "density")
 vals = np.array([v.value for v in d.citerOnValues()], dtype=np.float64)
 check(vals.size > 0 and np.all(vals == 0), f"smoke overflow: a density past a float is 0 ({vals.size} active, {np.unique(vals)[:4]})")
 
+# output.vdb_half: a temperature past half's range (ambient 70000) is written
+# at 65504, never read back as inf, and the run says so (warning, run.json).
+dh = os.path.join(work, "smoke_half")
+shutil.rmtree(dh, ignore_errors=True)
+r = subprocess.run([binary, "run", os.path.join(scenes, "vfx/plume_3d.toml"), "--quiet", "--out", dh,
+                    "--set", "grid.resolution=[12,20,12]", "--set", "time.duration=0.3", "--set", "output.every=30",
+                    "--set", "output.images=false", "--set", "output.vdb_half=true", "--set", "smoke.ambient=70000"],
+                   capture_output=True, text=True)
+check(r.returncode == 0, f"smoke half: exit {r.returncode} {r.stderr}")
+check("'temperature'" in r.stderr and "65504" in r.stderr, f"smoke half: the warning names the grid: {r.stderr!r}")
+with open(os.path.join(dh, "run.json")) as f:
+    clamped = json.load(f).get("vdb_half_clamped", {})
+check(clamped.get("temperature", 0) > 0 and "density" not in clamped, f"smoke half: run.json counts {clamped}")
+last = sorted(x for x in os.listdir(os.path.join(dh, "vdb")) if x.endswith(".vdb"))[-1]
+t = vdb.read(os.path.join(dh, "vdb", last), "temperature")
+vals = np.array([v.value for v in t.citerOnValues()], dtype=np.float64)
+check(vals.size > 0 and np.all(np.isfinite(vals)) and vals.max() == 65504.0, f"smoke half: finite, at most 65504 ({vals.max() if vals.size else None})")
+
 print(f"vdb_check: {'FAILED' if failures else 'ok'} ({len(failures)} failures)")
 sys.exit(1 if failures else 0)
