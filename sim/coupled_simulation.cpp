@@ -55,6 +55,7 @@ CoupledSimulation<D>::CoupledSimulation(const Scene& scene, Backend backend, War
       rd_(scene.rd.settings, *findModel(scene.rd.settings.model)),
       host_([this] { steps_->toHost(&fluid_, &rd_); }) {
   checkFluidLeft<D>(scene, fluid_);
+  warnOfEmptySources<D>(scene, fluid_, warn_);
   initialState<D>(scene, &rd_);
   applyScene<D>(scene, &rd_);
   const CouplingScene& C = scene.coupling;

@@ -12,6 +12,7 @@
 #include "sim/steppers.h"
 #include "core/parallel.h"
 #include "fluid/probes.h"
+#include "fluid/smoke.h"
 
 namespace morphoflow {
 
@@ -69,6 +70,7 @@ template <int D>
 FluidSimulation<D>::FluidSimulation(const Scene& scene, Backend backend, Warn warn)
     : scene_(scene), warn_(std::move(warn)), fluid_(scene.fluid), host_([this] { stepper_->toHost(&fluid_); }) {
   checkFluidLeft<D>(scene, fluid_);
+  warnOfEmptySources<D>(scene, fluid_, warn_);
   initialiseDye<D>(scene, &fluid_);
   stepper_ = makeFluidStepper<D>(backend, &fluid_);  // from the state set up here
   for (int a = 0; a < D; ++a)
@@ -232,6 +234,22 @@ void checkFluidLeft(const Scene& scene, const FluidSolver<D>& fluid) {
                   "make the obstacles smaller than the domain");
 }
 
+// A fixed source that covers no fluid cell (smaller than the samples of a
+// cell, inside an obstacle, an image or sdf with nothing inside) emits
+// nothing: said, as a source whose window opens after the run is.
+template <int D>
+void warnOfEmptySources(const Scene& scene, const FluidSolver<D>& fluid, const std::function<void(const std::string&)>& warn) {
+  const std::vector<SmokeSource>& sources = scene.fluid.smoke.sources;
+  for (size_t q = 0; q < sources.size(); ++q) {
+    if (!sources[q].motion.empty()) continue;  // (a moving one may come into the fluid)
+    const Grid<float, D> cover = sourceCover<D>(sources[q], sources[q].start, fluid.cells(), fluid.h(), fluid.solid());
+    if (std::all_of(cover.values().begin(), cover.values().end(), [](float c) { return c == 0.0f; }) && warn)
+      warn(fmt::format("warning: sources.{} covers no fluid cell (smaller than a cell, inside an obstacle, or an image "
+                       "or sdf with nothing inside): it emits nothing",
+                       q));
+  }
+}
+
 template <int D>
 void checkFluidBounded(const FluidSolver<D>& fluid, const std::string& where);
 
@@ -292,6 +310,8 @@ void checkFluidBounded(const FluidSolver<D>& fluid, const std::string& where) {
 
 template void checkFluidFinite<2>(const FluidSolver<2>&, const std::string&);
 template void checkFluidFinite<3>(const FluidSolver<3>&, const std::string&);
+template void warnOfEmptySources<2>(const Scene&, const FluidSolver<2>&, const std::function<void(const std::string&)>&);
+template void warnOfEmptySources<3>(const Scene&, const FluidSolver<3>&, const std::function<void(const std::string&)>&);
 template void checkFluidLeft<2>(const Scene&, const FluidSolver<2>&);
 template void checkFluidLeft<3>(const Scene&, const FluidSolver<3>&);
 template void initialiseDye<2>(const Scene&, FluidSolver<2>*);

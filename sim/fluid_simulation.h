@@ -29,6 +29,10 @@ void initialiseDye(const Scene& scene, FluidSolver<D>* fluid);
 template <int D>
 void checkFluidLeft(const Scene& scene, const FluidSolver<D>& fluid);
 
+// Warns of each fixed source that covers no fluid cell (it would emit nothing).
+template <int D>
+void warnOfEmptySources(const Scene& scene, const FluidSolver<D>& fluid, const std::function<void(const std::string&)>& warn);
+
 // Throws NonFiniteError when a velocity component or the dye is not finite.
 template <int D>
 void checkFluidFinite(const FluidSolver<D>& fluid, const std::string& where);

@@ -1,5 +1,9 @@
 #include "sim/simulation_factory.h"
 
+#include <memory>
+#include <set>
+#include <string>
+
 #include <stdexcept>
 
 #include "sim/coupled_simulation.h"
@@ -28,8 +32,15 @@ template <int D>
 std::unique_ptr<TimelineSimulation<D>> makeTimelineSimulation(const Scene& scene, Backend backend,
                                                               const std::function<void(const std::string&)>& say,
                                                               const std::function<void(const std::string&)>& warn) {
+  // Built again at each change: what a build says (a warning about the
+  // scene) is said once, not at every rebuild.
+  auto once = [seen = std::make_shared<std::set<std::string>>()](std::function<void(const std::string&)> f) {
+    return [seen, f](const std::string& line) {
+      if (seen->insert(line).second && f) f(line);
+    };
+  };
   return std::make_unique<TimelineSimulation<D>>(
-      scene, [backend, say, warn](const Scene& at) { return makeFixed<D>(at, backend, say, warn); });
+      scene, [backend, say = once(say), warn = once(warn)](const Scene& at) { return makeFixed<D>(at, backend, say, warn); });
 }
 
 template <int D>

@@ -290,6 +290,15 @@ TEST(HostileInput, ARunThatWouldDoNothingSaysSo) {
   r = runMorphoflow("run " + write(dir / "tiny.toml", tiny).string() + " --quiet" + out);
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("time.duration"), std::string::npos) << r.output;
+  // A source that covers no fluid cell (far smaller than a cell, or inside an
+  // obstacle) runs, and says it emits nothing; the plume as shipped does not.
+  const std::string plume = "run " + sceneFile("vfx/plume_2d.toml") + " --quiet --set grid.resolution=[32,48] --set time.duration=0.1" + out;
+  for (const std::string& sets : {std::string(" --set sources.0.radius=0.001"),
+                                  std::string(" --set 'obstacles=[{center=[0.5,0.15],radius=0.2}]'"), std::string()}) {
+    r = runMorphoflow(plume + sets);
+    EXPECT_EQ(r.status, 0) << sets << ": " << r.output;
+    EXPECT_EQ(r.output.find("sources.0 covers no fluid cell") != std::string::npos, !sets.empty()) << sets << ": " << r.output;
+  }
   fs::remove_all(dir);
 }
 
