@@ -40,6 +40,10 @@ ObstacleSpec parseRegion(SceneContext& c, const toml::table* o, const std::strin
     std::vector<double> sz = r.numbers(o, p, "size", {}, size_t(D), size_t(D), 0, 1e9, true);
     for (int a = 0; a < D; ++a) spec.halfSize[size_t(a)] = 0.5 * sz[size_t(a)];
   } else {
+    // The image (or sdf) is stretched over the domain: a centre would move nothing.
+    if (cn)
+      r.fail(cn, p + "center", "an " + shape + " region is its file stretched over the whole domain: a center does not apply",
+             "remove center, and draw the shape where it goes in the " + shape);
     const std::string key = "file";
     const toml::node* fn = r.node(o, p, key);
     if (!fn) r.fail(o, p + key, "an " + shape + " region needs file = \"path\"");

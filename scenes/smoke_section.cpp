@@ -26,6 +26,11 @@ SmokeSource parseSource(SceneContext& c, const toml::table* t, const std::string
   SmokeSource src;
   src.region = parseRegion(c, t, p);
   src.motion = parseMotion(c, t, p);
+  const bool fromFile = src.region.shape == ObstacleShape::Image || src.region.shape == ObstacleShape::Sdf;
+  if (fromFile && !src.motion.empty())
+    r.fail(r.node(t, p, "motion"), p + "motion",
+           "an image or sdf source is its file stretched over the whole domain: a motion would move nothing",
+           "remove motion, or give the source a circle or box shape that moves");
   src.start = r.number(t, p, "start", 0.0, 0.0, 1e12);
   src.end = r.number(t, p, "end", src.end, 0.0, 1e300);
   if (!(src.end > src.start))

@@ -110,6 +110,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadScene{"missing_radius", "[[obstacles]]\nshape = \"circle\"\n", "1:1", "needs a radius"},
         BadScene{"bad_palette", "[output]\ncolormap = \"virdis\"\n", "2:12", "did you mean 'viridis'"},
         BadScene{"missing_image", "[[obstacles]]\nshape = \"image\"\nfile = \"nope.png\"\n", "3:8", "cannot read"},
+        BadScene{"image_obstacle_center", "[[obstacles]]\nshape = \"image\"\ncenter = [0.5, 0.5]\nfile = \"nope.png\"\n", "3:10",
+                 "a center does not apply"},
         BadScene{"rd_unknown_model", "[rd]\nmodel = \"grey-scott\"\n", "2:9", "did you mean 'gray-scott'"},
         BadScene{"rd_negative_diffusion", "[rd]\nmodel = \"gray-scott\"\ndiffusion = [1.0, -0.5]\n", "3:19",
                  "expected a number in [0,"},

@@ -293,6 +293,14 @@ TEST(HostileInput, ARunThatWouldDoNothingSaysSo) {
   // A source that covers no fluid cell (far smaller than a cell, or inside an
   // obstacle) runs, and says it emits nothing; the plume as shipped does not.
   const std::string plume = "run " + sceneFile("vfx/plume_2d.toml") + " --quiet --set grid.resolution=[32,48] --set time.duration=0.1" + out;
+  // An image source's motion or center would move nothing: refused where it is written.
+  const std::string fish = sceneFile("rd/seeds/images/fish.png");
+  for (const std::string& extra : {std::string("center=[0.3,0.3]"), std::string("motion=[\"0.5\",\"t\"]")}) {
+    r = runMorphoflow(plume + " --set 'sources=[{shape=\"image\",file=\"" + fish + "\",density=1.0," + extra + "}]'");
+    EXPECT_EQ(r.status, 2) << extra << ": " << r.output;
+    EXPECT_NE(r.output.find(extra.substr(0, extra.find('=')) == "center" ? "a center does not apply" : "a motion would move nothing"),
+              std::string::npos) << r.output;
+  }
   for (const std::string& sets : {std::string(" --set sources.0.radius=0.001"),
                                   std::string(" --set 'obstacles=[{center=[0.5,0.15],radius=0.2}]'"), std::string()}) {
     r = runMorphoflow(plume + sets);
