@@ -1,4 +1,7 @@
 // [[obstacles]]: circles, spheres, boxes and image or signed-distance shapes.
+#include <cmath>
+#include <filesystem>
+
 #include <fmt/format.h>
 
 #include "render/image_io.h"
@@ -53,6 +56,14 @@ ObstacleSpec parseRegion(SceneContext& c, const toml::table* o, const std::strin
     std::string err;
     if (!readGrayImage(fp.string(), &img, &err)) r.fail(fn, p + key, "cannot read the image: " + err);
     r.noteInput(fp, fn, p + key);
+    // One rule for every sdf: a distance is finite (an infinite or NaN one
+    // would be read as no solid, where a finite negative one is solid).
+    for (size_t i = 0; i < img.pixels.size() && spec.shape == ObstacleShape::Sdf; ++i)
+      if (!std::isfinite(img.pixels[i]))
+        r.fail(fn, p + key,
+               fmt::format("the sdf holds {} at pixel ({}, {}): a signed distance is a finite number", img.pixels[i],
+                           i % size_t(img.width), i / size_t(img.width)),
+               "write finite distances (negative inside), or use shape = \"image\" with a threshold");
     spec.fieldWidth = img.width;
     spec.fieldHeight = img.height;
     spec.field = std::move(img.pixels);

@@ -2,6 +2,8 @@
 // (exit 2, naming the file or key, at once), never a crash, a hang, a huge
 // allocation or a NaN field.
 #include <gtest/gtest.h>
+
+#include <limits>
 #include <sys/stat.h>
 
 #include <chrono>
@@ -14,6 +16,7 @@
 #include "render/contact_sheet.h"
 #include "render/image_io.h"
 #include "render/vdb_volume.h"
+#include "render/field_dump.h"
 #include "test_support.h"
 
 using namespace morphoflow::testing;
@@ -306,6 +309,30 @@ TEST(HostileInput, ARunThatWouldDoNothingSaysSo) {
     r = runMorphoflow(plume + sets);
     EXPECT_EQ(r.status, 0) << sets << ": " << r.output;
     EXPECT_EQ(r.output.find("sources.0 covers no fluid cell") != std::string::npos, !sets.empty()) << sets << ": " << r.output;
+  }
+  fs::remove_all(dir);
+}
+
+// One rule for every sdf: a NaN or infinite distance is refused at the file
+// (it would be read as no solid), a finite one that is solid everywhere is
+// refused as covering every cell.
+TEST(HostileInput, AnSdfIsFiniteOrRefusedAndOneSolidEverywhereLeavesNoFluid) {
+  const fs::path dir = tempDir("hostile_sdf");
+  const std::string cavity = "run " + sceneFile("lid_driven_cavity.toml") +
+                             " --quiet --set grid.resolution=[16,16] --set time.duration=0.02 --out " + (dir / "o").string();
+  for (const auto& [value, expect] : {std::pair{-std::numeric_limits<float>::infinity(), std::string("the sdf holds -inf at pixel (0, 0)")},
+                                      std::pair{std::numeric_limits<float>::quiet_NaN(), std::string("the sdf holds nan at pixel (0, 0)")},
+                                      std::pair{-1.0f, std::string("the obstacles cover every cell")}}) {
+    morphoflow::FieldDump d;
+    d.resolution = {16, 16};
+    d.names = {"Y"};
+    d.channels = {std::vector<float>(256, value)};
+    const std::string file = (dir / "sdf.exr").string();
+    std::string error;
+    ASSERT_TRUE(morphoflow::writeFieldDump(file, d, &error)) << error;
+    CommandResult r = runMorphoflow(cavity + " --set 'obstacles=[{shape=\"sdf\",file=\"" + file + "\"}]'");
+    EXPECT_EQ(r.status, 2) << r.output;
+    EXPECT_NE(r.output.find(expect), std::string::npos) << r.output;
   }
   fs::remove_all(dir);
 }
