@@ -2,21 +2,20 @@
 // (exit 2, naming the file or key, at once), never a crash, a hang, a huge
 // allocation or a NaN field.
 #include <gtest/gtest.h>
-
-#include <limits>
 #include <sys/stat.h>
 
 #include <chrono>
 #include <fstream>
+#include <limits>
 #include <thread>
 
 #include <nlohmann/json.hpp>
 
 #include "render/allocation_limit.h"
 #include "render/contact_sheet.h"
+#include "render/field_dump.h"
 #include "render/image_io.h"
 #include "render/vdb_volume.h"
-#include "render/field_dump.h"
 #include "test_support.h"
 
 using namespace morphoflow::testing;
