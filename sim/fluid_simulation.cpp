@@ -228,10 +228,25 @@ std::vector<std::pair<std::string, std::string>> FluidSimulation<D>::measurement
 
 template <int D>
 void checkFluidLeft(const Scene& scene, const FluidSolver<D>& fluid) {
-  for (uint8_t solid : fluid.solid().values())
-    if (!solid) return;
-  throw UserError({scene.path, 0, 0}, "obstacles", "the obstacles cover every cell: no fluid is left to simulate",
-                  "make the obstacles smaller than the domain");
+  const Grid<uint8_t, D>& solid = fluid.solid();
+  if (std::all_of(solid.values().begin(), solid.values().end(), [](uint8_t s) { return s != 0; }))
+    throw UserError({scene.path, 0, 0}, "obstacles", "the obstacles cover every cell: no fluid is left to simulate",
+                    "make the obstacles smaller than the domain");
+  // An inflow side whose every cell is solid lets nothing in.
+  for (int a = 0; a < D; ++a)
+    for (bool high : {false, true}) {
+      if (scene.fluid.boundaries.side(a, high).kind != BoundaryKind::Inflow) continue;
+      bool open = false;
+      for (size_t i = 0; i < solid.size() && !open; ++i) {
+        const IVec<D> c = solid.coord(i);
+        open = c[a] == (high ? solid.dims()[a] - 1 : 0) && !solid[i];
+      }
+      if (!open)
+        throw UserError({scene.path, 0, 0}, "obstacles",
+                        fmt::format("the obstacles cover the whole inflow side ({} {}): no fluid can enter", high ? "high" : "low",
+                                    "xyz"[a]),
+                        "move or shrink the obstacles so that part of the inflow is open");
+    }
 }
 
 // A fixed source that covers no fluid cell (smaller than the samples of a

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <limits>
 #include <thread>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 
@@ -174,6 +175,15 @@ TEST(HostileInput, NoFluidLeftIsRefusedAndAnUnconvergedPressureIsAWarning) {
   const std::string fluid = write(dir / "fluid.toml", std::string(kFluidScene) +
                                   "[[obstacles]]\nshape = \"box\"\ncenter = [0.5, 0.5]\nsize = [2, 2]\n").string();
   expectUserError("run " + fluid + " --quiet --out " + (dir / "o").string(), "no fluid is left");
+  // An obstacle over the whole inflow side lets nothing in (fluid and coupled scenes).
+  for (const auto& [scene, box, side] :
+       {std::tuple{sceneFile("flow_past_obstacle.toml") + " --set grid.resolution=[220,41] --set time.duration=0.02",
+                   std::string("center=[0.02,0.2],size=[0.04,2.0]"), std::string("(low x)")},
+        std::tuple{sceneFile("coupled/obstacle_gray_scott_ard.toml") +
+                       " --set grid.resolution=[32,64] --set rd.resolution=[32,64] --set time.steps=2",
+                   std::string("center=[0.4,1.58],size=[2.0,0.04]"), std::string("(high y)")}})
+    expectUserError("run " + scene + " --quiet --set 'obstacles=[{shape=\"box\"," + box + "}]' --out " + (dir / "o").string(),
+                    "cover the whole inflow side " + side);
   const std::string cavity = write(dir / "cavity.toml", kFluidScene).string();
   for (const std::string& args : {cavity, sceneFile("coupled/cavity_gray_scott.toml") +
                                               " --set grid.resolution=[32,32] --set rd.resolution=[32,32] --set time.steps=3"}) {
