@@ -65,6 +65,10 @@ void ImageSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
   const bool two = o.colormap == kTwoSpeciesPalette;
   const std::vector<std::string> sp = sim.species();
   const Grid<float, D> shown = sim.field(two ? sp[0] : o.field).front();
+  if (!o.autoRange) {  // 8-bit colours of a fixed range: what lies beyond it is drawn at its ends, and counted
+    for (float v : shown.values()) clipped_ += (v < o.range[0] || v > o.range[1]) ? 1 : 0;
+    cells_ += shown.size();
+  }
   if constexpr (D == 3) {
     if (o.view == "volume") {
       rgb = two ? volumeTwoToRgb(shown, sim.field(sp[1]).front(), io, o.imageSize, &w, &h)
@@ -103,6 +107,10 @@ void ImageSink<D>::report(nlohmann::json* j) const {
   (*j)["frames_written"] = written_;
   addBytes(j, "frames", bytes_);
   if (videoDone_ && video_.written) addBytes(j, "video", fileBytes(videoFile_));
+  if (!scene_.output.autoRange)
+    (*j)["frames_range"] = {{"range", {scene_.output.range[0], scene_.output.range[1]}},
+                            {"cells_beyond", clipped_},
+                            {"fraction_beyond", cells_ > 0 ? double(clipped_) / double(cells_) : 0.0}};
   if (videoDone_)
     (*j)["video"] = {{"file", videoFile_.string()},
                      {"written", video_.written},
@@ -123,7 +131,7 @@ std::vector<std::string> ImageSink<D>::whereToLook() const {
 
 template <int D>
 nlohmann::json ImageSink<D>::state() const {
-  return {{"written", written_}, {"first_written", firstWritten_}, {"bytes", bytes_}};
+  return {{"written", written_}, {"first_written", firstWritten_}, {"bytes", bytes_}, {"clipped", clipped_}, {"cells", cells_}};
 }
 
 template <int D>
@@ -131,6 +139,8 @@ void ImageSink<D>::restore(const nlohmann::json& s) {
   written_ = stateCount<int>(s, "written");
   firstWritten_ = stateCount<long>(s, "first_written", -1);
   bytes_ = stateCount<uintmax_t>(s, "bytes");
+  clipped_ = stateCount<uintmax_t>(s, "clipped");
+  cells_ = stateCount<uintmax_t>(s, "cells");
 }
 
 template <int D>

@@ -65,6 +65,7 @@ class ImageSink : public OutputSink<D> {
   int written_ = 0;
   long firstWritten_ = -1;
   uintmax_t bytes_ = 0;
+  uintmax_t clipped_ = 0, cells_ = 0;  // a fixed output.range: the shown cells beyond it (drawn at its ends), of all shown
   bool videoDone_ = false;
   VideoResult video_;
   std::filesystem::path videoFile_;

@@ -111,6 +111,10 @@ class Driver {
     if (j.contains("video") && !j["video"]["written"].get<bool>())
       log_.warn("warning: " + j["video"]["warning"].get<std::string>());
     if (j.contains("vdb_half_warning")) log_.warn("warning: " + j["vdb_half_warning"].get<std::string>());
+    if (j.contains("frames_range") && j["frames_range"]["cells_beyond"].get<uintmax_t>() > 0)
+      log_.say(fmt::format("frames: {:.2g}% of the shown cells lay beyond output.range [{:g}, {:g}] and were drawn at its ends",
+                           100.0 * j["frames_range"]["fraction_beyond"].get<double>(), scene_.output.range[0],
+                           scene_.output.range[1]));
     if (steady_) sayHowSteady();
     log_.say(fmt::format("done: {} steps, t = {:.5g}, {:.2f} s wall, {} frames -> {}", sim_.steps(), sim_.time(),
                          wallSeconds(), j["frames_written"].get<int>(), out_.string()));

@@ -92,6 +92,26 @@ TEST(RunRecords, RunJsonSaysHowItEndedAndWhatItWrote) {
   fs::remove_all(dir);
 }
 
+// A fixed output.range maps to 8-bit colours: the shown cells beyond it are
+// drawn at its ends, counted in run.json and said in one line.
+TEST(RunRecords, AFixedRangeSaysHowMuchOfTheFieldLayBeyondIt) {
+  const fs::path dir = tempDir("records_range");
+  for (const auto& [range, beyond] : {std::pair{std::string("[-1.0,1.0]"), true}, std::pair{std::string("[-1e9,1e9]"), false}}) {
+    CommandResult r = runMorphoflow("run " + sceneFile("lid_driven_cavity.toml") +
+                                    " --set grid.resolution=[32,32] --set time.duration=0.5 --set output.range=" + range +
+                                    " --out " + (dir / "o").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    std::ifstream in(dir / "o" / "run.json");
+    const nlohmann::json f = nlohmann::json::parse(in)["frames_range"];
+    EXPECT_EQ(f["cells_beyond"].get<long>() > 0, beyond) << f;
+    EXPECT_EQ(r.output.find("lay beyond output.range") != std::string::npos, beyond) << r.output;
+    if (beyond) {
+      EXPECT_GT(f["fraction_beyond"].get<double>(), 0.01) << f;
+    }
+  }
+  fs::remove_all(dir);
+}
+
 TEST(RunRecords, TheMemoryEstimateMatchesThePeakAndATooLargeRunIsRefused) {
 #if defined(__SANITIZE_ADDRESS__)
   GTEST_SKIP() << "under AddressSanitizer the peak includes its shadow memory and redzones (scripts/asan)";
