@@ -73,6 +73,7 @@ std::vector<VelocityFrame> findVelocityFrames(const std::string& pattern, double
     const std::string prefix = head.filename().string();
     const std::string suffix = end == std::string::npos ? "" : pattern.substr(end);
     if (suffix.find('/') != std::string::npos) throw VelocityFileError(pattern, "the frame number ('#') must be in the file name");
+    if (digits > 18) throw VelocityFileError(pattern, std::to_string(digits) + " '#' make a frame number too long to count: use at most 18");
     std::error_code ec;
     fs::directory_iterator it(dir, ec);
     if (ec) throw VelocityFileError(pattern, "cannot list the folder " + dir.string() + ": " + ec.message());

@@ -172,6 +172,13 @@ TEST(GivenVelocity, VolumesThatCannotServeAreRefusedWithTheirPath) {
   r = runMorphoflow("validate " + none.string());
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("cannot list the folder"), std::string::npos) << r.output;
+  // A frame number of 25 digits (a file there to match it) cannot be counted: exit 2, not an internal error.
+  std::ofstream(dir / ("x." + std::string(25, '1') + ".vdb")) << "not a volume";
+  const fs::path longer = write(dir / "long.toml", "[rd]\nmodel = \"gray-scott\"\n[velocity]\nvdb = \"x." + std::string(25, '#') + ".vdb\"\n");
+  r = runMorphoflow("validate " + longer.string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("25 '#' make a frame number too long to count"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("internal error"), std::string::npos) << r.output;
   fs::remove_all(dir);
 }
 
