@@ -1,5 +1,6 @@
 #include "studio/edit_log.h"
 
+#include <algorithm>
 #include <set>
 #include <sstream>
 
@@ -41,7 +42,10 @@ toml::table* parentOf(toml::table& root, const std::vector<std::string>& parts) 
   toml::node* cur = &root;
   for (size_t i = 0; i + 1 < parts.size(); ++i) {
     if (toml::array* a = cur->as_array()) {
-      const size_t idx = std::stoul(parts[i]);
+      const std::string& n = parts[i];
+      if (n.empty() || n.size() > 9 || !std::all_of(n.begin(), n.end(), [](char c) { return c >= '0' && c <= '9'; }))
+        return nullptr;  // (not an index)
+      const size_t idx = std::stoul(n);
       if (idx >= a->size()) return nullptr;
       cur = a->get(idx);
       continue;

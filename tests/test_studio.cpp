@@ -353,6 +353,8 @@ TEST(StudioServer, BadCallsGetAMessageAndTheSimulationGoesOn) {
       {http::verb::post, "/api/set", "{not json", http::status::bad_request},
       {http::verb::post, "/api/set", R"({"rd.parameters.F": -1e300})", http::status::bad_request},
       {http::verb::post, "/api/set", R"({"grid.resolution": [8, 8]})", http::status::bad_request},
+      {http::verb::post, "/api/set", R"({"sources.x.density": 1.0})", http::status::bad_request},
+      {http::verb::post, "/api/set", R"({"sources.99999999999999999999.density": 1.0})", http::status::bad_request},
       {http::verb::post, "/api/set", R"([1, 2, 3])", http::status::bad_request},
       {http::verb::post, "/api/paint", R"({"kind": "meteor"})", http::status::bad_request},
       {http::verb::post, "/api/control", R"({"action": 7})", http::status::bad_request},
