@@ -249,11 +249,36 @@ void checkFluidLeft(const Scene& scene, const FluidSolver<D>& fluid) {
     }
 }
 
-// A fixed source that covers no fluid cell (smaller than the samples of a
-// cell, inside an obstacle, an image or sdf with nothing inside) emits
-// nothing: said, as a source whose window opens after the run is.
+// An obstacle the grid does not see, and a fixed source that covers no
+// fluid cell (smaller than the samples of a cell, inside an obstacle, an
+// image or sdf with nothing inside) and so emits nothing: said, as a source
+// whose window opens after the run is.
+// Whether an obstacle meets the grid: it holds a cell's centre, or (cut
+// boundary) its surface crosses a face plane, so that some face is partly closed.
+template <int D>
+bool meetsGrid(const ObstacleSpec& o, const IVec<D>& cells, double h) {
+  const Grid<uint8_t, D> solid = solidMask<D>({o}, cells, h);
+  if (std::any_of(solid.values().begin(), solid.values().end(), [](uint8_t v) { return v != 0; })) return true;
+  if (o.boundary == ObstacleBoundary::Voxel) return false;
+  if (o.shape == ObstacleShape::Circle && D == 3) return true;  // (a cylinder along z crosses every z face)
+  const bool round = o.shape == ObstacleShape::Circle || o.shape == ObstacleShape::Sphere;
+  if (!round && o.shape != ObstacleShape::Box) return true;  // (an image or sdf: its cells decide; none here is rare)
+  for (int a = 0; a < D; ++a) {
+    const double reach = round ? o.radius : o.halfSize[size_t(a)];
+    if (std::floor((o.center[size_t(a)] + reach) / h) != std::floor((o.center[size_t(a)] - reach) / h)) return true;
+  }
+  return false;
+}
+
 template <int D>
 void warnOfEmptySources(const Scene& scene, const FluidSolver<D>& fluid, const std::function<void(const std::string&)>& warn) {
+  const std::vector<ObstacleSpec>& obstacles = scene.fluid.obstacles;
+  for (size_t q = 0; q < obstacles.size() && warn; ++q)
+    if (!meetsGrid<D>(obstacles[q], fluid.cells(), fluid.h()))
+      warn(fmt::format("warning: obstacles.{} meets no cell centre or face of the grid (it lies between the faces of "
+                       "one cell): the flow does not see it, and its drag and lift are 0; make it larger than a cell "
+                       "or refine grid.resolution",
+                       q));
   const std::vector<SmokeSource>& sources = scene.fluid.smoke.sources;
   for (size_t q = 0; q < sources.size(); ++q) {
     if (!sources[q].motion.empty()) continue;  // (a moving one may come into the fluid)

@@ -305,6 +305,17 @@ TEST(HostileInput, ARunThatWouldDoNothingSaysSo) {
   // A source that covers no fluid cell (far smaller than a cell, or inside an
   // obstacle) runs, and says it emits nothing; the plume as shipped does not.
   const std::string plume = "run " + sceneFile("vfx/plume_2d.toml") + " --quiet --set grid.resolution=[32,48] --set time.duration=0.1" + out;
+  // An obstacle between the faces of one cell is not seen by the flow: said; one smaller than a cell
+  // that holds a cell's centre or crosses a face is seen, and nothing is said.
+  const std::string channel = "run " + sceneFile("flow_past_obstacle.toml") + " --quiet --set grid.resolution=[220,41] --set time.duration=0.02" + out;
+  for (const auto& [obstacle, unseen] : {std::pair{std::string("{center=[0.203,0.203],radius=0.002}"), true},
+                                         std::pair{std::string("{center=[0.203,0.203],radius=0.002,boundary=\"voxel\"}"), true},
+                                         std::pair{std::string("{center=[0.205,0.205],radius=0.003}"), false},
+                                         std::pair{std::string("{center=[0.2,0.205],radius=0.004}"), false}}) {
+    r = runMorphoflow(channel + " --set 'obstacles=[" + obstacle + "]'");
+    EXPECT_EQ(r.status, 0) << obstacle << ": " << r.output;
+    EXPECT_EQ(r.output.find("obstacles.0 meets no cell centre or face") != std::string::npos, unseen) << obstacle << ": " << r.output;
+  }
   // An image source's motion or center would move nothing: refused where it is written.
   const std::string fish = sceneFile("rd/seeds/images/fish.png");
   for (const std::string& extra : {std::string("center=[0.3,0.3]"), std::string("motion=[\"0.5\",\"t\"]")}) {
