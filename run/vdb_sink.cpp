@@ -240,7 +240,9 @@ void VdbSink<D>::report(nlohmann::json* j) const {
 
 template <int D>
 nlohmann::json VdbSink<D>::state() const {
-  return {{"written", written_}, {"bytes", bytes_}, {"nano_bytes", nanoBytes_}, {"clamped", clamped_}};
+  nlohmann::json s = {{"written", written_}, {"bytes", bytes_}, {"nano_bytes", nanoBytes_}};
+  for (const auto& [name, n] : clamped_) s["clamped:" + name] = n;  // (a checkpoint's sink state holds whole numbers only)
+  return s;
 }
 
 // Blender loads a numbered sequence as one animated volume from its first file.
@@ -260,9 +262,8 @@ void VdbSink<D>::restore(const nlohmann::json& s) {
   bytes_ = stateCount<uintmax_t>(s, "bytes");
   nanoBytes_ = stateCount<uintmax_t>(s, "nano_bytes");
   clamped_.clear();
-  if (s.contains("clamped") && s["clamped"].is_object())
-    for (const auto& [name, n] : s["clamped"].items())
-      if (n.is_number_unsigned()) clamped_[name] = n.template get<uintmax_t>();
+  for (const auto& [key, n] : s.items())
+    if (key.rfind("clamped:", 0) == 0 && n.is_number_unsigned()) clamped_[key.substr(8)] = n.template get<uintmax_t>();
 }
 
 template class VdbSink<2>;
