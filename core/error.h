@@ -46,6 +46,14 @@ class UserError : public std::runtime_error {
 
 // A field turned NaN, infinite or too large for a float: the run stops
 // (exit 2) with the step, the stage and what to change.
+// A run stopped because it diverged (a NonFiniteError met by the run loop),
+// reported as a UserError (exit 2) with the run's location; Python raises
+// FloatingPointError for it, as for a diverging step.
+class DivergedError : public UserError {
+ public:
+  using UserError::UserError;
+};
+
 class NonFiniteError : public std::runtime_error {
  public:
   NonFiniteError(const std::string& message, std::string hint) : std::runtime_error(message), hint_(std::move(hint)) {}

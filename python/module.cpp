@@ -117,6 +117,8 @@ PYBIND11_MODULE(morphoflow, m) {
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
+    } catch (const DivergedError& e) {  // (before UserError, its base)
+      PyErr_SetString(PyExc_FloatingPointError, e.what());
     } catch (const UserError& e) {
       PyErr_SetString(PyExc_ValueError, e.what());
     } catch (const NonFiniteError& e) {

@@ -61,7 +61,7 @@ class Driver {
     } catch (const NonFiniteError& e) {
       // Every frame and checkpoint written so far stays: each was checked finite.
       fail("diverged", e.what());
-      throw UserError({scene_.path, 0, 0}, "", e.what(), e.hint());
+      throw DivergedError({scene_.path, 0, 0}, "", e.what(), e.hint());
     } catch (const std::exception& e) {
       fail("failed", e.what());
       throw;

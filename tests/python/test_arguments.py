@@ -1,6 +1,7 @@
 """Python checks what the command line checks (docs/python.md, "Errors"):
 batch and sweep's jobs and out, override keys and values that cannot reach
 another key, Ctrl-C during a batch."""
+import json
 import os
 import signal
 import threading
@@ -50,3 +51,13 @@ def test_ctrl_c_during_a_batch_raises_keyboard_interrupt_and_the_module_goes_on(
     timer.cancel()
     short = dict(long, **{"time.steps": 200, "output.every": 100})
     assert morphoflow.batch([PEARSON], out=str(tmp_path / "c"), set=short)["status"] == 0
+
+
+def test_a_run_that_diverges_is_a_floating_point_error_as_a_diverging_step_is(tmp_path):
+    diverging = {"grid.resolution": [32, 32], "rd.integrator": "explicit", "time.dt": 50.0, "time.steps": 60}
+    scene = morphoflow.load_scene(PEARSON, set=diverging)
+    with pytest.raises(FloatingPointError, match="diverged"):
+        morphoflow.Simulation(scene).step(60)
+    with pytest.raises(FloatingPointError, match="diverged"):
+        morphoflow.Simulation(scene).run(str(tmp_path / "out"))
+    assert json.loads((tmp_path / "out" / "run.json").read_text())["exit_state"] == "diverged"
