@@ -7,11 +7,8 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include <algorithm>
-#include <cctype>
 #include <cstdlib>
 
-#include <fmt/format.h>
 #include <fstream>
 #include <memory>
 
@@ -22,6 +19,7 @@
 #include "core/state_archive.h"
 #include "python/py_simulation.h"
 #include "python/py_studio.h"
+#include "scenes/override_text.h"
 #include "scenes/scene_loader.h"
 
 namespace py = pybind11;
@@ -33,15 +31,7 @@ namespace {
 std::string tomlValue(const py::handle& v) {
   if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
   if (py::isinstance<py::int_>(v) || py::isinstance<py::float_>(v)) return py::str(py::repr(v));
-  if (py::isinstance<py::str>(v)) {
-    std::string s = "\"";
-    for (char c : v.cast<std::string>()) {
-      if (c == '"' || c == '\\') s += std::string("\\") + c;
-      else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) s += fmt::format("\\u{:04X}", static_cast<unsigned char>(c));
-      else s += c;
-    }
-    return s + "\"";
-  }
+  if (py::isinstance<py::str>(v)) return tomlString(v.cast<std::string>());
   if (py::isinstance<py::list>(v) || py::isinstance<py::tuple>(v)) {
     std::string s = "[";
     for (const py::handle& item : v) s += (s.size() > 1 ? "," : "") + tomlValue(item);
@@ -59,9 +49,7 @@ std::vector<std::string> overrides(const py::object& set) {
   for (const auto& [key, value] : set.cast<py::dict>()) {
     const std::string k = py::str(key).cast<std::string>();
     // A dotted key of bare names (what --set takes): '=', spaces or a newline would set another key.
-    const bool bare = !k.empty() && k.front() != '.' && k.back() != '.' && k.find("..") == std::string::npos &&
-                      std::all_of(k.begin(), k.end(), [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.'; });
-    if (!bare) throw py::value_error("set= takes dotted keys of letters, digits, '_' and '-' (as 'fluid.reynolds'), not '" + k + "'");
+    if (!isDottedKey(k)) throw py::value_error("set= takes dotted keys of letters, digits, '_' and '-' (as 'fluid.reynolds'), not '" + k + "'");
     out.push_back(k + "=" + tomlValue(value));
   }
   return out;
