@@ -4,8 +4,8 @@
 #include <CLI/CLI.hpp>
 
 #include "app/commands.h"
-#include "bench/bench_command.h"
-#include "run/memory_bench.h"
+#include "app/bench_arguments.h"
+#include "app/memory_bench.h"
 #include "studio/studio_bench.h"
 
 namespace morphoflow {

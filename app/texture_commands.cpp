@@ -10,7 +10,7 @@
 #include <fmt/format.h>
 
 #include "app/commands.h"
-#include "core/option_checks.h"
+#include "app/option_checks.h"
 #include "core/output_file.h"
 #include "core/error.h"
 #include "render/colormap.h"

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "core/simulation.h"
+#include "sim/simulation.h"
 #include "python/python_velocity.h"
 #include "scenes/scene.h"
 #include "sim/backend.h"

@@ -16,7 +16,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "core/simulation.h"
+#include "sim/simulation.h"
 #include "render/field_image.h"
 #include "render/video.h"
 #include "scenes/scene.h"

@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <limits>
 
-#include "core/simulation.h"
+#include "sim/simulation.h"
 #include "scenes/scene.h"
 
 namespace morphoflow {

@@ -5,7 +5,7 @@
 #pragma once
 
 #include "run/run_options.h"
-#include "core/simulation.h"
+#include "sim/simulation.h"
 #include "scenes/scene.h"
 
 namespace morphoflow {

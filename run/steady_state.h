@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "core/grid.h"
-#include "core/simulation.h"
+#include "sim/simulation.h"
 #include "core/state_archive.h"
 
 namespace morphoflow {

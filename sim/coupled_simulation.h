@@ -4,7 +4,7 @@
 // or tbb-overlap schedule, coupling/coupled_stepper.h, or the GPU's), as a
 // Simulation: species and fluid fields, and the time each side took. The
 // FluidSolver and RDSolver hold the state outputs read, refreshed when a
-// field or checkpoint needs it (core/host_copy.h).
+// field or checkpoint needs it (sim/host_copy.h).
 #pragma once
 
 #include <memory>
@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "sim/rd_simulation.h"
-#include "core/simulation.h"
-#include "core/host_copy.h"
+#include "sim/simulation.h"
+#include "sim/host_copy.h"
 #include "coupling/ard_solver.h"
 #include "coupling/coupled_steps.h"
 #include "scenes/scene.h"

@@ -3,7 +3,7 @@
 // the Strouhal number) and solver statistics. The steps are its
 // FluidStepper's (sim/steppers.h chooses it for the backend); the
 // FluidSolver holds the state outputs read, refreshed when a field, probe or
-// checkpoint needs it (core/host_copy.h).
+// checkpoint needs it (sim/host_copy.h).
 #pragma once
 
 #include <functional>
@@ -12,8 +12,8 @@
 #include <utility>
 #include <vector>
 
-#include "core/simulation.h"
-#include "core/host_copy.h"
+#include "sim/simulation.h"
+#include "sim/host_copy.h"
 #include "fluid/fluid_solver.h"
 #include "fluid/fluid_stepper.h"
 #include "scenes/scene.h"

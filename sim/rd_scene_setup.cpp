@@ -11,7 +11,7 @@
 
 #include "core/error.h"
 #include "core/parallel.h"
-#include "core/simulation.h"
+#include "sim/simulation.h"
 #include "core/spatial_field.h"
 #include "core/random.h"
 #include "rd/brush_strokes.h"

@@ -3,7 +3,7 @@
 // asks), its maps and anisotropy, and the solvers' statistics. The steps are
 // its LayerStepper's (sim/steppers.h chooses it for the backend: the
 // RDSolver's own, the fused float step, or the GPU's); the RDSolver holds the
-// state outputs read, refreshed when needed (core/host_copy.h).
+// state outputs read, refreshed when needed (sim/host_copy.h).
 #pragma once
 
 #include <functional>
@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "core/simulation.h"
-#include "core/host_copy.h"
+#include "sim/simulation.h"
+#include "sim/host_copy.h"
 #include "rd/layer_stepper.h"
 #include "rd/rd_solver.h"
 #include "scenes/scene.h"

@@ -7,7 +7,7 @@
 #include <memory>
 #include <string>
 
-#include "core/simulation.h"
+#include "sim/simulation.h"
 #include "scenes/scene.h"
 #include "sim/backend.h"
 #include "sim/steppers.h"

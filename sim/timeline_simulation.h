@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "core/simulation.h"
+#include "sim/simulation.h"
 #include "scenes/scene.h"
 
 namespace morphoflow {

@@ -8,7 +8,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/expression.h"
-#include "core/host_copy.h"
+#include "sim/host_copy.h"
 #include "core/sampling.h"
 #include "gpu/gl_context.h"
 #include "render/field_dump.h"

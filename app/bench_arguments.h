@@ -1,6 +1,6 @@
 // The `bench` subcommand's options and their checks, shared by the
-// morphoflow command line (which adds the memory suite of run/) and the
-// morphoflow-bench executable (the suites of this library alone).
+// morphoflow command line (which adds the memory and studio suites) and the
+// morphoflow-bench executable (the suites of bench/ alone).
 #pragma once
 
 #include <functional>

@@ -8,7 +8,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "bench/bench_command.h"
+#include "app/bench_arguments.h"
 #include "core/error.h"
 
 using namespace morphoflow;

@@ -1,10 +1,10 @@
-#include "bench/bench_command.h"
+#include "app/bench_arguments.h"
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include "app/option_checks.h"
 #include "core/error.h"
-#include "core/option_checks.h"
 #include "core/output_file.h"
 #include "core/system_memory.h"
 

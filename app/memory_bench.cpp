@@ -1,4 +1,4 @@
-#include "run/memory_bench.h"
+#include "app/memory_bench.h"
 
 #include <unistd.h>
 
