@@ -86,7 +86,7 @@ void writeSeeds(const fs::path& dir) {
     RunLog log(true, false);
     driveRun<2>(*sim, scene, opt, &log);
     const Checkpoint c = readCheckpoint(checkpointFile(out, kResumeStep));
-    fuzz::writeBytes(dir / ("framed-" + std::to_string(which)), std::string(1, char(which)) + c.header.dump() +
+    fuzz::writeBytes(dir / ("framed-" + std::to_string(which)), std::string(1, char(which)) + c.header.toJson().dump() +
                                                                      std::string(kStateMark) + c.state);
     fuzz::writeBytes(dir / ("whole-" + std::to_string(which)),
                      std::string(1, char(which | 4)) + fuzz::readBytes(checkpointFile(out, kResumeStep)));

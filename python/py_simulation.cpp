@@ -4,7 +4,6 @@
 #include <fstream>
 #include <iostream>
 
-#include <nlohmann/json.hpp>
 
 #include "core/parallel.h"
 #include "gpu/gl_context.h"
@@ -15,7 +14,6 @@
 #include "run/run_log.h"
 #include "run/run_options.h"
 #include "run/scene_hash.h"
-#include "run/version.h"
 #include "scenes/scene_loader.h"
 #include "sim/given_flow_simulation.h"
 #include "sim/simulation_factory.h"
@@ -223,11 +221,12 @@ void PySimulation::save(const std::string& path) const {
   Call call(*this, "save");
   const Scene& s = *scene_.scene;
   with([&](auto& sim) {
-    const nlohmann::json header = {
-        {"version", kVersion}, {"scene_hash", sceneHash(s)}, {"scene", s.resolvedJson}, {"step", sim.steps()},
-        {"time", sim.time()}, {"last_frame", -1}, {"sinks", nlohmann::json::array()}, {"log", ""},
-        {"checkpoint_bytes", 0u},
-        {"python", {{"scene_text", scene_.text}, {"scene_path", scene_.path}, {"overrides", scene_.overrides}}}};
+    CheckpointHeader header;
+    header.sceneHash = sceneHash(s);
+    header.scene = s.resolvedJson;
+    header.step = sim.steps();
+    header.time = sim.time();
+    header.python = CheckpointHeader::PythonScene{scene_.text, scene_.path, scene_.overrides};
     py::gil_scoped_release release;
     writeCheckpointFile(path, header, [&](StateWriter* w) { sim.save(w); });
     return 0;
@@ -236,17 +235,16 @@ void PySimulation::save(const std::string& path) const {
 
 PySimulation PySimulation::load(const std::string& path, const std::string& backend, int threads) {
   Checkpoint c = readCheckpoint(path);
-  const nlohmann::json& h = c.header;
-  if (!h.contains("python") || !h["python"].is_object())
+  const CheckpointHeader& h = c.header;
+  if (!h.python)
     throw py::value_error(path + ": not a checkpoint of Simulation.save (a run's checkpoints resume with "
                                  "Simulation.run(out, resume=True))");
-  const nlohmann::json& p = h["python"];
   PyScene scene;
-  scene.text = p.value("scene_text", "");
-  scene.path = p.value("scene_path", "");
-  scene.overrides = p.value("overrides", std::vector<std::string>());
+  scene.text = h.python->text;
+  scene.path = h.python->path;
+  scene.overrides = h.python->overrides;
   scene.scene = std::make_shared<Scene>(parseScene(scene.text, scene.path, scene.overrides));
-  if (sceneHash(*scene.scene) != h.value("scene_hash", ""))
+  if (sceneHash(*scene.scene) != h.sceneHash)
     throw py::value_error(path + ": the scene reads files that changed since the checkpoint was written");
   PySimulation sim(scene, backend, threads);
   {

@@ -51,6 +51,14 @@ std::string headerProblem(const nlohmann::json& h) {
   if (!has("checkpoint_bytes", &nlohmann::json::is_number_unsigned)) return "its header lacks the byte count 'checkpoint_bytes'";
   if (!has("time", &nlohmann::json::is_number)) return "its header lacks the number 'time'";
   if (!has("sinks", &nlohmann::json::is_array)) return "its header lacks the outputs' list 'sinks'";
+  if (h.contains("python")) {
+    const nlohmann::json& p = h["python"];
+    if (!p.is_object() || !p.contains("scene_text") || !p["scene_text"].is_string() || !p.contains("scene_path") ||
+        !p["scene_path"].is_string() || !p.contains("overrides") || !p["overrides"].is_array())
+      return "its header's 'python' lacks the scene's text, path or overrides";
+    for (const nlohmann::json& o : p["overrides"])
+      if (!o.is_string()) return "its header's 'python' holds an override that is not text";
+  }
   for (const nlohmann::json& sink : h["sinks"]) {
     if (!sink.is_object()) return "an output's state in its header is not an object";
     for (const char* key : {"written", "bytes"})
@@ -65,13 +73,41 @@ std::string headerProblem(const nlohmann::json& h) {
 
 }  // namespace
 
+nlohmann::json CheckpointHeader::toJson() const {
+  nlohmann::json h = {{"version", version}, {"scene_hash", sceneHash}, {"scene", scene},
+                      {"step", step},       {"time", time},            {"last_frame", lastFrame},
+                      {"sinks", sinks},     {"log", log},              {"checkpoint_bytes", checkpointBytes}};
+  if (python)
+    h["python"] = {{"scene_text", python->text}, {"scene_path", python->path}, {"overrides", python->overrides}};
+  return h;
+}
+
+CheckpointHeader CheckpointHeader::fromJson(const nlohmann::json& h) {
+  CheckpointHeader c;
+  c.version = h.at("version").get<std::string>();
+  c.sceneHash = h.at("scene_hash").get<std::string>();
+  c.scene = h.at("scene").get<std::string>();
+  c.step = h.at("step").get<long>();
+  c.time = h.at("time").get<double>();
+  c.lastFrame = h.at("last_frame").get<long>();
+  c.sinks = h.at("sinks");
+  c.log = h.at("log").get<std::string>();
+  c.checkpointBytes = h.at("checkpoint_bytes").get<uintmax_t>();
+  if (h.contains("python")) {
+    const nlohmann::json& p = h["python"];
+    c.python = PythonScene{p.at("scene_text").get<std::string>(), p.at("scene_path").get<std::string>(),
+                           p.at("overrides").get<std::vector<std::string>>()};
+  }
+  return c;
+}
+
 fs::path checkpointDir(const fs::path& out) { return out / kCheckpointFiles.folder; }
 
 fs::path checkpointFile(const fs::path& out, long step) {
   return checkpointDir(out) / fmt::format("{:010d}.ckpt", step);
 }
 
-fs::path writeCheckpoint(const fs::path& out, long step, const nlohmann::json& header,
+fs::path writeCheckpoint(const fs::path& out, long step, const CheckpointHeader& header,
                          const std::function<void(StateWriter*)>& save) {
   createOutputFolder(checkpointDir(out));
   const fs::path file = checkpointFile(out, step);
@@ -82,8 +118,8 @@ fs::path writeCheckpoint(const fs::path& out, long step, const nlohmann::json& h
   return file;
 }
 
-void writeCheckpointFile(const fs::path& file, const nlohmann::json& header, const std::function<void(StateWriter*)>& save) {
-  const std::string h = header.dump();
+void writeCheckpointFile(const fs::path& file, const CheckpointHeader& header, const std::function<void(StateWriter*)>& save) {
+  const std::string h = header.toJson().dump();
   // The state's length comes first in the file: one pass counts it, the
   // next streams the sections straight from the solvers into the file.
   uint64_t n = 0;
@@ -144,12 +180,14 @@ Checkpoint readCheckpoint(const fs::path& file) {
   if (16 + hn + 8 + sn != body) throw bad("its state is cut short");
   Checkpoint c;
   c.file = file;
+  nlohmann::json header;
   try {
-    c.header = nlohmann::json::parse(bytes.substr(16, hn));
+    header = nlohmann::json::parse(bytes.substr(16, hn));
   } catch (const std::exception& e) {
     throw bad(std::string("its header is not JSON: ") + e.what());
   }
-  if (const std::string problem = headerProblem(c.header); !problem.empty()) throw bad(problem);
+  if (const std::string problem = headerProblem(header); !problem.empty()) throw bad(problem);
+  c.header = CheckpointHeader::fromJson(header);
   // The state stays in the bytes read (no copy of a large run's state).
   bytes.resize(body);
   bytes.erase(0, 16 + hn + 8);

@@ -219,11 +219,15 @@ class Driver {
   }
 
   fs::path saveCheckpoint() {
-    nlohmann::json sinks = nlohmann::json::array();
-    for (const auto& s : sinks_) sinks.push_back(s->state());
-    const nlohmann::json header = {{"version", kVersion},      {"scene_hash", hash_},      {"scene", scene_.resolvedJson},
-                                   {"step", sim_.steps()},     {"time", sim_.time()},      {"last_frame", lastFrame_},
-                                   {"sinks", sinks},           {"log", log_.text()},       {"checkpoint_bytes", checkpointBytes_}};
+    CheckpointHeader header;
+    header.sceneHash = hash_;
+    header.scene = scene_.resolvedJson;
+    header.step = sim_.steps();
+    header.time = sim_.time();
+    header.lastFrame = lastFrame_;
+    for (const auto& s : sinks_) header.sinks.push_back(s->state());
+    header.log = log_.text();
+    header.checkpointBytes = checkpointBytes_;
     const fs::path file = writeCheckpoint(out_, sim_.steps(), header, [this](StateWriter* w) {
       sim_.save(w);
       if (steady_) steady_->save(w);
@@ -234,15 +238,15 @@ class Driver {
 
   void resume() {
     Checkpoint c = latestCheckpoint(out_, [this](const std::string& line) { log_.warn(line); });
-    const nlohmann::json& h = c.header;  // (its keys and types checked by readCheckpoint)
+    const CheckpointHeader& h = c.header;
     // Another version's checkpoint is read section by section, each checked
     // by name and size: one that does not fit is refused; the log says so.
-    if (h["version"] != kVersion)
+    if (h.version != kVersion)
       log_.warn(fmt::format("warning: {} was written by morphoflow {}, this is {}: its state is used only if every "
                             "section fits",
-                            c.file.string(), h["version"].get<std::string>(), kVersion));
-    if (h.value("scene_hash", "") != hash_ && !opt_.force) {
-      std::vector<std::string> keys = changedKeys(h.value("scene", "{}"), scene_.resolvedJson);
+                            c.file.string(), h.version, kVersion));
+    if (h.sceneHash != hash_ && !opt_.force) {
+      std::vector<std::string> keys = changedKeys(h.scene, scene_.resolvedJson);
       throw UserError({c.file.string(), 0, 0}, "--resume",
                       "the scene differs from the one this checkpoint was written by" +
                           (keys.empty() ? std::string() : " (changed: " + fmt::format("{}", fmt::join(keys, ", ")) + ")"),
@@ -256,16 +260,16 @@ class Driver {
       throw UserError({c.file.string(), 0, 0}, "--resume", std::string("the checkpoint does not fit this scene: ") + e.what(),
                       "run the scene without --resume to start it afresh");
     }
-    lastFrame_ = h.value("last_frame", -1L);
-    checkpointBytes_ = h.value("checkpoint_bytes", uintmax_t(0));
-    log_.restore(h.value("log", ""));
+    lastFrame_ = h.lastFrame;
+    checkpointBytes_ = h.checkpointBytes;
+    log_.restore(h.log);
     log_.say(fmt::format("resumed from {} (step {}, t = {:.5g})", c.file.string(), sim_.steps(), sim_.time()));
     resumedFrom_ = c.file.string();
     checkpoint_ = std::move(c);
   }
 
   void restoreSinks() {
-    const nlohmann::json& states = checkpoint_->header.at("sinks");
+    const nlohmann::json& states = checkpoint_->header.sinks;
     if (states.size() != sinks_.size())
       throw UserError({checkpoint_->file.string(), 0, 0}, "--resume", "the checkpoint was written with other outputs",
                       "resume with the outputs as they were, or run without --resume");
