@@ -13,7 +13,8 @@ namespace {
 
 // The options batch and sweep share.
 void addBatchOptions(CLI::App* cmd, BatchOptions* b) {
-  cmd->add_option("--jobs", b->jobs, "runs at once; the machine's threads are divided between them")->check(CLI::Range(1, 256));
+  cmd->add_option("--jobs", b->jobs, "runs at once; the machine's threads are divided between them")
+      ->check(CLI::Range(1, 256));
   cmd->add_option("--shard", b->shard, "I/N: only every N-th run, from the I-th (0-based)")
       ->check([](const std::string& s) { return s.empty() ? std::string("expected I/N, got ''") : std::string(); });
   cmd->add_option("--set", b->sets, "override a scene key in every run: key.path=value (TOML value)")
@@ -29,7 +30,8 @@ void addBatchOptions(CLI::App* cmd, BatchOptions* b) {
 
 void addBatchCommands(CLI::App& app, Commands* commands) {
   auto batch = std::make_shared<BatchOptions>();
-  CLI::App* batchCmd = app.add_subcommand("batch", "run several scenes, each in its own process, into OUT/<scene name>");
+  CLI::App* batchCmd =
+      app.add_subcommand("batch", "run several scenes, each in its own process, into OUT/<scene name>");
   batchCmd->add_option("scenes", batch->scenes, "scene files")->required();
   batchCmd->add_flag("--keep-going", batch->keepGoing, "run the valid scenes when some are invalid");
   addBatchOptions(batchCmd, batch.get());
@@ -37,7 +39,8 @@ void addBatchCommands(CLI::App& app, Commands* commands) {
 
   auto sweep = std::make_shared<BatchOptions>();
   auto sweepScene = std::make_shared<std::string>();
-  CLI::App* sweepCmd = app.add_subcommand("sweep", "run a scene over every combination of values, into OUT/<key=value,...>");
+  CLI::App* sweepCmd =
+      app.add_subcommand("sweep", "run a scene over every combination of values, into OUT/<key=value,...>");
   sweepCmd->add_option("scene", *sweepScene, "scene file")->required();
   sweepCmd->add_option("--vary", sweep->varies, "key=start:stop:count or key=[a,b,c] (TOML values)")
       ->required()

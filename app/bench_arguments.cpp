@@ -19,7 +19,8 @@ CLI::App* addBenchSubcommand(CLI::App& app, BenchArguments* a, const std::string
   cmd->add_option("--json", bench.json, "also write results as JSON");
   cmd->add_option("--seconds", bench.minSeconds, "minimum timed seconds per case")->check(finiteIn(0.0, 3600.0));
   cmd->add_option("--backend", bench.backend, "cpu | gpu")->check(CLI::IsMember({"cpu", "gpu"}))->capture_default_str();
-  cmd->add_option("--interpolation", bench.interpolation, "coupling: the chemicals' sample, linear | cubic | bspline | bfecc")
+  cmd->add_option("--interpolation", bench.interpolation,
+                  "coupling: the chemicals' sample, linear | cubic | bspline | bfecc")
       ->check(CLI::IsMember({"linear", "cubic", "bspline", "bfecc"}))
       ->capture_default_str()
       ->each([a](const std::string&) { a->interpolationGiven = true; });
@@ -33,11 +34,13 @@ int runBench(const BenchArguments& a, const std::function<int(const BenchArgumen
     throw UserError({"--interpolation", 0, 0}, "", "only the coupling suite carries chemicals",
                     "drop --interpolation or run `bench coupling`");
   if (!bench.trace.empty() && a.suite != "coupling")
-    throw UserError({"--trace", 0, 0}, "", "only the coupling suite writes a trace", "drop --trace or run `bench coupling`");
+    throw UserError({"--trace", 0, 0}, "", "only the coupling suite writes a trace",
+                    "drop --trace or run `bench coupling`");
   // A --size case of n^2 cells (the suites' own sizes are known to fit) needs at most ~1 kB a cell.
   if (const uintmax_t need = uintmax_t(bench.size) * uintmax_t(bench.size) * 1000; need > availableBytes())
-    throw UserError({"--size", 0, 0}, "", fmt::format("a {0} x {0} case needs about {1}; this machine has {2} free", bench.size,
-                                                      humanBytes(need), humanBytes(availableBytes())),
+    throw UserError({"--size", 0, 0}, "",
+                    fmt::format("a {0} x {0} case needs about {1}; this machine has {2} free", bench.size,
+                                humanBytes(need), humanBytes(availableBytes())),
                     "give a smaller --size");
   // the files it will write, checked before the long work
   if (!bench.json.empty()) checkOutputFile(bench.json, "--json");

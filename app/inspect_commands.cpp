@@ -45,8 +45,8 @@ int validate(const std::vector<std::string>& scenes) {
     Scene sc = loadScene(s);
     const std::string memory = "needs about " + humanBytes(estimateRunBytes(sc)) + " of memory";
     if (sc.hasFluid)
-      std::cout << fmt::format("{}: ok ({}D, {} steps, Re = {:.4g}, {})\n", s, sc.dimension, sc.totalSteps(), sc.reynolds,
-                               memory);
+      std::cout << fmt::format("{}: ok ({}D, {} steps, Re = {:.4g}, {})\n", s, sc.dimension, sc.totalSteps(),
+                               sc.reynolds, memory);
     else
       std::cout << fmt::format("{}: ok ({}D, {} steps, reaction-diffusion {}, {})\n", s, sc.dimension, sc.totalSteps(),
                                sc.rd.settings.model, memory);
@@ -71,7 +71,8 @@ int info() {
 int list(const std::string& what) {
   if (what == "palettes") {
     for (const auto& n : colormapNames())
-      std::cout << n << (n == kTwoSpeciesPalette ? "  (two species: the first in red, the second in green; seed 002)" : "")
+      std::cout << n
+                << (n == kTwoSpeciesPalette ? "  (two species: the first in red, the second in green; seed 002)" : "")
                 << "\n";
     std::cout << "custom: output.gradient = [\"#rrggbb\", ...] (two or more stops, evenly spaced)\n";
   } else if (what == "scenes") {
@@ -98,12 +99,15 @@ void addInspectCommands(CLI::App& app, Commands* commands) {
   validateCmd->add_option("scenes", *scenes, "scene files")->required();
   commands->add(validateCmd, [scenes] { return validate(*scenes); });
 
-  CLI::App* infoCmd = app.add_subcommand("info", "the backends built, the GL renderer, the CPU's vector features and threads");
+  CLI::App* infoCmd =
+      app.add_subcommand("info", "the backends built, the GL renderer, the CPU's vector features and threads");
   commands->add(infoCmd, info);
 
   auto what = std::make_shared<std::string>();
   CLI::App* listCmd = app.add_subcommand("list", "list models, scenes or palettes");
-  listCmd->add_option("what", *what, "models | scenes | palettes")->required()->check(CLI::IsMember({"models", "scenes", "palettes"}));
+  listCmd->add_option("what", *what, "models | scenes | palettes")
+      ->required()
+      ->check(CLI::IsMember({"models", "scenes", "palettes"}));
   commands->add(listCmd, [what] { return list(*what); });
 }
 

@@ -48,8 +48,9 @@ int main(int argc, char** argv) {
     std::cerr << "error: " << e.what() << " (" << e.hint() << ")\n";
     return 2;
   } catch (const std::bad_alloc&) {  // the estimate checked before the run fell short (docs/performance.md, Memory)
-    std::cerr << "error: out of memory: the machine, its cgroup or this process's limits (ulimit -v, -d) held less than "
-                 "the run needed (`morphoflow validate SCENE` prints the estimate; give a smaller grid)\n";
+    std::cerr
+        << "error: out of memory: the machine, its cgroup or this process's limits (ulimit -v, -d) held less than "
+           "the run needed (`morphoflow validate SCENE` prints the estimate; give a smaller grid)\n";
     return 2;
   } catch (const std::exception& e) {
     std::cerr << "internal error: " << e.what() << "\n";

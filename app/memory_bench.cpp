@@ -48,7 +48,8 @@ nlohmann::json runOnce(const MemoryCase& c, const fs::path& dir) {
 std::string sceneDir() {
   for (fs::path d : {fs::path("scenes"), fs::path(MORPHOFLOW_SCENE_DIR)})
     if (fs::exists(d / "lid_driven_cavity.toml")) return fs::absolute(d).string();
-  throw UserError({"scenes", 0, 0}, "", "bench memory runs the shipped scenes and cannot find them", "run it from the project folder");
+  throw UserError({"scenes", 0, 0}, "", "bench memory runs the shipped scenes and cannot find them",
+                  "run it from the project folder");
 }
 
 }  // namespace
@@ -60,35 +61,49 @@ bool runMemoryBench(const BenchOptions& o) {
   const int n2 = o.size > 0 ? o.size : 1024, n3 = o.size > 0 ? o.size : 128;
   auto grid = [](int n, int d) { return d == 2 ? fmt::format("[{0},{0}]", n) : fmt::format("[{0},{0},{0}]", n); };
   const std::vector<MemoryCase> cases = {
-      {"fluid 2D", s + "/lid_driven_cavity.toml", {"grid.resolution=" + grid(n2, 2), "time.cfl=0", "time.duration=0.04"}, double(n2) * n2},
-      {"fluid 3D", s + "/lid_driven_cavity_3d.toml", {"grid.resolution=" + grid(n3, 3), "time.cfl=0", "time.duration=0.08"},
+      {"fluid 2D",
+       s + "/lid_driven_cavity.toml",
+       {"grid.resolution=" + grid(n2, 2), "time.cfl=0", "time.duration=0.04"},
+       double(n2) * n2},
+      {"fluid 3D",
+       s + "/lid_driven_cavity_3d.toml",
+       {"grid.resolution=" + grid(n3, 3), "time.cfl=0", "time.duration=0.08"},
        double(n3) * n3 * n3},
       {"rd 2D kim-lin", s + "/rd/gray_scott_pearson.toml", {"grid.resolution=" + grid(n2, 2)}, double(n2) * n2},
-      {"rd 2D explicit (fused)", s + "/rd/gray_scott_pearson.toml",
-       {"grid.resolution=" + grid(n2, 2), "rd.integrator=\"explicit\"", "time.dt=0.5"}, double(n2) * n2},
-      {"rd 3D kim-lin", s + "/rd/turing_lawlor.toml", {"grid.resolution=" + grid(n3, 3), "domain.size=" + grid(n3, 3)},
+      {"rd 2D explicit (fused)",
+       s + "/rd/gray_scott_pearson.toml",
+       {"grid.resolution=" + grid(n2, 2), "rd.integrator=\"explicit\"", "time.dt=0.5"},
+       double(n2) * n2},
+      {"rd 3D kim-lin",
+       s + "/rd/turing_lawlor.toml",
+       {"grid.resolution=" + grid(n3, 3), "domain.size=" + grid(n3, 3)},
        double(n3) * n3 * n3},
-      {"coupled 2D", s + "/coupled/cavity_gray_scott.toml",
-       {"grid.resolution=" + grid(n2, 2), "rd.resolution=" + grid(n2, 2), "output.video=false"}, double(n2) * n2},
-      {"coupled 3D", s + "/coupled/cavity_gray_scott_3d.toml",
+      {"coupled 2D",
+       s + "/coupled/cavity_gray_scott.toml",
+       {"grid.resolution=" + grid(n2, 2), "rd.resolution=" + grid(n2, 2), "output.video=false"},
+       double(n2) * n2},
+      {"coupled 3D",
+       s + "/coupled/cavity_gray_scott_3d.toml",
        {"grid.resolution=" + grid(n3, 3), "rd.resolution=" + grid(n3, 3), "output.video=false", "output.vdb=false"},
        double(n3) * n3 * n3},
   };
   // The fixed overhead: the smallest coupled 3D run.
-  const MemoryCase tiny{"overhead", s + "/coupled/cavity_gray_scott_3d.toml",
-                        {"grid.resolution=[8,8,8]", "rd.resolution=[8,8,8]", "output.video=false", "output.vdb=false"}, 512};
+  const MemoryCase tiny{"overhead",
+                        s + "/coupled/cavity_gray_scott_3d.toml",
+                        {"grid.resolution=[8,8,8]", "rd.resolution=[8,8,8]", "output.video=false", "output.vdb=false"},
+                        512};
   const double overhead = runOnce(tiny, tmp / "tiny")["peak_memory_bytes"].get<double>();
   std::cout << fmt::format("fixed overhead (a 8^3 coupled run's peak): {:.0f} MiB\n", overhead / (1 << 20));
-  std::cout << fmt::format("{:<24} {:>14} {:>12} {:>14} {:>14} {:>10}\n", "case", "cells", "peak MiB", "B/cell (beyond)",
-                           "estimate MiB", "est/peak");
+  std::cout << fmt::format("{:<24} {:>14} {:>12} {:>14} {:>14} {:>10}\n", "case", "cells", "peak MiB",
+                           "B/cell (beyond)", "estimate MiB", "est/peak");
   nlohmann::json all = {{"overhead_bytes", overhead}, {"cases", nlohmann::json::array()}};
   int k = 0;
   for (const MemoryCase& c : cases) {
     const nlohmann::json j = runOnce(c, tmp / std::to_string(k++));
     const double peak = j["peak_memory_bytes"].get<double>(), estimate = j["memory_estimate_bytes"].get<double>();
     const double perCell = (peak - overhead) / c.cells;
-    std::cout << fmt::format("{:<24} {:>14.0f} {:>12.0f} {:>14.0f} {:>14.0f} {:>10.2f}\n", c.what, c.cells, peak / (1 << 20),
-                             perCell, estimate / (1 << 20), estimate / peak)
+    std::cout << fmt::format("{:<24} {:>14.0f} {:>12.0f} {:>14.0f} {:>14.0f} {:>10.2f}\n", c.what, c.cells,
+                             peak / (1 << 20), perCell, estimate / (1 << 20), estimate / peak)
               << std::flush;
     all["cases"].push_back({{"case", c.what}, {"cells", c.cells}, {"peak_bytes", peak}, {"bytes_per_cell", perCell},
                             {"estimate_bytes", estimate}});

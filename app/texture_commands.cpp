@@ -39,7 +39,8 @@ int analyzeCommand(const AnalyzeOptions& o) {
   if (!o.csv.empty()) checkOutputFile(o.csv, "--csv");
   FieldDump d;
   std::string err;
-  if (!readFieldDump(o.file, &d, &err)) throw UserError({o.file, 0, 0}, "", "cannot read: " + err, "give a PNG/EXR image or a fields/NNNNNN.exr dump");
+  if (!readFieldDump(o.file, &d, &err))
+    throw UserError({o.file, 0, 0}, "", "cannot read: " + err, "give a PNG/EXR image or a fields/NNNNNN.exr dump");
   size_t c = 0;
   if (!o.channel.empty()) {
     auto it = std::find(d.names.begin(), d.names.end(), o.channel);
@@ -60,16 +61,19 @@ int analyzeCommand(const AnalyzeOptions& o) {
   const std::vector<float>& ch = d.channels[c];
   std::vector<double> t(ch.begin() + long(z) * nx * ny, ch.begin() + long(z + 1) * nx * ny);
   if (nx < 4 || ny < 4)
-    throw UserError({o.file, 0, 0}, "", fmt::format("the image is {} x {}: a variogram needs at least 4 x 4 pixels", nx, ny),
+    throw UserError({o.file, 0, 0}, "",
+                    fmt::format("the image is {} x {}: a variogram needs at least 4 x 4 pixels", nx, ny),
                     "analyse a larger image");
   if (o.maxLag >= std::max(nx, ny))
     throw UserError({"--max-lag", 0, 0}, "", fmt::format("the lag must be below the field's size ({} x {})", nx, ny));
   Variogram v = variogram(t, nx, ny, {.maxLag = o.maxLag, .periodic = o.periodic});
   if (!(v.variance > 0))
-    throw UserError({o.file, 0, 0}, "", fmt::format("channel {} is constant (or not finite): it has no pattern to measure",
-                                                    d.names[c].empty() ? "0" : d.names[c]),
+    throw UserError({o.file, 0, 0}, "",
+                    fmt::format("channel {} is constant (or not finite): it has no pattern to measure",
+                                d.names[c].empty() ? "0" : d.names[c]),
                     "analyse a frame with a pattern, or pick another --channel");
-  std::cout << fmt::format("{}: {} x {}{}, channel {}\n", o.file, nx, ny, nz > 1 ? fmt::format(" (z slice {} of {})", z, nz) : "",
+  std::cout << fmt::format("{}: {} x {}{}, channel {}\n", o.file, nx, ny,
+                           nz > 1 ? fmt::format(" (z slice {} of {})", z, nz) : "",
                            d.names[c].empty() ? "0" : d.names[c]);
   printReg("variogram (seed 003 eq. 4-5, normalised by the variance)", v);
   if (!o.csv.empty()) {
@@ -84,7 +88,9 @@ int analyzeCommand(const AnalyzeOptions& o) {
 int textonCommand(TextonOptions o) {
   checkOutputFile(o.out, "--out");
   TextonWalkSettings& s = o.walk;
-  s.start = o.start == "regular" ? TextonStart::Regular : o.start == "uniform" ? TextonStart::Uniform : TextonStart::Pulse;
+  s.start = o.start == "regular"   ? TextonStart::Regular
+            : o.start == "uniform" ? TextonStart::Uniform
+                                   : TextonStart::Pulse;
   try {
     checkTextonWalk(s);
   } catch (const std::invalid_argument& e) {
@@ -140,20 +146,23 @@ int plotCommand(const PlotOptions& o) {
   if (!writeRgb8(o.out, o.size, o.size, polarPlotRgb(p, o.size), &err))
     throw UserError({o.out, 0, 0}, "--out", "cannot write the plot: " + err);
   const auto peak = std::max_element(p.begin(), p.end());
-  std::cout << fmt::format("{}: the propagator at |r| = {:g}, tau = {:g}; its largest value {:.4g} at {:.1f} degrees\n", o.out,
-                           o.radius, o.tau, *peak, 360.0 * double(peak - p.begin()) / double(p.size()));
+  std::cout << fmt::format("{}: the propagator at |r| = {:g}, tau = {:g}; its largest value {:.4g} at {:.1f} degrees\n",
+                           o.out, o.radius, o.tau, *peak, 360.0 * double(peak - p.begin()) / double(p.size()));
   return 0;
 }
 
 void addTextureCommands(CLI::App& app, Commands* commands) {
   auto analyze = std::make_shared<AnalyzeOptions>();
-  CLI::App* analyzeCmd = app.add_subcommand("analyze", "variogram and regularity REG of an image or field dump (seed 003)");
+  CLI::App* analyzeCmd =
+      app.add_subcommand("analyze", "variogram and regularity REG of an image or field dump (seed 003)");
   analyzeCmd->add_option("file", analyze->file, "PNG/EXR image or DIR/fields/NNNNNN.exr")->required();
   analyzeCmd->add_option("--channel", analyze->channel, "channel (species) to analyse; default the first");
-  analyzeCmd->add_option("--max-lag", analyze->maxLag, "largest spacing in cells (default: a quarter of the smaller side)")
+  analyzeCmd
+      ->add_option("--max-lag", analyze->maxLag, "largest spacing in cells (default: a quarter of the smaller side)")
       ->check(CLI::Range(1, 1 << 20));
   analyzeCmd->add_flag("--periodic", analyze->periodic, "pairs wrap around (for tiles of periodic runs)");
-  analyzeCmd->add_option("--slice", analyze->slice, "z slice of a 3D dump (default: the middle)")->check(CLI::Range(0, 1 << 20));
+  analyzeCmd->add_option("--slice", analyze->slice, "z slice of a 3D dump (default: the middle)")
+      ->check(CLI::Range(0, 1 << 20));
   analyzeCmd->add_option("--csv", analyze->csv, "also write the variogram per lag and direction");
   commands->add(analyzeCmd, [analyze] { return analyzeCommand(*analyze); });
 
@@ -164,7 +173,9 @@ void addTextureCommands(CLI::App& app, Commands* commands) {
   plotCmd->add_option("--out", plot->out, "the image (.png)")->required();
   plotCmd->add_option("--set", plot->overrides, "key.path=value overrides, as for run");
   plotCmd->add_option("--tau", plot->tau, "the propagator's time")->capture_default_str()->check(finiteIn(1e-3, 1e3));
-  plotCmd->add_option("--radius", plot->radius, "|r| of the circle plotted")->capture_default_str()->check(finiteIn(1e-3, 1e3));
+  plotCmd->add_option("--radius", plot->radius, "|r| of the circle plotted")
+      ->capture_default_str()
+      ->check(finiteIn(1e-3, 1e3));
   plotCmd->add_option("--size", plot->size, "pixels")->capture_default_str()->check(CLI::Range(64, 8192));
   commands->add(plotCmd, [plot] { return plotCommand(*plot); });
 
@@ -172,19 +183,33 @@ void addTextureCommands(CLI::App& app, Commands* commands) {
   TextonWalkSettings& walk = texton->walk;
   CLI::App* textonCmd = app.add_subcommand("texton", "random-walk texton texture (seed 003 eq. 6)");
   textonCmd->add_option("--out", texton->out, "output image (.png or .exr)")->required();
-  textonCmd->add_option("--size", walk.width, "field width and height in cells")->capture_default_str()->check(CLI::Range(1, 16384));
-  textonCmd->add_option("--elements", walk.elements, "number of textons")->capture_default_str()->check(CLI::Range(1, 10000000));
-  textonCmd->add_option("--steps", walk.steps, "random-walk steps")->capture_default_str()->check(CLI::Range(0, 100000000));
-  textonCmd->add_option("--step-size", walk.stepSize, "cells per move")->capture_default_str()->check(CLI::Range(1, 16384));
+  textonCmd->add_option("--size", walk.width, "field width and height in cells")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 16384));
+  textonCmd->add_option("--elements", walk.elements, "number of textons")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 10000000));
+  textonCmd->add_option("--steps", walk.steps, "random-walk steps")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 100000000));
+  textonCmd->add_option("--step-size", walk.stepSize, "cells per move")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 16384));
   textonCmd->add_option("--lifetime", walk.lifetime, "mean lifetime L in steps (0: never expire)")
       ->capture_default_str()
       ->check(finiteIn(0.0, 1e9));
-  textonCmd->add_option("-p", walk.p, "probability of moving right, given not expired")->capture_default_str()->check(finiteIn(0.0, 1.0));
-  textonCmd->add_option("-q", walk.q, "probability of moving left, given not expired")->capture_default_str()->check(finiteIn(0.0, 1.0));
+  textonCmd->add_option("-p", walk.p, "probability of moving right, given not expired")
+      ->capture_default_str()
+      ->check(finiteIn(0.0, 1.0));
+  textonCmd->add_option("-q", walk.q, "probability of moving left, given not expired")
+      ->capture_default_str()
+      ->check(finiteIn(0.0, 1.0));
   textonCmd->add_option("--start", texton->start, "pulse | regular | uniform")
       ->check(CLI::IsMember({"pulse", "regular", "uniform"}))
       ->capture_default_str();
-  textonCmd->add_option("--radius", walk.radius, "texton disc radius in cells")->capture_default_str()->check(finiteIn(0.0, 16384.0));
+  textonCmd->add_option("--radius", walk.radius, "texton disc radius in cells")
+      ->capture_default_str()
+      ->check(finiteIn(0.0, 16384.0));
   textonCmd->add_option("--seed", walk.seed, "random seed")->capture_default_str();
   textonCmd->add_flag("--analyze", texton->analyze, "also print the texture's REG");
   commands->add(textonCmd, [texton] {

@@ -61,8 +61,10 @@ class BatchRunner {
     validate();
     createOutputFolder(dir_);
     // one batch (or shard) at a time in a folder; its runs lock their own
-    const FolderLock lock(dir_, opt_.shard.empty() ? std::string(".morphoflow.lock")
-                                                   : ".morphoflow-shard-" + std::regex_replace(opt_.shard, std::regex("/"), "-of-") + ".lock");
+    const FolderLock lock(
+        dir_, opt_.shard.empty()
+                  ? std::string(".morphoflow.lock")
+                  : ".morphoflow-shard-" + std::regex_replace(opt_.shard, std::regex("/"), "-of-") + ".lock");
     checkBatchFolder(dir_, plan_);
     StopSignals signals;
     writeSummary();
@@ -111,7 +113,8 @@ class BatchRunner {
         std::cerr << e << "\n";
         shown.push_back(e);
       }
-    throw UserError({plan_.kind, 0, 0}, "", fmt::format("{} of {} runs are invalid; nothing was run", errors.size(), records_.size()),
+    throw UserError({plan_.kind, 0, 0}, "",
+                    fmt::format("{} of {} runs are invalid; nothing was run", errors.size(), records_.size()),
                     "fix them, or add --keep-going to run the valid ones");
   }
 
@@ -236,13 +239,16 @@ std::map<int, nlohmann::json> readShardSummaries(const std::string& dirText) {
       throw UserError({e.path().string(), 0, 0}, "", "not a batch summary: it is not a regular file", "remove it");
     const nlohmann::json j = readJsonFile(e.path());
     if (const std::string problem = summaryProblem(j, fs::path(dirText)); !problem.empty())
-      throw UserError({e.path().string(), 0, 0}, "", "not a batch summary: " + problem, "remove it, or run that shard again");
+      throw UserError({e.path().string(), 0, 0}, "", "not a batch summary: " + problem,
+                      "remove it, or run that shard again");
     const auto i = parseWhole(m[1]), n = parseWhole(m[2]);
     if (!i || !n || *n > 1000000 || *i >= *n)
-      throw UserError({e.path().string(), 0, 0}, "", "not a shard's summary (I/N with I below N <= 1000000)", "remove it");
+      throw UserError({e.path().string(), 0, 0}, "", "not a shard's summary (I/N with I below N <= 1000000)",
+                      "remove it");
     const nlohmann::json& other = shards.empty() ? j : shards.begin()->second;
     if (count && (*n != count || j["batch_id"] != other["batch_id"] || j["planned_runs"] != other["planned_runs"] ||
-                  j["kind"] != other["kind"] || j.value("keys", nlohmann::json::array()) != other.value("keys", nlohmann::json::array())))
+                  j["kind"] != other["kind"] ||
+                  j.value("keys", nlohmann::json::array()) != other.value("keys", nlohmann::json::array())))
       throw UserError({e.path().string(), 0, 0}, "", "the shard summaries are from different batches",
                       "gather each batch's folder on its own");
     count = int(*n);
@@ -255,7 +261,8 @@ std::map<int, nlohmann::json> readShardSummaries(const std::string& dirText) {
   for (int i = 0; i < count; ++i)
     if (!shards.count(i)) missing.push_back(std::to_string(i));
   if (!missing.empty())
-    throw UserError({dirText, 0, 0}, "", fmt::format("shards {} of {} have written no summary", fmt::join(missing, ", "), count),
+    throw UserError({dirText, 0, 0}, "",
+                    fmt::format("shards {} of {} have written no summary", fmt::join(missing, ", "), count),
                     "wait for them or run them again");
   return shards;
 }
@@ -271,8 +278,8 @@ std::vector<RunRecord> interleaveShards(const std::map<int, nlohmann::json>& sha
   for (const auto& [i, j] : shards)
     if (j["runs"].size() != (planned + count - 1 - size_t(i)) / count)
       throw UserError({dirText, 0, 0}, "",
-                      fmt::format("shard {} of {} lists {} runs, where the plan of {} runs gives it {}", i, count, j["runs"].size(),
-                                  planned, (planned + count - 1 - size_t(i)) / count),
+                      fmt::format("shard {} of {} lists {} runs, where the plan of {} runs gives it {}", i, count,
+                                  j["runs"].size(), planned, (planned + count - 1 - size_t(i)) / count),
                       "run that shard again");
   std::vector<RunRecord> records;
   for (size_t k = 0; k < total; ++k) {

@@ -33,7 +33,9 @@ void identify(BatchPlan* p) {
 // A folder name from sweep labels: no separators, no leading dot.
 std::string folderPart(const std::string& s) {
   std::string out;
-  for (char c : s) out += (std::isalnum(static_cast<unsigned char>(c)) || std::string("._+-[]").find(c) != std::string::npos) ? c : '_';
+  for (char c : s)
+    out +=
+        (std::isalnum(static_cast<unsigned char>(c)) || std::string("._+-[]").find(c) != std::string::npos) ? c : '_';
   return out;
 }
 
@@ -77,7 +79,8 @@ BatchPlan planSweep(const std::string& scene, const std::vector<Vary>& varies, c
   size_t total = 1;
   for (const Vary& v : varies)
     if ((total *= v.values.size()) > kMaxRuns)
-      throw UserError({"sweep", 0, 0}, "", fmt::format("the sweep has more than {} variants", kMaxRuns), "vary fewer values");
+      throw UserError({"sweep", 0, 0}, "", fmt::format("the sweep has more than {} variants", kMaxRuns),
+                      "vary fewer values");
   std::set<std::string> folders;
   for (const std::vector<size_t>& combo : cartesianProduct(varies)) {
     BatchRun r{scene, "", sets, {}};
@@ -88,7 +91,8 @@ BatchPlan planSweep(const std::string& scene, const std::vector<Vary>& varies, c
       r.folder += (k ? "," : "") + v.key + "=" + folderPart(v.labels[combo[k]]);
     }
     if (!folders.insert(r.folder).second)
-      throw UserError({"--vary", 0, 0}, "", "two variants would share the folder " + r.folder, "give each key distinct values");
+      throw UserError({"--vary", 0, 0}, "", "two variants would share the folder " + r.folder,
+                      "give each key distinct values");
     p.runs.push_back(std::move(r));
   }
   identify(&p);

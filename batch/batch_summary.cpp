@@ -96,7 +96,8 @@ void recordExit(const fs::path& batchDir, RunRecord* r) {
   else if (r->exitCode == 128 + SIGINT || r->exitCode == 128 + SIGTERM) r->status = "interrupted";
   else r->status = "failed";
   if (r->signal != 0 && r->status != "interrupted")
-    r->error = "killed by " + signalName(r->signal) + (r->signal == SIGKILL ? " (the out-of-memory killer, or kill -9)" : "");
+    r->error =
+        "killed by " + signalName(r->signal) + (r->signal == SIGKILL ? " (the out-of-memory killer, or kill -9)" : "");
   else if (r->exitCode != 0 && r->error.empty())
     r->error = lastLine(batchDir / r->run.folder / "console.txt");
 }
@@ -145,14 +146,18 @@ bool insideFolder(const std::string& path, const fs::path& batchDir, bool file) 
 std::string summaryProblem(const nlohmann::json& j, const fs::path& batchDir) {
   using json = nlohmann::json;
   if (!j.is_object()) return "it is not a JSON object";
-  auto is = [](const json& o, const char* key, bool (json::*test)() const noexcept) { return o.contains(key) && (o[key].*test)(); };
+  auto is = [](const json& o, const char* key, bool (json::*test)() const noexcept) {
+    return o.contains(key) && (o[key].*test)();
+  };
   if (!is(j, "runs", &json::is_array)) return "it has no list of runs";
   if (!is(j, "planned_runs", &json::is_number_unsigned)) return "it has no planned_runs count";
   if (!is(j, "kind", &json::is_string) || !is(j, "batch_id", &json::is_string)) return "it lacks its kind or batch_id";
   if (j["kind"] != "batch" && j["kind"] != "sweep") return "its kind is neither batch nor sweep";
-  if (j.contains("keys") && !(j["keys"].is_array() && std::all_of(j["keys"].begin(), j["keys"].end(), [](const json& k) { return k.is_string(); })))
+  if (j.contains("keys") && !(j["keys"].is_array() && std::all_of(j["keys"].begin(), j["keys"].end(),
+                                                                  [](const json& k) { return k.is_string(); })))
     return "its keys are not a list of names";
-  if (j["kind"] == "sweep" && (!j.contains("keys") || j["keys"].empty())) return "it is a sweep's without the keys it varies";
+  if (j["kind"] == "sweep" && (!j.contains("keys") || j["keys"].empty()))
+    return "it is a sweep's without the keys it varies";
   for (size_t k = 0; k < j["runs"].size(); ++k) {
     const json& r = j["runs"][k];
     const std::string at = "run " + std::to_string(k) + " ";
@@ -162,7 +167,8 @@ std::string summaryProblem(const nlohmann::json& j, const fs::path& batchDir) {
     for (const char* key : {"steps", "frames", "bytes_written"})
       if (!is(r, key, &json::is_number_unsigned)) return at + "lacks the count '" + key + "' (a whole number >= 0)";
     if (!is(r, "exit_code", &json::is_number_integer)) return at + "lacks its exit_code";
-    if (!is(r, "wall_seconds", &json::is_number) || r["wall_seconds"].get<double>() < 0) return at + "lacks its wall_seconds";
+    if (!is(r, "wall_seconds", &json::is_number) || r["wall_seconds"].get<double>() < 0)
+      return at + "lacks its wall_seconds";
     if (!is(r, "resumed", &json::is_boolean)) return at + "lacks 'resumed'";
     if (!is(r, "overrides", &json::is_array)) return at + "lacks its overrides";
     for (const json& o : r["overrides"])
@@ -172,7 +178,8 @@ std::string summaryProblem(const nlohmann::json& j, const fs::path& batchDir) {
       for (const auto& [key, v] : r["values"].items())
         if (!v.is_string()) return at + "has a value of '" + key + "' that is not text";
     if (r.contains("error") && !r["error"].is_string()) return at + "has an error that is not text";
-    if (!insideFolder(r["folder"].get<std::string>(), batchDir, false)) return at + "names a folder outside the batch folder";
+    if (!insideFolder(r["folder"].get<std::string>(), batchDir, false))
+      return at + "names a folder outside the batch folder";
     const std::string last = r["last_frame"].get<std::string>();
     if (!last.empty() && !insideFolder(last, batchDir, true))
       return at + "names a last frame (" + last + ") that is not a file inside the batch folder";
@@ -213,9 +220,10 @@ void printSummary(std::ostream& out, const std::vector<RunRecord>& records, cons
   int done = 0;
   for (const RunRecord& r : records) {
     done += succeeded(r);
-    out << fmt::format("{:<{}}  {:<11} {:>4} {:>8.1f}s {:>8} {:>6} {:>10}  {}\n", fs::path(r.run.scene).filename().string(),
-                       w, r.status, r.exitCode < 0 ? std::string("-") : std::to_string(r.exitCode), r.wallSeconds,
-                       r.steps, r.frames, humanBytes(r.bytesWritten), (batchDir / r.run.folder).string());
+    out << fmt::format("{:<{}}  {:<11} {:>4} {:>8.1f}s {:>8} {:>6} {:>10}  {}\n",
+                       fs::path(r.run.scene).filename().string(), w, r.status,
+                       r.exitCode < 0 ? std::string("-") : std::to_string(r.exitCode), r.wallSeconds, r.steps, r.frames,
+                       humanBytes(r.bytesWritten), (batchDir / r.run.folder).string());
   }
   out << fmt::format("{} of {} runs completed\n", done, records.size());
   for (const RunRecord& r : records)
@@ -273,7 +281,8 @@ void writeSweepOutputs(const fs::path& dir, const std::vector<std::string>& keys
   // Cells shrink so that the sheet stays within about 4096 pixels a side.
   const size_t most = std::max(sheet.columns.size(), sheet.rows.size());
   if (most > kMaxSheetCells) {
-    warn(fmt::format("warning: no contact sheet: {} values a side, more than the {} one sheet shows", most, kMaxSheetCells));
+    warn(fmt::format("warning: no contact sheet: {} values a side, more than the {} one sheet shows", most,
+                     kMaxSheetCells));
     return;
   }
   sheet.cellWidth = int(std::clamp<size_t>(4096 / most, 16, 160));

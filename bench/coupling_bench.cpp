@@ -23,7 +23,7 @@
 #include "core/error.h"
 #include "core/parallel.h"
 #include "core/stage_trace.h"
-#include "coupling/coupled_stepper.h"
+#include "coupling/cpu_coupled_stepper.h"
 #include "coupling/coupling_choices.h"
 #include "rd/model_registry.h"
 
@@ -51,7 +51,7 @@ CoupledTiming fluidOnly(int n, double minSeconds) {
 }
 
 template <int D>
-CoupledTiming fluidWithARD(int n, CouplingBackend backend, ChemicalInterpolation interpolation, double minSeconds,
+CoupledTiming fluidWithARD(int n, Backend backend, ChemicalInterpolation interpolation, double minSeconds,
                            StageTrace* trace) {
   FluidSolver<D> f(benchCavity<D>(n));
   // on the fluid's grid, diffusion rates 0.2 h^2 and 0.1 h^2 (the `rd` suite's, per cell)
@@ -63,10 +63,10 @@ CoupledTiming fluidWithARD(int n, CouplingBackend backend, ChemicalInterpolation
   domain.cells = rd.cells();
   domain.h = rd.h();
   ARDSolver<D> ard(&rd, ChemicalAdvector<D>(domain, interpolation), CouplingMode::ARD, rdScale);
-  CoupledStepper<D> stepper(&f, &ard, backend);
+  CpuCoupledStepper<D> stepper(&f, &ard, backend);
   for (int i = 0; i < kWarmup; ++i) stepper.step(dt);
   if (trace)
-    trace->beginGroup(fmt::format("{} {}^{}", backend == CouplingBackend::TBB ? "tbb" : "serial", n, D));
+    trace->beginGroup(fmt::format("{} {}^{}", backend == Backend::TBB ? "tbb" : "serial", n, D));
   stepper.setTrace(trace);
   std::vector<double> fluid, ardT;
   double bytes = 0.0;
@@ -89,9 +89,9 @@ nlohmann::json benchCase(int n, int threads, ChemicalInterpolation interpolation
                       {"fluid_only_steps_per_second", 1.0 / alone}, {"triad_gb_per_second", triad},
                       {"interpolation", interpolationName(interpolation)},
                       {"fluid_only_of_triad", fluid.bytes / alone / 1e9 / triad}};
-  for (CouplingBackend b : {CouplingBackend::Serial, CouplingBackend::TBB}) {
+  for (Backend b : {Backend::Serial, Backend::TBB}) {
     const CoupledTiming t = fluidWithARD<D>(n, b, interpolation, minSeconds, trace);
-    const std::string k = b == CouplingBackend::TBB ? "tbb" : "serial";
+    const std::string k = b == Backend::TBB ? "tbb" : "serial";
     j[k] = {{"ms", 1e3 * t.step},
             {"steps_per_second", 1.0 / t.step},
             {"fluid_part_ms", 1e3 * t.fluid},
@@ -105,7 +105,8 @@ nlohmann::json benchCase(int n, int threads, ChemicalInterpolation interpolation
 }  // namespace
 
 bool runCouplingBench(const BenchOptions& o) {
-  const std::vector<BenchCase> cases = selectBenchCases({{2, 128}, {2, 256}, {2, 512}, {2, 1024}, {3, 64}, {3, 128}}, o.size);
+  const std::vector<BenchCase> cases =
+      selectBenchCases({{2, 128}, {2, 256}, {2, 512}, {2, 1024}, {3, 64}, {3, 128}}, o.size);
   std::optional<StageTrace> trace;
   if (!o.trace.empty()) trace.emplace();
   nlohmann::json all = nlohmann::json::array();
@@ -118,22 +119,25 @@ bool runCouplingBench(const BenchOptions& o) {
   for (BenchCase c : cases)
     for (int threads : {1, 2}) {
       StageTrace* t = trace && threads == 2 ? &*trace : nullptr;
-      nlohmann::json j = c.dim == 2 ? benchCase<2>(c.n, threads, interpolation, o.minSeconds, t, triad[size_t(threads)])
-                                    : benchCase<3>(c.n, threads, interpolation, o.minSeconds, t, triad[size_t(threads)]);
-      std::cout << fmt::format("{:>4} {:>6} {:>4} {:>10.2f} {:>10.2f} {:>10.2f} {:>10.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f}\n", c.dim,
-                               c.n, threads, j["fluid_only_steps_per_second"].get<double>(),
-                               j["serial"]["steps_per_second"].get<double>(), j["tbb"]["steps_per_second"].get<double>(),
-                               j["tbb"]["ms"].get<double>(), j["serial"]["overhead"].get<double>(),
-                               j["tbb"]["overhead"].get<double>(), j["fluid_only_of_triad"].get<double>(),
-                               j["tbb"]["of_triad"].get<double>())
-                << std::flush;
+      nlohmann::json j = c.dim == 2
+                             ? benchCase<2>(c.n, threads, interpolation, o.minSeconds, t, triad[size_t(threads)])
+                             : benchCase<3>(c.n, threads, interpolation, o.minSeconds, t, triad[size_t(threads)]);
+      std::cout
+          << fmt::format(
+                 "{:>4} {:>6} {:>4} {:>10.2f} {:>10.2f} {:>10.2f} {:>10.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f}\n",
+                 c.dim, c.n, threads, j["fluid_only_steps_per_second"].get<double>(),
+                 j["serial"]["steps_per_second"].get<double>(), j["tbb"]["steps_per_second"].get<double>(),
+                 j["tbb"]["ms"].get<double>(), j["serial"]["overhead"].get<double>(),
+                 j["tbb"]["overhead"].get<double>(), j["fluid_only_of_triad"].get<double>(),
+                 j["tbb"]["of_triad"].get<double>())
+          << std::flush;
       all.push_back(j);
     }
   if (!o.json.empty()) writeFileAtomically(o.json, all.dump(2) + "\n");
   if (trace) {
     writeFileAtomically(o.trace, trace->chromeJson());
-    std::cout << fmt::format("trace: {} stages -> {} (open in ui.perfetto.dev or chrome://tracing)\n", trace->events().size(),
-                             o.trace);
+    std::cout << fmt::format("trace: {} stages -> {} (open in ui.perfetto.dev or chrome://tracing)\n",
+                             trace->events().size(), o.trace);
   }
   return true;
 }

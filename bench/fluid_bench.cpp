@@ -87,12 +87,13 @@ nlohmann::json benchFluid(int n, int threads, double minSeconds, double triad, b
 }  // namespace
 
 bool runFluidBench(const BenchOptions& o) {
-  const std::vector<BenchCase> cases = selectBenchCases({{2, 128}, {2, 256}, {2, 512}, {2, 1024}, {3, 64}, {3, 128}}, o.size);
+  const std::vector<BenchCase> cases =
+      selectBenchCases({{2, 128}, {2, 256}, {2, 512}, {2, 1024}, {3, 64}, {3, 128}}, o.size);
   nlohmann::json all = nlohmann::json::array();
   const std::array<double, 3> triad = suiteTriads(o.minSeconds);
-  std::cout << fmt::format("{:>4} {:>6} {:>6} {:>7} {:>12} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9}\n", "dim", "n", "smoke",
-                           "threads", "ms/step(med)", "p-iters", "v-iters", "forces", "advect", "diffuse", "project",
-                           "of triad");
+  std::cout << fmt::format("{:>4} {:>6} {:>6} {:>7} {:>12} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9}\n", "dim", "n",
+                           "smoke", "threads", "ms/step(med)", "p-iters", "v-iters", "forces", "advect", "diffuse",
+                           "project", "of triad");
   // 3D cases run again with smoke (sources, temperature, buoyancy, confinement), each right after the plain one.
   std::vector<std::pair<BenchCase, bool>> runs;
   for (BenchCase c : cases) {
@@ -103,14 +104,15 @@ bool runFluidBench(const BenchOptions& o) {
     for (int threads : {1, 2}) {
       nlohmann::json j = c.dim == 2 ? benchFluid<2>(c.n, threads, o.minSeconds, triad[size_t(threads)], smoke)
                                     : benchFluid<3>(c.n, threads, o.minSeconds, triad[size_t(threads)], smoke);
-      std::cout << fmt::format("{:>4} {:>6} {:>6} {:>7} {:>12.2f} {:>8.1f} {:>8.1f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f}{}\n",
-                               c.dim, c.n, smoke ? "yes" : "no", threads, j["ms_per_step_median"].get<double>(),
-                               j["pressure_iterations_mean"].get<double>(),
-                               j["viscosity_iterations_mean"].get<double>(), j["ms_forces"].get<double>(),
-                               j["ms_advect"].get<double>(), j["ms_diffuse"].get<double>(),
-                               j["ms_project"].get<double>(), j["of_triad"].get<double>(),
-                               j["pressure_converged"].get<bool>() ? "" : "  (unconverged)")
-                << std::flush;
+      std::cout
+          << fmt::format(
+                 "{:>4} {:>6} {:>6} {:>7} {:>12.2f} {:>8.1f} {:>8.1f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f}{}\n",
+                 c.dim, c.n, smoke ? "yes" : "no", threads, j["ms_per_step_median"].get<double>(),
+                 j["pressure_iterations_mean"].get<double>(), j["viscosity_iterations_mean"].get<double>(),
+                 j["ms_forces"].get<double>(), j["ms_advect"].get<double>(), j["ms_diffuse"].get<double>(),
+                 j["ms_project"].get<double>(), j["of_triad"].get<double>(),
+                 j["pressure_converged"].get<bool>() ? "" : "  (unconverged)")
+          << std::flush;
       all.push_back(j);
     }
   }

@@ -33,8 +33,9 @@ inline double announceGpu() {
     throw UserError({"--backend", 0, 0}, "", std::string("no usable GPU context: ") + e.what(), "bench on the CPU");
   }
   const double peak = peakBandwidth(context->renderer());
-  std::cout << fmt::format("gpu: {}, OpenGL {}; peak bandwidth {}\n", context->renderer(), context->version(),
-                           peak > 0 ? fmt::format("{:.0f} GB/s", peak) : std::string("unknown (set MORPHOFLOW_GPU_PEAK_GBS)"));
+  std::cout << fmt::format(
+      "gpu: {}, OpenGL {}; peak bandwidth {}\n", context->renderer(), context->version(),
+      peak > 0 ? fmt::format("{:.0f} GB/s", peak) : std::string("unknown (set MORPHOFLOW_GPU_PEAK_GBS)"));
   // The suites' Kim & Lin rows step Gray-Scott's Newton: say when this driver cannot (gpu/gpu_newton_check.h).
   if (const std::string defect = gpuNewtonDefect("gray-scott"); !defect.empty())
     std::cout << "warning: this driver does not run Kim & Lin's Newton in double precision (" << defect

@@ -5,7 +5,7 @@
 // Gray-Scott ARD layer on its grid (Kim & Lin at ten times the explicit
 // diffusion limit, linear advection), and the overhead (fluid + ARD) / fluid
 // (seed 001 Table 1). Both print GB/s, the traffic model of
-// gpu/gpu_kernels.h over the time, and its fraction of the device's peak.
+// gpu/gpu_programs.h over the time, and its fraction of the device's peak.
 #include <fstream>
 #include <iostream>
 #include <vector>
@@ -22,7 +22,7 @@
 #include "gpu/gpu_ard_solver.h"
 #include "fluid/fluid_solver.h"
 #include "gpu/gpu_fluid.h"
-#include "gpu/gpu_kernels.h"
+#include "gpu/gpu_programs.h"
 #include "gpu/gpu_rd_layer.h"
 #include "rd/model_registry.h"
 
@@ -101,7 +101,8 @@ nlohmann::json benchGpuCoupling(int n, ChemicalInterpolation interpolation, doub
   };
   for (int i = 0; i < kWarmup; ++i) step();
   std::vector<double> ardSeconds;
-  const Timed t = timeGpu(minSeconds, step, [&] { ardSeconds.push_back(ard.stageSeconds()[0] + ard.stageSeconds()[1]); });
+  const Timed t =
+      timeGpu(minSeconds, step, [&] { ardSeconds.push_back(ard.stageSeconds()[0] + ard.stageSeconds()[1]); });
   const double alone = 1e-3 * fluid["ms_per_step_median"].get<double>();
   nlohmann::json j = {{"dim", D}, {"n", n}, {"backend", "gpu"}, {"fluid_only_ms", 1e3 * alone},
                       {"fluid_only_steps_per_second", 1.0 / alone}, {"ms", 1e3 * t.seconds},
@@ -117,19 +118,23 @@ nlohmann::json benchGpuCoupling(int n, ChemicalInterpolation interpolation, doub
 
 bool runGpuFluidBench(const BenchOptions& o) {
   const double peak = announceGpu();
-  std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>8} {:>7} {:>10} {:>7}\n", "dim", "n",
-                           "backend", "ms/step(med)", "p-iters", "v-iters", "forces", "advect", "diffuse", "project", "GB/s",
-                           "of peak", "dispatches", "waits");
+  std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>8} {:>7} {:>10} {:>7}\n",
+                           "dim", "n", "backend", "ms/step(med)", "p-iters", "v-iters", "forces", "advect", "diffuse",
+                           "project", "GB/s", "of peak", "dispatches", "waits");
   nlohmann::json all = nlohmann::json::array();
   for (BenchCase c : selectBenchCases(kCases, o.size)) {
-    const nlohmann::json j = c.dim == 2 ? benchGpuFluid<2>(c.n, o.minSeconds, peak) : benchGpuFluid<3>(c.n, o.minSeconds, peak);
-    std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12.3f} {:>8.1f} {:>8.1f} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.3f} {:>8.1f} {:>7} {:>10.1f} {:>7.1f}{}\n",
-                             c.dim, c.n, "gpu", j["ms_per_step_median"].get<double>(),
-                             j["pressure_iterations_mean"].get<double>(), j["viscosity_iterations_mean"].get<double>(),
-                             j["ms_forces"].get<double>(), j["ms_advect"].get<double>(), j["ms_diffuse"].get<double>(),
-                             j["ms_project"].get<double>(), j["gb_per_second"].get<double>(),
-                             ofPeak(j["gb_per_second"].get<double>(), peak), j["dispatches_per_step"].get<double>(),
-                             j["host_waits_per_step"].get<double>(), j["pressure_converged"].get<bool>() ? "" : "  (unconverged)")
+    const nlohmann::json j =
+        c.dim == 2 ? benchGpuFluid<2>(c.n, o.minSeconds, peak) : benchGpuFluid<3>(c.n, o.minSeconds, peak);
+    std::cout << fmt::format(
+                     "{:>4} {:>6} {:>7} {:>12.3f} {:>8.1f} {:>8.1f} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.3f} {:>8.1f} {:>7} "
+                     "{:>10.1f} {:>7.1f}{}\n",
+                     c.dim, c.n, "gpu", j["ms_per_step_median"].get<double>(),
+                     j["pressure_iterations_mean"].get<double>(), j["viscosity_iterations_mean"].get<double>(),
+                     j["ms_forces"].get<double>(), j["ms_advect"].get<double>(), j["ms_diffuse"].get<double>(),
+                     j["ms_project"].get<double>(), j["gb_per_second"].get<double>(),
+                     ofPeak(j["gb_per_second"].get<double>(), peak), j["dispatches_per_step"].get<double>(),
+                     j["host_waits_per_step"].get<double>(),
+                     j["pressure_converged"].get<bool>() ? "" : "  (unconverged)")
               << std::flush;
     all.push_back(j);
   }
@@ -140,21 +145,24 @@ bool runGpuFluidBench(const BenchOptions& o) {
 bool runGpuCouplingBench(const BenchOptions& o) {
   const double peak = announceGpu();
   const ChemicalInterpolation interpolation = interpolationNamed(o.interpolation);
-  std::cout << "overhead = (fluid + ARD) / fluid only; targets: >= 1000 steps/s at 1024^2, >= 30 at 256^3, overhead <= 1.10; "
-               "chemicals: "
-            << o.interpolation << " interpolation\n";
-  std::cout << fmt::format("{:>4} {:>6} {:>10} {:>10} {:>10} {:>10} {:>9} {:>8} {:>7} {:>10} {:>7}\n", "dim", "n", "fluid/s",
-                           "gpu/s", "ms gpu", "ms ARD", "overhead", "GB/s", "of peak", "dispatches", "waits");
+  std::cout
+      << "overhead = (fluid + ARD) / fluid only; targets: >= 1000 steps/s at 1024^2, >= 30 at 256^3, overhead <= 1.10; "
+         "chemicals: "
+      << o.interpolation << " interpolation\n";
+  std::cout << fmt::format("{:>4} {:>6} {:>10} {:>10} {:>10} {:>10} {:>9} {:>8} {:>7} {:>10} {:>7}\n", "dim", "n",
+                           "fluid/s", "gpu/s", "ms gpu", "ms ARD", "overhead", "GB/s", "of peak", "dispatches",
+                           "waits");
   nlohmann::json all = nlohmann::json::array();
   for (BenchCase c : selectBenchCases(kCases, o.size)) {
     const nlohmann::json j =
         c.dim == 2 ? benchGpuCoupling<2>(c.n, interpolation, o.minSeconds, peak)
                    : benchGpuCoupling<3>(c.n, interpolation, o.minSeconds, peak);
-    std::cout << fmt::format("{:>4} {:>6} {:>10.1f} {:>10.1f} {:>10.3f} {:>10.3f} {:>9.2f} {:>8.1f} {:>7} {:>10.1f} {:>7.1f}\n", c.dim, c.n,
-                             j["fluid_only_steps_per_second"].get<double>(), j["steps_per_second"].get<double>(),
-                             j["ms"].get<double>(), j["ard_part_ms"].get<double>(), j["overhead"].get<double>(),
-                             j["gb_per_second"].get<double>(), ofPeak(j["gb_per_second"].get<double>(), peak),
-                             j["dispatches_per_step"].get<double>(), j["host_waits_per_step"].get<double>())
+    std::cout << fmt::format(
+                     "{:>4} {:>6} {:>10.1f} {:>10.1f} {:>10.3f} {:>10.3f} {:>9.2f} {:>8.1f} {:>7} {:>10.1f} {:>7.1f}\n",
+                     c.dim, c.n, j["fluid_only_steps_per_second"].get<double>(), j["steps_per_second"].get<double>(),
+                     j["ms"].get<double>(), j["ard_part_ms"].get<double>(), j["overhead"].get<double>(),
+                     j["gb_per_second"].get<double>(), ofPeak(j["gb_per_second"].get<double>(), peak),
+                     j["dispatches_per_step"].get<double>(), j["host_waits_per_step"].get<double>())
               << std::flush;
     all.push_back(j);
   }

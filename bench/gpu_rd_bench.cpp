@@ -3,7 +3,7 @@
 // of Kim & Lin's implicit split at ten times that step (gpu/gpu_rd_layer.h:
 // double precision, Newton, CG diffusion to 1e-8), the same start and steps
 // as the CPU suite; 2D 256^2..4096^2 and 3D 128^3, 256^3. GB/s is the
-// traffic model of gpu/gpu_kernels.h over the time (the explicit update reads
+// traffic model of gpu/gpu_programs.h over the time (the explicit update reads
 // and writes two float species, 16 bytes); the fraction of the device's
 // peak is printed for the devices whose peak is known
 // (MORPHOFLOW_GPU_PEAK_GBS gives it for any other).
@@ -22,7 +22,7 @@
 #include "gpu/gpu_counts.h"
 #include "gpu/gl_context.h"
 #include "gpu/gpu_explicit_rd.h"
-#include "gpu/gpu_kernels.h"
+#include "gpu/gpu_programs.h"
 #include "gpu/gpu_rd_layer.h"
 #include "rd/model_registry.h"
 #include "rd/rd_solver.h"
@@ -94,8 +94,9 @@ bool runGpuRDBench(const BenchOptions& o) {
   nlohmann::json all = nlohmann::json::array();
   for (BenchCase c : selectBenchCases({{2, 256}, {2, 1024}, {2, 4096}, {3, 128}, {3, 256}}, o.size)) {
     for (bool implicit : {false, true}) {
-      nlohmann::json j = implicit ? (c.dim == 2 ? benchGpuKimLin<2>(c.n, o.minSeconds) : benchGpuKimLin<3>(c.n, o.minSeconds))
-                                  : (c.dim == 2 ? benchGpuRD<2>(c.n, o.minSeconds) : benchGpuRD<3>(c.n, o.minSeconds));
+      nlohmann::json j =
+          implicit ? (c.dim == 2 ? benchGpuKimLin<2>(c.n, o.minSeconds) : benchGpuKimLin<3>(c.n, o.minSeconds))
+                   : (c.dim == 2 ? benchGpuRD<2>(c.n, o.minSeconds) : benchGpuRD<3>(c.n, o.minSeconds));
       const double gbs = j["gb_per_second"];
       if (peak > 0) j["fraction_of_peak_bandwidth"] = gbs / peak;
       std::cout << fmt::format("{:>4} {:>6} {:>10} {:>12.3f} {:>14.1f} {:>9.1f} {:>7} {:>10.1f} {:>7.1f}\n", c.dim, c.n,

@@ -92,7 +92,8 @@ void addSolverKernels(int n, double explicitDt, std::vector<Kernel>* out) {
   // One V-cycle from zero (MGPCG's preconditioner): read r, write z, the
   // fine coefficients at least once; the cycle's sweeps are on top.
   auto mg = std::make_shared<Multigrid<D>>(P);
-  out->push_back({"pressure V-cycle (float levels)", D, n, 16.0 + coefficients, [fluid, mg, x, y] { mg->apply(*x, y.get()); }, nullptr});
+  out->push_back({"pressure V-cycle (float levels)", D, n, 16.0 + coefficients,
+                  [fluid, mg, x, y] { mg->apply(*x, y.get()); }, nullptr});
   // The viscosity's Chebyshev iteration on the x velocity at the suite's
   // step (dt = h): a step reads two float iterates and g, writes one.
   auto visc = std::make_shared<ViscousSystem<D>>(viscousSystem<D>(fluid->constraints(), 0));
@@ -117,7 +118,8 @@ void addSolverKernels(int n, double explicitDt, std::vector<Kernel>* out) {
 template <int D>
 void addKernels(int n, std::vector<Kernel>* out) {
   // rd: RDSolver's double explicit step (two species read and written: 32 B).
-  auto rd = std::make_shared<RDSolver<D>>(benchGrayScott<D>(n, 1.0, RDIntegrator::ExplicitEuler), *findModel("gray-scott"));
+  auto rd =
+      std::make_shared<RDSolver<D>>(benchGrayScott<D>(n, 1.0, RDIntegrator::ExplicitEuler), *findModel("gray-scott"));
   pearsonStart(rd.get());
   const double dt = 0.9 * rd->explicitDiffusionLimit();
   out->push_back({"rd explicit (double)", D, n, 32, [rd, dt] { rd->step(dt); }, nullptr});
@@ -134,7 +136,8 @@ void addKernels(int n, std::vector<Kernel>* out) {
     for (int s = 0; s < 2; ++s) k5->field(s) = fused->field(s);
     out->push_back({"rd fused 5x5 (float)", D, n, 16, [k5, dt] { k5->step(dt); }, nullptr});
   }
-  // coupling: two double species traced back through a float MAC velocity on the same grid (read 2 x 8 + D x 4, write 2 x 8).
+  // coupling: two double species traced back through a float MAC velocity on the same grid (read 2 x 8 + D x 4, write 2
+  // x 8).
   std::array<bool, D> walls{};
   auto vel = std::make_shared<MacVelocity<D>>(cube<D>(n), 1.0 / n, walls);
   for (int a = 0; a < D; ++a)
@@ -165,10 +168,11 @@ bool runRooflineBench(const BenchOptions& o) {
   for (int threads : {1, 2}) {
     bw[threads] = triadBandwidth(threads, o.minSeconds);
     all["triad"][std::to_string(threads)] = bw[threads];
-    std::cout << fmt::format("triad, {} thread{}: {:.1f} GB/s\n", threads, threads > 1 ? "s" : "", bw[threads]) << std::flush;
+    std::cout << fmt::format("triad, {} thread{}: {:.1f} GB/s\n", threads, threads > 1 ? "s" : "", bw[threads])
+              << std::flush;
   }
-  std::cout << fmt::format("{:<30} {:>4} {:>6} {:>7} {:>10} {:>16} {:>10} {:>9}\n", "kernel", "dim", "n", "threads", "B/update",
-                           "Mcell-updates/s", "GB/s", "of triad");
+  std::cout << fmt::format("{:<30} {:>4} {:>6} {:>7} {:>10} {:>16} {:>10} {:>9}\n", "kernel", "dim", "n", "threads",
+                           "B/update", "Mcell-updates/s", "GB/s", "of triad");
   std::vector<Kernel> kernels;
   for (BenchCase c : selectBenchCases({{2, 1024}, {3, 128}}, o.size)) {
     kernels.clear();
@@ -181,8 +185,8 @@ bool runRooflineBench(const BenchOptions& o) {
         const double passes = k.passes ? double(std::max(1, *k.passes)) : 1.0;
         const double rate = passes * cellsOf(k.dim, k.n) / median(timeSteps(o.minSeconds, k.step, [] {}));
         const double gbs = rate * k.bytes / 1e9;
-        std::cout << fmt::format("{:<30} {:>4} {:>6} {:>7} {:>10.0f} {:>16.1f} {:>10.1f} {:>9.2f}\n", k.name, k.dim, k.n,
-                                 threads, k.bytes, rate / 1e6, gbs, gbs / bw[threads])
+        std::cout << fmt::format("{:<30} {:>4} {:>6} {:>7} {:>10.0f} {:>16.1f} {:>10.1f} {:>9.2f}\n", k.name, k.dim,
+                                 k.n, threads, k.bytes, rate / 1e6, gbs, gbs / bw[threads])
                   << std::flush;
         all["kernels"].push_back({{"kernel", k.name}, {"dim", k.dim}, {"n", k.n}, {"threads", threads},
                                   {"bytes_per_cell_update", k.bytes}, {"cell_updates_per_second", rate},

@@ -145,7 +145,8 @@ class Parser {
   void expect(const char* tok, const char* what) {
     if (!accept(tok)) {
       skip();
-      fail(p_, std::string("expected ") + what + (p_ < s_.size() ? std::string(", found '") + s_[p_] + "'" : ", found the end"));
+      fail(p_, std::string("expected ") + what +
+                   (p_ < s_.size() ? std::string(", found '") + s_[p_] + "'" : ", found the end"));
     }
   }
   static NodePtr make(Kind k, std::vector<NodePtr> args, Op op = Op::Add) {

@@ -42,7 +42,6 @@ class Grid {
 
  public:
   using value_type = T;
-  static constexpr int kDim = D;
 
   Grid() = default;
   explicit Grid(IVec<D> dims, T value = T{}) : dims_(dims) {

@@ -385,8 +385,8 @@ void LaplaceSystem<D>::apply(const std::vector<T>& x, std::vector<T>* y) const {
 template <int D>
 double LaplaceSystem<D>::applyDot(const Vector& x, Vector* y) const {
   const size_t nx = size_t(dims[0]);
-  return deterministicRowSum<D>(dims,
-                                [&](size_t row) { return applyRow<double, true>(row, x.data(), y->data() + row * nx); });
+  return deterministicRowSum<D>(
+      dims, [&](size_t row) { return applyRow<double, true>(row, x.data(), y->data() + row * nx); });
 }
 
 template <int D>

@@ -37,7 +37,8 @@ void checkReplaceable(const fs::path& path) {
   struct stat st;
   if (::lstat(path.c_str(), &st) != 0) return;  // nothing there
   if (!S_ISREG(st.st_mode))
-    throw OutputError(path, "an output would replace something that is not a regular file (a folder, device, pipe or link)",
+    throw OutputError(path,
+                      "an output would replace something that is not a regular file (a folder, device, pipe or link)",
                       "move it away or choose another --out");
 }
 

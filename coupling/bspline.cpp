@@ -136,7 +136,9 @@ double sampleBSpline(const Grid<double, D>& c, const Grid<double, D>& f, const s
 
 template void bsplineCoefficients<2>(const Grid<double, 2>&, const std::array<bool, 2>&, Grid<double, 2>*);
 template void bsplineCoefficients<3>(const Grid<double, 3>&, const std::array<bool, 3>&, Grid<double, 3>*);
-template double sampleBSpline<2>(const Grid<double, 2>&, const Grid<double, 2>&, const std::array<bool, 2>&, const Vec<2>&);
-template double sampleBSpline<3>(const Grid<double, 3>&, const Grid<double, 3>&, const std::array<bool, 3>&, const Vec<3>&);
+template double sampleBSpline<2>(const Grid<double, 2>&, const Grid<double, 2>&, const std::array<bool, 2>&,
+                                 const Vec<2>&);
+template double sampleBSpline<3>(const Grid<double, 3>&, const Grid<double, 3>&, const std::array<bool, 3>&,
+                                 const Vec<3>&);
 
 }  // namespace morphoflow

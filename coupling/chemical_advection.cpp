@@ -151,8 +151,9 @@ __attribute__((target("avx2"))) size_t linearRunAvx2(const LinearRun<D>& r, size
     for (size_t s = 0; s < r.species; ++s) {
       __m256d v = _mm256_setzero_pd();
       for (int k = 0; k < (1 << D); ++k)
-        v = _mm256_add_pd(v, _mm256_mul_pd(weight[k], _mm256_mask_i32gather_pd(_mm256_setzero_pd(), r.src[s], index[k],
-                                                                                _mm256_castsi256_pd(_mm256_set1_epi64x(-1)), 8)));
+        v = _mm256_add_pd(
+            v, _mm256_mul_pd(weight[k], _mm256_mask_i32gather_pd(_mm256_setzero_pd(), r.src[s], index[k],
+                                                                 _mm256_castsi256_pd(_mm256_set1_epi64x(-1)), 8)));
       const __m256d in = _mm256_set1_pd(r.in[s]);
       const __m256d out = _mm256_add_pd(_mm256_mul_pd(w, in), _mm256_mul_pd(keep, v));
       _mm256_storeu_pd(r.dst[s] + i, _mm256_blendv_pd(out, in, full));
@@ -196,7 +197,8 @@ ChemicalAdvector<D>::ChemicalAdvector(ChemicalDomain<D> domain, ChemicalInterpol
     : domain_(std::move(domain)), interpolation_(interpolation) {
   size_t n = 1;
   for (int a = 0; a < D; ++a) n *= size_t(domain_.cells[a]);
-  if (!domain_.solid.empty() && domain_.solid.size() != n) throw std::invalid_argument("coupling: solid mask has the wrong size");
+  if (!domain_.solid.empty() && domain_.solid.size() != n)
+    throw std::invalid_argument("coupling: solid mask has the wrong size");
   if (!domain_.inflowValues.empty()) fromInflow_.assign(n, 0);
 }
 
@@ -377,7 +379,9 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
 
 template class ChemicalAdvector<2>;
 template class ChemicalAdvector<3>;
-template double sampleChemical<2>(const Grid<double, 2>&, const std::array<bool, 2>&, const Vec<2>&, ChemicalInterpolation);
-template double sampleChemical<3>(const Grid<double, 3>&, const std::array<bool, 3>&, const Vec<3>&, ChemicalInterpolation);
+template double sampleChemical<2>(const Grid<double, 2>&, const std::array<bool, 2>&, const Vec<2>&,
+                                  ChemicalInterpolation);
+template double sampleChemical<3>(const Grid<double, 3>&, const std::array<bool, 3>&, const Vec<3>&,
+                                  ChemicalInterpolation);
 
 }  // namespace morphoflow

@@ -46,7 +46,8 @@ class ChemicalAdvector {
   // thread count (every cell is computed independently).
   // The feet and the species' scratch are borrowed from `pool` (if given)
   // for the call; the species go through the scratch one at a time.
-  void advect(const MacVelocity<D>& u, double dt, const std::vector<Grid<double, D>*>& species, WorkPool* pool = nullptr);
+  void advect(const MacVelocity<D>& u, double dt, const std::vector<Grid<double, D>*>& species,
+              WorkPool* pool = nullptr);
   // Sets the solid cells of every species to the solid values.
   void emptySolids(const std::vector<Grid<double, D>*>& species) const;
 
@@ -58,7 +59,8 @@ class ChemicalAdvector {
   // Foot of every cell (grid coordinates, per axis; single precision, as
   // the fluid's own traces: 1e-7 of the domain, far below a cell).
   std::array<std::vector<float>, D> feet_;
-  std::vector<double> fromInflow_;  // weight of the inflow value (1: the foot left through an inflow side); empty without inflow
+  std::vector<double>
+      fromInflow_;  // weight of the inflow value (1: the foot left through an inflow side); empty without inflow
   std::array<std::vector<float>, D> backFeet_;  // bfecc: the feet over -dt
   std::vector<double> backFromInflow_;          // bfecc: their inflow weights
   Grid<double, D> scratch_;  // one species' advected values (borrowed, with a pool)

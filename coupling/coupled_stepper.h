@@ -1,68 +1,49 @@
-// CoupledStepper<D>: advances a fluid and its ARD layer together.
-//
-//   serial: fluid step n + 1, then the ARD step n: reaction-diffusion, then
-//           the chemicals advected through the velocity the fluid's step
-//           advected through (velocity n with step n + 1's forces, which the
-//           fluid keeps until its next step: no copy of it is made).
-//   tbb:    the same two steps run concurrently (seed 001 sec. 7): the ARD's
-//           reaction-diffusion beside the fluid's step from its start, its
-//           advection once the fluid's advection is done too, and both steps
-//           split into TBB tasks, so RD work fills the cores while the
-//           pressure solve waits on memory.
-//
-// Both orders compute exactly the same numbers: neither step reads what the
-// other writes, and every parallel loop has a fixed decomposition, so the
-// output does not depend on the backend or the thread count.
+// CoupledStepper<D>: what advances a fluid and its advection-reaction-diffusion
+// layer together, with one shape for every backend: the CPU's serial or tbb
+// schedule (cpu_coupled_stepper.h) and the GPU's (gpu/gpu_coupled_stepper.h). The
+// host FluidSolver and RDSolver hold the state that fields and checkpoints
+// read; a backend whose state lives elsewhere copies it there when asked.
 #pragma once
 
-#include "core/stage_trace.h"
-#include "coupling/ard_solver.h"
-#include "coupling/coupled_steps.h"
-#include "fluid/fluid_solver.h"
+#include <array>
+
+#include <nlohmann/json.hpp>
+
+#include "core/state_archive.h"
+#include "coupling/smoke_layer.h"
+#include "fluid/fluid_stepper.h"
+#include "rd/rd_solver.h"
 
 namespace morphoflow {
 
-enum class CouplingBackend { Serial, TBB };
-
 template <int D>
-class CoupledStepper final : public CoupledSteps<D> {
+class CoupledStepper {
  public:
-  CoupledStepper(FluidSolver<D>* fluid, ARDSolver<D>* ard, CouplingBackend backend);
+  virtual ~CoupledStepper() = default;
 
-  void step(double dt) override;
-  const FluidStepper<D>& fluid() const override { return fluidStepper_; }
-  const RDStepStats& layerStats() const override { return ard_->rd().lastStats(); }
-  std::array<double, 3> seconds() const override { return {fluidSeconds_, ardSeconds_, stepSeconds_}; }
-  bool overlapped() const override { return backend_ != CouplingBackend::Serial; }
-  // (the hosts are the solvers stepped)
-  void toHost(FluidSolver<D>*, RDSolver<D>*) const override {}
-  void fromHost(const FluidSolver<D>&, const RDSolver<D>&) override {}
-  void save(StateWriter*) const override {}
-  void load(const StateReader&) override {}
-  void report(nlohmann::json*) const override {}
-  void blendLayer(int, const Grid<float, D>& cover, const std::vector<double>& values) override {
-    morphoflow::blendLayer<D>(&ard_->rd(), cover, values);
-  }
-  void maskLayer(const SmokeTaps<D>& taps, double threshold, const std::vector<double>& rest) override {
-    morphoflow::maskLayer<D>(&ard_->rd(), fluid_->dye(), taps, threshold, rest);
-  }
-
-  // Wall seconds of the last step: the fluid's, the ARD's, and the whole step.
-  double fluidSeconds() const { return fluidSeconds_; }
-  double ardSeconds() const { return ardSeconds_; }
-  double stepSeconds() const { return stepSeconds_; }
-
-  // Records every later step's stages (the fluid's four, the ARD's two) on
-  // the thread that ran each, into `trace` (null: stop).
-  void setTrace(StageTrace* trace) { trace_ = trace; }
-
- private:
-  FluidSolver<D>* fluid_;
-  CpuFluidStepper<D> fluidStepper_;
-  ARDSolver<D>* ard_;
-  CouplingBackend backend_;
-  double fluidSeconds_ = 0, ardSeconds_ = 0, stepSeconds_ = 0;
-  StageTrace* trace_ = nullptr;
+  virtual void step(double dt) = 0;
+  // The fluid side: the clock, its solvers' results, the CFL step, finiteness.
+  virtual const FluidStepper<D>& fluid() const = 0;
+  // The layer's Newton and diffusion results of the last step.
+  virtual const RDStepStats& layerStats() const = 0;
+  // Seconds of the last step: the fluid's, the ARD's, the whole step's.
+  virtual std::array<double, 3> seconds() const = 0;
+  // Whether the two sides ran concurrently.
+  virtual bool overlapped() const = 0;
+  // The state into the hosts (nothing where the hosts are what is stepped),
+  // and from them (after a checkpoint was read into them).
+  virtual void toHost(FluidSolver<D>* fluid, RDSolver<D>* rd) const = 0;
+  virtual void fromHost(const FluidSolver<D>& fluid, const RDSolver<D>& rd) = 0;
+  // Checkpoints: what the backend keeps besides the hosts' state.
+  virtual void save(StateWriter* out) const = 0;
+  virtual void load(const StateReader& in) = 0;
+  // run.json: the backend's own entries.
+  virtual void report(nlohmann::json* run) const = 0;
+  // The pattern on the smoke (smoke_layer.h) on the stepped layer: a
+  // source's blend (`id` names a cover that stays the same from step to
+  // step, -1 one that moves) and the mask.
+  virtual void blendLayer(int id, const Grid<float, D>& cover, const std::vector<double>& values) = 0;
+  virtual void maskLayer(const SmokeTaps<D>& taps, double threshold, const std::vector<double>& rest) = 0;
 };
 
 }  // namespace morphoflow

@@ -35,8 +35,8 @@ inline CouplingMode couplingModeNamed(const std::string& name) {
   throw std::invalid_argument("no coupling mode '" + name + "'");
 }
 inline ChemicalInterpolation interpolationNamed(const std::string& name) {
-  for (ChemicalInterpolation i : {ChemicalInterpolation::Linear, ChemicalInterpolation::Cubic, ChemicalInterpolation::BSpline,
-                                  ChemicalInterpolation::BFECC})
+  for (ChemicalInterpolation i : {ChemicalInterpolation::Linear, ChemicalInterpolation::Cubic,
+                                  ChemicalInterpolation::BSpline, ChemicalInterpolation::BFECC})
     if (name == interpolationName(i)) return i;
   throw std::invalid_argument("no interpolation '" + name + "'");
 }

@@ -72,8 +72,11 @@ std::vector<VelocityFrame> findVelocityFrames(const std::string& pattern, double
     const fs::path dir = head.parent_path().empty() ? fs::path(".") : head.parent_path();
     const std::string prefix = head.filename().string();
     const std::string suffix = end == std::string::npos ? "" : pattern.substr(end);
-    if (suffix.find('/') != std::string::npos) throw VelocityFileError(pattern, "the frame number ('#') must be in the file name");
-    if (digits > 18) throw VelocityFileError(pattern, std::to_string(digits) + " '#' make a frame number too long to count: use at most 18");
+    if (suffix.find('/') != std::string::npos)
+      throw VelocityFileError(pattern, "the frame number ('#') must be in the file name");
+    if (digits > 18)
+      throw VelocityFileError(pattern,
+                              std::to_string(digits) + " '#' make a frame number too long to count: use at most 18");
     std::error_code ec;
     fs::directory_iterator it(dir, ec);
     if (ec) throw VelocityFileError(pattern, "cannot list the folder " + dir.string() + ": " + ec.message());
@@ -86,7 +89,8 @@ std::vector<VelocityFrame> findVelocityFrames(const std::string& pattern, double
       if (!std::all_of(number.begin(), number.end(), [](char c) { return c >= '0' && c <= '9'; })) continue;
       files.push_back({std::stol(number), e.path().string()});
     }
-    if (files.empty()) throw VelocityFileError(pattern, "no file matches (each '#' stands for one digit of the frame number)");
+    if (files.empty())
+      throw VelocityFileError(pattern, "no file matches (each '#' stands for one digit of the frame number)");
     std::sort(files.begin(), files.end());
   }
   std::vector<VelocityFrame> frames;
@@ -98,7 +102,8 @@ std::vector<VelocityFrame> findVelocityFrames(const std::string& pattern, double
     if (!readVdbTime(path, &f.time, &has, &err)) throw VelocityFileError(path, err);
     if (!has) {
       if (!(frameTime > 0))
-        throw VelocityFileError(path, "the file has no 'time' metadata, so the frame's time is unknown; give velocity.frame_time");
+        throw VelocityFileError(
+            path, "the file has no 'time' metadata, so the frame's time is unknown; give velocity.frame_time");
       f.time = double(number) * frameTime;
     }
     if (!frames.empty() && !(f.time > frames.back().time))
@@ -121,7 +126,8 @@ void resample(const VelocityVolume& v, MacVelocity<D>* u) {
   auto value = [&](int comp, const std::array<long, 3>& c) -> double {
     for (int b = 0; b < 3; ++b)
       if (c[size_t(b)] < 0 || c[size_t(b)] >= v.cells[size_t(b)]) return 0.0;  // inactive: the background
-    return v.values[size_t(comp)][(size_t(c[2]) * size_t(v.cells[1]) + size_t(c[1])) * size_t(v.cells[0]) + size_t(c[0])];
+    return v
+        .values[size_t(comp)][(size_t(c[2]) * size_t(v.cells[1]) + size_t(c[1])) * size_t(v.cells[0]) + size_t(c[0])];
   };
   for (int a = 0; a < D; ++a) {
     Grid<float, D>& g = (*u)[a];
@@ -167,9 +173,10 @@ const MacVelocity<D>& VdbVelocitySequence<D>::frame(size_t k, const MacVelocity<
   if (v.hasDomain) {
     for (int a = 0; a < D; ++a)
       if (std::abs(v.domain[size_t(a)] - domain_[size_t(a)]) > 1e-6 * domain_[size_t(a)])
-        throw VelocityFileError(path, "the volume was written for a domain of size " + std::to_string(v.domain[0]) + " x " +
-                                          std::to_string(v.domain[1]) + (D == 3 ? " x " + std::to_string(v.domain[2]) : "") +
-                                          ", not the scene's " + std::to_string(domain_[0]) + " x " + std::to_string(domain_[1]) +
+        throw VelocityFileError(path, "the volume was written for a domain of size " + std::to_string(v.domain[0]) +
+                                          " x " + std::to_string(v.domain[1]) +
+                                          (D == 3 ? " x " + std::to_string(v.domain[2]) : "") + ", not the scene's " +
+                                          std::to_string(domain_[0]) + " x " + std::to_string(domain_[1]) +
                                           (D == 3 ? " x " + std::to_string(domain_[2]) : ""));
   } else {
     for (int a = 0; a < D; ++a) {  // a foreign file: its active voxels must lie in the domain
@@ -177,8 +184,9 @@ const MacVelocity<D>& VdbVelocitySequence<D>::frame(size_t k, const MacVelocity<
       const double hi = lo + v.cells[size_t(a)] * v.voxelSize;
       if (v.cells[size_t(a)] > 0 && (lo < -v.voxelSize || hi > domain_[size_t(a)] + 2 * v.voxelSize))
         throw VelocityFileError(path, "the velocity's active voxels reach from " + std::to_string(lo) + " to " +
-                                          std::to_string(hi) + " along " + "xyz"[a] + ", outside the scene's domain [0, " +
-                                          std::to_string(domain_[size_t(a)]) + "]");
+                                          std::to_string(hi) + " along " + "xyz"[a] +
+                                          ", outside the scene's domain [0, " + std::to_string(domain_[size_t(a)]) +
+                                          "]");
     }
   }
   if (cache_.size() >= 2) cache_.erase(cache_.begin()->first < k ? cache_.begin() : std::prev(cache_.end()));
@@ -213,7 +221,8 @@ void VdbVelocitySequence<D>::sample(double t, MacVelocity<D>* u) {
   const MacVelocity<D> f0 = frame(k, *u);  // a copy: loading the next frame may evict it
   const MacVelocity<D>& f1 = frame(k + 1, *u);
   if (f0.cells() != f1.cells())
-    throw VelocityFileError(frames_[k + 1].path, "its velocity grid differs from the previous frame's, so the two cannot be blended");
+    throw VelocityFileError(frames_[k + 1].path,
+                            "its velocity grid differs from the previous frame's, so the two cannot be blended");
   *u = f0;
   for (int a = 0; a < D; ++a)
     for (size_t i = 0; i < (*u)[a].size(); ++i) (*u)[a][i] = float((1.0 - w) * f0[a][i] + w * f1[a][i]);

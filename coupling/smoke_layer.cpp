@@ -56,7 +56,9 @@ template SmokeTaps<2> smokeTaps<2>(const Layout<2>&, const IVec<2>&, const IVec<
 template SmokeTaps<3> smokeTaps<3>(const Layout<3>&, const IVec<3>&, const IVec<3>&, double);
 template void blendLayer<2>(RDSolver<2>*, const Grid<float, 2>&, const std::vector<double>&);
 template void blendLayer<3>(RDSolver<3>*, const Grid<float, 3>&, const std::vector<double>&);
-template void maskLayer<2>(RDSolver<2>*, const Grid<float, 2>&, const SmokeTaps<2>&, double, const std::vector<double>&);
-template void maskLayer<3>(RDSolver<3>*, const Grid<float, 3>&, const SmokeTaps<3>&, double, const std::vector<double>&);
+template void maskLayer<2>(RDSolver<2>*, const Grid<float, 2>&, const SmokeTaps<2>&, double,
+                           const std::vector<double>&);
+template void maskLayer<3>(RDSolver<3>*, const Grid<float, 3>&, const SmokeTaps<3>&, double,
+                           const std::vector<double>&);
 
 }  // namespace morphoflow

@@ -133,8 +133,9 @@ MF_INLINE V vinterpolate(const float* data, const size_t* s, const VTap<V>* tap,
     return blendCorners<D, V>([d](size_t off) __attribute__((always_inline)) { return vload<V>(d + off); }, sy, sz,
                               t, lo, hi);
   }
-  return blendCorners<D, V>([data, idx](size_t off) __attribute__((always_inline)) { return gather<V>(data + off, idx); },
-                            sy, sz, t, lo, hi);
+  return blendCorners<D, V>(
+      [ data, idx ](size_t off) __attribute__((always_inline)) { return gather<V>(data + off, idx); }, sy, sz, t, lo,
+      hi);
 }
 
 // MacSampler on a vector of positions.
@@ -391,7 +392,8 @@ std::optional<UniformRows> uniformRows(const Grid<float, D>& g, const std::array
 // ... of what a pass wrote from `before`: its skipped rows are flat (value
 // + 0); the others are taken as not flat (skipping less is still exact).
 template <int D>
-std::optional<UniformRows> uniformRows(const IVec<D>& dims, const UniformRows& before, const std::array<int, D>& reach) {
+std::optional<UniformRows> uniformRows(const IVec<D>& dims, const UniformRows& before,
+                                       const std::array<int, D>& reach) {
   std::vector<uint32_t> bits(before.value.size());
   for (size_t r = 0; r < bits.size(); ++r) bits[r] = std::bit_cast<uint32_t>(before.value[r] + 0.0f);
   return uniformRows<D>(dims, before.skip, bits, reach);

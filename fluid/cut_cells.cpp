@@ -83,8 +83,8 @@ float openFraction(const CutSurface& surface, int axis, const IVec<D>& k, double
       for (int p = 0; p < kSamples; ++p)
         for (int q = 0; q < kSamples; ++q, ++total) {
           const double u = (p + 0.5) / kSamples, v = (q + 0.5) / kSamples;
-          const double value = (1 - u) * (1 - v) * phi[i][j] + u * (1 - v) * phi[i + 1][j] + (1 - u) * v * phi[i][j + 1] +
-                               u * v * phi[i + 1][j + 1];
+          const double value = (1 - u) * (1 - v) * phi[i][j] + u * (1 - v) * phi[i + 1][j] +
+                               (1 - u) * v * phi[i][j + 1] + u * v * phi[i + 1][j + 1];
           open += value > 0.0 ? 1 : 0;
         }
   return float(double(open) / total);

@@ -86,7 +86,8 @@ void PressureProjection<D>::divergenceTimes(const MacVelocity<D>& u, double fact
     double* out = div->data() + row * nx;
     for (size_t x = 0; x < nx; ++x) {
       double d = 0.0;
-      for (int a = 0; a < D; ++a) d += double(openHi[a][x]) * double(hi[a][x]) - double(openLo[a][x]) * double(lo[a][x]);
+      for (int a = 0; a < D; ++a)
+        d += double(openHi[a][x]) * double(hi[a][x]) - double(openLo[a][x]) * double(lo[a][x]);
       out[x] = active[x] == 0.0f ? 0.0 : d * factor;
     }
   });

@@ -14,7 +14,8 @@
 namespace morphoflow {
 
 template <int D>
-Grid<float, D> sourceCover(const SmokeSource& src, double t, const IVec<D>& cells, double h, const Grid<uint8_t, D>& solid) {
+Grid<float, D> sourceCover(const SmokeSource& src, double t, const IVec<D>& cells, double h,
+                           const Grid<uint8_t, D>& solid) {
   constexpr int kSub = 4;  // samples per cell and axis
   ObstacleSpec region = src.region;
   for (size_t a = 0; a < src.motion.size(); ++a) {
@@ -67,8 +68,8 @@ std::vector<Grid<float, D>> sourceCoverage(const std::vector<SmokeSource>& sourc
 }
 
 template <int D>
-void emitSmoke(const SmokeSettings& s, const std::vector<Grid<float, D>>& coverage, const Grid<uint8_t, D>& solid, double t,
-               double dt, Grid<float, D>* density, Grid<float, D>* temperature, MacVelocity<D>* u) {
+void emitSmoke(const SmokeSettings& s, const std::vector<Grid<float, D>>& coverage, const Grid<uint8_t, D>& solid,
+               double t, double dt, Grid<float, D>* density, Grid<float, D>* temperature, MacVelocity<D>* u) {
   for (size_t q = 0; q < s.sources.size(); ++q) {
     const SmokeSource& src = s.sources[q];
     const double on = std::min(t + dt, src.end) - std::max(t, src.start);  // the step's time inside the window
@@ -105,8 +106,9 @@ void decaySmoke(const SmokeSettings& s, double dt, Grid<float, D>* density, Grid
   }
   if (s.cooling > 0.0) {
     const double k = std::exp(-s.cooling * dt);
-    parallelFor(temperature->size(), [&](size_t i) { (*temperature)[i] = float(decayed((*temperature)[i], k, s.ambient)); },
-                4096);
+    parallelFor(
+        temperature->size(), [&](size_t i) { (*temperature)[i] = float(decayed((*temperature)[i], k, s.ambient)); },
+        4096);
   }
 }
 

@@ -25,7 +25,8 @@ namespace morphoflow {
 // cells excluded, with its region centred where its motion puts it at time
 // t: the emission integrates to rate x time x the region's volume.
 template <int D>
-Grid<float, D> sourceCover(const SmokeSource& source, double t, const IVec<D>& cells, double h, const Grid<uint8_t, D>& solid);
+Grid<float, D> sourceCover(const SmokeSource& source, double t, const IVec<D>& cells, double h,
+                           const Grid<uint8_t, D>& solid);
 // Every fixed source's cover (a moving one's: zeros, computed each step it emits).
 template <int D>
 std::vector<Grid<float, D>> sourceCoverage(const std::vector<SmokeSource>& sources, const IVec<D>& cells, double h,
@@ -36,8 +37,8 @@ std::vector<Grid<float, D>> sourceCoverage(const std::vector<SmokeSource>& sourc
 // density and the temperature; injecting sources set the velocity of the
 // faces they cover (blended by coverage).
 template <int D>
-void emitSmoke(const SmokeSettings& s, const std::vector<Grid<float, D>>& coverage, const Grid<uint8_t, D>& solid, double t,
-               double dt, Grid<float, D>* density, Grid<float, D>* temperature, MacVelocity<D>* u);
+void emitSmoke(const SmokeSettings& s, const std::vector<Grid<float, D>>& coverage, const Grid<uint8_t, D>& solid,
+               double t, double dt, Grid<float, D>* density, Grid<float, D>* temperature, MacVelocity<D>* u);
 
 // u += dt f for the buoyancy and the vorticity confinement, on work grids
 // lent from `pool` for the stage.

@@ -80,9 +80,9 @@ std::array<double, 3> surfaceForce(const std::vector<SurfaceElement>& elements, 
 
 template std::vector<SurfaceElement> cutSurfaceElements<2>(const VelocityConstraints<2>&);
 template std::vector<SurfaceElement> cutSurfaceElements<3>(const VelocityConstraints<3>&);
-template std::array<double, 3> surfaceForce<2>(const std::vector<SurfaceElement>&, const MacVelocity<2>&, const Grid<float, 2>&,
-                                               double);
-template std::array<double, 3> surfaceForce<3>(const std::vector<SurfaceElement>&, const MacVelocity<3>&, const Grid<float, 3>&,
-                                               double);
+template std::array<double, 3> surfaceForce<2>(const std::vector<SurfaceElement>&, const MacVelocity<2>&,
+                                               const Grid<float, 2>&, double);
+template std::array<double, 3> surfaceForce<3>(const std::vector<SurfaceElement>&, const MacVelocity<3>&,
+                                               const Grid<float, 3>&, double);
 
 }  // namespace morphoflow

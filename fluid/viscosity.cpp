@@ -24,7 +24,8 @@ ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
   Grid<float, D> phi;
   if (cut) {
     phi = Grid<float, D>(fixed.dims(), 0.0f);
-    forEachCell<D>(fixed.dims(), [&](const IVec<D>& k, size_t i) { phi[i] = float(vc.cut.distance(vc.facePosition(a, k).data())); });
+    forEachCell<D>(fixed.dims(),
+                   [&](const IVec<D>& k, size_t i) { phi[i] = float(vc.cut.distance(vc.facePosition(a, k).data())); });
     C.insideCut.assign(C.A.size(), 0);
   }
   forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) {
@@ -137,7 +138,8 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
     return SolverResult{true, 0, 0.0};
   }
   const std::initializer_list<Vector*> doubles = {&b_, &x_, &pcgWork_.b, &pcgWork_.r, &pcgWork_.p, &pcgWork_.q};
-  const std::initializer_list<std::vector<float>*> floats = {&chebyshevWork_.e[0], &chebyshevWork_.e[1], &chebyshevWork_.g};
+  const std::initializer_list<std::vector<float>*> floats = {&chebyshevWork_.e[0], &chebyshevWork_.e[1],
+                                                             &chebyshevWork_.g};
   if (pool) pool->lend(doubles), pool->lend(floats);
   const SolverResult result = solveComponents(u, nu * dt / (vc_.h * vc_.h));
   if (pool) pool->give(doubles), pool->give(floats);
@@ -189,7 +191,8 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
     const int history = C.history;
     x_.resize(C.A.size());
     eachUnknown<D>(C.dims, g, [&](size_t i, size_t gi) {
-      const double rate = history >= 1 ? double(C.rate[i]) + (history >= 2 ? double(fromBfloat16(C.change[i])) : 0.0) : 0.0;
+      const double rate =
+          history >= 1 ? double(C.rate[i]) + (history >= 2 ? double(fromBfloat16(C.change[i])) : 0.0) : 0.0;
       x_[i] = C.held(fixed, i, gi) ? 0.0 : double(g[gi]) + s * rate;
     });
     SolverOptions options = options_;

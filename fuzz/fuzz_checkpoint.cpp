@@ -41,9 +41,10 @@ const Scene& sceneOf(int which) {
     };
     return std::vector<Scene>{
         loadScene(dir + "/rd/gray_scott_pearson.toml", with({"grid.resolution=[16,16]", "time.steps=8"})),
-        loadScene(dir + "/lid_driven_cavity.toml", with({"grid.resolution=[16,16]", "time.duration=0.08", "time.cfl=0",
-                                                         "probes.centerlines=false"})),
-        loadScene(dir + "/coupled/cavity_gray_scott.toml", with({"grid.resolution=[16,16]", "rd.resolution=[16,16]", "time.steps=8"})),
+        loadScene(dir + "/lid_driven_cavity.toml",
+                  with({"grid.resolution=[16,16]", "time.duration=0.08", "time.cfl=0", "probes.centerlines=false"})),
+        loadScene(dir + "/coupled/cavity_gray_scott.toml",
+                  with({"grid.resolution=[16,16]", "rd.resolution=[16,16]", "time.steps=8"})),
         loadScene(dir + "/flow/cavity_vdb_gray_scott.toml", with({"grid.resolution=[16,16]", "time.steps=8"})),
     };
   }();
@@ -110,7 +111,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     file = rest;
   } else {
     const size_t at = rest.find(kStateMark);
-    file = at == std::string_view::npos ? frame(rest, {}) : frame(rest.substr(0, at), rest.substr(at + kStateMark.size()));
+    file =
+        at == std::string_view::npos ? frame(rest, {}) : frame(rest.substr(0, at), rest.substr(at + kStateMark.size()));
   }
   const fs::path out = fuzz::freshScratch("checkpoint");
   fuzz::writeBytes(checkpointFile(out, kResumeStep), file);

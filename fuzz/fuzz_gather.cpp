@@ -42,7 +42,8 @@ void writeFiles(std::string_view input, const fs::path& dir) {
     const size_t next = input.find("\n" + std::string(kFileMark), nameEnd);
     const std::string name(input.substr(nameStart, nameEnd - nameStart));
     const size_t body = std::min(nameEnd + 1, input.size());
-    if (safeName(name)) fuzz::writeBytes(dir / name, input.substr(body, (next == std::string_view::npos ? input.size() : next) - body));
+    if (safeName(name))
+      fuzz::writeBytes(dir / name, input.substr(body, (next == std::string_view::npos ? input.size() : next) - body));
     at = next;
   }
 }

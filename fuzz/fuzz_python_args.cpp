@@ -115,7 +115,8 @@ void writeSeeds(const std::filesystem::path& dir) {
   };
   int i = 0;
   for (const auto& [key, rest] : seeds)
-    fuzz::writeBytes(dir / ("seed-" + std::to_string(i++)), rest.substr(0, 1) + key + std::string(1, '\0') + rest.substr(1));
+    fuzz::writeBytes(dir / ("seed-" + std::to_string(i++)),
+                     rest.substr(0, 1) + key + std::string(1, '\0') + rest.substr(1));
 }
 
 }  // namespace

@@ -25,7 +25,8 @@ inline std::filesystem::path freshScratch(const std::string& name) {
   static const std::filesystem::path root = [] {
     std::atexit([] {
       std::error_code ec;
-      std::filesystem::remove_all(std::filesystem::temp_directory_path() / ("morphoflow-fuzz-" + std::to_string(getpid())), ec);
+      std::filesystem::remove_all(
+          std::filesystem::temp_directory_path() / ("morphoflow-fuzz-" + std::to_string(getpid())), ec);
     });
     return std::filesystem::temp_directory_path() / ("morphoflow-fuzz-" + std::to_string(getpid()));
   }();

@@ -21,7 +21,8 @@ ComputeProgram::ComputeProgram(const std::string& shader, const std::string& pro
     GLint n = 0;
     isProgram ? glGetProgramiv(object, GL_INFO_LOG_LENGTH, &n) : glGetShaderiv(object, GL_INFO_LOG_LENGTH, &n);
     std::string log(size_t(std::max(n, 1)), '\0');
-    isProgram ? glGetProgramInfoLog(object, n, nullptr, log.data()) : glGetShaderInfoLog(object, n, nullptr, log.data());
+    isProgram ? glGetProgramInfoLog(object, n, nullptr, log.data())
+              : glGetShaderInfoLog(object, n, nullptr, log.data());
     return log;
   };
   if (!ok) {

@@ -94,7 +94,8 @@ bool makeContext(EGLDisplay d, GlContext::Egl* egl) {
 }
 
 #ifndef NDEBUG
-void GLAPIENTRY debugMessage(GLenum, GLenum type, GLuint, GLenum severity, GLsizei, const GLchar* message, const void*) {
+void GLAPIENTRY debugMessage(GLenum, GLenum type, GLuint, GLenum severity, GLsizei, const GLchar* message,
+                             const void*) {
   if (severity != GL_DEBUG_SEVERITY_NOTIFICATION)
     std::fprintf(stderr, "GL %s: %s\n", type == GL_DEBUG_TYPE_ERROR ? "error" : "debug", message);
 }
@@ -143,7 +144,8 @@ GlContext::GlContext() : egl_(std::make_unique<Egl>()) {
   if (egl_->context == EGL_NO_CONTEXT)
     throw GpuUnavailable("no OpenGL 4.3 core context: neither an EGL device nor Mesa's surfaceless platform offers one "
                          "(install libegl-mesa0 and libgl1-mesa-dri for llvmpipe)");
-  if (epoxy_gl_version() < 43) throw GpuUnavailable(fmt::format("OpenGL {:.1f} only; compute shaders need 4.3", epoxy_gl_version() / 10.0));
+  if (epoxy_gl_version() < 43)
+    throw GpuUnavailable(fmt::format("OpenGL {:.1f} only; compute shaders need 4.3", epoxy_gl_version() / 10.0));
   holder_ = std::this_thread::get_id();  // (makeContext made it current here)
   renderer_ = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
   version_ = reinterpret_cast<const char*>(glGetString(GL_VERSION));
@@ -177,8 +179,9 @@ void GlContext::check(const char* what) {
                                "the last checkpoint is intact: continue with --resume",
                                what));
   throw GpuError(fmt::format("OpenGL error 0x{:04x} ({}) in {}", e,
-                             e == GL_OUT_OF_MEMORY ? "out of GPU memory" : e == GL_INVALID_OPERATION ? "invalid operation"
-                                                                                                    : "invalid value or enum",
+                             e == GL_OUT_OF_MEMORY       ? "out of GPU memory"
+                             : e == GL_INVALID_OPERATION ? "invalid operation"
+                                                         : "invalid value or enum",
                              what));
 }
 

@@ -8,17 +8,22 @@
 
 #include "gpu/gpu_stage_timer.h"
 #include "gpu/compute_program.h"
-#include "gpu/gpu_kernels.h"
+#include "gpu/gpu_programs.h"
 
 namespace morphoflow {
 
 template <int D>
-GpuARDSolver<D>::GpuARDSolver(GpuRDLayer<D>* layer, const ChemicalDomain<D>& domain, ChemicalInterpolation interpolation,
-                              CouplingMode mode, double rdTimeScale, const IVec<D>& fluidCells, double fluidH)
-    : layer_(layer), domain_(domain), cubic_(interpolation == ChemicalInterpolation::Cubic),
-      spline_(interpolation == ChemicalInterpolation::BSpline), bfecc_(interpolation == ChemicalInterpolation::BFECC),
+GpuARDSolver<D>::GpuARDSolver(GpuRDLayer<D>* layer, const ChemicalDomain<D>& domain,
+                              ChemicalInterpolation interpolation, CouplingMode mode, double rdTimeScale,
+                              const IVec<D>& fluidCells, double fluidH)
+    : layer_(layer),
+      domain_(domain),
+      cubic_(interpolation == ChemicalInterpolation::Cubic),
+      spline_(interpolation == ChemicalInterpolation::BSpline),
+      bfecc_(interpolation == ChemicalInterpolation::BFECC),
       mode_(mode),
-      rdTimeScale_(rdTimeScale), fluidH_(fluidH) {
+      rdTimeScale_(rdTimeScale),
+      fluidH_(fluidH) {
   if (!(rdTimeScale > 0)) throw std::invalid_argument("coupling: the reaction-diffusion time scale must be > 0");
   for (int a = 0; a < D; ++a) {
     fluidCells_[size_t(a)] = fluidCells[a];
@@ -37,7 +42,7 @@ GpuARDSolver<D>::GpuARDSolver(GpuRDLayer<D>* layer, const ChemicalDomain<D>& dom
 template <int D>
 void GpuARDSolver<D>::emptySolids() {
   if (!hasSolids_) return;
-  const ComputeProgram& p = useKernel("chem_advect.comp", fmt::format("#define DIM {}\n#define MODE_SOLIDS", D));
+  const ComputeProgram& p = useProgram("chem_advect.comp", fmt::format("#define DIM {}\n#define MODE_SOLIDS", D));
   setUniform(p, "rdCells", rdCells_);
   auto value = [&](size_t s) { return s < domain_.solidValues.size() ? domain_.solidValues[s] : 0.0; };
   glUniform2d(p.uniform("solidValue"), value(0), value(1));
@@ -57,7 +62,8 @@ void GpuARDSolver<D>::prefilter() {
     coefficients_[size_t(s)].copyFrom(layer_->field(s), layer_->cells() * sizeof(double));
     for (int a = 0; a < D; ++a) {
       const int n = rdCells_[size_t(a)];
-      const ComputeProgram& p = useKernel("chem_advect.comp", fmt::format("#define DIM {}\n#define MODE_PREFILTER", D));
+      const ComputeProgram& p =
+          useProgram("chem_advect.comp", fmt::format("#define DIM {}\n#define MODE_PREFILTER", D));
       setUniform(p, "rdCells", rdCells_);
       setUniform(p, "periodic", periodic_);
       setUniform(p, "axis", a);
@@ -78,10 +84,11 @@ void GpuARDSolver<D>::prefilter() {
 // (reading the backward step from coefficients_).
 template <int D>
 void GpuARDSolver<D>::advectPass(double dt, const GpuFluid<D>& fluid, Pair from, Pair into, bool correct) {
-  const ComputeProgram& p = useKernel("chem_advect.comp", fmt::format("#define DIM {}\n#define MODE_ADVECT", D));
+  const ComputeProgram& p = useProgram("chem_advect.comp", fmt::format("#define DIM {}\n#define MODE_ADVECT", D));
   setUniform(p, "cells", fluidCells_);
   setUniform(p, "periodic", periodic_);
-  setUniform(p, "velOff", std::array<int, 3>{int(fluid.offset(0)), int(fluid.offset(1)), D == 3 ? int(fluid.offset(2)) : 0});
+  setUniform(p, "velOff",
+             std::array<int, 3>{int(fluid.offset(0)), int(fluid.offset(1)), D == 3 ? int(fluid.offset(2)) : 0});
   setUniform(p, "rdCells", rdCells_);
   setUniform(p, "c", float(dt / fluidH_));
   setUniform(p, "r", float(domain_.h / fluidH_));

@@ -7,7 +7,7 @@
 #include "gpu/compute_program.h"
 #include "gpu/gl_context.h"
 #include "gpu/gpu_counts.h"
-#include "gpu/gpu_kernels.h"
+#include "gpu/gpu_programs.h"
 #include "gpu/gpu_models.h"
 
 namespace morphoflow {
@@ -16,8 +16,9 @@ namespace {
 constexpr int kGroup = 8;  // 8 x 8 (x 4 in 3D) invocations a work group
 }
 
-GpuExplicitRD::GpuExplicitRD(const RDSettings& s, const std::vector<double>& diffusion, const std::vector<double>& params,
-                             const std::vector<int>& clamped, const std::vector<float>& u, const std::vector<float>& v) {
+GpuExplicitRD::GpuExplicitRD(const RDSettings& s, const std::vector<double>& diffusion,
+                             const std::vector<double>& params, const std::vector<int>& clamped,
+                             const std::vector<float>& u, const std::vector<float>& v) {
   GlContext::instance();
   const int D = int(s.resolution.size());
   for (int a = 0; a < D; ++a) cells_[size_t(a)] = s.resolution[size_t(a)];

@@ -11,7 +11,7 @@
 #include "fluid/smoke.h"
 #include "gpu/compute_program.h"
 #include "gpu/gl_context.h"
-#include "gpu/gpu_kernels.h"
+#include "gpu/gpu_programs.h"
 #include "gpu/kernel_modes.h"
 #include "gpu/gpu_laplace.h"
 #include "gpu/gpu_multigrid.h"
@@ -137,11 +137,13 @@ size_t GpuFluid<D>::deviceBytes(const IVec<D>& cells) {
   }
   const double system = (D + 1) * 4.0;       // face weights and diagonal, float
   const double coarse = 1.0 / ((1 << D) - 1);  // the multigrid levels below the fine one, relative to it
-  const double bytes = 4.0 * 6 * double(f)     // u, its scratch, fixed flags, prescribed values, open fractions, held flags
-                       + 4.0 * 4 * double(c) + 4.0 * 4 * double(g)  // dye, its scratch, solid, inactive; the schemes' scratch
-                       // pressure: system, phi, rhs, rate; PCG vectors; each level's x and b
-                       + double(c) * (system + 3 * 8 + 5 * 8 + 2 * 4 + coarse * (system + 2 * 4))
-                       + double(f) * (system + 3 * 8 + 5 * 8);  // viscosity: system, b, x, rhs, PCG vectors
+  const double bytes =
+      4.0 * 6 * double(f)  // u, its scratch, fixed flags, prescribed values, open fractions, held flags
+      + 4.0 * 4 * double(c) +
+      4.0 * 4 * double(g)  // dye, its scratch, solid, inactive; the schemes' scratch
+      // pressure: system, phi, rhs, rate; PCG vectors; each level's x and b
+      + double(c) * (system + 3 * 8 + 5 * 8 + 2 * 4 + coarse * (system + 2 * 4)) +
+      double(f) * (system + 3 * 8 + 5 * 8);  // viscosity: system, b, x, rhs, PCG vectors
   return size_t(bytes);
 }
 
@@ -174,7 +176,7 @@ void GpuFluid<D>::applyConstraints(const GpuBuffer& vel) {
   for (FluidOp mode : {FluidOp::Fixed, FluidOp::Periodic})
     for (int a = 0; a < D; ++a) {
       if (mode == FluidOp::Periodic && !periodic_[size_t(a)]) continue;
-      const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, mode));
+      const ComputeProgram& p = useProgram("fluid_ops.comp", dimDefine(D, mode));
       setUniform(p, "cells", cells_);
       setUniform(p, "axis", a);
       setUniform(p, "n", int(faces(a)));
@@ -193,7 +195,7 @@ void GpuFluid<D>::forces(double dt) {
     const float f = float(dt * settings_.force[size_t(a)]);
     const float b = dyeActive_ ? float(dt * settings_.buoyancy * settings_.buoyancyDirection[size_t(a)]) : 0.0f;
     if (f == 0.0f && b == 0.0f) continue;
-    const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, FluidOp::Forces));
+    const ComputeProgram& p = useProgram("fluid_ops.comp", dimDefine(D, FluidOp::Forces));
     setUniform(p, "cells", cells_);
     setUniform(p, "axis", a);
     setUniform(p, "n", int(faces(a)));
@@ -208,8 +210,9 @@ void GpuFluid<D>::forces(double dt) {
 }
 
 template <int D>
-void GpuFluid<D>::runSmoke(SmokeOp mode, size_t n, int axis, const std::function<void(const ComputeProgram&)>& uniforms) {
-  const ComputeProgram& p = useKernel("smoke.comp", fmt::format("#define DIM {}\n#define {}", D, define(mode)));
+void GpuFluid<D>::runSmoke(SmokeOp mode, size_t n, int axis,
+                           const std::function<void(const ComputeProgram&)>& uniforms) {
+  const ComputeProgram& p = useProgram("smoke.comp", fmt::format("#define DIM {}\n#define {}", D, define(mode)));
   setUniform(p, "cells", cells_);
   setUniform(p, "periodic", periodic_);
   setUniform(p, "velOff", velocityOffsets());
@@ -247,7 +250,8 @@ void GpuFluid<D>::emitSmoke(double dt) {
     });
     if (!src.inject) continue;
     for (int a = 0; a < D; ++a)
-      runSmoke(SmokeOp::Inject, faces(a), a, [&](const ComputeProgram& p) { setUniform(p, "value", src.velocity[size_t(a)]); });
+      runSmoke(SmokeOp::Inject, faces(a), a,
+               [&](const ComputeProgram& p) { setUniform(p, "value", src.velocity[size_t(a)]); });
   }
 }
 
@@ -275,7 +279,8 @@ void GpuFluid<D>::smokeForces(double dt) {
     runSmoke(SmokeOp::Vorticity, cellCount_, 0, hs);
     runSmoke(SmokeOp::Confine, cellCount_, 0, hs);
   }
-  for (int a = 0; a < D; ++a) runSmoke(SmokeOp::AddFaces, faces(a), a, [&](const ComputeProgram& p) { setUniform(p, "dt", dt); });
+  for (int a = 0; a < D; ++a)
+    runSmoke(SmokeOp::AddFaces, faces(a), a, [&](const ComputeProgram& p) { setUniform(p, "dt", dt); });
 }
 
 template <int D>
@@ -295,7 +300,8 @@ void GpuFluid<D>::advectField(const GpuBuffer& src, size_t srcOff, const std::ar
                               const std::array<float, 3>& offset, double dt, GpuBuffer* dst, size_t dstOff) {
   const size_t n = size_t(dims[0]) * size_t(dims[1]) * size_t(dims[2]);
   auto pass = [&](const GpuBuffer& in, size_t inOff, double step, GpuBuffer* out, size_t outOff, bool limits) {
-    const ComputeProgram& p = useKernel("advect.comp", fmt::format("#define DIM {}{}", D, limits ? "\n#define LIMITS" : ""));
+    const ComputeProgram& p =
+        useProgram("advect.comp", fmt::format("#define DIM {}{}", D, limits ? "\n#define LIMITS" : ""));
     setUniform(p, "cells", cells_);
     setUniform(p, "periodic", periodic_);
     setUniform(p, "velOff", velocityOffsets());
@@ -314,7 +320,7 @@ void GpuFluid<D>::advectField(const GpuBuffer& src, size_t srcOff, const std::ar
   };
   auto combine = [&](FluidOp mode, const GpuBuffer& f0, size_t f0Off, const GpuBuffer& f1, size_t f1Off,
                      const GpuBuffer& f2, const GpuBuffer& f3, const GpuBuffer& f4) {
-    const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, mode));
+    const ComputeProgram& p = useProgram("fluid_ops.comp", dimDefine(D, mode));
     setUniform(p, "n", int(n));
     setUniform(p, "dstOff", int(f0Off));
     setUniform(p, "f1Off", int(f1Off));
@@ -372,7 +378,7 @@ void GpuFluid<D>::advect(double dt) {
   for (int a = 0; a < D; ++a)
     for (bool high : {false, true}) {
       if (settings_.inflowDyeStripes <= 0 || settings_.boundaries.side(a, high).kind != BoundaryKind::Inflow) continue;
-      const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, FluidOp::InflowDye));
+      const ComputeProgram& p = useProgram("fluid_ops.comp", dimDefine(D, FluidOp::InflowDye));
       setUniform(p, "cells", cells_);
       setUniform(p, "n", int(cellCount_));
       setUniform(p, "inflow", std::array<int, 4>{a, high ? 1 : 0, a == 0 ? 1 : 0, settings_.inflowDyeStripes});
@@ -394,7 +400,7 @@ void GpuFluid<D>::diffuse(double dt) {
     const Viscous& V = *viscous_[size_t(a)];
     std::array<int, 3> udims{1, 1, 1};
     for (int b = 0; b < D; ++b) udims[size_t(b)] = V.host.dims[b];
-    const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, mode));
+    const ComputeProgram& p = useProgram("fluid_ops.comp", dimDefine(D, mode));
     setUniform(p, "cells", cells_);
     setUniform(p, "axis", a);
     setUniform(p, "n", int(V.host.A.size()));
@@ -420,7 +426,8 @@ void GpuFluid<D>::diffuse(double dt) {
   // The components as one block system, to the relative residual of the
   // whole velocity system (the CPU's: sum_a ||r_a||^2 <= tol^2 sum_a
   // ||b_a||^2); its result read with the pressure's (readSolverStats).
-  foldWorst(&stats_.viscosity, viscousPcg_->solve(&viscousB_, &viscousX_, nullptr, {settings_.viscosityTolerance, 500}, true));
+  foldWorst(&stats_.viscosity,
+            viscousPcg_->solve(&viscousB_, &viscousX_, nullptr, {settings_.viscosityTolerance, 500}, true));
   for (int a = 0; a < D; ++a) run(FluidOp::ViscousStore, a);
   storageBarrier();
   s_ = s;
@@ -431,7 +438,7 @@ template <int D>
 void GpuFluid<D>::project(double dt) {
   auto run = [&](FluidOp mode, int axis, size_t n) {
     const bool cut = mode == FluidOp::Divergence && viscousHeld_.bytes() > 0;  // (made for cut obstacles only)
-    const ComputeProgram& p = useKernel("fluid_ops.comp", dimDefine(D, mode) + (cut ? "\n#define CUT_FACES" : ""));
+    const ComputeProgram& p = useProgram("fluid_ops.comp", dimDefine(D, mode) + (cut ? "\n#define CUT_FACES" : ""));
     setUniform(p, "cells", cells_);
     setUniform(p, "periodic", periodic_);
     setUniform(p, "axis", axis);

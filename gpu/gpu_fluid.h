@@ -102,8 +102,8 @@ class GpuFluid final : public FluidStepper<D> {
   void decaySmoke(double dt);
   void runSmoke(SmokeOp mode, size_t n, int axis, const std::function<void(const ComputeProgram&)>& uniforms);
   void advect(double dt);
-  void advectField(const GpuBuffer& src, size_t srcOff, const std::array<int, 3>& dims, const std::array<float, 3>& offset,
-                   double dt, GpuBuffer* dst, size_t dstOff);
+  void advectField(const GpuBuffer& src, size_t srcOff, const std::array<int, 3>& dims,
+                   const std::array<float, 3>& offset, double dt, GpuBuffer* dst, size_t dstOff);
   void diffuse(double dt);
   void project(double dt);
   size_t faces(int a) const;

@@ -7,7 +7,7 @@
 
 #include "gpu/compute_program.h"
 #include "gpu/gpu_counts.h"
-#include "gpu/gpu_kernels.h"
+#include "gpu/gpu_programs.h"
 
 namespace morphoflow {
 
@@ -28,7 +28,7 @@ void GpuGate::leave() { routeDispatches(nullptr); }
 void GpuGate::run(const char* mode, const GpuBuffer& scalars, Slots slots, double tolerance, int maxIterations,
                   const Finals& finals) {
   DispatchRoute* was = routeDispatches(nullptr);  // the gate's own kernel is not gated
-  const ComputeProgram& p = useKernel("gate.comp", std::string("#define ") + mode);
+  const ComputeProgram& p = useProgram("gate.comp", std::string("#define ") + mode);
   setTestUniforms(slots, tolerance, maxIterations);
   glUniform2i(p.uniform("finals"), finals.slots[0], finals.slots[1]);
   setUniform(p, "groups", int(finals.groups));

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "gpu/gpu_buffer.h"
-#include "gpu/gpu_kernels.h"
+#include "gpu/gpu_programs.h"
 
 namespace morphoflow {
 

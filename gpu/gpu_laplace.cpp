@@ -5,7 +5,7 @@
 
 #include "gpu/compute_program.h"
 #include "gpu/gl_context.h"
-#include "gpu/gpu_kernels.h"
+#include "gpu/gpu_programs.h"
 
 namespace morphoflow {
 
@@ -105,7 +105,7 @@ GpuBuffer& GpuLaplace::crossBuffer(int k) {
 }
 
 void GpuLaplace::recomputeDiagonal() {
-  const ComputeProgram& p = useKernel("laplace_build.comp", fmt::format("#define DIM {}\n#define MODE_DIAG", dim_));
+  const ComputeProgram& p = useProgram("laplace_build.comp", fmt::format("#define DIM {}\n#define MODE_DIAG", dim_));
   setUniform(p, "dims", dims_);
   for (int a = 0; a < 3; ++a) w_[size_t(a < dim_ ? a : 0)].bind(a);
   c_.bind(3);
@@ -115,7 +115,7 @@ void GpuLaplace::recomputeDiagonal() {
 }
 
 void GpuLaplace::assignShifted(GpuLaplace& source, double k) {
-  const ComputeProgram& p = useKernel("laplace_build.comp", fmt::format("#define DIM {}\n#define MODE_SHIFT", dim_));
+  const ComputeProgram& p = useProgram("laplace_build.comp", fmt::format("#define DIM {}\n#define MODE_SHIFT", dim_));
   setUniform(p, "dims", dims_);
   setUniform(p, "k", k);
   for (int a = 0; a < 3; ++a) {
@@ -129,7 +129,7 @@ void GpuLaplace::assignShifted(GpuLaplace& source, double k) {
   storageBarrier();
   if (source.hasCross_) {
     const int mixed = dim_ == 3 ? 6 : 2;
-    const ComputeProgram& q = useKernel("laplace_build.comp", fmt::format("#define DIM {}\n#define CROSS", dim_));
+    const ComputeProgram& q = useProgram("laplace_build.comp", fmt::format("#define DIM {}\n#define CROSS", dim_));
     setUniform(q, "dims", dims_);
     setUniform(q, "k", k);
     for (int m = 0; m < mixed; ++m) {
@@ -155,7 +155,8 @@ void GpuLaplace::run(LaplaceMode mode, bool single, const GpuBuffer& x, const Gp
   const bool block = !blocks_.empty();
   if (block && (mode == LaplaceMode::Smooth || mode == LaplaceMode::Jacobi))
     throw GpuError("a block system is not smoothed (no multigrid)");
-  std::string defines = fmt::format("#define DIM {}\n#define REAL {}\n#define {}", dim_, single ? "float" : "double", define(mode));
+  std::string defines =
+      fmt::format("#define DIM {}\n#define REAL {}\n#define {}", dim_, single ? "float" : "double", define(mode));
   const auto add = [&](bool on, const char* name) {
     if (on) defines += std::string("\n#define ") + name;
   };
@@ -165,7 +166,7 @@ void GpuLaplace::run(LaplaceMode mode, bool single, const GpuBuffer& x, const Gp
   add(dot, "DOT_PARTIAL");
   add(pUpdate, "P_UPDATE");
   add(pUpdate && pUpdate->first, "P_FIRST");
-  const ComputeProgram& p = useKernel("laplace.comp", defines);
+  const ComputeProgram& p = useProgram("laplace.comp", defines);
   if (block) {
     setBlockUniforms(p);
   } else {
@@ -185,7 +186,8 @@ void GpuLaplace::run(LaplaceMode mode, bool single, const GpuBuffer& x, const Gp
   // x and y (and b), the face weights, c and the diagonal (and the mixed
   // terms); a smoothing pass touches half the cells
   const double real = single ? 4.0 : 8.0, coefficients = 4.0 * (dim_ + 2 + crossBuffers);
-  const double bytes = mode == LaplaceMode::Smooth ? 0.5 * (3 * real + coefficients) : (y ? 2 : 1) * real + (b ? real : 0) + coefficients;
+  const double bytes = mode == LaplaceMode::Smooth ? 0.5 * (3 * real + coefficients)
+                                                   : (y ? 2 : 1) * real + (b ? real : 0) + coefficients;
   if (pUpdate) {
     pUpdate->pNew->bind(8);
     pUpdate->scalars->bind(15);
@@ -211,7 +213,9 @@ void GpuLaplace::run(LaplaceMode mode, bool single, const GpuBuffer& x, const Gp
   storageBarrier();
 }
 
-void GpuLaplace::apply(const GpuBuffer& x, GpuBuffer* y) const { run(LaplaceMode::Apply, false, x, y, nullptr, 0, 0.0f); }
+void GpuLaplace::apply(const GpuBuffer& x, GpuBuffer* y) const {
+  run(LaplaceMode::Apply, false, x, y, nullptr, 0, 0.0f);
+}
 
 void GpuLaplace::apply(const GpuBuffer& x, GpuBuffer* y, FusedDot dot) const {
   run(LaplaceMode::Apply, false, x, y, nullptr, 0, 0.0f, &dot);
@@ -219,7 +223,8 @@ void GpuLaplace::apply(const GpuBuffer& x, GpuBuffer* y, FusedDot dot) const {
 
 void GpuLaplace::residual(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* r, FusedDot dot,
                           const ResidualExtras& extras) const {
-  if ((extras.noRhs >= 0 || extras.bSum >= 0) && !extras.scalars) throw GpuError("the residual's b = 0 test and mean read the scalars");
+  if ((extras.noRhs >= 0 || extras.bSum >= 0) && !extras.scalars)
+    throw GpuError("the residual's b = 0 test and mean read the scalars");
   if (extras.rz >= 0 && (!extras.z || hasCross_))
     throw GpuError("the residual's diagonal preconditioner needs z and no mixed terms");
   if (extras.rz >= 0 && extras.xSum >= 0) throw GpuError("the residual sums r . z or x, not both");

@@ -76,7 +76,6 @@ class GpuLaplace {
   GpuBuffer& cBuffer() { return c_; }
   const GpuBuffer& weights(int a) const { return w_[size_t(a)]; }
   const GpuBuffer& cBuffer() const { return c_; }
-  GpuBuffer& diagBuffer() { return diag_; }
   // The mixed terms' couplings (up, down per plane), allocated (zero) if the
   // system had none: for an operator rebuilt on the GPU.
   GpuBuffer& crossBuffer(int k);
@@ -93,7 +92,8 @@ class GpuLaplace {
   // or r . r (residual) into `dot`: bitwise a GpuReduction::dot after them,
   // one dispatch fewer.
   void apply(const GpuBuffer& x, GpuBuffer* y, FusedDot dot) const;
-  void residual(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* r, FusedDot dot, const ResidualExtras& extras = {}) const;
+  void residual(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* r, FusedDot dot,
+                const ResidualExtras& extras = {}) const;
   // The PCG's operator with its p update fused in (laplace.comp's P_UPDATE;
   // not with mixed terms): pNew = z + beta p and q = A pNew, with pNew . q's
   // partials into `pq`; beta from `scalars` at slots[0] (rzNew, summed from

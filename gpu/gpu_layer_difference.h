@@ -24,7 +24,8 @@ std::vector<std::vector<double>> perturbNearInitial(RDSolver<D>* rd, uint64_t se
   for (size_t k = 0; k < start.size(); ++k) {
     const double v = info.initial[k];
     Grid<double, D>& f = rd->field(int(k));
-    for (size_t i = 0; i < f.size(); ++i) f[i] = v + 0.1 * (1.0 + std::abs(v)) * (uniform01(seed, uint64_t(k), i) - 0.5);
+    for (size_t i = 0; i < f.size(); ++i)
+      f[i] = v + 0.1 * (1.0 + std::abs(v)) * (uniform01(seed, uint64_t(k), i) - 0.5);
     start[k] = f.values();
   }
   return start;
@@ -36,7 +37,8 @@ struct LayerDifference {
   double worst = 0.0, moved = 0.0;
 };
 template <int D>
-LayerDifference layerDifference(const GpuRDLayer<D>& gpu, const RDSolver<D>& cpu, const std::vector<std::vector<double>>& start) {
+LayerDifference layerDifference(const GpuRDLayer<D>& gpu, const RDSolver<D>& cpu,
+                                const std::vector<std::vector<double>>& start) {
   LayerDifference d;
   for (size_t k = 0; k < start.size(); ++k) {
     const std::vector<double> g = gpu.download(int(k));

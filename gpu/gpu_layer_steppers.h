@@ -17,7 +17,8 @@ template <int D>
 class GpuLayerStepper final : public LayerStepper<D> {
  public:
   // The layer of `host` (whose operators it borrows: rd/layer_upload.h) from its current state.
-  explicit GpuLayerStepper(const RDSolver<D>& host) : species_(host.model().info().species), layer_(layerUpload(host)) {}
+  explicit GpuLayerStepper(const RDSolver<D>& host)
+      : species_(host.model().info().species), layer_(layerUpload(host)) {}
 
   void advance(double dt, long count) override;
   double time() const override { return time_; }

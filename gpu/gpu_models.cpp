@@ -21,7 +21,8 @@ std::string dialect(int species, bool doublePrecision) {
 
 std::string functions(const std::string& rates, const std::string& jacobian) {
   return "#define RATES void " + rates + "(T x[NSPECIES], PT p[NPARAMETERS], precise out T r[NSPECIES])\n" +
-         "#define JACOBIAN void " + jacobian + "(T x[NSPECIES], PT p[NPARAMETERS], precise out T J[NSPECIES * NSPECIES])\n";
+         "#define JACOBIAN void " + jacobian +
+         "(T x[NSPECIES], PT p[NPARAMETERS], precise out T J[NSPECIES * NSPECIES])\n";
 }
 
 }  // namespace

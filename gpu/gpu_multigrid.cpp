@@ -9,7 +9,7 @@
 #include "core/parallel.h"
 #include "gpu/compute_program.h"
 #include "gpu/gl_context.h"
-#include "gpu/gpu_kernels.h"
+#include "gpu/gpu_programs.h"
 #include "gpu/kernel_modes.h"
 
 namespace morphoflow {
@@ -181,7 +181,7 @@ void GpuMultigrid::packTail() {
 void GpuMultigrid::runTail() {
   const GpuLaplace& A = *levels_[tail_].A;
   const int count = int(levels_.size() - tail_);
-  const ComputeProgram& p = useKernel("vcycle_tail.comp", fmt::format("#define DIM {}", A.dimension()));
+  const ComputeProgram& p = useProgram("vcycle_tail.comp", fmt::format("#define DIM {}", A.dimension()));
   std::vector<int> dims;
   std::vector<double> scales;
   double bytes = 0.0;
@@ -235,7 +235,7 @@ void GpuMultigrid::cycle(size_t l) {
   const int dim = L.A->dimension();
   if (l + 1 == levels_.size()) {
     if (dense_.id()) {
-      const ComputeProgram& p = useKernel("multigrid.comp", fmt::format("#define DIM {}\n#define MODE_DENSE", dim));
+      const ComputeProgram& p = useProgram("multigrid.comp", fmt::format("#define DIM {}\n#define MODE_DENSE", dim));
       setUniform(p, "n", int(L.A->size()));
       L.b.bind(0);
       L.x.bind(1);
@@ -258,7 +258,8 @@ void GpuMultigrid::cycle(size_t l) {
   smooth(L, false, options_.preSmooth, fused, false);
   auto transfer = [&](TransferMode mode, const GpuBuffer& fine, const GpuBuffer& coarse, const GpuBuffer& fineX,
                       const GpuBuffer& diag, size_t samples) {
-    const ComputeProgram& p = useKernel("multigrid.comp", fmt::format("#define DIM {}\n#define {}", dim, define(mode)));
+    const ComputeProgram& p =
+        useProgram("multigrid.comp", fmt::format("#define DIM {}\n#define {}", dim, define(mode)));
     setUniform(p, "fd", L.A->dims());
     setUniform(p, "cd", C.A->dims());
     setUniformBools(p, "periodic", L.A->periodic());
@@ -294,10 +295,11 @@ void GpuMultigrid::apply(const GpuBuffer& r, GpuBuffer* z, const GpuBuffer& scal
   const bool fused = sweepsFused();
   auto convert = [&](VectorOp op, const GpuBuffer& in, const GpuBuffer& out) {
     const bool back = op == VectorOp::FromFloat;
-    const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + define(op) + "\n#define DOT_PARTIAL" +
-                                                               (!fused  ? ""
-                                                                : fmt::format("\n#define DIM {}\n#define {}", L.A->dimension(),
-                                                                              back ? "SWEEP_LAST" : "SWEEP_FIRST")));
+    const ComputeProgram& p =
+        useProgram("vector_ops.comp", std::string("#define ") + define(op) + "\n#define DOT_PARTIAL" +
+                                          (!fused ? ""
+                                                  : fmt::format("\n#define DIM {}\n#define {}", L.A->dimension(),
+                                                                back ? "SWEEP_LAST" : "SWEEP_FIRST")));
     if (fused) {
       setUniform(p, "levelDims", L.A->dims());
       setUniform(p, "levelScale", L.A->scale());

@@ -45,9 +45,10 @@ std::string check(const ReactionModel& m) {
   const auto [worst, moved] = layerDifference<2>(gpu, cpu, start);
   const int gpuFailures = gpu.lastStats().newton.failures, cpuFailures = cpu.lastStats().newton.failures;
   if (!(worst <= 1e-9 * moved) || gpuFailures > cpuFailures)
-    return fmt::format("its Newton failed in {} of {} cells (the CPU's in {}) and its roots differ from the CPU's by {:.2g} of "
-                       "the step's change",
-                       gpuFailures, cpu.cells()[0] * cpu.cells()[1], cpuFailures, moved > 0 ? worst / moved : worst);
+    return fmt::format(
+        "its Newton failed in {} of {} cells (the CPU's in {}) and its roots differ from the CPU's by {:.2g} of "
+        "the step's change",
+        gpuFailures, cpu.cells()[0] * cpu.cells()[1], cpuFailures, moved > 0 ? worst / moved : worst);
   return "";
 }
 

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "gpu/compute_program.h"
-#include "gpu/gpu_kernels.h"
+#include "gpu/gpu_programs.h"
 #include "gpu/gpu_multigrid.h"
 
 namespace morphoflow {
@@ -26,8 +26,9 @@ GpuPcg::GpuPcg(const GpuLaplace& A)
 void GpuPcg::op(VectorOp name, const GpuBuffer& x, const GpuBuffer& y, const GpuBuffer& z, const GpuBuffer& q,
                 std::array<int, 4> slots, bool first, const SolverOptions* check) {
   // (every PCG op has its reductions fused in: DOT_PARTIAL)
-  const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + define(name) + "\n#define DOT_PARTIAL" +
-                                                             (check ? "\n#define GATE" : ""));
+  const ComputeProgram& p =
+      useProgram("vector_ops.comp",
+                 std::string("#define ") + define(name) + "\n#define DOT_PARTIAL" + (check ? "\n#define GATE" : ""));
   if (check) gate_.checkInNext(kGateSlots, check->tolerance, check->maxIterations);
   setUniform(p, "n", int(A_.size()));
   setUniform(p, "slots", slots);
@@ -39,7 +40,9 @@ void GpuPcg::op(VectorOp name, const GpuBuffer& x, const GpuBuffer& y, const Gpu
   A_.diag().bind(4);  // (no float vector in these ops)
   A_.diag().bind(5);
   sums_.scalars().bind(6);
-  const double bytes = name == VectorOp::UpdateXR ? (slots[3] >= 0 ? 68.0 : 48.0) : name == VectorOp::UpdateP ? 24.0 : 20.0;
+  const double bytes = name == VectorOp::UpdateXR  ? (slots[3] >= 0 ? 68.0 : 48.0)
+                       : name == VectorOp::UpdateP ? 24.0
+                                                   : 20.0;
   sums_.partials().bind(8);
   z_.bind(9);  // the fused diagonal preconditioner's z
   countGpuTraffic(double(A_.size()) * bytes);
@@ -132,7 +135,8 @@ void GpuPcg::iterateFused(GpuBuffer* xp, GpuMultigrid* M, const SolverOptions& o
 SolverResult GpuPcg::fromTally(const GpuGate::Tally& t, bool last) {
   SolverResult r;
   r.converged = last ? t.lastConverged : t.unconverged == 0;
-  r.iterations = int(last ? t.lastIterations : (t.iterations + t.solves - 1) / std::max(t.solves, 1u));  // (a solve's mean)
+  r.iterations =
+      int(last ? t.lastIterations : (t.iterations + t.solves - 1) / std::max(t.solves, 1u));  // (a solve's mean)
   r.residual = last ? t.lastResidual : t.maxResidual;
   // The schedule: the most iterations seen, a quarter more and 2; doubled
   // where it cut a solve short; calibrated again while the solves took none

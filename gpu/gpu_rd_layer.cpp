@@ -9,7 +9,7 @@
 #include "rd/cosine_lobe.h"
 #include "rd/diffusion_tensor.h"
 #include "gpu/compute_program.h"
-#include "gpu/gpu_kernels.h"
+#include "gpu/gpu_programs.h"
 #include "gpu/gpu_laplace.h"
 #include "gpu/gpu_models.h"
 #include "gpu/gpu_multigrid.h"
@@ -105,7 +105,7 @@ size_t GpuRDLayer<D>::deviceBytes(size_t n, int species) {
 template <int D>
 void GpuRDLayer<D>::vectorOp(VectorOp op, const GpuBuffer& x, GpuBuffer* y, double a, double b,
                              const GpuBuffer* held) const {
-  const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + define(op));
+  const ComputeProgram& p = useProgram("vector_ops.comp", std::string("#define ") + define(op));
   setUniform(p, "n", int(n_));
   setUniform(p, "ca", a);
   setUniform(p, "cb", b);
@@ -118,9 +118,9 @@ void GpuRDLayer<D>::vectorOp(VectorOp op, const GpuBuffer& x, GpuBuffer* y, doub
 }
 
 template <int D>
-void GpuRDLayer<D>::thetaStep(const GpuBuffer& rates, GpuBuffer* x, const GpuBuffer& ax, const GpuBuffer& faces, double dt,
-                              double explicitD, double ghost) const {
-  const ComputeProgram& p = useKernel("vector_ops.comp", std::string("#define ") + define(VectorOp::ThetaStep));
+void GpuRDLayer<D>::thetaStep(const GpuBuffer& rates, GpuBuffer* x, const GpuBuffer& ax, const GpuBuffer& faces,
+                              double dt, double explicitD, double ghost) const {
+  const ComputeProgram& p = useProgram("vector_ops.comp", std::string("#define ") + define(VectorOp::ThetaStep));
   setUniform(p, "n", int(n_));
   setUniform(p, "ca", dt);
   setUniform(p, "cb", explicitD);
@@ -140,7 +140,7 @@ void GpuRDLayer<D>::react(double dt, bool implicit) {
   std::string gather = "#define GATHER_PARAMETERS";
   for (size_t k = 0; k < up_.parameters.size(); ++k)
     gather += fmt::format(" p[{0}] = mapAt[{0}] < 0 ? uniformP[{0}] : maps[mapAt[{0}] + i];", k);
-  const ComputeProgram& p = useKernel("rd_react.comp", gpuReaction(up_.settings.model, true) + gather + "\n" +
+  const ComputeProgram& p = useProgram("rd_react.comp", gpuReaction(up_.settings.model, true) + gather + "\n" +
                                                            (implicit ? "#define MODE_IMPLICIT" : "#define MODE_RATES"));
   setUniform(p, "n", int(n_));
   setUniform(p, "dt", dt);
@@ -180,8 +180,9 @@ SolverResult GpuRDLayer<D>::diffuse(int s, double thetaDt) {
     df.pcg = std::make_unique<GpuPcg>(*df.A);
     // multigrid once diffusion dominates the identity, the diagonal below
     const double scale = thetaDt * d / (up_.h * up_.h);
-    df.M = scale > 1.0 ? std::make_unique<GpuMultigrid>(Multigrid<D>(df.host.axis, kDiffusionCycle), *df.A, kDiffusionCycle)
-                       : nullptr;
+    df.M = scale > 1.0
+               ? std::make_unique<GpuMultigrid>(Multigrid<D>(df.host.axis, kDiffusionCycle), *df.A, kDiffusionCycle)
+               : nullptr;
     df.thetaDt = thetaDt;
   }
   GpuBuffer& b = x_[size_t(s)];
@@ -258,7 +259,7 @@ void GpuRDLayer<D>::readStats() {
 template <int D>
 void GpuRDLayer<D>::lobeKernel(LobeMode mode, int species, GpuLaplace* target, GpuBuffer* faces) {
   const CosineLobeSpec& spec = *up_.lobes;
-  const ComputeProgram& p = useKernel("rd_lobes.comp", fmt::format("#define DIM {}\n#define {}", D, define(mode)));
+  const ComputeProgram& p = useProgram("rd_lobes.comp", fmt::format("#define DIM {}\n#define {}", D, define(mode)));
   std::array<int, 3> dims{1, 1, 1};
   for (int a = 0; a < D; ++a) dims[size_t(a)] = up_.cells[a];
   setUniform(p, "dims", dims);
@@ -297,7 +298,7 @@ bool GpuRDLayer<D>::rebuilt(int s) const {
 template <int D>
 void GpuRDLayer<D>::tensorKernel(TensorMode mode, GpuLaplace* target) {
   const DiffusionTensorSpec<D>& spec = *up_.tensor;
-  const ComputeProgram& p = useKernel("rd_tensor.comp", fmt::format("#define DIM {}\n#define {}", D, define(mode)));
+  const ComputeProgram& p = useProgram("rd_tensor.comp", fmt::format("#define DIM {}\n#define {}", D, define(mode)));
   std::array<int, 3> dims{1, 1, 1};
   for (int a = 0; a < D; ++a) dims[size_t(a)] = up_.cells[a];
   setUniform(p, "dims", dims);
@@ -370,7 +371,8 @@ void GpuRDLayer<D>::save(StateWriter* out) const {
     out->put(p + "has_increment", df.hasIncrement ? 1 : 0);
     out->put(p + "increment_theta_dt", df.incrementThetaDt);
     if (df.hasIncrement) out->putVector(p + "increment", df.increment.template read<double>(n_));
-    if (isFrozen_[size_t(s)] && frozenTaken_) out->putVector(p + "frozen", frozen_[size_t(s)].template read<double>(n_));
+    if (isFrozen_[size_t(s)] && frozenTaken_)
+      out->putVector(p + "frozen", frozen_[size_t(s)].template read<double>(n_));
   }
   out->put("gpu.rd.frozen_taken", frozenTaken_ ? 1 : 0);
 }

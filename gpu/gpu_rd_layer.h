@@ -39,12 +39,10 @@ class GpuRDLayer {
   GpuRDLayer& operator=(const GpuRDLayer&) = delete;
 
   void step(double dt);
-  // The step's statistics (Newton failures and iterations, the worst diffusion solve). The diffusion solves decide their convergence on
-  // the device (gpu_gate.h) and everything is read back at steps 1, 2, 4, 8 and
-  // then every 16th (statsDue): a step reports the last read's diffusion results, and Newton's
-  // failures and most iterations since the read before on the steps that
-  // read them (0 on the others, so their sums and maxima over the steps are
-  // exact).
+  // The step's statistics (Newton failures and iterations, the worst diffusion solve). The diffusion solves decide
+  // their convergence on the device (gpu_gate.h) and everything is read back at steps 1, 2, 4, 8 and then every 16th
+  // (statsDue): a step reports the last read's diffusion results, and Newton's failures and most iterations since the
+  // read before on the steps that read them (0 on the others, so their sums and maxima over the steps are exact).
   const RDStepStats& lastStats() const { return stats_; }
   int species() const { return species_; }
   size_t cells() const { return n_; }

@@ -8,7 +8,7 @@
 #include <fmt/format.h>
 
 #include "gpu/compute_program.h"
-#include "gpu/gpu_kernels.h"
+#include "gpu/gpu_programs.h"
 
 namespace morphoflow {
 
@@ -26,7 +26,7 @@ GpuReduction::GpuReduction() : partial_(kSlots * kGroups * sizeof(double)), scal
 void GpuReduction::run(const char* term, const GpuBuffer& x, const GpuBuffer& y, const GpuBuffer& diag, size_t n,
                        int slot, bool partialOnly) {
   const unsigned groups = GpuReduction::groups(n);
-  const ComputeProgram& p = useKernel("reduce.comp", fmt::format("#define MODE_PARTIAL\n#define {}", term));
+  const ComputeProgram& p = useProgram("reduce.comp", fmt::format("#define MODE_PARTIAL\n#define {}", term));
   setUniform(p, "n", int(n));
   setUniform(p, "slot", slot);
   x.bind(0);
@@ -40,7 +40,7 @@ void GpuReduction::run(const char* term, const GpuBuffer& x, const GpuBuffer& y,
   countGpuTraffic(double(n) * (t == "TERM_DOT" ? 16.0 : t == "TERM_ACTIVE_SUM" ? 12.0 : 4.0));
   storageBarrier();
   if (partialOnly) return;
-  const ComputeProgram& f = useKernel("reduce.comp", std::string("#define MODE_FINAL\n#define ") + term);
+  const ComputeProgram& f = useProgram("reduce.comp", std::string("#define MODE_FINAL\n#define ") + term);
   setUniform(f, "n", int(groups));
   setUniform(f, "slot", slot);
   partial_.bind(3);
@@ -49,7 +49,9 @@ void GpuReduction::run(const char* term, const GpuBuffer& x, const GpuBuffer& y,
   storageBarrier();
 }
 
-void GpuReduction::dot(const GpuBuffer& x, const GpuBuffer& y, size_t n, int slot) { run("TERM_DOT", x, y, x, n, slot); }
+void GpuReduction::dot(const GpuBuffer& x, const GpuBuffer& y, size_t n, int slot) {
+  run("TERM_DOT", x, y, x, n, slot);
+}
 
 void GpuReduction::activeSum(const GpuBuffer& x, const GpuBuffer& diag, size_t n, int slot, bool partialOnly) {
   run("TERM_ACTIVE_SUM", x, x, diag, n, slot, partialOnly);

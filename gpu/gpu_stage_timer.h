@@ -22,8 +22,7 @@ class GpuStageTimer {
   // Ends the step: the seconds of each stage of the step before it (zeros
   // for the first step), which the GPU has finished by now.
   std::vector<double> endStep();
-  // The dispatches and host waits of each stage, summed over the steps ended, and those steps.
-  const std::vector<GpuCounts>& stageCounts() const { return counts_; }
+  // The steps ended.
   long steps() const { return steps_; }
   // run.json's per-stage counts: {name: perStep(...)} for the stages named.
   nlohmann::json countsPerStep(const char* const* names) const;

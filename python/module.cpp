@@ -49,7 +49,9 @@ std::vector<std::string> overrides(const py::object& set) {
   for (const auto& [key, value] : set.cast<py::dict>()) {
     const std::string k = py::str(key).cast<std::string>();
     // A dotted key of bare names (what --set takes): '=', spaces or a newline would set another key.
-    if (!isDottedKey(k)) throw py::value_error("set= takes dotted keys of letters, digits, '_' and '-' (as 'fluid.reynolds'), not '" + k + "'");
+    if (!isDottedKey(k))
+      throw py::value_error("set= takes dotted keys of letters, digits, '_' and '-' (as 'fluid.reynolds'), not '" + k +
+                            "'");
     out.push_back(k + "=" + tomlValue(value));
   }
   return out;
@@ -67,7 +69,8 @@ PyScene sceneFrom(std::string text, std::string path, std::vector<std::string> s
 // The summary a batch or sweep wrote into `out`, with its exit status.
 py::dict batchResult(int status, const std::string& out) {
   if (status == 130 || status == 143) {  // Ctrl-C (or SIGTERM): the runs checkpointed; resume=True goes on
-    PyErr_SetString(PyExc_KeyboardInterrupt, ("the batch in " + out + " stopped; its runs checkpointed (resume=True goes on)").c_str());
+    PyErr_SetString(PyExc_KeyboardInterrupt,
+                    ("the batch in " + out + " stopped; its runs checkpointed (resume=True goes on)").c_str());
     throw py::error_already_set();
   }
   py::dict r;
@@ -84,8 +87,10 @@ std::string executable() {
   return MORPHOFLOW_EXECUTABLE;
 }
 
-BatchOptions batchOptions(const std::string& out, int jobs, const py::object& set, bool keepGoing, bool resume, bool quiet) {
-  if (jobs < 1 || jobs > 256) throw py::value_error("jobs must be in [1, 256] (as --jobs), not " + std::to_string(jobs));
+BatchOptions batchOptions(const std::string& out, int jobs, const py::object& set, bool keepGoing, bool resume,
+                          bool quiet) {
+  if (jobs < 1 || jobs > 256)
+    throw py::value_error("jobs must be in [1, 256] (as --jobs), not " + std::to_string(jobs));
   if (out.empty()) throw py::value_error("out must name a folder, not ''");
   BatchOptions o;
   o.out = out;
@@ -123,12 +128,17 @@ PYBIND11_MODULE(morphoflow, m) {
       .def_property_readonly(
           "settings", [](const PyScene& s) { return py::module_::import("json").attr("loads")(s.scene->resolvedJson); },
           "The scene's resolved settings, as run.json records them (a dict).")
-      .def("__repr__", [](const PyScene& s) { return "<morphoflow.Scene '" + s.scene->name + "' from " + s.path + ">"; });
+      .def("__repr__",
+           [](const PyScene& s) { return "<morphoflow.Scene '" + s.scene->name + "' from " + s.path + ">"; });
 
-  m.def("load_scene", [](const std::string& path, const py::object& set) { return sceneFrom(readSceneText(path), path, overrides(set)); },
-        py::arg("path"), py::arg("set") = py::none(),
-        "Reads a scene file; set={'fluid.reynolds': 400} overrides keys as --set does. A bad scene raises "
-        "ValueError naming file:line:column.");
+  m.def(
+      "load_scene",
+      [](const std::string& path, const py::object& set) {
+        return sceneFrom(readSceneText(path), path, overrides(set));
+      },
+      py::arg("path"), py::arg("set") = py::none(),
+      "Reads a scene file; set={'fluid.reynolds': 400} overrides keys as --set does. A bad scene raises "
+      "ValueError naming file:line:column.");
   m.def("scene_from_toml", [](const std::string& text, const std::string& path, const py::object& set) {
           return sceneFrom(text, path, overrides(set));
         },

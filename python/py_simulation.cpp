@@ -70,8 +70,8 @@ PySimulation::Call::Call(const PySimulation& sim, const char* what) : sim_(const
   {
     std::lock_guard<std::mutex> lk(sim_.calls_->mutex);
     if (sim_.calls_->busy)
-      throw std::runtime_error(std::string("this Simulation is in ") + sim_.calls_->busy + "() (on another thread, or this is " +
-                               "a callback of that call): one call at a time");
+      throw std::runtime_error(std::string("this Simulation is in ") + sim_.calls_->busy +
+                               "() (on another thread, or this is " + "a callback of that call): one call at a time");
     sim_.calls_->busy = what;
   }
   if (sim_.backend_ != Backend::Gpu) return;
@@ -171,10 +171,12 @@ void PySimulation::setField(const std::string& name, const py::object& values) {
   if (!py::isinstance<py::array>(values)) throw py::type_error("set_field takes a numpy array of float32");
   const py::array a = values.cast<py::array>();
   if (!a.dtype().is(py::dtype::of<float>()))
-    throw py::type_error("set_field takes float32 values, not " + std::string(py::str(a.dtype())) + " (astype(numpy.float32))");
+    throw py::type_error("set_field takes float32 values, not " + std::string(py::str(a.dtype())) +
+                         " (astype(numpy.float32))");
   const py::array_t<float> now = fieldOf(name);
   std::vector<py::ssize_t> want(now.shape(), now.shape() + now.ndim()), got(a.shape(), a.shape() + a.ndim());
-  if (want != got) throw py::value_error("the values of '" + name + "' have the shape " + shapeText(got) + ", not " + shapeText(want));
+  if (want != got)
+    throw py::value_error("the values of '" + name + "' have the shape " + shapeText(got) + ", not " + shapeText(want));
   const py::array_t<float, py::array::c_style> c(a);
   const float* p = c.data();
   for (py::ssize_t i = 0; i < c.size(); ++i)
@@ -202,7 +204,8 @@ void PySimulation::setVelocity(py::object velocity) {
     const RDSettings& rd = scene_.scene->rd.settings;
     IVec<D> cells;
     std::array<bool, D> periodic{};
-    for (int k = 0; k < D; ++k) cells[k] = rd.resolution[size_t(k)], periodic[size_t(k)] = rd.boundary == RDBoundary::Periodic;
+    for (int k = 0; k < D; ++k)
+      cells[k] = rd.resolution[size_t(k)], periodic[size_t(k)] = rd.boundary == RDBoundary::Periodic;
     MacVelocity<D> trial(cells, rd.size[0] / rd.resolution[0], periodic);
     PythonVelocity<D> check;
     check.set(velocity);

@@ -14,7 +14,7 @@
 #include "sim/simulation.h"
 #include "python/python_velocity.h"
 #include "scenes/scene.h"
-#include "sim/backend.h"
+#include "core/backend.h"
 
 namespace morphoflow {
 

@@ -63,7 +63,8 @@ void bindStudio(py::module_& m, std::function<std::string()> executable) {
       .def_property_readonly("token", &PyStudio::token)
       .def_property_readonly("port", &PyStudio::port)
       .def_property_readonly("running", &PyStudio::running)
-      .def("state", &PyStudio::state, "The studio's state as /api/state gives it (a dict; None before a scene is open).")
+      .def("state", &PyStudio::state,
+           "The studio's state as /api/state gives it (a dict; None before a scene is open).")
       .def("scene", &PyStudio::sceneText, "The scene with every edit made so far (TOML text), as Save gives it.")
       .def("stop", &PyStudio::stop, "Stops the simulation and the server; the object then only says running = False.")
       .def("__enter__", [](PyStudio& s) -> PyStudio& { return s; })
@@ -74,10 +75,12 @@ void bindStudio(py::module_& m, std::function<std::string()> executable) {
 
   m.def(
       "studio",
-      [executable](const std::optional<std::string>& scene, int port, const std::string& listen, const std::string& backend,
-                   int threads, const std::string& out) {
-        if (port < 0 || port > 65535) throw py::value_error("port must be in [0, 65535] (0: any free port), not " + std::to_string(port));
-        if (threads < 0) throw py::value_error("threads must be 0 (every core) or more, not " + std::to_string(threads));
+      [executable](const std::optional<std::string>& scene, int port, const std::string& listen,
+                   const std::string& backend, int threads, const std::string& out) {
+        if (port < 0 || port > 65535)
+          throw py::value_error("port must be in [0, 65535] (0: any free port), not " + std::to_string(port));
+        if (threads < 0)
+          throw py::value_error("threads must be 0 (every core) or more, not " + std::to_string(threads));
         if (backend != "serial" && backend != "tbb" && backend != "gpu")
           throw py::value_error("backend must be 'serial', 'tbb' or 'gpu', not '" + backend + "'");
         ServerOptions server;
@@ -93,7 +96,8 @@ void bindStudio(py::module_& m, std::function<std::string()> executable) {
       py::arg("scene") = py::none(), py::arg("port") = 0, py::arg("listen") = "127.0.0.1", py::arg("backend") = "tbb",
       py::arg("threads") = 0, py::arg("out") = "studio",
       "Serves a scene file in the browser as `morphoflow studio` does, on threads of its own, and returns a Studio "
-      "(its `url` holds the token; stop() or a `with` block ends it). Without a scene the page offers the shipped ones.");
+      "(its `url` holds the token; stop() or a `with` block ends it). Without a scene the page offers the shipped "
+      "ones.");
 }
 
 }  // namespace morphoflow

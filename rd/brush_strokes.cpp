@@ -188,7 +188,9 @@ PaintedStrokes<D> paintStrokes(const std::vector<BrushStroke>& strokes, const IV
 
 template std::vector<uint8_t> strokeCoverage<2>(const BrushStroke&, const IVec<2>&, const std::vector<double>&, bool);
 template std::vector<uint8_t> strokeCoverage<3>(const BrushStroke&, const IVec<3>&, const std::vector<double>&, bool);
-template PaintedStrokes<2> paintStrokes<2>(const std::vector<BrushStroke>&, const IVec<2>&, const std::vector<double>&, bool);
-template PaintedStrokes<3> paintStrokes<3>(const std::vector<BrushStroke>&, const IVec<3>&, const std::vector<double>&, bool);
+template PaintedStrokes<2> paintStrokes<2>(const std::vector<BrushStroke>&, const IVec<2>&, const std::vector<double>&,
+                                           bool);
+template PaintedStrokes<3> paintStrokes<3>(const std::vector<BrushStroke>&, const IVec<3>&, const std::vector<double>&,
+                                           bool);
 
 }  // namespace morphoflow

@@ -21,14 +21,16 @@ double wrap(double phi, double period) {
 
 void validateCosineLobes(const CosineLobeSpec& spec) {
   if (spec.witkinKass) {
-    if (spec.speeds.size() != 2) throw std::invalid_argument("cosine lobes: Witkin-Kass (eq. 15) takes two speeds, a1 and a2");
+    if (spec.speeds.size() != 2)
+      throw std::invalid_argument("cosine lobes: Witkin-Kass (eq. 15) takes two speeds, a1 and a2");
     for (double a : spec.speeds)
       if (!(a > 0) || !std::isfinite(a)) throw std::invalid_argument("cosine lobes: Witkin-Kass speeds must be > 0");
     return;
   }
   if (spec.speeds.empty()) throw std::invalid_argument("cosine lobes: at least one lobe speed (eq. 16)");
   for (double a : spec.speeds)
-    if (!(a >= 0) || !std::isfinite(a)) throw std::invalid_argument("cosine lobes: lobe speeds must be >= 0 and finite");
+    if (!(a >= 0) || !std::isfinite(a))
+      throw std::invalid_argument("cosine lobes: lobe speeds must be >= 0 and finite");
 }
 
 double lobeDiffusivity(const CosineLobeSpec& spec, double phi) {
@@ -68,7 +70,8 @@ std::array<std::vector<double>, AnisotropicSystem<D>::kComponents> lobeTensor(co
   forEachCell<D>(u.dims(), [&](const IVec<D>& c, size_t i) {
     const double gx = centralDifference<D>(u, c, 0, periodic), gy = centralDifference<D>(u, c, 1, periodic);
     double a = mean;  // theta undefined
-    if (gx != 0.0 || gy != 0.0) a = lobeDiffusivity(spec, std::atan2(gy, gx) + (spec.theta0.empty() ? 0.0 : spec.theta0[i]));
+    if (gx != 0.0 || gy != 0.0)
+      a = lobeDiffusivity(spec, std::atan2(gy, gx) + (spec.theta0.empty() ? 0.0 : spec.theta0[i]));
     for (int k = 0; k < D; ++k) sigma[size_t(k)][i] = a;
   });
   return sigma;

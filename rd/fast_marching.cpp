@@ -79,7 +79,8 @@ MarchingResult fastMarch(const IVec<D>& cells, double h, bool periodic, const Ma
       }
       if (best.d < kFar) up.push_back(best);
     }
-    std::sort(up.begin(), up.end(), [](const Upwind& x, const Upwind& y) { return x.d < y.d || (x.d == y.d && x.cell < y.cell); });
+    std::sort(up.begin(), up.end(),
+              [](const Upwind& x, const Upwind& y) { return x.d < y.d || (x.d == y.d && x.cell < y.cell); });
     size_t used = 0;
     const double d = solveEikonal(up, h, &used);
     if (!(d < out.distance[i])) return;

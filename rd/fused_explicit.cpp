@@ -203,7 +203,8 @@ MF_INLINE int interiorKernel(const RowJob<D, M::N>& job, int x, int end) {
       if (!(j.kernel >> s & 1u)) {
         for (int k = 0; k < count; ++k) {
           const int xk = x + k * n;
-          lap[k][s] = laplacian<D, N, L, false>(j, s, w, [&](const float* row, int dx) { return load(row + xk + dx, L()); });
+          lap[k][s] =
+              laplacian<D, N, L, false>(j, s, w, [&](const float* row, int dx) { return load(row + xk + dx, L()); });
         }
         continue;
       }
@@ -261,7 +262,9 @@ void edgeCell(const RowJob<D, M::N>& j, int x) {
 }
 
 template <class M>
-constexpr bool kLaneRates = M::N == 2 && requires(const NewtonLanes* y, const double* q, NewtonLanes* r) { M::rates(y, q, r); };
+constexpr bool kLaneRates = M::N == 2 && requires(const NewtonLanes* y, const double* q, NewtonLanes* r) {
+  M::rates(y, q, r);
+};
 static_assert(!kFloatLanes<models::MeinhardtLateral>);
 
 template <int D, class M>
@@ -302,7 +305,9 @@ class Engine final : public FusedExplicitRD<D> {
 
  private:
   int outer() const { return this->cells_[D - 1]; }
-  size_t sliceCells() const { return D == 2 ? size_t(this->cells_[0]) : size_t(this->cells_[0]) * size_t(this->cells_[1]); }
+  size_t sliceCells() const {
+    return D == 2 ? size_t(this->cells_[0]) : size_t(this->cells_[0]) * size_t(this->cells_[1]);
+  }
   int reach() const { return kernelSpecies_ ? 2 : 1; }  // the stencil's reach along the outer axis
   static int wrap(int q, int n) { return (q % n + n) % n; }
   // Outer slice q's neighbour on `side` (a wall: q itself; periodic: unwrapped).
@@ -379,7 +384,8 @@ class Engine final : public FusedExplicitRD<D> {
     const size_t rows = D == 2 ? size_t(outer()) : size_t(outer()) * size_t(this->cells_[1]);
     const bool wide = useAvx2();
     auto row = [&](size_t r) {
-      const int y = D == 2 ? 0 : int(r % size_t(this->cells_[1])), q = D == 2 ? int(r) : int(r / size_t(this->cells_[1]));
+      const int y = D == 2 ? 0 : int(r % size_t(this->cells_[1])),
+                q = D == 2 ? int(r) : int(r / size_t(this->cells_[1]));
       float* out[N];
       for (int s = 0; s < N; ++s) out[s] = this->next_[size_t(s)].data() + size_t(q) * sliceCells();
       runRow(y, q, dt, [this](int s, int p) { return stateSlice(s, p); }, out, wide);
@@ -470,25 +476,10 @@ std::unique_ptr<FusedExplicitRD<D>> FusedExplicitRD<D>::create(const std::string
                                                                bool periodic, const std::vector<double>& d,
                                                                const std::vector<double>& p) {
   std::unique_ptr<FusedExplicitRD<D>> e;
-  auto tryModel = [&](auto tag) {
+  models::forEach([&](auto tag) {
     using M = typename decltype(tag)::type;
     if (!e) e = make<D, M>(model, cells, h, periodic, d, p);
-  };
-  using namespace models;
-  tryModel(std::type_identity<Turing>{});
-  tryModel(std::type_identity<TuringSanderson>{});
-  tryModel(std::type_identity<GrayScott>{});
-  tryModel(std::type_identity<GrayScottSanderson>{});
-  tryModel(std::type_identity<FitzHughNagumo>{});
-  tryModel(std::type_identity<Barkley>{});
-  tryModel(std::type_identity<BarkleyTurbulent>{});
-  tryModel(std::type_identity<MeinhardtSpots>{});
-  tryModel(std::type_identity<Brusselator>{});
-  tryModel(std::type_identity<GiererMeinhardt>{});
-  tryModel(std::type_identity<Oregonator>{});
-  tryModel(std::type_identity<MeinhardtLateral>{});
-  tryModel(std::type_identity<CoupledBrusselator>{});
-  tryModel(std::type_identity<OregonatorThreeLayer>{});
+  });
   return e;
 }
 

@@ -28,8 +28,9 @@ template <int D>
 class FusedExplicitRD {
  public:
   // The engine for `model` (null for a model without fixed-size rates).
-  static std::unique_ptr<FusedExplicitRD> create(const std::string& model, const IVec<D>& cells, double h, bool periodic,
-                                                 const std::vector<double>& diffusion, const std::vector<double>& parameters);
+  static std::unique_ptr<FusedExplicitRD> create(const std::string& model, const IVec<D>& cells, double h,
+                                                 bool periodic, const std::vector<double>& diffusion,
+                                                 const std::vector<double>& parameters);
   virtual ~FusedExplicitRD() = default;
 
   // McGraw's generalized diffusion (seed 000 eq. 37): the species (empty:

@@ -112,7 +112,8 @@ GeneralizedDiffusion::GeneralizedDiffusion(const KramersMoyalTensors& t, int nx,
   const int fx = std::min(nx, 512), fy = std::min(ny, 512);
   symbols_.resize(size_t(fx) * size_t(fy));
   for (int q = 0; q < fy; ++q)
-    for (int p = 0; p < fx; ++p) symbols_[size_t(q) * size_t(fx) + size_t(p)] = symbol(kTwoPi * p / fx, kTwoPi * q / fy);
+    for (int p = 0; p < fx; ++p)
+      symbols_[size_t(q) * size_t(fx) + size_t(p)] = symbol(kTwoPi * p / fx, kTwoPi * q / fy);
 }
 
 void GeneralizedDiffusion::apply(const std::vector<double>& x, std::vector<double>* out) const {

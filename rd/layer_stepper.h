@@ -86,7 +86,8 @@ class FusedLayerStepper final : public LayerStepper<D> {
   long stepsTogether() const override { return fused_->stepsPerPass(); }
   double time() const override { return time_; }
   long steps() const override { return steps_; }
-  const RDRunStats* runStats() const override { return &stats_; }
+  // (no Newton and no solves: statistics of nothing, as run.json has them)
+  const RDRunStats* runStats() const override;
   void toHost(RDSolver<D>* host) const override;
   void fromHost(const RDSolver<D>&) override { fromHost(); }
   void save(StateWriter* out) const override;
@@ -101,7 +102,6 @@ class FusedLayerStepper final : public LayerStepper<D> {
   std::unique_ptr<FusedExplicitRD<D>> fused_;
   double time_ = 0.0;
   long steps_ = 0;
-  RDRunStats stats_;  // (none: kept for the checkpoints' format)
 };
 
 }  // namespace morphoflow

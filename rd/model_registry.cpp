@@ -1,6 +1,7 @@
 #include "rd/model_registry.h"
 
 #include <sstream>
+#include <tuple>
 
 #include "rd/model_adapter.h"
 #include "rd/models.h"
@@ -26,26 +27,20 @@ bool newtonSolve(const ReactionModel& m, const double* x0, const double* p, doub
   return r.converged;
 }
 
-const std::vector<const ReactionModel*>& allModels() {
-  static const ModelAdapter<models::Turing> turing;
-  static const ModelAdapter<models::TuringSanderson> turingSanderson;
-  static const ModelAdapter<models::GrayScott> grayScott;
-  static const ModelAdapter<models::GrayScottSanderson> grayScottSanderson;
-  static const ModelAdapter<models::FitzHughNagumo> fhn;
-  static const ModelAdapter<models::Barkley> barkley;
-  static const ModelAdapter<models::BarkleyTurbulent> barkleyTurbulent;
-  static const ModelAdapter<models::MeinhardtSpots> meinhardt;
-  static const ModelAdapter<models::Brusselator> brusselator;
-  static const ModelAdapter<models::GiererMeinhardt> gierer;
-  static const ModelAdapter<models::Oregonator> oregonator;
-  static const ModelAdapter<models::MeinhardtLateral> lateral;
-  static const ModelAdapter<models::CoupledBrusselator> coupled;
-  static const ModelAdapter<models::OregonatorThreeLayer> oregonator3;
-  static const std::vector<const ReactionModel*> all = {
-      &turing, &turingSanderson, &grayScott, &grayScottSanderson, &fhn,     &barkley,  &barkleyTurbulent,
-      &meinhardt, &brusselator, &gierer,   &oregonator,  &lateral,     &coupled, &oregonator3};
+namespace {
+
+// One adapter of each model of the list (rd/models.h).
+template <class... M>
+const std::vector<const ReactionModel*>& adapted(std::tuple<M...>*) {
+  static const std::tuple<ModelAdapter<M>...> adapters;
+  static const std::vector<const ReactionModel*> all =
+      std::apply([](const auto&... a) { return std::vector<const ReactionModel*>{&a...}; }, adapters);
   return all;
 }
+
+}  // namespace
+
+const std::vector<const ReactionModel*>& allModels() { return adapted(static_cast<models::All*>(nullptr)); }
 
 const ReactionModel* findModel(const std::string& name) {
   for (const ReactionModel* m : allModels())

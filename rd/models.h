@@ -15,6 +15,9 @@
 // the scene's domain says otherwise); every default is overridable.
 #pragma once
 
+#include <tuple>
+#include <type_traits>
+
 #include "rd/reaction_model.h"
 
 // The C++ side of the kernels' dialect (kernels/README.md).
@@ -38,7 +41,7 @@ struct Turing {
             "da/dt = s (alpha - a b) + d_a lap a\ndb/dt = s (a b - b - beta) + d_b lap b   (b clamped at 0)",
             {"a", "b"},
             {{"s", 1.0 / 128, "reaction rate"}, {"alpha", 16.0, "growth of a"}, {"beta", 12.0, "decay of b"}},
-            {0.25, 0.0625}, {4.0, 4.0}, 0.0, 16.0, true, {1}};
+            {0.25, 0.0625}, {4.0, 4.0}, 0.0, 16.0, {1}};
   }
   static constexpr const char* kKernel = "turing.inc";
 #include "kernels/models/turing.inc"
@@ -52,7 +55,7 @@ struct TuringSanderson {
             "da/dt = s (a b - a - alpha) + d_a lap a   (a clamped at 0)\ndb/dt = s (beta - a b) + d_b lap b",
             {"a", "b"},
             {{"s", 1.0 / 128, "reaction rate"}, {"alpha", 12.0, "decay of a"}, {"beta", 16.0, "growth of b"}},
-            {1.0 / 16, 1.0 / 4}, {4.0, 4.0}, 0.0, 16.0, true, {0}};
+            {1.0 / 16, 1.0 / 4}, {4.0, 4.0}, 0.0, 16.0, {0}};
   }
   static constexpr const char* kKernel = "turing_sanderson.inc";
 #include "kernels/models/turing_sanderson.inc"
@@ -66,7 +69,7 @@ struct GrayScott {
             "du/dt = -u v^2 + F (1 - u) + d_u lap u\ndv/dt = u v^2 - (F + k) v + d_v lap v",
             {"u", "v"},
             {{"F", 0.04, "feed rate"}, {"k", 0.06, "kill rate"}},
-            {2e-5, 1e-5}, {1.0, 0.0}, 0.0, 1.0, false, {}};
+            {2e-5, 1e-5}, {1.0, 0.0}, 0.0, 1.0, {}};
   }
   static constexpr const char* kKernel = "gray_scott.inc";
 #include "kernels/models/gray_scott.inc"
@@ -80,7 +83,7 @@ struct GrayScottSanderson {
             "da/dt = s (a^2 b - (F + k) a) + d_a lap a\ndb/dt = s (-a^2 b + F (1 - b)) + d_b lap b",
             {"a", "b"},
             {{"s", 1.0, "reaction rate"}, {"F", 0.04, "feed rate"}, {"k", 0.06, "kill rate"}},
-            {1e-5, 2e-5}, {0.0, 1.0}, 0.0, 1.0, false, {}};
+            {1e-5, 2e-5}, {0.0, 1.0}, 0.0, 1.0, {}};
   }
   static constexpr const char* kKernel = "gray_scott_sanderson.inc";
 #include "kernels/models/gray_scott_sanderson.inc"
@@ -94,7 +97,7 @@ struct FitzHughNagumo {
             "dA/dt = A - A^3 - B + d_A lap A\ndB/dt = eps (A - a1 B - a0) + d_B lap B",
             {"A", "B"},
             {{"eps", 0.02, "time-scale ratio"}, {"a0", -0.8, "offset"}, {"a1", 1.0, "recovery slope"}},
-            {1.0, 0.0}, {-0.9283, -0.1283}, -2.0, 2.0, false, {}};
+            {1.0, 0.0}, {-0.9283, -0.1283}, -2.0, 2.0, {}};
   }
   static constexpr const char* kKernel = "fitzhugh_nagumo.inc";
 #include "kernels/models/fitzhugh_nagumo.inc"
@@ -111,7 +114,7 @@ struct BarkleyT {
                       : "dA/dt = (1/eps) A (1 - A) (A - (B + b)/a) + d_A lap A\ndB/dt = A - B + d_B lap B",
             {"A", "B"},
             {{"a", 0.75, "excitation threshold slope"}, {"b", 0.02, "threshold offset"}, {"eps", 0.02, "stiffness"}},
-            {1.0, 0.0}, {0.0, 0.0}, 0.0, 1.0, false, {}};
+            {1.0, 0.0}, {0.0, 0.0}, 0.0, 1.0, {}};
   }
   static constexpr const char* kKernel = "barkley.inc";
   static constexpr const char* kKernelDefines = Turbulent ? "#define TURBULENT true\n" : "#define TURBULENT false\n";
@@ -129,7 +132,7 @@ struct MeinhardtSpots {
             {"A", "B"},
             {{"s", 1.0, "reaction rate"}, {"alpha", 1.0, "autocatalysis"}, {"p1", -0.04, "decay of A"},
              {"p2", -0.08, "decay of B"}, {"p3", 0.001, "basic production of A"}},
-            {0.1, 4.0}, {2.025, 0.5126}, 0.0, 8.0, true, {0}};
+            {0.1, 4.0}, {2.025, 0.5126}, 0.0, 8.0, {0}};
   }
   static constexpr const char* kKernel = "meinhardt.inc";
 #include "kernels/models/meinhardt.inc"
@@ -143,7 +146,7 @@ struct Brusselator {
             "da/dt = s (alpha - (1 + beta) a + a^2 b) + d_a lap a\ndb/dt = s (beta a - a^2 b) + d_b lap b",
             {"a", "b"},
             {{"s", 1.0, "reaction rate"}, {"alpha", 3.0, "feed"}, {"beta", 9.0, "conversion"}},
-            {49.5, 117.6}, {3.0, 3.0}, 0.0, 8.0, false, {}};
+            {49.5, 117.6}, {3.0, 3.0}, 0.0, 8.0, {}};
   }
   static constexpr const char* kKernel = "brusselator.inc";
 #include "kernels/models/brusselator.inc"
@@ -158,7 +161,7 @@ struct GiererMeinhardt {
             {"a", "b"},
             {{"s", 1.0, "reaction rate"}, {"alpha", 0.5, "decay of a"}, {"beta", 1.0, "decay of b"},
              {"gamma", 0.1, "basic production of a"}},
-            {1.0, 40.0}, {2.2, 4.84}, 0.0, 10.0, true, {0}};
+            {1.0, 40.0}, {2.2, 4.84}, 0.0, 10.0, {0}};
   }
   static constexpr const char* kKernel = "gierer_meinhardt.inc";
 #include "kernels/models/gierer_meinhardt.inc"
@@ -173,7 +176,7 @@ struct Oregonator {
             "db/dt = a - b + d_b lap b",
             {"a", "b"},
             {{"eps", 0.05, "time-scale ratio"}, {"f", 1.4, "stoichiometry"}, {"q", 0.002, "scaling"}},
-            {1.0, 0.6}, {0.0, 0.0}, 0.0, 1.0, false, {}};
+            {1.0, 0.6}, {0.0, 0.0}, 0.0, 1.0, {}};
   }
   static constexpr const char* kKernel = "oregonator.inc";
 #include "kernels/models/oregonator.inc"
@@ -193,7 +196,7 @@ struct MeinhardtLateral {
             {{"c", 1.0, "autocatalysis"}, {"alpha", 0.1, "decay of g"}, {"beta", 0.1, "decay of r"},
              {"gamma", 0.1, "relaxation of s to g"}, {"rho0", 0.001, "basic production of g"},
              {"rho1", 0.0, "basic production of s"}},
-            {0.01, 0.01, 0.0, 0.4, 0.4}, {0.51, 0.51, 2.65, 0.51, 0.51}, 0.0, 4.0, true, {0, 1, 3, 4}};
+            {0.01, 0.01, 0.0, 0.4, 0.4}, {0.51, 0.51, 2.65, 0.51, 0.51}, 0.0, 4.0, {0, 1, 3, 4}};
   }
   static constexpr const char* kKernel = "meinhardt_lateral.inc";
 #include "kernels/models/meinhardt_lateral.inc"
@@ -210,7 +213,7 @@ struct CoupledBrusselator : Brusselator {
             {"a1", "b1", "a2", "b2"},
             {{"s", 1.0, "reaction rate"}, {"alpha", 3.0, "feed"}, {"beta", 9.0, "conversion"},
              {"mu", 0.1, "coupling of a"}, {"nu", 0.1, "coupling of b"}},
-            {16.7, 36.4, 49.5, 117.6}, {3.0, 3.0, 3.0, 3.0}, 0.0, 8.0, false, {}};
+            {16.7, 36.4, 49.5, 117.6}, {3.0, 3.0, 3.0, 3.0}, 0.0, 8.0, {}};
   }
   static constexpr const char* kKernel = "brusselator_coupled.inc";
   static constexpr const char* kKernelBase = "brusselator.inc";  // its kernels, included first
@@ -231,12 +234,25 @@ struct OregonatorThreeLayer : Oregonator {
              {"q", 0.002, "top-layer scaling"}, {"eps2", 0.05, "bottom-layer time-scale ratio"},
              {"f2", 1.1, "bottom-layer stoichiometry"}, {"q2", 0.002, "bottom-layer scaling"},
              {"delta", 2.0, "top/middle exchange time"}, {"delta_bar", 2.0, "middle/bottom exchange time"}},
-            {1.0, 0.6, 1.0, 1.0, 0.6}, {0.0, 0.0, 0.0, 0.0, 0.0}, 0.0, 1.0, false, {}};
+            {1.0, 0.6, 1.0, 1.0, 0.6}, {0.0, 0.0, 0.0, 0.0, 0.0}, 0.0, 1.0, {}};
   }
   static constexpr const char* kKernel = "oregonator_3layer.inc";
   static constexpr const char* kKernelBase = "oregonator.inc";  // its kernels, included first
 #include "kernels/models/oregonator_3layer.inc"
 };
+
+// Every model, in the order `morphoflow list` shows them. The registry
+// (rd/model_registry.cpp) and the fused step (rd/fused_explicit.cpp) walk
+// this one list.
+using All = std::tuple<Turing, TuringSanderson, GrayScott, GrayScottSanderson, FitzHughNagumo, Barkley,
+                       BarkleyTurbulent, MeinhardtSpots, Brusselator, GiererMeinhardt, Oregonator, MeinhardtLateral,
+                       CoupledBrusselator, OregonatorThreeLayer>;
+
+// Calls f(std::type_identity<M>{}) for each model M of All, in order.
+template <class F>
+void forEach(F&& f) {
+  [&]<class... M>(std::tuple<M...>*) { (f(std::type_identity<M>{}), ...); }(static_cast<All*>(nullptr));
+}
 
 }  // namespace morphoflow::models
 

@@ -124,7 +124,8 @@ void RDSolver<D>::setDiffusionTensor(DiffusionTensorSpec<D> spec) {
   if (lobeSpec_) throw std::invalid_argument("rd: a diffusion tensor and cosine lobes cannot be combined");
   const size_t cells = cellCount_;
   for (int a = 0; a < D; ++a)
-    if (spec.direction[size_t(a)].size() != cells) throw std::invalid_argument("rd: tensor direction has the wrong size");
+    if (spec.direction[size_t(a)].size() != cells)
+      throw std::invalid_argument("rd: tensor direction has the wrong size");
   if (spec.lambda1.size() != cells || spec.lambda2.size() != cells)
     throw std::invalid_argument("rd: principal diffusivities have the wrong size");
   for (size_t i = 0; i < cells; ++i)
@@ -204,7 +205,8 @@ template <int D>
 void RDSolver<D>::buildLobes() {
   const bool periodic = settings_.boundary == RDBoundary::Periodic;
   for (int s = 0; s < species(); ++s)
-    if (lobed(s)) assemble(lobeTensor<D>(*lobeSpec_, x_[size_t(s)], periodic), &lobeSystem_[size_t(s)], &lobeBoundary_[size_t(s)]);
+    if (lobed(s))
+      assemble(lobeTensor<D>(*lobeSpec_, x_[size_t(s)], periodic), &lobeSystem_[size_t(s)], &lobeBoundary_[size_t(s)]);
   ++operatorVersion_;
 }
 
@@ -405,7 +407,8 @@ void RDSolver<D>::step(double dt) {
   const double theta = diffusionTheta(integ);
   react(dt, implicitReaction);  // Kim & Lin: updates x in place (projected per cell)
   const std::initializer_list<Vector*> doubles = {&solveX_, &pcgWork_.b, &pcgWork_.r, &pcgWork_.p, &pcgWork_.q};
-  const std::initializer_list<std::vector<float>*> floats = {&chebyshevWork_.e[0], &chebyshevWork_.e[1], &chebyshevWork_.g};
+  const std::initializer_list<std::vector<float>*> floats = {&chebyshevWork_.e[0], &chebyshevWork_.e[1],
+                                                             &chebyshevWork_.g};
   if (pool_) pool_->lend(doubles), pool_->lend(floats);
   // The species are independent from here on: one after another (each
   // splits into row tasks), sharing the solvers' work vectors.

@@ -28,8 +28,7 @@ struct ModelInfo {
   std::vector<double> diffusion;       // default d_s (domain units^2 / time)
   std::vector<double> initial;         // default uniform state
   double lutLow = 0.0, lutHigh = 1.0;  // lookup-table range of every species
-  bool nonNegative = false;            // clamps species listed in `clamped` at 0
-  std::vector<int> clamped;
+  std::vector<int> clamped;            // species the step clamps at 0
 };
 
 // Where a model's rates and Jacobian are written (kernels/models/): the

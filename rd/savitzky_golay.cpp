@@ -37,7 +37,8 @@ Kernel5 savitzkyGolayDerivative(int i, int j, int degree) {
       if (std::abs(N[r][c]) > std::abs(N[p][c])) p = r;
     std::swap(N[c], N[p]);
     const double pivot = N[c][c];
-    if (std::abs(pivot) < 1e-12) throw std::invalid_argument("Savitzky-Golay: the fit is singular (degree too high for 5 x 5)");
+    if (std::abs(pivot) < 1e-12)
+      throw std::invalid_argument("Savitzky-Golay: the fit is singular (degree too high for 5 x 5)");
     for (size_t k = 0; k < m + 25; ++k) N[c][k] /= pivot;
     for (size_t r = 0; r < m; ++r) {
       if (r == c || N[r][c] == 0.0) continue;

@@ -42,8 +42,6 @@ std::vector<std::string> colormapNames() {
   return names;
 }
 
-bool hasColormap(const std::string& name) { return maps().count(name) > 0 || name == kTwoSpeciesPalette; }
-
 Palette namedPalette(const std::string& name) {
   auto it = maps().find(name);
   return Palette{it != maps().end() ? it->second : maps().at("grayscale")};

@@ -26,7 +26,6 @@ inline constexpr const char* kTwoSpeciesPalette = "red-green";
 
 // Scalar palettes by name, then the two-species palette.
 std::vector<std::string> colormapNames();
-bool hasColormap(const std::string& name);
 // A scalar palette by name (grayscale for an unknown or the two-species name).
 Palette namedPalette(const std::string& name);
 // An 8-bit sRGB channel as linear light in [0, 1] (IEC 61966-2-1), as

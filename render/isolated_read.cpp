@@ -44,7 +44,8 @@ bool writeAll(int fd, const char* p, size_t n) {
 // time ran out first (the child may be blocked, using no processor time).
 bool readAll(int fd, double wallSeconds, std::string* got) {
   using Clock = std::chrono::steady_clock;
-  const auto deadline = Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(wallSeconds));
+  const auto deadline =
+      Clock::now() + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(wallSeconds));
   char buf[1 << 16];
   for (;;) {
     const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
@@ -95,7 +96,8 @@ bool runIsolated(const std::function<std::string()>& work, const ReaderLimits& l
       status = 3;
     }
     const uint64_t n = bytes.size();
-    if (status == 0 && !(writeAll(fds[1], reinterpret_cast<const char*>(&n), sizeof n) && writeAll(fds[1], bytes.data(), n)))
+    if (status == 0 &&
+        !(writeAll(fds[1], reinterpret_cast<const char*>(&n), sizeof n) && writeAll(fds[1], bytes.data(), n)))
       status = 4;
     ::_exit(status);
   }
@@ -123,7 +125,8 @@ bool runIsolated(const std::function<std::string()>& work, const ReaderLimits& l
     return false;
   }
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || got.size() < sizeof n) {
-    *error = "the file is damaged: its reader stopped (status " + std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")";
+    *error = "the file is damaged: its reader stopped (status " +
+             std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")";
     return false;
   }
   std::memcpy(&n, got.data(), sizeof n);

@@ -32,7 +32,8 @@ std::vector<float> surfaceNormals(const Grid<float, 2>& height, const NormalMapO
   for (int y = 0; y < height.dim(1); ++y)
     for (int x = 0; x < height.dim(0); ++x) {
       const IVec<2> c(x, y);
-      const double nx = -o.strength * slope(height, c, 0, o.periodic), ny = -o.strength * slope(height, c, 1, o.periodic);
+      const double nx = -o.strength * slope(height, c, 0, o.periodic),
+                   ny = -o.strength * slope(height, c, 1, o.periodic);
       const double len = std::sqrt(nx * nx + ny * ny + 1.0);
       const size_t i = 3 * height.index(c);
       n[i] = float(nx / len), n[i + 1] = float(ny / len), n[i + 2] = float(1.0 / len);
@@ -46,7 +47,8 @@ std::vector<uint8_t> normalMapRgb(const Grid<float, 2>& height, const NormalMapO
   std::vector<uint8_t> rgb(n.size());
   for (int y = 0; y < hgt; ++y)
     for (int x = 0; x < w; ++x) {
-      const size_t src = 3 * (size_t(y) * size_t(w) + size_t(x)), dst = 3 * (size_t(hgt - 1 - y) * size_t(w) + size_t(x));
+      const size_t src = 3 * (size_t(y) * size_t(w) + size_t(x)),
+                   dst = 3 * (size_t(hgt - 1 - y) * size_t(w) + size_t(x));
       for (int k = 0; k < 3; ++k)
         rgb[dst + size_t(k)] = uint8_t(std::lround(std::clamp(0.5 * (n[src + size_t(k)] + 1.0), 0.0, 1.0) * 255.0));
     }

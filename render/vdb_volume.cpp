@@ -145,7 +145,8 @@ openvdb::MetaMap metaMap(const VolumeMetadata& m) {
   meta.insertMeta("morphoflow_version", openvdb::StringMetadata(m.version));
   meta.insertMeta("settings_hash", openvdb::StringMetadata(m.settingsHash));
   meta.insertMeta("units", openvdb::StringMetadata(m.units));
-  if (m.domain[0] > 0) meta.insertMeta("domain_size", openvdb::Vec3DMetadata(openvdb::Vec3d(m.domain[0], m.domain[1], m.domain[2])));
+  if (m.domain[0] > 0)
+    meta.insertMeta("domain_size", openvdb::Vec3DMetadata(openvdb::Vec3d(m.domain[0], m.domain[1], m.domain[2])));
   return meta;
 }
 
@@ -196,7 +197,8 @@ std::string encodeNanoVdb(const std::vector<VolumeGrid>& grids, const VolumeMeta
   // stream allows only over bytes it holds: hold the header's size first.
   nanovdb::io::Segment segment(nanovdb::io::Codec::NONE);
   for (const auto& h : handles) segment.add(h);
-  std::stringstream os(std::string(segment.memUsage(), '\0'), std::ios_base::in | std::ios_base::out | std::ios_base::binary);
+  std::stringstream os(std::string(segment.memUsage(), '\0'),
+                       std::ios_base::in | std::ios_base::out | std::ios_base::binary);
   nanovdb::io::writeGrids<nanovdb::HostBuffer, std::vector>(os, handles, nanovdb::io::Codec::NONE);
   if (!os) throw std::runtime_error("the NanoVDB grids could not be serialised");
   return os.str();
@@ -278,7 +280,8 @@ bool readVelocityHere(const std::string& path, VelocityVolume* out, std::string*
     const openvdb::Vec3d o = t.indexToWorld(openvdb::Vec3d(0.0));
     if (!(std::isfinite(vs[0]) && vs[0] > 0.0 && vs[0] < 1e30) || !std::isfinite(o[0]) || !std::isfinite(o[1]) ||
         !std::isfinite(o[2])) {
-      *error = "the grid '" + grid->getName() + "' has a transform that is not finite (voxel size " + std::to_string(vs[0]) + ")";
+      *error = "the grid '" + grid->getName() + "' has a transform that is not finite (voxel size " +
+               std::to_string(vs[0]) + ")";
       return false;
     }
     VelocityVolume v;
@@ -358,7 +361,8 @@ std::string encodeAnswer(bool ok, const VelocityVolume& v, const std::string& er
   put(&s, v.staggered), put(&s, v.origin), put(&s, v.cells), put(&s, v.voxelSize), put(&s, v.indexOrigin);
   put(&s, v.hasTime), put(&s, v.hasDomain), put(&s, v.time), put(&s, v.domain);
   for (const std::vector<float>& c : v.values)
-    putText(&s, c.empty() ? std::string() : std::string(reinterpret_cast<const char*>(c.data()), c.size() * sizeof(float)));
+    putText(&s,
+            c.empty() ? std::string() : std::string(reinterpret_cast<const char*>(c.data()), c.size() * sizeof(float)));
   return s;
 }
 

@@ -55,7 +55,8 @@ struct VolumeOptions {
 // fields give the same bytes (a resumed run writes what an uninterrupted one does).
 std::string encodeVdb(const std::vector<VolumeGrid>& grids, const VolumeMetadata& meta, const VolumeOptions& options);
 // The same grids as a NanoVDB file (.nvdb), uncompressed, for GPU renderers.
-std::string encodeNanoVdb(const std::vector<VolumeGrid>& grids, const VolumeMetadata& meta, const VolumeOptions& options);
+std::string encodeNanoVdb(const std::vector<VolumeGrid>& grids, const VolumeMetadata& meta,
+                          const VolumeOptions& options);
 
 // A velocity read back from a .vdb file: the grid `vel_mac` (staggered, as
 // morphoflow writes it with output.vdb_mac_velocity) if the file has one,

@@ -161,7 +161,8 @@ std::vector<uint8_t> volumeToRgb(const Grid<float, 3>& f, const FieldImageOption
 
 std::vector<uint8_t> volumeTwoToRgb(const Grid<float, 3>& red, const Grid<float, 3>& green,
                                     const FieldImageOptions& o, int size, int* width, int* height) {
-  const std::array<double, 2> rr = valueRange(red.data(), red.size(), o), gr = valueRange(green.data(), green.size(), o);
+  const std::array<double, 2> rr = valueRange(red.data(), red.size(), o),
+                              gr = valueRange(green.data(), green.size(), o);
   *width = *height = size;
   return march(red.dims(), size, [&](const V3& p) {
     const double r = normalised(sample(red, p), rr), g = normalised(sample(green, p), gr);

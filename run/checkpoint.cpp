@@ -42,13 +42,17 @@ std::vector<fs::path> checkpointsNewestFirst(const fs::path& dir) {
 // header without them is unusable as a damaged file is (an empty string: it has them).
 std::string headerProblem(const nlohmann::json& h) {
   if (!h.is_object()) return "its header is not a JSON object";
-  auto has = [&](const char* key, bool (nlohmann::json::*is)() const noexcept) { return h.contains(key) && (h[key].*is)(); };
+  auto has = [&](const char* key, bool (nlohmann::json::*is)() const noexcept) {
+    return h.contains(key) && (h[key].*is)();
+  };
   for (const char* key : {"version", "scene_hash", "scene", "log"})
     if (!has(key, &nlohmann::json::is_string)) return std::string("its header lacks the text '") + key + "'";
   for (const char* key : {"step", "last_frame"})
-    if (!has(key, &nlohmann::json::is_number_integer)) return std::string("its header lacks the whole number '") + key + "'";
+    if (!has(key, &nlohmann::json::is_number_integer))
+      return std::string("its header lacks the whole number '") + key + "'";
   if (h["step"].get<long>() < 0 || h["last_frame"].get<long>() < -1) return "its header holds a negative step or frame";
-  if (!has("checkpoint_bytes", &nlohmann::json::is_number_unsigned)) return "its header lacks the byte count 'checkpoint_bytes'";
+  if (!has("checkpoint_bytes", &nlohmann::json::is_number_unsigned))
+    return "its header lacks the byte count 'checkpoint_bytes'";
   if (!has("time", &nlohmann::json::is_number)) return "its header lacks the number 'time'";
   if (!has("sinks", &nlohmann::json::is_array)) return "its header lacks the outputs' list 'sinks'";
   if (h.contains("python")) {
@@ -118,7 +122,8 @@ fs::path writeCheckpoint(const fs::path& out, long step, const CheckpointHeader&
   return file;
 }
 
-void writeCheckpointFile(const fs::path& file, const CheckpointHeader& header, const std::function<void(StateWriter*)>& save) {
+void writeCheckpointFile(const fs::path& file, const CheckpointHeader& header,
+                         const std::function<void(StateWriter*)>& save) {
   const std::string h = header.toJson().dump();
   // The state's length comes first in the file: one pass counts it, the
   // next streams the sections straight from the solvers into the file.
@@ -171,9 +176,11 @@ Checkpoint readCheckpoint(const fs::path& file) {
     throw bad("it is " + humanBytes(size) + ", more than this process can hold");
   }
   if (!in.read(bytes.data(), std::streamsize(bytes.size()))) throw bad("it cannot be read");
-  if (bytes.size() < 8 + 8 + 8 + 8 || std::memcmp(bytes.data(), kMagic, 8) != 0) throw bad("it is not a morphoflow checkpoint, or it is cut short");
+  if (bytes.size() < 8 + 8 + 8 + 8 || std::memcmp(bytes.data(), kMagic, 8) != 0)
+    throw bad("it is not a morphoflow checkpoint, or it is cut short");
   const size_t body = bytes.size() - 8;
-  if (XXH64(bytes.data(), body, 0) != read64(bytes, body)) throw bad("its checksum does not match (cut short or corrupted)");
+  if (XXH64(bytes.data(), body, 0) != read64(bytes, body))
+    throw bad("its checksum does not match (cut short or corrupted)");
   const uint64_t hn = read64(bytes, 8);
   if (hn > body - 16) throw bad("its header is cut short");
   const uint64_t sn = read64(bytes, 16 + hn);

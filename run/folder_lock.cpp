@@ -28,9 +28,10 @@ FolderLock::FolderLock(const std::filesystem::path& folder, const std::string& n
     ::close(fd_);
     fd_ = -1;
     const std::string holder = n > 0 ? std::string(text, size_t(n)) : std::string("another process");
-    throw UserError({folder.string(), 0, 0}, "",
-                    "the output folder is in use by another morphoflow run (" + holder.substr(0, holder.find('\n')) + ")",
-                    "wait for it to end, or give another --out");
+    throw UserError(
+        {folder.string(), 0, 0}, "",
+        "the output folder is in use by another morphoflow run (" + holder.substr(0, holder.find('\n')) + ")",
+        "wait for it to end, or give another --out");
   }
   const std::string me = fmt::format("pid {}\n", ::getpid());
   if (::ftruncate(fd_, 0) == 0 && ::pwrite(fd_, me.data(), me.size(), 0) < 0) {

@@ -44,7 +44,8 @@ double cellsOf(const std::vector<int>& res) {
 uintmax_t estimateRunBytes(const Scene& s) {
   const int d = s.dimension == 3 ? 1 : 0;
   double bytes = kFixedBytes;
-  if (s.hasFluid) bytes += cellsOf(s.fluid.resolution) * (s.rd.enabled ? kCoupledFluidBytesPerCell[d] : kFluidBytesPerCell[d]);
+  if (s.hasFluid)
+    bytes += cellsOf(s.fluid.resolution) * (s.rd.enabled ? kCoupledFluidBytesPerCell[d] : kFluidBytesPerCell[d]);
   const bool smoke = s.hasFluid && s.fluid.smoke.enabled;
   if (smoke)  // counted, not measured: the temperature, each source's cover, and the forces' float work
               // grids (forces, centre velocities, vorticity and its magnitude: 6 in 2D, 10 in 3D)
@@ -65,7 +66,9 @@ uintmax_t estimateRunBytes(const Scene& s) {
     const double species = double(s.rd.initial.values.size());
     const bool fused = !s.hasFluid && !s.velocity.enabled && s.rd.plainExplicit();
     bytes += cellsOf(s.rd.settings.resolution) * species *
-             (s.hasFluid ? kCoupledSpeciesBytesPerCell[d] : fused ? kFusedSpeciesBytesPerCell : kSpeciesBytesPerCell[d]);
+             (s.hasFluid ? kCoupledSpeciesBytesPerCell[d]
+              : fused    ? kFusedSpeciesBytesPerCell
+                         : kSpeciesBytesPerCell[d]);
   }
   return uintmax_t(bytes);
 }

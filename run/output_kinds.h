@@ -21,8 +21,8 @@ inline constexpr OutputKind kVdbFiles{"vdb", R"(.+\.\d{6}\.(vdb|nvdb))"};
 inline constexpr OutputKind kCheckpointFiles{"checkpoints", R"(\d{10}\.ckpt)"};
 inline constexpr OutputKind kProfileFiles{"profiles", R"((u_vertical|v_horizontal)_centerline\.csv)"};
 
-inline constexpr std::array<OutputKind, 7> kOutputKinds = {kFrameFiles,  kFieldFiles,      kNormalMapFiles, kHeightFiles,
-                                                           kVdbFiles,    kCheckpointFiles, kProfileFiles};
+inline constexpr std::array<OutputKind, 7> kOutputKinds = {kFrameFiles, kFieldFiles,      kNormalMapFiles, kHeightFiles,
+                                                           kVdbFiles,   kCheckpointFiles, kProfileFiles};
 
 // The files in the output folder itself: the records, the force probe's
 // table (the video is named after the scene, and handled by the cleanup).

@@ -21,7 +21,8 @@ std::filesystem::path endFile(const std::filesystem::path& dir, const std::strin
   std::error_code ec;
   for (const auto& e : std::filesystem::directory_iterator(dir, ec)) {
     const std::string name = e.path().filename().string();
-    if (name.size() <= extension.size() || name.compare(name.size() - extension.size(), extension.size(), extension) != 0)
+    if (name.size() <= extension.size() ||
+        name.compare(name.size() - extension.size(), extension.size(), extension) != 0)
       continue;
     if (found.empty() || (last ? e.path() > found : e.path() < found)) found = e.path();
   }
@@ -51,7 +52,8 @@ void addBytes(nlohmann::json* run, const std::string& kind, uintmax_t bytes) {
 }
 
 template <int D>
-ImageSink<D>::ImageSink(const std::filesystem::path& out, const Scene& scene) : dir_(out / kFrameFiles.folder), scene_(scene) {
+ImageSink<D>::ImageSink(const std::filesystem::path& out, const Scene& scene)
+    : dir_(out / kFrameFiles.folder), scene_(scene) {
   createOutputFolder(dir_);
 }
 
@@ -122,8 +124,8 @@ template <int D>
 std::vector<std::string> ImageSink<D>::whereToLook() const {
   std::vector<std::string> lines;
   if (videoDone_ && video_.written)
-    lines.push_back(fmt::format("animation: {} (play it with `ffplay -loop 0 {}` or any video player)", videoFile_.string(),
-                                videoFile_.string()));
+    lines.push_back(fmt::format("animation: {} (play it with `ffplay -loop 0 {}` or any video player)",
+                                videoFile_.string(), videoFile_.string()));
   if (const std::filesystem::path newest = endFile(dir_, "." + scene_.output.format, true); !newest.empty())
     lines.push_back(fmt::format("newest frame: {} (of {} in {}/)", newest.string(), written_, dir_.string()));
   return lines;
@@ -131,7 +133,11 @@ std::vector<std::string> ImageSink<D>::whereToLook() const {
 
 template <int D>
 nlohmann::json ImageSink<D>::state() const {
-  return {{"written", written_}, {"first_written", firstWritten_}, {"bytes", bytes_}, {"clipped", clipped_}, {"cells", cells_}};
+  return {{"written", written_},
+          {"first_written", firstWritten_},
+          {"bytes", bytes_},
+          {"clipped", clipped_},
+          {"cells", cells_}};
 }
 
 template <int D>
@@ -197,7 +203,8 @@ void NormalMapSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
     const OutputSettings& o = scene_.output;
     const std::string name = o.colormap == kTwoSpeciesPalette ? sim.species()[0] : o.field;
     Grid<float, 2> height = sim.field(name).front();
-    const std::array<double, 2> range = valueRange(height.data(), height.size(), frameImageOptions(o, sim.symmetric(name)));
+    const std::array<double, 2> range =
+        valueRange(height.data(), height.size(), frameImageOptions(o, sim.symmetric(name)));
     const double span = range[1] > range[0] ? range[1] - range[0] : 1.0;
     for (float& v : height.values()) v = float(std::clamp((double(v) - range[0]) / span, 0.0, 1.0));
     const bool periodic = scene_.rd.enabled ? scene_.rd.settings.boundary == RDBoundary::Periodic

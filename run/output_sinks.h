@@ -65,7 +65,8 @@ class ImageSink : public OutputSink<D> {
   int written_ = 0;
   long firstWritten_ = -1;
   uintmax_t bytes_ = 0;
-  uintmax_t clipped_ = 0, cells_ = 0;  // a fixed output.range: the shown cells beyond it (drawn at its ends), of all shown
+  uintmax_t clipped_ = 0,
+            cells_ = 0;  // a fixed output.range: the shown cells beyond it (drawn at its ends), of all shown
   bool videoDone_ = false;
   VideoResult video_;
   std::filesystem::path videoFile_;
@@ -132,7 +133,8 @@ T stateCount(const nlohmann::json& state, const char* key, long long lowest = 0)
     return T(u);
   }
   const long long n = v.get<long long>();
-  if (n < lowest || (n > 0 && static_cast<unsigned long long>(n) > static_cast<unsigned long long>(std::numeric_limits<T>::max())))
+  if (n < lowest ||
+      (n > 0 && static_cast<unsigned long long>(n) > static_cast<unsigned long long>(std::numeric_limits<T>::max())))
     throw outOfRange();
   return T(n);
 }

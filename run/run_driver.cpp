@@ -112,9 +112,9 @@ class Driver {
       log_.warn("warning: " + j["video"]["warning"].get<std::string>());
     if (j.contains("vdb_half_warning")) log_.warn("warning: " + j["vdb_half_warning"].get<std::string>());
     if (j.contains("frames_range") && j["frames_range"]["cells_beyond"].get<uintmax_t>() > 0)
-      log_.say(fmt::format("frames: {:.2g}% of the shown cells lay beyond output.range [{:g}, {:g}] and were drawn at its ends",
-                           100.0 * j["frames_range"]["fraction_beyond"].get<double>(), scene_.output.range[0],
-                           scene_.output.range[1]));
+      log_.say(fmt::format(
+          "frames: {:.2g}% of the shown cells lay beyond output.range [{:g}, {:g}] and were drawn at its ends",
+          100.0 * j["frames_range"]["fraction_beyond"].get<double>(), scene_.output.range[0], scene_.output.range[1]));
     if (steady_) sayHowSteady();
     log_.say(fmt::format("done: {} steps, t = {:.5g}, {:.2f} s wall, {} frames -> {}", sim_.steps(), sim_.time(),
                          wallSeconds(), j["frames_written"].get<int>(), out_.string()));
@@ -139,12 +139,13 @@ class Driver {
     if (scene_.time.cfl <= 0 || scene_.time.steps > 0) return;
     const double left = (scene_.time.duration - sim_.time()) / lastDt_;
     if (double(sim_.steps()) + left <= double(TimeSettings::kMaxSteps)) return;
-    throw UserError({scene_.path, 0, 0}, "time.cfl",
-                    fmt::format("at step {} (t = {:.5g}) the CFL limit {:g} gives dt = {:.3g}: the {:.3g} time units left "
-                                "would take {:.3g} steps, more than {}",
-                                sim_.steps(), sim_.time(), scene_.time.cfl, lastDt_, scene_.time.duration - sim_.time(), left,
-                                TimeSettings::kMaxSteps),
-                    "raise time.cfl or shorten time.duration");
+    throw UserError(
+        {scene_.path, 0, 0}, "time.cfl",
+        fmt::format("at step {} (t = {:.5g}) the CFL limit {:g} gives dt = {:.3g}: the {:.3g} time units left "
+                    "would take {:.3g} steps, more than {}",
+                    sim_.steps(), sim_.time(), scene_.time.cfl, lastDt_, scene_.time.duration - sim_.time(), left,
+                    TimeSettings::kMaxSteps),
+        "raise time.cfl or shorten time.duration");
   }
 
   void sayHowSteady() {
@@ -169,8 +170,8 @@ class Driver {
     nlohmann::json s = {{"tolerance", steady_->tolerance()}, {"steady", steady_->steady()}};
     s["relative_change_per_time"] = steady_->checked() ? nlohmann::json(steady_->change()) : nlohmann::json(nullptr);
     if (!steady_->checked())
-      s["not_measured_because"] = fmt::format("output.every ({} steps) is longer than the run ({} steps)", schedule_.every(),
-                                              sim_.steps());
+      s["not_measured_because"] =
+          fmt::format("output.every ({} steps) is longer than the run ({} steps)", schedule_.every(), sim_.steps());
     s["stopped_because"] = steady_->steady()                  ? "steady"
                            : schedule_.pastLast(sim_.steps()) ? "--frames"
                            : scene_.time.steps > 0            ? "time.steps"
@@ -247,17 +248,19 @@ class Driver {
                             c.file.string(), h.version, kVersion));
     if (h.sceneHash != hash_ && !opt_.force) {
       std::vector<std::string> keys = changedKeys(h.scene, scene_.resolvedJson);
-      throw UserError({c.file.string(), 0, 0}, "--resume",
-                      "the scene differs from the one this checkpoint was written by" +
-                          (keys.empty() ? std::string() : " (changed: " + fmt::format("{}", fmt::join(keys, ", ")) + ")"),
-                      "resume with the scene as it was, add --force to continue anyway, or run without --resume");
+      throw UserError(
+          {c.file.string(), 0, 0}, "--resume",
+          "the scene differs from the one this checkpoint was written by" +
+              (keys.empty() ? std::string() : " (changed: " + fmt::format("{}", fmt::join(keys, ", ")) + ")"),
+          "resume with the scene as it was, add --force to continue anyway, or run without --resume");
     }
     try {
       const StateReader state(std::move(c.state));
       sim_.load(state);
       if (steady_) steady_->load(state, sim_);
     } catch (const StateError& e) {
-      throw UserError({c.file.string(), 0, 0}, "--resume", std::string("the checkpoint does not fit this scene: ") + e.what(),
+      throw UserError({c.file.string(), 0, 0}, "--resume",
+                      std::string("the checkpoint does not fit this scene: ") + e.what(),
                       "run the scene without --resume to start it afresh");
     }
     lastFrame_ = h.lastFrame;

@@ -55,7 +55,8 @@ int removeEarlierRun(const fs::path& out, const std::string& videoStem) {
   const std::regex topPattern(top);
   for (const auto& e : fs::directory_iterator(out, ec)) {
     const std::string name = e.path().filename().string();
-    if (fs::is_regular_file(e.symlink_status(ec)) && std::regex_match(name, topPattern) && fs::remove(e.path(), ec)) ++n;
+    if (fs::is_regular_file(e.symlink_status(ec)) && std::regex_match(name, topPattern) && fs::remove(e.path(), ec))
+      ++n;
   }
   return n;
 }

@@ -84,7 +84,8 @@ void RunLog::endProgress() {
 void RunLog::restore(const std::string& text) {
   std::vector<std::string> earlier;
   size_t at = 0;
-  for (size_t nl; (nl = text.find('\n', at)) != std::string::npos; at = nl + 1) earlier.push_back(text.substr(at, nl - at));
+  for (size_t nl; (nl = text.find('\n', at)) != std::string::npos; at = nl + 1)
+    earlier.push_back(text.substr(at, nl - at));
   lines_.insert(lines_.begin(), earlier.begin(), earlier.end());
 }
 

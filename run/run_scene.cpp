@@ -24,7 +24,8 @@ template <int D>
 int run(const Scene& scene, const RunOptions& opt, Backend backend) {
   RunLog log(opt.quiet, stderrIsTerminal());
   std::unique_ptr<Simulation<D>> sim = makeSimulation<D>(
-      scene, backend, [&log](const std::string& line) { log.say(line); }, [&log](const std::string& line) { log.warn(line); });
+      scene, backend, [&log](const std::string& line) { log.say(line); },
+      [&log](const std::string& line) { log.warn(line); });
   return driveRun<D>(*sim, scene, opt, &log);
 }
 
@@ -35,8 +36,8 @@ void checkFrames(const Scene& scene, const RunOptions& opt) {
   const long last = scene.totalSteps() / scene.output.every;
   if (opt.firstFrame > last)
     throw UserError({"--frames", 0, 0}, "",
-                    fmt::format("frame {} is beyond the run's last frame, {} ({} steps, a frame every {})", opt.firstFrame,
-                                last, scene.totalSteps(), scene.output.every),
+                    fmt::format("frame {} is beyond the run's last frame, {} ({} steps, a frame every {})",
+                                opt.firstFrame, last, scene.totalSteps(), scene.output.every),
                     fmt::format("give --frames A:B with A <= {}", last));
 }
 

@@ -241,7 +241,8 @@ void VdbSink<D>::report(nlohmann::json* j) const {
 template <int D>
 nlohmann::json VdbSink<D>::state() const {
   nlohmann::json s = {{"written", written_}, {"bytes", bytes_}, {"nano_bytes", nanoBytes_}};
-  for (const auto& [name, n] : clamped_) s["clamped:" + name] = n;  // (a checkpoint's sink state holds whole numbers only)
+  for (const auto& [name, n] : clamped_)
+    s["clamped:" + name] = n;  // (a checkpoint's sink state holds whole numbers only)
   return s;
 }
 

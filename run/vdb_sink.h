@@ -39,7 +39,8 @@ class VdbSink : public OutputSink<D> {
   const std::string hash_;  // the scene's settings hash, for the metadata
   int written_ = 0;
   uintmax_t bytes_ = 0, nanoBytes_ = 0;
-  std::map<std::string, uintmax_t> clamped_;  // output.vdb_half: voxels per grid beyond half's range, written at its limit
+  std::map<std::string, uintmax_t>
+      clamped_;  // output.vdb_half: voxels per grid beyond half's range, written at its limit
 };
 
 }  // namespace morphoflow

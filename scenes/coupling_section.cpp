@@ -10,7 +10,8 @@ void parseCoupling(SceneContext& c, Scene* sp) {
   const std::vector<std::string>& species = c.species;
   if (const toml::table* ct = r.table(root, "", "coupling")) {
     if (!s.rd.enabled || !(s.hasFluid || s.velocity.enabled))
-      r.fail(ct, "coupling", "[coupling] joins a [fluid] (or a given [velocity]) and an [rd] layer, and this scene lacks one of them",
+      r.fail(ct, "coupling",
+             "[coupling] joins a [fluid] (or a given [velocity]) and an [rd] layer, and this scene lacks one of them",
              "add the missing table or drop [coupling]");
   }
   if (s.rd.enabled && (s.hasFluid || s.velocity.enabled)) {
@@ -18,7 +19,8 @@ void parseCoupling(SceneContext& c, Scene* sp) {
     CouplingScene& C = s.coupling;
     C.enabled = true;
     C.mode = couplingModeNamed(r.string(ct, "coupling.", "mode", "ard", {"ard", "passive", "rd-only"}));
-    C.interpolation = interpolationNamed(r.string(ct, "coupling.", "interpolation", "linear", {"linear", "cubic", "bspline", "bfecc"}));
+    C.interpolation = interpolationNamed(
+        r.string(ct, "coupling.", "interpolation", "linear", {"linear", "cubic", "bspline", "bfecc"}));
     C.rdTimeScale = r.number(ct, "coupling.", "rd_time_scale", 1.0, 0, 1e9, true);
     const size_t n = species.size();
     C.inflowValues = r.numbers(ct, "coupling.", "inflow_values", s.rd.initial.values, n, n, -1e12, 1e12);

@@ -70,7 +70,9 @@ void parseSchemes(const SceneContext& c, const toml::table* fluid, Scene& s) {
                       : adv == "bfecc"         ? AdvectionScheme::Bfecc
                                                : AdvectionScheme::MacCormack;
   std::string ps = r.string(fluid, "fluid.", "pressure_solver", "mgpcg", {"mgpcg", "icpcg", "multigrid"});
-  s.fluid.pressureSolver = ps == "icpcg" ? PressureSolver::ICPCG : ps == "multigrid" ? PressureSolver::Multigrid : PressureSolver::MGPCG;
+  s.fluid.pressureSolver = ps == "icpcg"       ? PressureSolver::ICPCG
+                           : ps == "multigrid" ? PressureSolver::Multigrid
+                                               : PressureSolver::MGPCG;
   s.fluid.pressureTolerance = r.number(fluid, "fluid.", "pressure_tolerance", 1e-6, 0, 1, true);
   s.fluid.pressureMaxIterations = int(r.integer(fluid, "fluid.", "pressure_max_iterations", 500, 1, 100000));
   std::vector<double> force = r.numbers(fluid, "fluid.", "force", std::vector<double>(D, 0.0), D, D, -1e9, 1e9);
@@ -107,7 +109,8 @@ void parseFluid(SceneContext& c, Scene* sp) {
   double lid = r.number(fluid, "fluid.", "lid_velocity", 0.0, -1e6, 1e6);
   if (lid != 0.0) {
     if (s.fluid.boundaries.sides[3].kind != BoundaryKind::Wall)
-      r.fail(r.node(fluid, "fluid.", "lid_velocity"), "fluid.lid_velocity", "the lid is the y_max side, which must be a wall");
+      r.fail(r.node(fluid, "fluid.", "lid_velocity"), "fluid.lid_velocity",
+             "the lid is the y_max side, which must be a wall");
     s.fluid.boundaries.sides[3].wallVelocity = {lid, 0.0, 0.0};
   }
   setReferenceScales(c, lid, s);

@@ -31,12 +31,14 @@ void parseGrid(SceneContext& c, Scene* sp) {
   for (double v : res) defSize.push_back(rdOnly ? v : v / res[0]);
   const toml::table* domain = r.table(root, "", "domain");
   const toml::node* sizeNode = nullptr;
-  std::vector<double> size = r.numbers(domain, "domain.", "size", defSize, size_t(D), size_t(D), 0, 1e9, true, &sizeNode);
+  std::vector<double> size =
+      r.numbers(domain, "domain.", "size", defSize, size_t(D), size_t(D), 0, 1e9, true, &sizeNode);
   const double h = size[0] / res[0];
   // Below this, positions and back-traces in cells lose all precision.
   if (!(h >= 1e-9))
     r.fail(sizeNode ? sizeNode : resNode, "domain.size",
-           fmt::format("cells of {:g} are smaller than 1e-9 domain units", h), "use larger domain.size (units are arbitrary)");
+           fmt::format("cells of {:g} are smaller than 1e-9 domain units", h),
+           "use larger domain.size (units are arbitrary)");
   for (int a = 1; a < D; ++a)
     if (std::abs(size[size_t(a)] / res[size_t(a)] - h) > 1e-6 * h) {
       std::ostringstream hint;

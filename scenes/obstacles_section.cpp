@@ -32,7 +32,8 @@ ObstacleSpec parseRegion(SceneContext& c, const toml::table* o, const std::strin
   centre = r.numbers(o, p, "center", centre, size_t(D), size_t(D), -1e9, 1e9, false, &cn);
   for (int a = 0; a < D; ++a) {
     if (centre[size_t(a)] < 0 || centre[size_t(a)] > size[size_t(a)])
-      r.fail(cn, p + "center", "the centre lies outside the domain", fmt::format("domain.size is {:g} along axis {}", size[size_t(a)], a));
+      r.fail(cn, p + "center", "the centre lies outside the domain",
+             fmt::format("domain.size is {:g} along axis {}", size[size_t(a)], a));
     spec.center[size_t(a)] = centre[size_t(a)];
   }
   if (spec.shape == ObstacleShape::Circle || spec.shape == ObstacleShape::Sphere) {
@@ -45,13 +46,15 @@ ObstacleSpec parseRegion(SceneContext& c, const toml::table* o, const std::strin
   } else {
     // The image (or sdf) is stretched over the domain: a centre would move nothing.
     if (cn)
-      r.fail(cn, p + "center", "an " + shape + " region is its file stretched over the whole domain: a center does not apply",
+      r.fail(cn, p + "center",
+             "an " + shape + " region is its file stretched over the whole domain: a center does not apply",
              "remove center, and draw the shape where it goes in the " + shape);
     const std::string key = "file";
     const toml::node* fn = r.node(o, p, key);
     if (!fn) r.fail(o, p + key, "an " + shape + " region needs file = \"path\"");
     std::string file = r.string(o, p, key, "");
-    std::filesystem::path fp = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : c.sceneDir / file;
+    std::filesystem::path fp =
+        std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : c.sceneDir / file;
     GrayImage img;
     std::string err;
     if (!readGrayImage(fp.string(), &img, &err)) r.fail(fn, p + key, "cannot read the image: " + err);

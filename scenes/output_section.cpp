@@ -78,9 +78,11 @@ void parseVdbOutput(SceneContext& c, const toml::table* out, Scene& s) {
     r.fail(mac, "output.vdb_mac_velocity", "this scene has no fluid, so it has no velocity of its own to write",
            "drop output.vdb_mac_velocity");
   if (!o.vdb)
-    for (const char* k : {"vdb_density", "vdb_fields", "vdb_tolerance", "vdb_half", "nanovdb", "vdb_mac_velocity", "vdb_color", "vdb_sparse"})
+    for (const char* k : {"vdb_density", "vdb_fields", "vdb_tolerance", "vdb_half", "nanovdb", "vdb_mac_velocity",
+                          "vdb_color", "vdb_sparse"})
       if (const toml::node* n = r.node(out, "output.", k); n && !(n->is_boolean() && !n->value<bool>().value()))
-        r.fail(n, std::string("output.") + k, "only applies with output.vdb = true", "add output.vdb = true or drop it");
+        r.fail(n, std::string("output.") + k, "only applies with output.vdb = true",
+               "add output.vdb = true or drop it");
 }
 
 // The frames' palette: output.colormap or output.gradient, and output.range.
@@ -89,12 +91,14 @@ void parsePalette(const SceneContext& c, const toml::table* out, OutputSettings&
   o.colormap = r.string(out, "output.", "colormap", o.field == "vorticity" ? "coolwarm" : "viridis", colormapNames());
   if (o.colormap == kTwoSpeciesPalette && c.species.size() < 2)
     r.fail(r.node(out, "output.", "colormap"), "output.colormap",
-           std::string(kTwoSpeciesPalette) + " shows two reaction-diffusion species (the first in red, the second in green)",
+           std::string(kTwoSpeciesPalette) +
+               " shows two reaction-diffusion species (the first in red, the second in green)",
            "use it with an [rd] model of two or more species, or pick a scalar palette");
   if (const toml::node* g = r.node(out, "output.", "gradient")) {
     const toml::array* arr = g->as_array();
     if (!arr || arr->size() < 2)
-      r.fail(g, "output.gradient", "expected an array of two or more colours, e.g. [\"#000000\", \"#ff8800\", \"#ffffff\"]");
+      r.fail(g, "output.gradient",
+             "expected an array of two or more colours, e.g. [\"#000000\", \"#ff8800\", \"#ffffff\"]");
     for (const toml::node& e : *arr) {
       Rgb8 colour;
       auto text = e.value<std::string>();

@@ -36,19 +36,22 @@ void parseGeneralized(SceneContext& c, const toml::table& rdt, Scene* sp) {
   const std::string p = "rd.generalized.";
   G.enabled = true;
   G.where = r.where(g, "rd.generalized");
-  if (c.D != 2) r.fail(g, "rd.generalized", "generalized diffusion's 5 x 5 kernels are 2D, and this scene is 3D", "run it in 2D");
+  if (c.D != 2)
+    r.fail(g, "rd.generalized", "generalized diffusion's 5 x 5 kernels are 2D, and this scene is 3D", "run it in 2D");
   if (s.rd.settings.boundary != RDBoundary::Periodic)
     r.fail(g, "rd.generalized", "generalized diffusion needs a periodic layer (the paper's seamless tiles)",
            "set rd.boundary = \"periodic\"");
   if (s.rd.anisotropy.enabled || s.rd.lobes.enabled)
-    r.fail(g, "rd.generalized", "[rd.generalized] replaces the diffusion operator, as [rd.anisotropy] and [rd.cosine_lobes] do; use one",
+    r.fail(g, "rd.generalized",
+           "[rd.generalized] replaces the diffusion operator, as [rd.anisotropy] and [rd.cosine_lobes] do; use one",
            "drop the other table");
   const std::vector<std::string> presets = kramersMoyalPresets();
   if (r.node(g, p, "preset")) {
     G.preset = r.string(g, p, "preset", "", presets);
     G.tensors = *kramersMoyalPreset(G.preset);
   } else if (!r.node(g, p, "d2") && !r.node(g, p, "d3") && !r.node(g, p, "d4")) {
-    r.fail(g, p + "preset", "[rd.generalized] needs a preset (Table 2's column: " + join(presets) + ") or tensors d2, d3, d4");
+    r.fail(g, p + "preset",
+           "[rd.generalized] needs a preset (Table 2's column: " + join(presets) + ") or tensors d2, d3, d4");
   }
   components(r, g, p, "d2", "Dxx, Dxy, Dyy", &G.tensors.d2);
   components(r, g, p, "d3", "Dxxx, Dxxy, Dxyy, Dyyy", &G.tensors.d3);
@@ -68,8 +71,9 @@ void parseGeneralized(SceneContext& c, const toml::table& rdt, Scene* sp) {
   // The step's amplification on this grid (exact: the operator is homogeneous and periodic).
   const RDSettings& st = s.rd.settings;
   const double h = st.size[0] / st.resolution[0];
-  const GeneralizedDiffusion op(G.tensors, st.resolution[0], st.resolution[1], h,
-                                G.savitzkyGolaySecond ? SecondDerivatives::SavitzkyGolay : SecondDerivatives::CentralDifferences);
+  const GeneralizedDiffusion op(
+      G.tensors, st.resolution[0], st.resolution[1], h,
+      G.savitzkyGolaySecond ? SecondDerivatives::SavitzkyGolay : SecondDerivatives::CentralDifferences);
   const double theta = diffusionTheta(st.integrator);
   for (size_t k = 0; k < st.diffusion.size(); ++k) {
     const bool mine = G.species.empty() || std::find(G.species.begin(), G.species.end(), int(k)) != G.species.end();
@@ -77,13 +81,18 @@ void parseGeneralized(SceneContext& c, const toml::table& rdt, Scene* sp) {
     const double rho = op.spectralRadius(s.time.dt * st.diffusion[k], theta);
     if (rho <= G.maxSpectralRadius) continue;
     const double limit = op.largestStableStep(st.diffusion[k], theta, s.time.dt, G.maxSpectralRadius);
-    r.fail(bn ? bn : g, p + "max_spectral_radius",
-           fmt::format("with time.dt = {:g} the {} step of species {} has spectral radius {:.4g} (seed 000 sec. 5), above {:g}: "
-                       "it would amplify errors",
-                       s.time.dt, theta == 0.0 ? "explicit" : theta == 0.5 ? "Crank-Nicolson" : "implicit", c.species[k], rho,
-                       G.maxSpectralRadius),
-           limit > 0 ? fmt::format("use time.dt <= {:.4g}, the largest step within the bound", limit)
-                     : std::string("no step keeps it within the bound: raise max_spectral_radius or change the tensors"));
+    r.fail(
+        bn ? bn : g, p + "max_spectral_radius",
+        fmt::format(
+            "with time.dt = {:g} the {} step of species {} has spectral radius {:.4g} (seed 000 sec. 5), above {:g}: "
+            "it would amplify errors",
+            s.time.dt,
+            theta == 0.0   ? "explicit"
+            : theta == 0.5 ? "Crank-Nicolson"
+                           : "implicit",
+            c.species[k], rho, G.maxSpectralRadius),
+        limit > 0 ? fmt::format("use time.dt <= {:.4g}, the largest step within the bound", limit)
+                  : std::string("no step keeps it within the bound: raise max_spectral_radius or change the tensors"));
   }
 }
 

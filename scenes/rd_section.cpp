@@ -1,4 +1,5 @@
-// [rd]: the reaction-diffusion layer (model, integrator, boundary, parameters, initial state, maps, fixed regions, anisotropy, coarse-to-fine), and the check that every spatial field is finite on its grid.
+// [rd]: the reaction-diffusion layer (model, integrator, boundary, parameters, initial state, maps, fixed regions,
+// anisotropy, coarse-to-fine), and the check that every spatial field is finite on its grid.
 #include "scenes/scene_reader.h"
 
 #include <algorithm>
@@ -44,7 +45,8 @@ void parseResolution(const RDTable& t, RDSettings& st) {
   if (c.rdOnly) return;
   // A coupled layer spans the fluid's domain, on its own grid if asked.
   const toml::node* rn = nullptr;
-  std::vector<double> rr = t.r.numbers(&t.rdt, "rd.", "resolution", c.res, size_t(c.D), size_t(c.D), 4, 8192, false, &rn);
+  std::vector<double> rr =
+      t.r.numbers(&t.rdt, "rd.", "resolution", c.res, size_t(c.D), size_t(c.D), 4, 8192, false, &rn);
   st.resolution.clear();
   for (int a = 0; a < c.D; ++a) {
     st.resolution.push_back(int(rr[size_t(a)]));
@@ -72,11 +74,13 @@ void parseBoundary(const RDTable& t, const Scene& s, RDSettings& st) {
            "a coupled layer must wrap exactly where the fluid does (the fluid is " +
                std::string(fluidPeriodic == D ? "periodic" : "walled") + ")",
            "use rd.boundary = \"" + bcDefault + "\" or leave it out");
-  st.boundary = bc == "neumann" ? RDBoundary::Neumann : bc == "dirichlet" ? RDBoundary::Dirichlet : RDBoundary::Periodic;
+  st.boundary = bc == "neumann"     ? RDBoundary::Neumann
+                : bc == "dirichlet" ? RDBoundary::Dirichlet
+                                    : RDBoundary::Periodic;
   st.dirichletValues = r.numbers(rdt, "rd.", "boundary_values", {}, t.n, t.n, -1e12, 1e12);
   if (st.boundary == RDBoundary::Dirichlet && st.dirichletValues.empty())
-    r.fail(r.node(rdt, "rd.", "boundary"), "rd.boundary_values", "Dirichlet boundaries need boundary_values, one per species",
-           "species: " + join(t.c.species));
+    r.fail(r.node(rdt, "rd.", "boundary"), "rd.boundary_values",
+           "Dirichlet boundaries need boundary_values, one per species", "species: " + join(t.c.species));
 }
 
 // The solver's settings: grid, diffusion, integrator, boundary, lookup table,
@@ -87,7 +91,8 @@ void parseSettings(const RDTable& t, const Scene& s, RDSettings& st) {
   st.model = t.model;
   parseResolution(t, st);
   st.diffusion = r.numbers(rdt, "rd.", "diffusion", t.in.diffusion, t.n, t.n, 0, 1e12);
-  const std::string integ = r.string(rdt, "rd.", "integrator", "kim-lin", {"kim-lin", "explicit", "semi-implicit", "crank-nicolson"});
+  const std::string integ =
+      r.string(rdt, "rd.", "integrator", "kim-lin", {"kim-lin", "explicit", "semi-implicit", "crank-nicolson"});
   st.integrator = integ == "explicit"        ? RDIntegrator::ExplicitEuler
                   : integ == "semi-implicit" ? RDIntegrator::SemiImplicit
                   : integ == "crank-nicolson" ? RDIntegrator::CrankNicolson
@@ -125,8 +130,8 @@ void parseInitial(const RDTable& t, RDScene& R) {
   I.square = r.number(it, "rd.initial.", "square", 0.0, 0, 1);
   I.squareValues = r.numbers(it, "rd.initial.", "square_values", {}, n, n, -1e12, 1e12);
   if (I.square > 0 && I.squareValues.empty())
-    r.fail(r.node(it, "rd.initial.", "square"), "rd.initial.square_values", "a central square needs square_values, one per species",
-           "species: " + join(species));
+    r.fail(r.node(it, "rd.initial.", "square"), "rd.initial.square_values",
+           "a central square needs square_values, one per species", "species: " + join(species));
   const toml::table* im = it ? r.table(*it, "rd.initial.", "maps") : nullptr;
   if (!im) return;
   for (auto&& [k, v] : *im) {
@@ -214,7 +219,8 @@ void parseAnisotropyDirection(const RDTable& t, const toml::table* an, const RDS
   const toml::node* dn = r.node(an, p, "direction");
   A.directionFromVelocity = dn && dn->is_string() && dn->value<std::string>().value() == "velocity";
   if (A.directionFromVelocity && !t.c.givenVelocity)
-    r.fail(dn, p + "direction", "\"velocity\" orients the tensor along the given velocity, but the scene has no [velocity]",
+    r.fail(dn, p + "direction",
+           "\"velocity\" orients the tensor along the given velocity, but the scene has no [velocity]",
            "add [velocity] field = [...] or vdb = \"...\"");
   if (A.directionFromVelocity && th)
     r.fail(th, p + "theta", "give either theta or direction = \"velocity\", not both", "drop one of them");
@@ -225,8 +231,9 @@ void parseAnisotropyDirection(const RDTable& t, const toml::table* an, const RDS
              "drop one of them");
     const toml::array* arr = dn->as_array();
     if (!arr || arr->size() != size_t(t.c.D))
-      r.fail(dn, p + "direction",
-             "expected an array of " + std::to_string(t.c.D) + " fields (one per axis), e.g. [\"y - 0.5\", \"x - 0.5\"]");
+      r.fail(
+          dn, p + "direction",
+          "expected an array of " + std::to_string(t.c.D) + " fields (one per axis), e.g. [\"y - 0.5\", \"x - 0.5\"]");
     for (size_t q = 0; q < arr->size(); ++q)
       A.direction.push_back(r.field(arr->get(q), p + "direction." + std::to_string(q), t.c.sceneDir));
   } else if (!A.thetaFromStrokes) {
@@ -297,7 +304,8 @@ void parseCoarseToFine(const RDTable& t, RDScene& R) {
   const toml::node* lv = r.node(cf, "rd.coarse_to_fine.", "levels");
   R.coarseLevels = int(r.integer(cf, "rd.coarse_to_fine.", "levels", 2, 1, 8));
   R.coarseSteps = r.integer(cf, "rd.coarse_to_fine.", "steps", 1000, 0, 1'000'000'000);
-  R.coarseScaleDt = r.boolean(cf, "rd.coarse_to_fine.", "scale_dt", R.settings.integrator == RDIntegrator::ExplicitEuler);
+  R.coarseScaleDt =
+      r.boolean(cf, "rd.coarse_to_fine.", "scale_dt", R.settings.integrator == RDIntegrator::ExplicitEuler);
   for (double v : t.c.res) {
     const long cells = long(v);
     if (cells % (1L << R.coarseLevels) != 0 || (cells >> R.coarseLevels) < 4)
@@ -375,7 +383,8 @@ void parseRD(SceneContext& c, Scene* sp) {
   RDScene& R = s.rd;
   R.enabled = true;
   const std::vector<std::string> names = modelNames();
-  if (!r.node(rdt, "rd.", "model")) r.fail(rdt, "rd.model", "a reaction-diffusion scene needs rd.model", "models: " + join(names));
+  if (!r.node(rdt, "rd.", "model"))
+    r.fail(rdt, "rd.model", "a reaction-diffusion scene needs rd.model", "models: " + join(names));
   const std::string model = r.string(rdt, "rd.", "model", "", names);
   const ModelInfo& in = findModel(model)->info();
   c.species = in.species;

@@ -24,14 +24,15 @@ std::vector<std::array<double, 3>> strokePoints(Reader& r, const toml::node* n, 
     const toml::node* e = arr->get(q);
     const toml::array* pa = e->as_array();
     const std::string full = key + "." + std::to_string(q);
-    if (!pa || pa->size() != size_t(D)) r.fail(e, full, "expected a point " + axes + " of " + std::to_string(D) + " numbers");
+    if (!pa || pa->size() != size_t(D))
+      r.fail(e, full, "expected a point " + axes + " of " + std::to_string(D) + " numbers");
     std::array<double, 3> p{0.0, 0.0, 0.0};
     for (int a = 0; a < D; ++a) {
       p[size_t(a)] = r.checkNumber(pa->get(size_t(a)), full, -1e12, 1e12, false);
       if (p[size_t(a)] < 0.0 || p[size_t(a)] > size[size_t(a)]) {
         std::ostringstream m;
-        m << "the point is outside the domain: " << "xyz"[a] << " = " << p[size_t(a)] << " is not in [0, " << size[size_t(a)]
-          << "]";
+        m << "the point is outside the domain: "
+          << "xyz"[a] << " = " << p[size_t(a)] << " is not in [0, " << size[size_t(a)] << "]";
         r.fail(e, full, m.str(), "stroke points are in domain units ([domain] size)");
       }
     }
@@ -58,8 +59,10 @@ void parseStrokes(SceneContext& c, const toml::table& rdt, RDScene* out) {
     s.key = p + "points";
     const toml::node* pts = r.node(t, p, "points");
     const toml::node* img = r.node(t, p, "image");
-    if (pts && img) r.fail(img, p + "image", "give either points (a polyline) or image (a picture of strokes), not both");
-    if (!pts && !img) r.fail(t, p + "points", "a stroke needs points = [[x, y], ...] (domain units) or image = \"file\"");
+    if (pts && img)
+      r.fail(img, p + "image", "give either points (a polyline) or image (a picture of strokes), not both");
+    if (!pts && !img)
+      r.fail(t, p + "points", "a stroke needs points = [[x, y], ...] (domain units) or image = \"file\"");
     if (pts) {
       s.stroke.points = strokePoints(r, pts, p + "points", c.D, c.size);
     } else {
@@ -68,7 +71,9 @@ void parseStrokes(SceneContext& c, const toml::table& rdt, RDScene* out) {
       s.stroke.image = r.field(t, "rd.strokes." + std::to_string(q), c.sceneDir).field;
       bool bright = false;
       for (float v : s.stroke.image.image) bright |= v > 0.5f;
-      if (!bright) r.fail(img, p + "image", "the image has no stroke: no pixel is brighter than half", "strokes are light on dark");
+      if (!bright)
+        r.fail(img, p + "image", "the image has no stroke: no pixel is brighter than half",
+               "strokes are light on dark");
     }
     s.stroke.width = r.number(t, p, "width", 0.0, 0.0, 1e12);
     s.start = r.number(t, p, "start", 0.0, 0.0, 1e12);
@@ -79,7 +84,8 @@ void parseStrokes(SceneContext& c, const toml::table& rdt, RDScene* out) {
     }
     if (!s.species.empty()) {
       if (!r.node(t, p, "values"))
-        r.fail(t, p + "values", "a stroke that deposits species needs values, one per species", "species: " + join(c.species));
+        r.fail(t, p + "values", "a stroke that deposits species needs values, one per species",
+               "species: " + join(c.species));
       s.values = r.numbers(t, p, "values", {}, s.species.size(), s.species.size(), -1e12, 1e12);
     }
     out->strokes.push_back(std::move(s));

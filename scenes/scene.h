@@ -44,7 +44,7 @@ struct OutputSettings {
   std::string vdbDensity;           // the field in the "density" grid (default: field), or an expression of fields
   std::vector<std::string> vdbFields;  // fluid scalars as grids of their own
   double vdbTolerance = 0.0;        // |value| <= this: inactive voxel (with [smoke]: of the smoke, in every grid)
-  bool vdbSparse = false;           // with [smoke]: every grid active where the smoke exceeds vdbTolerance (false: every voxel)
+  bool vdbSparse = false;  // with [smoke]: every grid active where the smoke exceeds vdbTolerance (false: every voxel)
   bool vdbColor = false;            // a `color` grid: the palette applied to output.field (default with [smoke])
   bool vdbHalf = false;             // floats saved as half
   bool nanovdb = false;             // also DIR/vdb/<name>.NNNNNN.nvdb

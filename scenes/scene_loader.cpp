@@ -41,10 +41,11 @@ void checkBackTraces(SceneContext& c, const Scene& s) {
   const double cells = s.probes.referenceSpeed * s.time.dt / (c.size[0] / c.res[0]);
   if (cells > 1e6) {
     const toml::table* time = c.root["time"].as_table();
-    c.r.fail(time ? time->get("dt") : nullptr, "time.dt",
-             fmt::format("a back-trace at speed {:g} crosses {:.3g} cells per step (speed x dt / cell size), more than 1e6",
-                         s.probes.referenceSpeed, cells),
-             "use a smaller time.dt, or set time.cfl");
+    c.r.fail(
+        time ? time->get("dt") : nullptr, "time.dt",
+        fmt::format("a back-trace at speed {:g} crosses {:.3g} cells per step (speed x dt / cell size), more than 1e6",
+                    s.probes.referenceSpeed, cells),
+        "use a smaller time.dt, or set time.cfl");
   }
 }
 
@@ -58,9 +59,11 @@ std::string readSceneText(const std::string& path) {
   // What the path is, before opening it: a FIFO would block and /dev/zero never ends.
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
-  if (ec || !std::filesystem::exists(status)) throw UserError({path, 0, 0}, "", "cannot open the scene file", "check the path");
+  if (ec || !std::filesystem::exists(status))
+    throw UserError({path, 0, 0}, "", "cannot open the scene file", "check the path");
   if (!std::filesystem::is_regular_file(status))
-    throw UserError({path, 0, 0}, "", "the scene is not a regular file (a folder, device or pipe)", "give a .toml file");
+    throw UserError({path, 0, 0}, "", "the scene is not a regular file (a folder, device or pipe)",
+                    "give a .toml file");
   const uintmax_t size = std::filesystem::file_size(path, ec);
   if (ec || size > kMaxSceneBytes)
     throw UserError({path, 0, 0}, "", "the scene file is larger than " + std::to_string(kMaxSceneBytes >> 20) + " MiB",
@@ -111,7 +114,8 @@ Scene parseTree(toml::table& root, const std::string& path, const std::map<std::
 // Every keyframe's value goes through the checks a value in the file does:
 // the scene is read with it in place, an error named at the key's value.
 void checkKeyframeValues(const toml::table& root, const std::string& path,
-                         const std::map<std::string, SourceLocation>& overrideLocs, const std::vector<KeyedValue>& keyed) {
+                         const std::map<std::string, SourceLocation>& overrideLocs,
+                         const std::vector<KeyedValue>& keyed) {
   for (const KeyedValue& k : keyed)
     for (size_t i = 1; i < k.times.size(); ++i) {
       toml::table copy = root;

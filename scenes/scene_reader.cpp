@@ -89,7 +89,8 @@ std::vector<int> speciesIndices(Reader& r, const toml::node* n, const std::strin
                                 const std::vector<std::string>& species, const std::string& model, bool allowEmpty) {
   std::vector<int> out;
   const toml::array* sa = n->as_array();
-  if (!sa || (sa->empty() && !allowEmpty)) r.fail(n, key, "expected an array of species names", "species: " + join(species));
+  if (!sa || (sa->empty() && !allowEmpty))
+    r.fail(n, key, "expected an array of species names", "species: " + join(species));
   for (const toml::node& e : *sa) {
     auto v = e.value<std::string>();
     auto f = v ? std::find(species.begin(), species.end(), *v) : species.end();

@@ -129,7 +129,8 @@ class Reader {
     if (!arr) fail(n, full, "expected an array of numbers, found " + describe(*n));
     if (arr->size() < minLen || arr->size() > maxLen)
       fail(n, full,
-           "expected " + (minLen == maxLen ? std::to_string(minLen) : std::to_string(minLen) + " or " + std::to_string(maxLen)) +
+           "expected " +
+               (minLen == maxLen ? std::to_string(minLen) : std::to_string(minLen) + " or " + std::to_string(maxLen)) +
                " numbers, found " + std::to_string(arr->size()));
     std::vector<double> v;
     for (const toml::node& e : *arr) v.push_back(checkNumber(&e, full, lo, hi, loOpen));
@@ -175,11 +176,13 @@ class Reader {
     }
     const toml::table* t = n->as_table();
     if (!t)
-      fail(n, full, "expected an expression string or a table { image = \"file\", range = [low, high] }, found " + describe(*n));
+      fail(n, full,
+           "expected an expression string or a table { image = \"file\", range = [low, high] }, found " + describe(*n));
     const toml::node* img = node(t, full + ".", "image");
     if (!img) fail(n, full, "an image field needs image = \"path\"");
     std::string file = string(t, full + ".", "image", "");
-    std::filesystem::path fp = std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : sceneDir / file;
+    std::filesystem::path fp =
+        std::filesystem::path(file).is_absolute() ? std::filesystem::path(file) : sceneDir / file;
     GrayImage g;
     std::string err;
     if (!readGrayImage(fp.string(), &g, &err)) fail(img, full + ".image", "cannot read the image: " + err);

@@ -34,7 +34,8 @@ SmokeSource parseSource(SceneContext& c, const toml::table* t, const std::string
   src.start = r.number(t, p, "start", 0.0, 0.0, 1e12);
   src.end = r.number(t, p, "end", src.end, 0.0, 1e300);
   if (!(src.end > src.start))
-    r.fail(r.node(t, p, "end"), p + "end", fmt::format("the window ends (t = {:g}) before it starts (t = {:g})", src.end, src.start),
+    r.fail(r.node(t, p, "end"), p + "end",
+           fmt::format("the window ends (t = {:g}) before it starts (t = {:g})", src.end, src.start),
            "give end > start, or leave end out to emit until the run ends");
   src.density = r.number(t, p, "density", 0.0, 0.0, 1e9);
   src.temperature = r.number(t, p, "temperature", 0.0, 0.0, 1e9);

@@ -37,7 +37,8 @@ KeyedValue parseKeyframes(Reader& r, const toml::table& t, const std::string& ke
     if (!pair || pair->size() != 2) r.fail(e, at, "expected a pair [t, value], found " + describe(*e), hint);
     const double time = r.checkNumber(pair->get(0), at, 0.0, 1e12, false);
     if (i > 0 && !(time > k.times.back()))
-      r.fail(pair->get(0), at, fmt::format("the keys' times must increase: t = {:g} follows t = {:g}", time, k.times.back()));
+      r.fail(pair->get(0), at,
+             fmt::format("the keys' times must increase: t = {:g} follows t = {:g}", time, k.times.back()));
     const toml::node* v = pair->get(1);
     std::vector<double> value;
     if (const toml::array* a = v->as_array()) {
@@ -72,7 +73,8 @@ void extract(Reader& r, toml::table& t, const std::string& prefix, std::vector<K
       out->push_back(parseKeyframes(r, *sub, key));
       keyed.push_back(std::string(name.str()));
     } else if (toml::array* a = v.as_array(); a && a->is_array_of_tables()) {
-      for (size_t i = 0; i < a->size(); ++i) extract(r, *a->get(i)->as_table(), key + "." + std::to_string(i) + ".", out);
+      for (size_t i = 0; i < a->size(); ++i)
+        extract(r, *a->get(i)->as_table(), key + "." + std::to_string(i) + ".", out);
     }
   }
   for (const std::string& name : keyed) {
@@ -132,7 +134,8 @@ TimeWindow parseWindow(Reader& r, const toml::table* t, const std::string& p) {
   w.start = r.number(t, p, "start", 0.0, 0.0, 1e12);
   w.end = r.number(t, p, "end", w.end, 0.0, 1e300);
   if (!(w.end > w.start))
-    r.fail(r.node(t, p, "end"), p + "end", fmt::format("it ends (t = {:g}) before it starts (t = {:g})", w.end, w.start),
+    r.fail(r.node(t, p, "end"), p + "end",
+           fmt::format("it ends (t = {:g}) before it starts (t = {:g})", w.end, w.start),
            "give end > start, or leave end out");
   return w;
 }

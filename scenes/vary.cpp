@@ -62,13 +62,16 @@ void rangeValues(const std::string& text, const std::string& range, Vary* v) {
   const auto start = parseNumber(a), stop = parseNumber(b);
   const auto count = parseWhole(c);
   if (!start || !stop) bad(text, "start and stop must be numbers");
-  if (!count || *count < 1 || *count > kMaxValues) bad(text, fmt::format("count must be a whole number from 1 to {}", kMaxValues));
+  if (!count || *count < 1 || *count > kMaxValues)
+    bad(text, fmt::format("count must be a whole number from 1 to {}", kMaxValues));
   // Integers stay integers (grid sizes, step counts) when every value is whole.
-  const bool whole = parseWhole(a) && parseWhole(b) && (*count == 1 || std::fmod(*stop - *start, double(*count - 1)) == 0.0);
+  const bool whole =
+      parseWhole(a) && parseWhole(b) && (*count == 1 || std::fmod(*stop - *start, double(*count - 1)) == 0.0);
   for (long i = 0; i < *count; ++i) {
     const double x = *count == 1 ? *start : *start + (*stop - *start) * double(i) / double(*count - 1);
     // 12 significant digits: 0.02:0.06:5 gives 0.03, not 0.030000000000000002.
-    const std::string s = whole ? fmt::format("{}", std::llround(x)) : fmt::format("{}", std::stod(fmt::format("{:.12g}", x)));
+    const std::string s =
+        whole ? fmt::format("{}", std::llround(x)) : fmt::format("{}", std::stod(fmt::format("{:.12g}", x)));
     v->values.push_back(s);
     v->labels.push_back(s);
   }

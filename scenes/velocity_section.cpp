@@ -36,9 +36,10 @@ void parseVelocityField(SceneContext& c, const toml::node* fn, VelocityScene& V)
   const toml::array* arr = fn->as_array();
   if (!arr || arr->size() != size_t(c.D))
     r.fail(fn, p + "field",
-           "expected " + axes + " expressions, one per axis, in x, y" + (c.D == 3 ? ", z" : "") + " (domain units) and t" +
-               (arr ? ", found " + std::to_string(arr->size()) : ""),
-           c.D == 2 ? "e.g. field = [\"-(y - 0.5)\", \"x - 0.5\"] (a rigid rotation about the centre of a unit domain)" : "");
+           "expected " + axes + " expressions, one per axis, in x, y" + (c.D == 3 ? ", z" : "") +
+               " (domain units) and t" + (arr ? ", found " + std::to_string(arr->size()) : ""),
+           c.D == 2 ? "e.g. field = [\"-(y - 0.5)\", \"x - 0.5\"] (a rigid rotation about the centre of a unit domain)"
+                    : "");
   V.field = expressionList(r, *arr, p + "field", ExpressionVelocity<3>::variables(), "velocity",
                            "the variables are x, y, z (domain units) and t");
 }
@@ -88,7 +89,9 @@ void parseVelocity(SceneContext& c, Scene* sp) {
   const toml::node* pn = r.node(vt, p, "python");
   V.python = pn && r.boolean(vt, p, "python", false);
   if (V.python) {  // the velocity comes from the Python module (Simulation.set_velocity)
-    if (fn || vn) r.fail(fn ? fn : vn, p + (fn ? "field" : "vdb"), "python = true takes the velocity from Python: give no field or vdb");
+    if (fn || vn)
+      r.fail(fn ? fn : vn, p + (fn ? "field" : "vdb"),
+             "python = true takes the velocity from Python: give no field or vdb");
     V.where = r.where(pn, p + "python");
     V.key = p + "python";
   }

@@ -53,7 +53,7 @@ CoupledSimulation<D>::CoupledSimulation(const Scene& scene, Backend backend, War
       warn_(std::move(warn)),
       fluid_(scene.fluid),
       rd_(scene.rd.settings, *findModel(scene.rd.settings.model)),
-      host_([this] { steps_->toHost(&fluid_, &rd_); }) {
+      host_([this] { stepper_->toHost(&fluid_, &rd_); }) {
   checkFluidLeft<D>(scene, fluid_);
   warnOfEmptySources<D>(scene, fluid_, warn_);
   initialState<D>(scene, &rd_);
@@ -61,9 +61,10 @@ CoupledSimulation<D>::CoupledSimulation(const Scene& scene, Backend backend, War
   const CouplingScene& C = scene.coupling;
   const ChemicalDomain<D> domain = chemicalDomain<D>(scene, fluid_, rd_);
   ard_ = std::make_unique<ARDSolver<D>>(&rd_, ChemicalAdvector<D>(domain, C.interpolation), C.mode, C.rdTimeScale);
-  steps_ = makeCoupledSteps<D>(scene, backend, &fluid_, ard_.get(), domain);  // from the state set up here
+  stepper_ = makeCoupledStepper<D>(scene, backend, &fluid_, ard_.get(), domain);  // from the state set up here
   if (scene.fluid.smoke.enabled) {
-    sourceCoverage_ = sourceCoverage<D>(scene.fluid.smoke.sources, rd_.cells(), rd_.h(), Grid<uint8_t, D>(rd_.cells(), 0));
+    sourceCoverage_ =
+        sourceCoverage<D>(scene.fluid.smoke.sources, rd_.cells(), rd_.h(), Grid<uint8_t, D>(rd_.cells(), 0));
     smokeTaps_ = smokeTaps<D>(fluid_.cellLayout(), fluid_.cells(), rd_.cells(), rd_.h());
   }
 }
@@ -80,12 +81,13 @@ void CoupledSimulation<D>::smokeOnLayer(double dt) {
     const SmokeSource& src = sm.sources[q];
     if (src.chemicals.empty() || !(std::min(t0 + dt, src.end) > std::max(t0, src.start))) continue;
     if (src.motion.empty())
-      steps_->blendLayer(int(q), sourceCoverage_[q], src.chemicals);
+      stepper_->blendLayer(int(q), sourceCoverage_[q], src.chemicals);
     else
-      steps_->blendLayer(-1, sourceCover<D>(src, t0 + 0.5 * dt, rd_.cells(), rd_.h(), Grid<uint8_t, D>(rd_.cells(), 0)),
-                         src.chemicals);
+      stepper_->blendLayer(-1,
+                           sourceCover<D>(src, t0 + 0.5 * dt, rd_.cells(), rd_.h(), Grid<uint8_t, D>(rd_.cells(), 0)),
+                           src.chemicals);
   }
-  if (C.smokeMask >= 0.0) steps_->maskLayer(smokeTaps_, C.smokeMask, C.smokeValues);
+  if (C.smokeMask >= 0.0) stepper_->maskLayer(smokeTaps_, C.smokeMask, C.smokeValues);
 }
 
 template <int D>
@@ -93,28 +95,29 @@ CoupledSimulation<D>::~CoupledSimulation() = default;
 
 template <int D>
 double CoupledSimulation<D>::cflTimeStep(double cfl, double dtMax) const {
-  return steps_->fluid().cflTimeStep(cfl, dtMax);
+  return stepper_->fluid().cflTimeStep(cfl, dtMax);
 }
 
 template <int D>
 void CoupledSimulation<D>::step(double dt) {
-  steps_->step(dt);
+  stepper_->step(dt);
   if (scene_.fluid.smoke.enabled) smokeOnLayer(dt);
   host_.stepped();
-  const std::array<double, 3> sec = steps_->seconds();
+  const std::array<double, 3> sec = stepper_->seconds();
   fluidSeconds_ += sec[0];
   ardSeconds_ += sec[1];
   stepSeconds_ += sec[2];
-  const FluidStepStats& fs = steps_->fluid().lastStats();
+  const FluidStepStats& fs = stepper_->fluid().lastStats();
   pressureIterations_ += fs.pressure.iterations;
-  diffusionIterations_ += steps_->layerStats().diffusion.iterations;
+  diffusionIterations_ += stepper_->layerStats().diffusion.iterations;
   const SolverResult& pressure = fs.pressure;
   if (!pressure.converged && unconverged_++ == 0)
     warn_(fmt::format("warning: step {}: pressure solve stopped at relative residual {:.2e} after {} iterations",
                       steps(), pressure.residual, pressure.iterations));
-  if (!steps_->fluid().finite())
-    throw NonFiniteError(fmt::format("the simulation diverged at step {} in the fluid step: the velocity is not finite", steps()),
-                         "use a smaller time.dt or set time.cfl, and check the forces and boundary speeds");
+  if (!stepper_->fluid().finite())
+    throw NonFiniteError(
+        fmt::format("the simulation diverged at step {} in the fluid step: the velocity is not finite", steps()),
+        "use a smaller time.dt or set time.cfl, and check the forces and boundary speeds");
 }
 
 template <int D>
@@ -129,7 +132,7 @@ void CoupledSimulation<D>::setField(const std::string& name, const Grid<float, D
   host_.refresh();
   if (!setSpeciesField<D>(&rd_, name, values) && !setFluidField<D>(&fluid_, name, values))
     Simulation<D>::setField(name, values);
-  steps_->fromHost(fluid_, rd_);
+  stepper_->fromHost(fluid_, rd_);
 }
 
 template <int D>
@@ -152,7 +155,7 @@ void CoupledSimulation<D>::save(StateWriter* out) const {
   host_.refresh();
   fluid_.save(out);
   rd_.save(out);
-  steps_->save(out);
+  stepper_->save(out);
   out->put("coupled.stats.seconds", std::array<double, 3>{fluidSeconds_, ardSeconds_, stepSeconds_});
   out->put("coupled.stats.iterations", std::array<long, 2>{pressureIterations_, diffusionIterations_});
   out->put("coupled.stats.unconverged", unconverged_);
@@ -162,8 +165,8 @@ template <int D>
 void CoupledSimulation<D>::load(const StateReader& in) {
   fluid_.load(in);
   rd_.load(in);
-  steps_->fromHost(fluid_, rd_);
-  steps_->load(in);
+  stepper_->fromHost(fluid_, rd_);
+  stepper_->load(in);
   std::array<double, 3> s{};
   std::array<long, 2> it{};
   in.get("coupled.stats.seconds", &s);
@@ -195,11 +198,11 @@ nlohmann::json CoupledSimulation<D>::resolved() const {
 template <int D>
 void CoupledSimulation<D>::report(nlohmann::json* j) const {
   const double steps = double(this->steps());
-  steps_->report(j);
+  stepper_->report(j);
   (*j)["coupling"] = {{"fluid_seconds", fluidSeconds_},
                       {"ard_seconds", ardSeconds_},
                       {"step_seconds", stepSeconds_},
-                      {"overlapped", steps_->overlapped()}};
+                      {"overlapped", stepper_->overlapped()}};
   (*j)["solvers"] = {{"pressure_iterations_mean", steps ? double(pressureIterations_) / steps : 0.0},
                      {"pressure_unconverged_steps", unconverged_},
                      {"diffusion_iterations_mean", steps ? double(diffusionIterations_) / steps : 0.0}};

@@ -1,7 +1,7 @@
 // CoupledSimulation<D>: a scene's stable fluid carrying its
 // advection-reaction-diffusion layer (seed 001 sec. 5, 7), stepped by the
-// CoupledSteps that sim/steppers.h chooses for the backend (the CPU's serial
-// or tbb-overlap schedule, coupling/coupled_stepper.h, or the GPU's), as a
+// CoupledStepper that sim/steppers.h chooses for the backend (the CPU's serial
+// or tbb-overlap schedule, coupling/cpu_coupled_stepper.h, or the GPU's), as a
 // Simulation: species and fluid fields, and the time each side took. The
 // FluidSolver and RDSolver hold the state outputs read, refreshed when a
 // field or checkpoint needs it (sim/host_copy.h).
@@ -16,9 +16,9 @@
 #include "sim/simulation.h"
 #include "sim/host_copy.h"
 #include "coupling/ard_solver.h"
-#include "coupling/coupled_steps.h"
+#include "coupling/coupled_stepper.h"
 #include "scenes/scene.h"
-#include "sim/backend.h"
+#include "core/backend.h"
 
 namespace morphoflow {
 
@@ -31,8 +31,8 @@ class CoupledSimulation : public Simulation<D> {
 
   void step(double dt) override;
   double cflTimeStep(double cfl, double dtMax) const override;
-  double time() const override { return steps_->fluid().time(); }
-  long steps() const override { return steps_->fluid().steps(); }
+  double time() const override { return stepper_->fluid().time(); }
+  long steps() const override { return stepper_->fluid().steps(); }
   std::vector<std::string> fieldNames() const override;
   std::vector<std::string> species() const override { return rd_.model().info().species; }
   std::vector<std::string> dumpFieldNames() const override { return species(); }
@@ -52,7 +52,7 @@ class CoupledSimulation : public Simulation<D> {
   mutable FluidSolver<D> fluid_;
   mutable RDSolver<D> rd_;
   std::unique_ptr<ARDSolver<D>> ard_;
-  std::unique_ptr<CoupledSteps<D>> steps_;
+  std::unique_ptr<CoupledStepper<D>> stepper_;
   HostCopy host_;
   double fluidSeconds_ = 0, ardSeconds_ = 0, stepSeconds_ = 0;
   long pressureIterations_ = 0, diffusionIterations_ = 0;

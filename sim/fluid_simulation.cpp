@@ -98,8 +98,9 @@ void FluidSimulation<D>::step(double dt) {
     warn_(fmt::format("warning: step {}: pressure solve stopped at relative residual {:.2e} after {} iterations",
                       steps(), st.pressure.residual, st.pressure.iterations));
   if (!stepper_->finite())
-    throw NonFiniteError(fmt::format("the simulation diverged at step {} in the fluid step: the velocity is not finite", steps()),
-                         "use a smaller time.dt or set time.cfl, and check the forces and boundary speeds");
+    throw NonFiniteError(
+        fmt::format("the simulation diverged at step {} in the fluid step: the velocity is not finite", steps()),
+        "use a smaller time.dt or set time.cfl, and check the forces and boundary speeds");
   if (scene_.probes.forces) {
     const ProbeSettings& pr = scene_.probes;
     const double q = 0.5 * scene_.fluid.density * pr.referenceSpeed * pr.referenceSpeed * pr.referenceArea;
@@ -214,8 +215,10 @@ std::vector<std::pair<std::string, std::string>> FluidSimulation<D>::measurement
   const ProbeSettings& pr = scene_.probes;
   if (pr.centerlines) {
     // Vertical centreline: u along y; horizontal centreline: v along x.
-    files.push_back({"profiles/u_vertical_centerline.csv", profileCsv(centerlineProfile<D>(fluid_, 0, 1, pr.referenceSpeed))});
-    files.push_back({"profiles/v_horizontal_centerline.csv", profileCsv(centerlineProfile<D>(fluid_, 1, 0, pr.referenceSpeed))});
+    files.push_back(
+        {"profiles/u_vertical_centerline.csv", profileCsv(centerlineProfile<D>(fluid_, 0, 1, pr.referenceSpeed))});
+    files.push_back(
+        {"profiles/v_horizontal_centerline.csv", profileCsv(centerlineProfile<D>(fluid_, 1, 0, pr.referenceSpeed))});
   }
   if (pr.forces) {
     std::string csv = "step,time,drag_coefficient,lift_coefficient\n";
@@ -243,8 +246,8 @@ void checkFluidLeft(const Scene& scene, const FluidSolver<D>& fluid) {
       }
       if (!open)
         throw UserError({scene.path, 0, 0}, "obstacles",
-                        fmt::format("the obstacles cover the whole inflow side ({} {}): no fluid can enter", high ? "high" : "low",
-                                    "xyz"[a]),
+                        fmt::format("the obstacles cover the whole inflow side ({} {}): no fluid can enter",
+                                    high ? "high" : "low", "xyz"[a]),
                         "move or shrink the obstacles so that part of the inflow is open");
     }
 }
@@ -271,7 +274,8 @@ bool meetsGrid(const ObstacleSpec& o, const IVec<D>& cells, double h) {
 }
 
 template <int D>
-void warnOfEmptySources(const Scene& scene, const FluidSolver<D>& fluid, const std::function<void(const std::string&)>& warn) {
+void warnOfEmptySources(const Scene& scene, const FluidSolver<D>& fluid,
+                        const std::function<void(const std::string&)>& warn) {
   const std::vector<ObstacleSpec>& obstacles = scene.fluid.obstacles;
   for (size_t q = 0; q < obstacles.size() && warn; ++q)
     if (!meetsGrid<D>(obstacles[q], fluid.cells(), fluid.h()))
@@ -302,9 +306,10 @@ void checkFluidFinite(const FluidSolver<D>& fluid, const std::string& where) {
   };
   for (int a = 0; a < D; ++a)
     if (!finite(fluid.velocity()[a]))
-      throw NonFiniteError(fmt::format("the simulation diverged {} in the fluid step: velocity component {} is not finite",
-                                       where, "xyz"[a]),
-                           "use a smaller time.dt or set time.cfl, and check the forces and boundary speeds");
+      throw NonFiniteError(
+          fmt::format("the simulation diverged {} in the fluid step: velocity component {} is not finite", where,
+                      "xyz"[a]),
+          "use a smaller time.dt or set time.cfl, and check the forces and boundary speeds");
   if (fluid.hasDye() && !finite(fluid.dye()))
     throw NonFiniteError(fmt::format("the simulation diverged {} in the fluid step: the dye is not finite", where),
                          "use a smaller time.dt or set time.cfl");
@@ -338,11 +343,13 @@ void checkFluidBounded(const FluidSolver<D>& fluid, const std::string& where) {
   say("smoke.buoyancy", f.smoke.heat);
   say("smoke.weight", f.smoke.weight);
   say("fluid.buoyancy", f.buoyancy);
-  for (int a = 0; a < D; ++a) say(a == 0 ? "fluid.force[0]" : a == 1 ? "fluid.force[1]" : "fluid.force[2]", f.force[size_t(a)]);
+  for (int a = 0; a < D; ++a)
+    say(a == 0 ? "fluid.force[0]" : a == 1 ? "fluid.force[1]" : "fluid.force[2]", f.force[size_t(a)]);
   throw NonFiniteError(
-      fmt::format("the simulation blew up {} in the fluid step: the speed reached {:.3g}, more than 1000 domain lengths "
-                  "and 1000 times the scene's speeds ({:g} in all) per unit time",
-                  where, top, bound),
+      fmt::format(
+          "the simulation blew up {} in the fluid step: the speed reached {:.3g}, more than 1000 domain lengths "
+          "and 1000 times the scene's speeds ({:g} in all) per unit time",
+          where, top, bound),
       forces.empty() ? std::string("use a smaller time.dt or set time.cfl, and check the boundary speeds")
                      : fmt::format("the forces set, the likeliest causes: {}; lower them, or use a smaller time.dt",
                                    fmt::join(forces, ", ")));
@@ -350,8 +357,10 @@ void checkFluidBounded(const FluidSolver<D>& fluid, const std::string& where) {
 
 template void checkFluidFinite<2>(const FluidSolver<2>&, const std::string&);
 template void checkFluidFinite<3>(const FluidSolver<3>&, const std::string&);
-template void warnOfEmptySources<2>(const Scene&, const FluidSolver<2>&, const std::function<void(const std::string&)>&);
-template void warnOfEmptySources<3>(const Scene&, const FluidSolver<3>&, const std::function<void(const std::string&)>&);
+template void warnOfEmptySources<2>(const Scene&, const FluidSolver<2>&,
+                                    const std::function<void(const std::string&)>&);
+template void warnOfEmptySources<3>(const Scene&, const FluidSolver<3>&,
+                                    const std::function<void(const std::string&)>&);
 template void checkFluidLeft<2>(const Scene&, const FluidSolver<2>&);
 template void checkFluidLeft<3>(const Scene&, const FluidSolver<3>&);
 template void initialiseDye<2>(const Scene&, FluidSolver<2>*);
@@ -362,7 +371,8 @@ bool setFluidField(FluidSolver<D>* fluid, const std::string& name, const Grid<fl
   if (name != "dye" && !temperature) return false;
   Grid<float, D>& g = temperature ? fluid->temperature() : fluid->dye();
   if (values.dims() != g.dims())
-    throw UserError({"set_field", 0, 0}, "", "the values of '" + name + "' are not on its grid", "give field()'s shape");
+    throw UserError({"set_field", 0, 0}, "", "the values of '" + name + "' are not on its grid",
+                    "give field()'s shape");
   for (size_t i = 0; i < g.size(); ++i)
     if (!std::isnan(values[i])) g[i] = values[i];  // (NaN: the cell keeps its value)
   return true;

@@ -17,7 +17,7 @@
 #include "fluid/fluid_solver.h"
 #include "fluid/fluid_stepper.h"
 #include "scenes/scene.h"
-#include "sim/backend.h"
+#include "core/backend.h"
 
 namespace morphoflow {
 
@@ -31,7 +31,8 @@ void checkFluidLeft(const Scene& scene, const FluidSolver<D>& fluid);
 
 // Warns of each fixed source that covers no fluid cell (it would emit nothing).
 template <int D>
-void warnOfEmptySources(const Scene& scene, const FluidSolver<D>& fluid, const std::function<void(const std::string&)>& warn);
+void warnOfEmptySources(const Scene& scene, const FluidSolver<D>& fluid,
+                        const std::function<void(const std::string&)>& warn);
 
 // Throws NonFiniteError when a velocity component or the dye is not finite.
 template <int D>

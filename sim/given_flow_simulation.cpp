@@ -86,11 +86,13 @@ void GivenFlowSimulation<D>::checkVelocityFinite(double t) const {
       std::string at = "face (" + std::to_string(k[0]);
       for (int b = 1; b < D; ++b) at += ", " + std::to_string(k[b]);
       const bool fromFile = !scene_.velocity.vdb.empty();
-      throw UserError(scene_.velocity.where, scene_.velocity.key,
-                      fmt::format("the given velocity's {} component is {} at {}) at t = {:g}", "uvw"[a],
-                                  std::isnan(g[i]) ? "NaN" : "infinite", at, t),
-                      fromFile ? "the velocity file holds values that are not finite: write it again from a run that did not diverge"
-                               : "guard divisions and logarithms, and keep the values within float range (|v| < 3e38)");
+      throw UserError(
+          scene_.velocity.where, scene_.velocity.key,
+          fmt::format("the given velocity's {} component is {} at {}) at t = {:g}", "uvw"[a],
+                      std::isnan(g[i]) ? "NaN" : "infinite", at, t),
+          fromFile
+              ? "the velocity file holds values that are not finite: write it again from a run that did not diverge"
+              : "guard divisions and logarithms, and keep the values within float range (|v| < 3e38)");
     }
   }
 }

@@ -83,8 +83,9 @@ PaintedStrokes<D> paintSceneStrokes(const Scene& scene, const RDSolver<D>& rd) {
       strokeCoverage<D>(s.stroke, rd.cells(), rd.settings().size, periodic);
     } catch (const std::invalid_argument&) {
       throw UserError(s.where, s.key, "the stroke covers no cell of the grid",
-                      s.stroke.isImage() ? "an image stroke covers the cells brighter than its range's middle: this image has none"
-                                         : "give points inside the domain, or a wider stroke");
+                      s.stroke.isImage()
+                          ? "an image stroke covers the cells brighter than its range's middle: this image has none"
+                          : "give points inside the domain, or a wider stroke");
     }
   }
   const bool steers = (scene.rd.anisotropy.enabled && scene.rd.anisotropy.thetaFromStrokes) ||
@@ -96,8 +97,9 @@ PaintedStrokes<D> paintSceneStrokes(const Scene& scene, const RDSolver<D>& rd) {
     return paintStrokes<D>(strokes, rd.cells(), rd.settings().size, periodic);
   } catch (const std::invalid_argument&) {  // every stroke an image without edges
     const RDStroke& first = scene.rd.strokes.front();
-    throw UserError(first.where, first.key, "the strokes give no direction: an image stroke's direction comes from its edges, "
-                                            "and these images are uniform where they cover",
+    throw UserError(first.where, first.key,
+                    "the strokes give no direction: an image stroke's direction comes from its edges, "
+                    "and these images are uniform where they cover",
                     "add a polyline stroke, use an image with edges, or give the direction another way");
   }
 }
@@ -217,10 +219,11 @@ void checkFinite(const RDSolver<D>& rd, const std::string& where, const std::str
         throw NonFiniteError(
             fmt::format("the simulation diverged {} in {}: species {} is {} (it must fit a float to be stored)", where,
                         stage, rd.model().info().species[size_t(s)], std::isnan(v) ? "NaN" : fmt::format("{:g}", v)),
-            isExplicit ? fmt::format("the explicit integrator's limit for this diffusion is time.dt = {:.4g}, and a stiff "
-                                     "reaction needs less; integrator = \"kim-lin\" is stable at any step (seed 001)",
-                                     rd.explicitDiffusionLimit())
-                       : std::string("use a smaller time.dt"));
+            isExplicit
+                ? fmt::format("the explicit integrator's limit for this diffusion is time.dt = {:.4g}, and a stiff "
+                              "reaction needs less; integrator = \"kim-lin\" is stable at any step (seed 001)",
+                              rd.explicitDiffusionLimit())
+                : std::string("use a smaller time.dt"));
       }
 }
 

@@ -26,7 +26,8 @@ bool setSpeciesField(RDSolver<D>* rd, const std::string& name, const Grid<float,
   if (it == names.end()) return false;
   Grid<double, D>& g = rd->field(int(it - names.begin()));
   if (values.dims() != g.dims())
-    throw UserError({"set_field", 0, 0}, "", "the values of '" + name + "' are not on its grid", "give field()'s shape");
+    throw UserError({"set_field", 0, 0}, "", "the values of '" + name + "' are not on its grid",
+                    "give field()'s shape");
   for (size_t i = 0; i < g.size(); ++i)
     if (!std::isnan(values[i])) g[i] = double(values[i]);  // (NaN: the cell keeps its value)
   return true;
@@ -66,7 +67,8 @@ template <int D>
 void RDSimulation<D>::checkFinite(const std::string& when) const {
   host_.refresh();
   const std::string stage = rdStage(rd_.settings());
-  morphoflow::checkFinite<D>(rd_, when, backend_ == Backend::Gpu ? "the reaction-diffusion step (gpu, " + stage + ")" : stage);
+  morphoflow::checkFinite<D>(rd_, when,
+                             backend_ == Backend::Gpu ? "the reaction-diffusion step (gpu, " + stage + ")" : stage);
 }
 
 template <int D>

@@ -16,7 +16,7 @@
 #include "rd/layer_stepper.h"
 #include "rd/rd_solver.h"
 #include "scenes/scene.h"
-#include "sim/backend.h"
+#include "core/backend.h"
 
 namespace morphoflow {
 

@@ -39,8 +39,9 @@ std::unique_ptr<TimelineSimulation<D>> makeTimelineSimulation(const Scene& scene
       if (seen->insert(line).second && f) f(line);
     };
   };
-  return std::make_unique<TimelineSimulation<D>>(
-      scene, [backend, say = once(say), warn = once(warn)](const Scene& at) { return makeFixed<D>(at, backend, say, warn); });
+  return std::make_unique<TimelineSimulation<D>>(scene, [backend, say = once(say), warn = once(warn)](const Scene& at) {
+    return makeFixed<D>(at, backend, say, warn);
+  });
 }
 
 template <int D>
@@ -51,15 +52,17 @@ std::unique_ptr<Simulation<D>> makeSimulation(const Scene& scene, Backend backen
   return makeFixed<D>(scene, backend, say, warn);
 }
 
-template std::unique_ptr<TimelineSimulation<2>> makeTimelineSimulation<2>(const Scene&, Backend,
-                                                                          const std::function<void(const std::string&)>&,
-                                                                          const std::function<void(const std::string&)>&);
-template std::unique_ptr<TimelineSimulation<3>> makeTimelineSimulation<3>(const Scene&, Backend,
-                                                                          const std::function<void(const std::string&)>&,
-                                                                          const std::function<void(const std::string&)>&);
-template std::unique_ptr<Simulation<2>> makeSimulation<2>(const Scene&, Backend, const std::function<void(const std::string&)>&,
+template std::unique_ptr<TimelineSimulation<2>> makeTimelineSimulation<2>(
+    const Scene&, Backend, const std::function<void(const std::string&)>&,
+    const std::function<void(const std::string&)>&);
+template std::unique_ptr<TimelineSimulation<3>> makeTimelineSimulation<3>(
+    const Scene&, Backend, const std::function<void(const std::string&)>&,
+    const std::function<void(const std::string&)>&);
+template std::unique_ptr<Simulation<2>> makeSimulation<2>(const Scene&, Backend,
+                                                          const std::function<void(const std::string&)>&,
                                                           const std::function<void(const std::string&)>&);
-template std::unique_ptr<Simulation<3>> makeSimulation<3>(const Scene&, Backend, const std::function<void(const std::string&)>&,
+template std::unique_ptr<Simulation<3>> makeSimulation<3>(const Scene&, Backend,
+                                                          const std::function<void(const std::string&)>&,
                                                           const std::function<void(const std::string&)>&);
 
 }  // namespace morphoflow

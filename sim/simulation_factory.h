@@ -9,7 +9,7 @@
 
 #include "sim/simulation.h"
 #include "scenes/scene.h"
-#include "sim/backend.h"
+#include "core/backend.h"
 #include "sim/steppers.h"
 #include "sim/timeline_simulation.h"
 

@@ -3,22 +3,15 @@
 #include <fmt/format.h>
 
 #include "core/error.h"
-#include "coupling/coupled_stepper.h"
+#include "coupling/cpu_coupled_stepper.h"
 #include "gpu/gl_context.h"
-#include "gpu/gpu_coupled_steps.h"
+#include "gpu/gpu_coupled_stepper.h"
 #include "gpu/gpu_fluid.h"
 #include "gpu/gpu_layer_steppers.h"
 #include "gpu/gpu_models.h"
 #include "gpu/gpu_newton_check.h"
 
 namespace morphoflow {
-
-Backend backendNamed(const std::string& name) {
-  if (name == "tbb") return Backend::TBB;
-  if (name == "serial") return Backend::Serial;
-  if (name == "gpu") return Backend::Gpu;
-  throw std::invalid_argument("no backend '" + name + "'");
-}
 
 namespace {
 
@@ -47,8 +40,9 @@ void checkGpuRuns(const Scene& scene) {
   if (scene.rd.enabled && scene.rd.settings.integrator == RDIntegrator::KimLin)
     if (const std::string defect = gpuNewtonDefect(scene.rd.settings.model); !defect.empty())
       throw UserError({scene.path, 0, 0}, "rd.integrator",
-                      "this GPU (" + g.renderer + ", " + g.version + ") cannot run Kim & Lin's implicit reaction of model " +
-                          scene.rd.settings.model + ": " + defect,
+                      "this GPU (" + g.renderer + ", " + g.version +
+                          ") cannot run Kim & Lin's implicit reaction of model " + scene.rd.settings.model + ": " +
+                          defect,
                       "run this scene with --backend tbb, or with another rd.integrator; docs/gpu.md says why");
   // Checked before anything is allocated: the fluid's buffers, and the
   // layer's (two float buffers per species for the explicit step).
@@ -60,7 +54,8 @@ void checkGpuRuns(const Scene& scene) {
                                 : GpuRDLayer<3>::deviceBytes(cells, gpuSpecies(scene.rd.settings.model));
   if (scene.hasFluid) {
     const std::vector<int>& r = scene.fluid.resolution;
-    need += scene.dimension == 2 ? GpuFluid<2>::deviceBytes({r[0], r[1]}) : GpuFluid<3>::deviceBytes({r[0], r[1], r[2]});
+    need +=
+        scene.dimension == 2 ? GpuFluid<2>::deviceBytes({r[0], r[1]}) : GpuFluid<3>::deviceBytes({r[0], r[1], r[2]});
   }
   const size_t have = GlContext::instance().availableBytes();
   if (have > 0 && need > have)
@@ -98,13 +93,12 @@ std::unique_ptr<LayerStepper<D>> makeLayerStepper(const Scene& scene, Backend ba
 }
 
 template <int D>
-std::unique_ptr<CoupledSteps<D>> makeCoupledSteps(const Scene& scene, Backend backend, FluidSolver<D>* fluid,
+std::unique_ptr<CoupledStepper<D>> makeCoupledStepper(const Scene& scene, Backend backend, FluidSolver<D>* fluid,
                                                   ARDSolver<D>* ard, const ChemicalDomain<D>& domain) {
   const CouplingScene& C = scene.coupling;
   if (backend == Backend::Gpu)
-    return std::make_unique<GpuCoupledSteps<D>>(*fluid, ard->rd(), domain, C.interpolation, C.mode, C.rdTimeScale);
-  return std::make_unique<CoupledStepper<D>>(fluid, ard,
-                                             backend == Backend::Serial ? CouplingBackend::Serial : CouplingBackend::TBB);
+    return std::make_unique<GpuCoupledStepper<D>>(*fluid, ard->rd(), domain, C.interpolation, C.mode, C.rdTimeScale);
+  return std::make_unique<CpuCoupledStepper<D>>(fluid, ard, backend);
 }
 
 template <int D>
@@ -121,9 +115,9 @@ template std::unique_ptr<FluidStepper<2>> makeFluidStepper<2>(Backend, FluidSolv
 template std::unique_ptr<FluidStepper<3>> makeFluidStepper<3>(Backend, FluidSolver<3>*);
 template std::unique_ptr<LayerStepper<2>> makeLayerStepper<2>(const Scene&, Backend, RDSolver<2>*);
 template std::unique_ptr<LayerStepper<3>> makeLayerStepper<3>(const Scene&, Backend, RDSolver<3>*);
-template std::unique_ptr<CoupledSteps<2>> makeCoupledSteps<2>(const Scene&, Backend, FluidSolver<2>*, ARDSolver<2>*,
+template std::unique_ptr<CoupledStepper<2>> makeCoupledStepper<2>(const Scene&, Backend, FluidSolver<2>*, ARDSolver<2>*,
                                                               const ChemicalDomain<2>&);
-template std::unique_ptr<CoupledSteps<3>> makeCoupledSteps<3>(const Scene&, Backend, FluidSolver<3>*, ARDSolver<3>*,
+template std::unique_ptr<CoupledStepper<3>> makeCoupledStepper<3>(const Scene&, Backend, FluidSolver<3>*, ARDSolver<3>*,
                                                               const ChemicalDomain<3>&);
 template CoarseAdvance<2> coarseAdvance<2>(Backend);
 template CoarseAdvance<3> coarseAdvance<3>(Backend);

@@ -1,17 +1,17 @@
 // The one place that decides how a scene's parts are stepped on a backend:
 // whether the scene runs there at all (the GPU's refusals, naming the stage
 // it lacks), and the fluid, layer and coupled steppers the simulations hold
-// (fluid/fluid_stepper.h, rd/layer_stepper.h, coupling/coupled_steps.h).
+// (fluid/fluid_stepper.h, rd/layer_stepper.h, coupling/coupled_stepper.h).
 #pragma once
 
 #include <memory>
 
 #include "coupling/ard_solver.h"
-#include "coupling/coupled_steps.h"
+#include "coupling/coupled_stepper.h"
 #include "fluid/fluid_stepper.h"
 #include "rd/layer_stepper.h"
 #include "scenes/scene.h"
-#include "sim/backend.h"
+#include "core/backend.h"
 #include "sim/rd_scene_setup.h"
 
 namespace morphoflow {
@@ -33,7 +33,7 @@ std::unique_ptr<LayerStepper<D>> makeLayerStepper(const Scene& scene, Backend ba
 
 // The coupled step of `fluid` and `ard` (whose domain is `domain`), from their current state.
 template <int D>
-std::unique_ptr<CoupledSteps<D>> makeCoupledSteps(const Scene& scene, Backend backend, FluidSolver<D>* fluid,
+std::unique_ptr<CoupledStepper<D>> makeCoupledStepper(const Scene& scene, Backend backend, FluidSolver<D>* fluid,
                                                   ARDSolver<D>* ard, const ChemicalDomain<D>& domain);
 
 // How a coarse-to-fine start steps its coarse levels on the backend.

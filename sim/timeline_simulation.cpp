@@ -71,7 +71,8 @@ void TimelineSimulation<D>::prepare(double dt) {
   const double t = inner_->time(), te = t + 1e-6 * dt;  // (scenes/timeline.h, dueAt)
   if (stale_ || signatureAt(te) != signature_) rebuildAt(te);
   const std::vector<Deposit>& deposits = scene_->timeline.deposits;
-  for (; deposited_ < deposits.size() && dueAt(deposits[deposited_].time, t, dt); ++deposited_) deposit(deposits[deposited_]);
+  for (; deposited_ < deposits.size() && dueAt(deposits[deposited_].time, t, dt); ++deposited_)
+    deposit(deposits[deposited_]);
 }
 
 template <int D>

@@ -38,7 +38,9 @@ class TimelineSimulation : public Simulation<D> {
   void setField(const std::string& name, const Grid<float, D>& values) override { inner_->setField(name, values); }
   bool symmetric(const std::string& name) const override { return inner_->symmetric(name); }
   bool hasObstacles() const override { return inner_->hasObstacles(); }
-  std::vector<std::pair<std::string, std::string>> measurementFiles() const override { return inner_->measurementFiles(); }
+  std::vector<std::pair<std::string, std::string>> measurementFiles() const override {
+    return inner_->measurementFiles();
+  }
   void checkFinite(const std::string& when) const override { inner_->checkFinite(when); }
   void save(StateWriter* out) const override;
   void load(const StateReader& in) override;

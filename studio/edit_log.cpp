@@ -78,7 +78,8 @@ void insertJson(toml::table& t, const std::string& key, const nlohmann::json& v)
   else if (v.is_boolean()) t.insert_or_assign(key, v.get<bool>());
   else if (v.is_string()) t.insert_or_assign(key, v.get<std::string>());
   else if (v.is_array()) t.insert_or_assign(key, jsonArray(v));
-  else throw UserError(kStudio, key, "expected a number, string, boolean or array, found " + std::string(v.type_name()));
+  else
+    throw UserError(kStudio, key, "expected a number, string, boolean or array, found " + std::string(v.type_name()));
 }
 
 toml::array numberArray(const std::vector<double>& v) {
@@ -142,12 +143,14 @@ std::string EditLog::text() const { return text_; }
 
 void EditLog::set(const std::string& key, const nlohmann::json& value, double t) {
   if (!isSteerableKey(key))
-    throw UserError(kStudio, key, "not a key the studio steers", "steerable keys: " + fmt::format("{}", fmt::join(steerableKeyPatterns(), ", ")));
+    throw UserError(kStudio, key, "not a key the studio steers",
+                    "steerable keys: " + fmt::format("{}", fmt::join(steerableKeyPatterns(), ", ")));
   const auto it = scene_.numericKeys.find(key);
   if (it == scene_.numericKeys.end()) throw UserError(kStudio, key, "this scene has no such key");
   const std::vector<double> v = numbersOf(key, value), now = it->second.values;
   if (v.size() != now.size())
-    throw UserError(kStudio, key, fmt::format("expected {} number{}, found {}", now.size(), now.size() > 1 ? "s" : "", v.size()));
+    throw UserError(kStudio, key,
+                    fmt::format("expected {} number{}, found {}", now.size(), now.size() > 1 ? "s" : "", v.size()));
   const bool array = value.is_array();
   toml::table tree = readTree(text_, path_);
   const std::vector<std::string> parts = split(key);
@@ -197,7 +200,8 @@ void EditLog::paint(const nlohmann::json& edit, double t) {
     for (const auto& [k, v] : edit.items()) {
       if (k == "kind") continue;
       if (!add->second.second.count(k))
-        throw UserError(kStudio, k, "not a key of a " + kind, "keys: " + fmt::format("{}", fmt::join(add->second.second, ", ")));
+        throw UserError(kStudio, k, "not a key of a " + kind,
+                        "keys: " + fmt::format("{}", fmt::join(add->second.second, ", ")));
       insertJson(entry, k, v);
     }
     if (kind == "deposit") entry.insert("t", t);
@@ -228,7 +232,9 @@ void EditLog::paint(const nlohmann::json& edit, double t) {
       old.insert_or_assign("end", t);
     }
   } else {
-    throw UserError(kStudio, "kind", "expected \"deposit\", \"stroke\", \"source\", \"obstacle\", \"move\" or \"erase\", found \"" + kind + "\"");
+    throw UserError(
+        kStudio, "kind",
+        "expected \"deposit\", \"stroke\", \"source\", \"obstacle\", \"move\" or \"erase\", found \"" + kind + "\"");
   }
   commit(writeTree(tree));
 }

@@ -92,8 +92,8 @@ std::string npyFile(const std::vector<Grid<float, D>>& field) {
   std::vector<size_t> shape;
   if (field.size() > 1) shape.push_back(field.size());
   for (int a = D - 1; a >= 0; --a) shape.push_back(size_t(field[0].dims()[a]));
-  std::string dict = fmt::format("{{'descr': '<f4', 'fortran_order': False, 'shape': ({}{}), }}", fmt::join(shape, ", "),
-                                 shape.size() == 1 ? "," : "");
+  std::string dict = fmt::format("{{'descr': '<f4', 'fortran_order': False, 'shape': ({}{}), }}",
+                                 fmt::join(shape, ", "), shape.size() == 1 ? "," : "");
   // Magic, version 1.0, header length; the header padded with spaces to a multiple of 64 and ended by '\n'.
   const size_t total = (10 + dict.size() + 1 + 63) / 64 * 64;
   dict.append(total - 10 - dict.size() - 1, ' ');
@@ -109,8 +109,10 @@ std::string npyFile(const std::vector<Grid<float, D>>& field) {
   return out;
 }
 
-template std::string encodeFrame<2>(const std::vector<Grid<float, 2>>&, const Palette&, bool, const double[2], bool, nlohmann::json);
-template std::string encodeFrame<3>(const std::vector<Grid<float, 3>>&, const Palette&, bool, const double[2], bool, nlohmann::json);
+template std::string encodeFrame<2>(const std::vector<Grid<float, 2>>&, const Palette&, bool, const double[2], bool,
+                                    nlohmann::json);
+template std::string encodeFrame<3>(const std::vector<Grid<float, 3>>&, const Palette&, bool, const double[2], bool,
+                                    nlohmann::json);
 template std::string npyFile<2>(const std::vector<Grid<float, 2>>&);
 template std::string npyFile<3>(const std::vector<Grid<float, 3>>&);
 

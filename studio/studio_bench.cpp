@@ -111,7 +111,8 @@ class Watcher {
   std::atomic<long> lastStep_{-1}, frames_{0};
 };
 
-nlohmann::json post(unsigned short port, const std::string& token, const std::string& target, const nlohmann::json& body) {
+nlohmann::json post(unsigned short port, const std::string& token, const std::string& target,
+                    const nlohmann::json& body) {
   boost::asio::io_context ioc;
   beast::tcp_stream stream(ioc);
   stream.connect({boost::asio::ip::make_address("127.0.0.1"), port});
@@ -161,8 +162,9 @@ Row measure(const std::string& name, const std::string& text, const std::string&
     for (int k = 0; k < 20; ++k) {
       const double x = 0.2 + 0.03 * k;
       const Clock::time_point t0 = Clock::now();
-      const long step = post(server.port(), server.token(), "/api/paint",
-                             {{"kind", "deposit"}, {"field", "v"}, {"center", {x, 0.5}}, {"radius", 0.03}, {"value", 0.5}})["step"];
+      const long step =
+          post(server.port(), server.token(), "/api/paint",
+               {{"kind", "deposit"}, {"field", "v"}, {"center", {x, 0.5}}, {"radius", 0.03}, {"value", 0.5}})["step"];
       while (watcher.lastStep() <= step) std::this_thread::sleep_for(std::chrono::microseconds(200));
       ms.push_back(1e3 * secondsSince(t0));
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
@@ -175,10 +177,13 @@ Row measure(const std::string& name, const std::string& text, const std::string&
 }  // namespace
 
 void runStudioBench(const std::string& sceneDir, double seconds, const std::string& json) {
-  const std::string cavity = sceneDir + "/coupled/cavity_gray_scott.toml", cavity3 = sceneDir + "/coupled/cavity_gray_scott_3d.toml";
-  fmt::print("studio: {} thread(s); steps/s alone and in the studio with one client taking every frame (steps per frame 1),\n"
-             "medians of 3 interleaved rounds of {:g} s; edit to frame: a deposit posted to the first frame after it (20 edits)\n\n",
-             hardwareThreads(), seconds);
+  const std::string cavity = sceneDir + "/coupled/cavity_gray_scott.toml",
+                    cavity3 = sceneDir + "/coupled/cavity_gray_scott_3d.toml";
+  fmt::print(
+      "studio: {} thread(s); steps/s alone and in the studio with one client taking every frame (steps per frame 1),\n"
+      "medians of 3 interleaved rounds of {:g} s; edit to frame: a deposit posted to the first frame after it (20 "
+      "edits)\n\n",
+      hardwareThreads(), seconds);
   const std::vector<Row> rows = {
       measure("2D 128^2 fluid, 256^2 chemicals", sceneText(cavity, 2, 128, 256), cavity, seconds, true),
       measure("3D 64^3 fluid, 64^3 chemicals", sceneText(cavity3, 3, 64, 64), cavity3, seconds, false)};
@@ -187,14 +192,23 @@ void runStudioBench(const std::string& sceneDir, double seconds, const std::stri
   nlohmann::json out = nlohmann::json::array();
   for (const Row& r : rows) {
     const double cost = r.alone / r.watched - 1.0;  // the extra time a step takes in the studio
-    fmt::print("{:<34} {:>10.1f} {:>10.1f} {:>6.1f}% {:>9.1f} {:>9.1f} {:>9.2f} {:>18}\n", r.name, r.alone, r.watched, 100 * cost,
-               r.framesPerSecond, r.frameBytes / 1024, r.frameMs,
-               r.latencyMedian > 0 ? fmt::format("{:.1f} (max {:.1f})", r.latencyMedian, r.latencyMax) : std::string("-"));
-    out.push_back({{"case", r.name}, {"steps_per_second_alone", r.alone}, {"steps_per_second_studio", r.watched},
-                   {"cost", cost}, {"frames_per_second", r.framesPerSecond}, {"frame_bytes", r.frameBytes}, {"frame_ms", r.frameMs},
-                   {"edit_to_frame_ms_median", r.latencyMedian}, {"edit_to_frame_ms_max", r.latencyMax}});
+    fmt::print(
+        "{:<34} {:>10.1f} {:>10.1f} {:>6.1f}% {:>9.1f} {:>9.1f} {:>9.2f} {:>18}\n", r.name, r.alone, r.watched,
+        100 * cost, r.framesPerSecond, r.frameBytes / 1024, r.frameMs,
+        r.latencyMedian > 0 ? fmt::format("{:.1f} (max {:.1f})", r.latencyMedian, r.latencyMax) : std::string("-"));
+    out.push_back({{"case", r.name},
+                   {"steps_per_second_alone", r.alone},
+                   {"steps_per_second_studio", r.watched},
+                   {"cost", cost},
+                   {"frames_per_second", r.framesPerSecond},
+                   {"frame_bytes", r.frameBytes},
+                   {"frame_ms", r.frameMs},
+                   {"edit_to_frame_ms_median", r.latencyMedian},
+                   {"edit_to_frame_ms_max", r.latencyMax}});
   }
-  if (!json.empty()) std::ofstream(json) << nlohmann::json{{"suite", "studio"}, {"threads", hardwareThreads()}, {"cases", out}}.dump(2) << "\n";
+  if (!json.empty())
+    std::ofstream(json) << nlohmann::json{{"suite", "studio"}, {"threads", hardwareThreads()}, {"cases", out}}.dump(2)
+                        << "\n";
 }
 
 }  // namespace morphoflow

@@ -70,7 +70,8 @@ std::string listValue(std::string_view list, char separator, std::string_view na
     std::string_view pair = list.substr(0, end);
     while (!pair.empty() && pair.front() == ' ') pair.remove_prefix(1);
     const size_t eq = pair.find('=');
-    if (pair.substr(0, eq) == name) return eq == std::string_view::npos ? std::string() : std::string(pair.substr(eq + 1));
+    if (pair.substr(0, eq) == name)
+      return eq == std::string_view::npos ? std::string() : std::string(pair.substr(eq + 1));
     if (end == std::string_view::npos) break;
     list = list.substr(end + 1);
   }
@@ -149,10 +150,12 @@ struct StudioServer::Impl {
       return r;
     };
     const std::string host(sv(req[http::field::host]));
-    if (!hostAllowed(host)) return refuse(http::status::forbidden, "forbidden: the Host '" + host + "' is not this studio's");
+    if (!hostAllowed(host))
+      return refuse(http::status::forbidden, "forbidden: the Host '" + host + "' is not this studio's");
     const std::string_view origin = sv(req[http::field::origin]);
     if (!origin.empty() && origin != "http://" + host)
-      return refuse(http::status::forbidden, "forbidden: requests from another site (Origin " + std::string(origin) + ") are refused");
+      return refuse(http::status::forbidden,
+                    "forbidden: requests from another site (Origin " + std::string(origin) + ") are refused");
     std::string token = queryValue(sv(req.target()), "token");
     const std::string_view auth = sv(req[http::field::authorization]);
     if (token.empty() && auth.substr(0, 7) == "Bearer ") token = std::string(auth.substr(7));
@@ -189,7 +192,8 @@ struct StudioServer::Impl {
   std::vector<std::string> shippedScenes() const {
     std::vector<std::string> names;
     std::error_code ec;
-    for (auto it = std::filesystem::recursive_directory_iterator(sceneDir, ec); !ec && it != decltype(it)(); it.increment(ec))
+    for (auto it = std::filesystem::recursive_directory_iterator(sceneDir, ec); !ec && it != decltype(it)();
+         it.increment(ec))
       if (it->is_regular_file() && it->path().extension() == ".toml")
         names.push_back(std::filesystem::relative(it->path(), sceneDir).string());
     std::sort(names.begin(), names.end());
@@ -235,12 +239,17 @@ struct StudioServer::Impl {
       if (call == "scenes" && get)
         return json(req, {{"scenes", shippedScenes()}, {"open", s ? s->state()["scene"] : nlohmann::json()}});
       if (call == "open" && post) return open(req, body);
-      if (!s) return error(req, http::status::conflict, "no scene is open: POST /api/open {\"scene\": NAME} (GET /api/scenes)");
+      if (!s)
+        return error(req, http::status::conflict,
+                     "no scene is open: POST /api/open {\"scene\": NAME} (GET /api/scenes)");
       if (call == "state" && get) return json(req, s->state());
-      if (call == "scene" && get) return reply(req, http::status::ok, s->sceneText(), "application/toml; charset=utf-8");
+      if (call == "scene" && get)
+        return reply(req, http::status::ok, s->sceneText(), "application/toml; charset=utf-8");
       if (call == "field" && get) {
-        Response r = reply(req, http::status::ok, s->fieldNpy(queryValue(sv(req.target()), "name")), "application/octet-stream");
-        r.set(http::field::content_disposition, "attachment; filename=\"" + queryValue(sv(req.target()), "name") + ".npy\"");
+        Response r =
+            reply(req, http::status::ok, s->fieldNpy(queryValue(sv(req.target()), "name")), "application/octet-stream");
+        r.set(http::field::content_disposition,
+              "attachment; filename=\"" + queryValue(sv(req.target()), "name") + ".npy\"");
         return r;
       }
       if (call == "control" && post) return json(req, s->control(body));
@@ -253,7 +262,8 @@ struct StudioServer::Impl {
     } catch (const std::exception& e) {
       return error(req, http::status::bad_request, e.what());
     }
-    const std::set<std::string> known = {"scenes", "open", "state", "scene", "field", "control", "set", "paint", "view", "render"};
+    const std::set<std::string> known = {"scenes",  "open", "state", "scene", "field",
+                                         "control", "set",  "paint", "view",  "render"};
     if (known.count(call)) return error(req, http::status::method_not_allowed, "wrong method for /api/" + call);
     return error(req, http::status::not_found, "no such call: /api/" + call);
   }
@@ -358,8 +368,11 @@ struct StudioServer::Impl {
       stream.expires_after(std::chrono::seconds(30));
       co_await http::async_read(stream, buffer, parser, asio::redirect_error(use_awaitable, ec));
       if (ec == http::error::body_limit || ec == http::error::header_limit) {
-        Response r{ec == http::error::body_limit ? http::status::payload_too_large : http::status::request_header_fields_too_large, 11};
-        r.body() = fmt::format("{{\"error\": \"the request is larger than the studio takes ({} bytes of body)\"}}\n", options.maxBody);
+        Response r{ec == http::error::body_limit ? http::status::payload_too_large
+                                                 : http::status::request_header_fields_too_large,
+                   11};
+        r.body() = fmt::format("{{\"error\": \"the request is larger than the studio takes ({} bytes of body)\"}}\n",
+                               options.maxBody);
         r.keep_alive(false);
         r.prepare_payload();
         co_await http::async_write(stream, r, asio::redirect_error(use_awaitable, ec));
@@ -421,13 +434,16 @@ StudioServer::StudioServer(const ServerOptions& server, const StudioOptions& stu
   }
   beast::error_code ec;
   const asio::ip::address address = asio::ip::make_address(server.listen, ec);
-  if (ec) throw UserError({"--listen", 0, 0}, "", "'" + server.listen + "' is not an IP address", "e.g. 127.0.0.1 or 0.0.0.0");
+  if (ec)
+    throw UserError({"--listen", 0, 0}, "", "'" + server.listen + "' is not an IP address",
+                    "e.g. 127.0.0.1 or 0.0.0.0");
   const tcp::endpoint at(address, server.port);
   m.acceptor.open(at.protocol());
   m.acceptor.set_option(asio::socket_base::reuse_address(true));
   m.acceptor.bind(at, ec);
   if (ec)
-    throw UserError({"--port", 0, 0}, "", fmt::format("cannot listen on {}:{}: {}", server.listen, server.port, ec.message()),
+    throw UserError({"--port", 0, 0}, "",
+                    fmt::format("cannot listen on {}:{}: {}", server.listen, server.port, ec.message()),
                     "give another --port, or 0 for any free one");
   m.acceptor.listen();
   m.port = m.acceptor.local_endpoint().port();

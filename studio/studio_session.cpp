@@ -30,7 +30,9 @@ Palette paletteOf(const OutputSettings& out) {
 
 nlohmann::json region(const ObstacleSpec& r, int D) {
   nlohmann::json j;
-  j["shape"] = r.shape == ObstacleShape::Box ? "box" : r.shape == ObstacleShape::Image || r.shape == ObstacleShape::Sdf ? "image" : "circle";
+  j["shape"] = r.shape == ObstacleShape::Box                                      ? "box"
+               : r.shape == ObstacleShape::Image || r.shape == ObstacleShape::Sdf ? "image"
+                                                                                  : "circle";
   j["center"] = std::vector<double>(r.center.begin(), r.center.begin() + D);
   j["radius"] = r.radius;
   std::vector<double> size;
@@ -179,7 +181,8 @@ void StudioSession::stepOnce() {
         if (!pastEnd_) {
           pastEnd_ = true;
           running_ = false, stepsToDo_ = 0;
-          error_ = fmt::format("the scene's run ends here (t = {:.5g}, step {}): play to run on", sim.time(), sim.steps());
+          error_ =
+              fmt::format("the scene's run ends here (t = {:.5g}, step {}): play to run on", sim.time(), sim.steps());
           return;
         }
         dt = t.cfl > 0 ? sim.cflTimeStep(t.cfl, t.dt) : t.dt;
@@ -222,7 +225,8 @@ void StudioSession::publish() {
       }
       const OutputSettings& out = clockScene_->output;
       const bool autoRange = field != out.field || out.autoRange;
-      const nlohmann::json meta = {{"field", field}, {"t", sim.time()}, {"step", sim.steps()}, {"dimension", dimension_}};
+      const nlohmann::json meta = {
+          {"field", field}, {"t", sim.time()}, {"step", sim.steps()}, {"dimension", dimension_}};
       return encodeFrame(sim.field(field), paletteOf(out), autoRange, out.range, sim.symmetric(field), meta);
     });
   } catch (const std::exception& e) {
@@ -296,7 +300,8 @@ nlohmann::json StudioSession::state() const {
     std::optional<ChildExit> done = const_cast<ChildProcess&>(*render_).poll();
     long frames = 0;
     std::error_code ec;
-    for (const auto& f : fs::directory_iterator(fs::path(renderOut_) / "frames", ec)) frames += f.is_regular_file() ? 1 : 0;
+    for (const auto& f : fs::directory_iterator(fs::path(renderOut_) / "frames", ec))
+      frames += f.is_regular_file() ? 1 : 0;
     render = {{"running", !done}, {"out", renderOut_}, {"frames", frames}, {"total_frames", renderFrames_},
               {"progress", renderFrames_ > 0 ? std::min(1.0, double(frames) / double(renderFrames_)) : 0.0}};
     if (done) render["exit_code"] = done->signal ? 128 + done->signal : done->code;
@@ -337,8 +342,9 @@ nlohmann::json StudioSession::control(const nlohmann::json& body) {
       return where();
     });
   } else {
-    throw UserError(kStudio, "action", "expected \"play\", \"pause\", \"step\" or \"reset\", found " +
-                                           (body.is_object() && body.contains("action") ? body["action"].dump() : std::string("nothing")));
+    throw UserError(kStudio, "action",
+                    "expected \"play\", \"pause\", \"step\" or \"reset\", found " +
+                        (body.is_object() && body.contains("action") ? body["action"].dump() : std::string("nothing")));
   }
   wake_.notify_all();
   return {{"ok", true}};
@@ -390,7 +396,8 @@ nlohmann::json StudioSession::adopt(EditLog&& edited) {
 nlohmann::json StudioSession::view(const nlohmann::json& body) {
   if (!body.is_object()) throw UserError(kStudio, "", "expected {\"field\": name} or {\"steps_per_frame\": n}");
   for (const auto& [key, v] : body.items())
-    if (key != "field" && key != "steps_per_frame") throw UserError(kStudio, key, "unknown key", "expected field or steps_per_frame");
+    if (key != "field" && key != "steps_per_frame")
+      throw UserError(kStudio, key, "unknown key", "expected field or steps_per_frame");
   if (body.contains("steps_per_frame")) {
     const nlohmann::json& n = body["steps_per_frame"];
     if (!n.is_number_integer() || n.get<long>() < 1 || n.get<long>() > 10000)
@@ -403,7 +410,8 @@ nlohmann::json StudioSession::view(const nlohmann::json& body) {
     return onSimThread<nlohmann::json>([&] {
       const std::vector<std::string> names = with([](auto& sim) { return sim.fieldNames(); });
       if (!f.is_string() || std::find(names.begin(), names.end(), f.get<std::string>()) == names.end())
-        throw UserError(kStudio, "field", "no field " + f.dump(), "the fields: " + fmt::format("{}", fmt::join(names, ", ")));
+        throw UserError(kStudio, "field", "no field " + f.dump(),
+                        "the fields: " + fmt::format("{}", fmt::join(names, ", ")));
       {
         std::lock_guard<std::mutex> lk(mutex_);
         field_ = f.get<std::string>();
@@ -425,7 +433,8 @@ std::string StudioSession::fieldNpy(const std::string& name) {
     return with([&](auto& sim) {
       const std::vector<std::string> names = sim.fieldNames();
       if (std::find(names.begin(), names.end(), name) == names.end())
-        throw UserError(kStudio, "name", "no field '" + name + "'", "the fields: " + fmt::format("{}", fmt::join(names, ", ")));
+        throw UserError(kStudio, "name", "no field '" + name + "'",
+                        "the fields: " + fmt::format("{}", fmt::join(names, ", ")));
       return npyFile(sim.field(name));
     });
   });
@@ -447,7 +456,8 @@ nlohmann::json StudioSession::render() {
   renderOut_ = (out / (s.name + "_render")).string();
   renderFrames_ = s.time.cfl > 0 ? 0 : s.totalSteps() / s.output.every + 1;
   render_.reset();
-  render_.emplace(options_.executable, std::vector<std::string>{"run", file.string(), "--out", renderOut_, "--backend", options_.backend},
+  render_.emplace(options_.executable,
+                  std::vector<std::string>{"run", file.string(), "--out", renderOut_, "--backend", options_.backend},
                   out / (s.name + "_render.log"));
   return {{"ok", true}, {"scene", file.string()}, {"out", renderOut_}};
 }

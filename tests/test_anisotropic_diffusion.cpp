@@ -54,9 +54,9 @@ double derivative(const std::function<double(const Vec<D>&)>& f, Vec<D> p, int a
 // sigma(x) given per component, grad u analytic, the outer divergence by
 // 4th-order differences.
 template <int D>
-double operatorError(int N, const std::function<std::array<double, AnisotropicSystem<D>::kComponents>(const Vec<D>&)>& sigma,
-                     const std::function<double(const Vec<D>&)>& u,
-                     const std::function<Vec<D>(const Vec<D>&)>& grad) {
+double operatorError(int N,
+                     const std::function<std::array<double, AnisotropicSystem<D>::kComponents>(const Vec<D>&)>& sigma,
+                     const std::function<double(const Vec<D>&)>& u, const std::function<Vec<D>(const Vec<D>&)>& grad) {
   constexpr int kC = AnisotropicSystem<D>::kComponents;
   IVec<D> dims(N);
   const double h = 1.0 / N;
@@ -229,8 +229,8 @@ TEST(AnisotropicSystem, SymmetricAndPositive) {
       spec.lambda1[i] = 2.0 + std::sin(0.3 * k[0]);
     });
     auto comp = diffusionTensor<2>(spec, n, periodic, nullptr);
-    const AnisotropicSystem<2> A =
-        AnisotropicSystem<2>::fromTensor(n, {periodic, periodic}, 1.0, {comp[0].data(), comp[1].data(), comp[2].data()});
+    const AnisotropicSystem<2> A = AnisotropicSystem<2>::fromTensor(n, {periodic, periodic}, 1.0,
+                                                                    {comp[0].data(), comp[1].data(), comp[2].data()});
     for (uint64_t t = 0; t < 20; ++t) {
       Vector u(cells), v(cells), Au, Av;
       for (size_t i = 0; i < cells; ++i) u[i] = uniform01(7, t, i) - 0.5, v[i] = uniform01(8, t, i) - 0.5;
@@ -309,7 +309,8 @@ void blobCovariance(RDIntegrator integrator, int n, double w, double dt, int ste
   for (int a = 0; a < D; ++a)
     for (int b = 0; b < D; ++b) {
       const double sig = (a == b ? 0.5 : 0.0) + 1.5 * dir[size_t(a)] * dir[size_t(b)] / len;
-      EXPECT_NEAR(c1[a][b] - c0[a][b], 2 * d * sig * t, 1e-6 * 2 * d * t) << "component " << a << b << " integrator " << int(integrator);
+      EXPECT_NEAR(c1[a][b] - c0[a][b], 2 * d * sig * t, 1e-6 * 2 * d * t)
+          << "component " << a << b << " integrator " << int(integrator);
     }
 }
 
@@ -432,7 +433,8 @@ TEST(AnisotropicDiffusion, TuringSelectsTheFastestAnisotropicMode) {
     for (int q = 0; q < n; ++q) {
       std::complex<double> acc = 0;
       for (int y = 0; y < n; ++y) acc += rows[size_t(y * n + p)] * std::polar(1.0, -kTwoPi * q * y / n);
-      if ((p || q) && std::abs(acc) > peak) peak = std::abs(acc), bp = p > n / 2 ? p - n : p, bq = q > n / 2 ? q - n : q;
+      if ((p || q) && std::abs(acc) > peak)
+        peak = std::abs(acc), bp = p > n / 2 ? p - n : p, bq = q > n / 2 ? q - n : q;
     }
   const double observed = growth(symbol(bp, bq, sxx, syy, sxy));
   EXPECT_GT(observed, best - 0.02 * std::abs(best)) << "mode (" << bp << ", " << bq << ")";

@@ -22,13 +22,16 @@ namespace fs = std::filesystem;
 namespace {
 
 // A small Gray-Scott scene (Pearson's square), `steps` long, a frame every `every`.
-fs::path writeScene(const fs::path& dir, const std::string& name, long steps, long every, const std::string& extra = "") {
+fs::path writeScene(const fs::path& dir, const std::string& name, long steps, long every,
+                    const std::string& extra = "") {
   const fs::path p = dir / (name + ".toml");
   std::ofstream(p) << "name = \"" << name << "\"\n[grid]\nresolution = [40, 40]\n[domain]\nsize = [0.5, 0.5]\n"
-                   << "[time]\ndt = 1.0\nsteps = " << steps << "\n[rd]\nmodel = \"gray-scott\"\nintegrator = \"kim-lin\"\n"
+                   << "[time]\ndt = 1.0\nsteps = " << steps
+                   << "\n[rd]\nmodel = \"gray-scott\"\nintegrator = \"kim-lin\"\n"
                    << "boundary = \"periodic\"\ndiffusion = [2e-5, 1e-5]\n[rd.parameters]\nF = 0.04\nk = 0.06\n"
                    << "[rd.initial]\nvalues = [1.0, 0.0]\nsquare = 0.1\nsquare_values = [0.5, 0.25]\n"
-                   << "[output]\nevery = " << every << "\nfield = \"v\"\nimage_size = 64\n" << extra;
+                   << "[output]\nevery = " << every << "\nfield = \"v\"\nimage_size = 64\n"
+                   << extra;
   return p;
 }
 
@@ -88,10 +91,12 @@ TEST(Batch, ASecondBatchIsRefusedAndTheRunsStopWhenTheBatchIsKilled) {
   const fs::path scene = writeScene(dir, "long", 1000000, 50);
   const pid_t batch = startMorphoflow(batchArgs({scene}, out, {"--quiet"}), dir / "batch.log");
   pid_t child = -1;
-  ASSERT_TRUE(waitUntil([&] { return (child = childRunning(batch, scene)) > 0 && fs::exists(out / "long" / "frames"); }, 60));
+  ASSERT_TRUE(
+      waitUntil([&] { return (child = childRunning(batch, scene)) > 0 && fs::exists(out / "long" / "frames"); }, 60));
   const CommandResult second = runMorphoflow("batch " + scene.string() + " --resume --quiet --out " + out.string());
   EXPECT_EQ(second.status, 2) << second.output;
-  EXPECT_NE(second.output.find("in use by another morphoflow run (pid " + std::to_string(batch) + ")"), std::string::npos)
+  EXPECT_NE(second.output.find("in use by another morphoflow run (pid " + std::to_string(batch) + ")"),
+            std::string::npos)
       << second.output;
   kill(batch, SIGKILL);
   EXPECT_EQ(waitMorphoflow(batch), 128 + SIGKILL);
@@ -106,7 +111,8 @@ TEST(Batch, ACrashAndAKillNineInTwoScenesNeverStopTheOthers) {
   const fs::path segv = writeScene(dir, "segv", 1000000, 1000), oom = writeScene(dir, "oom", 1000000, 1000);
   const pid_t batch = startMorphoflow(batchArgs({segv, a, oom, b}, out, {"--jobs", "4"}), dir / "log.txt");
   pid_t p1 = -1, p2 = -1;
-  ASSERT_TRUE(waitUntil([&] { return (p1 = childRunning(batch, segv)) > 0 && (p2 = childRunning(batch, oom)) > 0; }, 30));
+  ASSERT_TRUE(
+      waitUntil([&] { return (p1 = childRunning(batch, segv)) > 0 && (p2 = childRunning(batch, oom)) > 0; }, 30));
   kill(p1, SIGSEGV);
   kill(p2, SIGKILL);  // what the out-of-memory killer sends
   EXPECT_EQ(waitMorphoflow(batch), 1);
@@ -144,7 +150,8 @@ TEST(Batch, AnInvalidSceneStopsTheBatchBeforeAnythingRunsUnlessKeepGoing) {
   EXPECT_NE(r.output.find("--keep-going"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(dir / "o1" / "good"));
 
-  r = runMorphoflow("batch " + good.string() + " " + bad.string() + " --keep-going --quiet --out " + (dir / "o2").string());
+  r = runMorphoflow("batch " + good.string() + " " + bad.string() + " --keep-going --quiet --out " +
+                    (dir / "o2").string());
   EXPECT_EQ(r.status, 2) << r.output;
   const nlohmann::json s = readJson(dir / "o2" / "batch.json");
   EXPECT_EQ(runNamed(s, "good")["status"], "completed");
@@ -156,7 +163,8 @@ TEST(Batch, AnInvalidSceneStopsTheBatchBeforeAnythingRunsUnlessKeepGoing) {
 TEST(Batch, SetAppliesToEveryRunAndJobsDivideTheThreads) {
   const fs::path dir = tempDir("batch_set");
   const fs::path a = writeScene(dir, "a", 50, 10), b = writeScene(dir, "b", 60, 10);
-  CommandResult one = runMorphoflow("run " + a.string() + " --quiet --set time.steps=1 --out " + (dir / "one").string());
+  CommandResult one =
+      runMorphoflow("run " + a.string() + " --quiet --set time.steps=1 --out " + (dir / "one").string());
   ASSERT_EQ(one.status, 0) << one.output;
   const int machine = readJson(dir / "one" / "run.json")["threads"];
   // Scene files may follow a --set (each takes one value).
@@ -195,9 +203,12 @@ TEST(Batch, ResumeWithAChangedSetRunsTheSceneAgain) {
 // is done again, not skipped as completed; unchanged, it is skipped.
 TEST(Batch, ResumeRunsASceneAgainWhenAnInputFileChanged) {
   const fs::path dir = tempDir("batch_resume_input"), out = dir / "out";
-  auto image = [&](int grey) { std::ofstream(dir / "m.pgm", std::ios::binary) << "P5 8 8 255\n" << std::string(64 + grey % 2, char(grey)); };
+  auto image = [&](int grey) {
+    std::ofstream(dir / "m.pgm", std::ios::binary) << "P5 8 8 255\n" << std::string(64 + grey % 2, char(grey));
+  };
   image(100);
-  const fs::path scene = writeScene(dir, "mapped", 20, 10, "[rd.maps]\nF = { image = \"m.pgm\", range = [0.03, 0.05] }\n");
+  const fs::path scene =
+      writeScene(dir, "mapped", 20, 10, "[rd.maps]\nF = { image = \"m.pgm\", range = [0.03, 0.05] }\n");
   const std::string cmd = "batch " + scene.string() + " --quiet --out " + out.string();
   ASSERT_EQ(runMorphoflow(cmd).status, 0);
   ASSERT_EQ(runMorphoflow(cmd + " --resume").status, 0);
@@ -210,7 +221,8 @@ TEST(Batch, ResumeRunsASceneAgainWhenAnInputFileChanged) {
 
 TEST(Batch, SigintCheckpointsTheRunningScenesAndResumeFinishesOnlyWhatIsLeft) {
   const fs::path dir = tempDir("batch_resume"), out = dir / "out";
-  const fs::path quick = writeScene(dir, "quick", 20, 10), slow = writeScene(dir, "slow", 30000, 1000, "checkpoint_every = 1\n");
+  const fs::path quick = writeScene(dir, "quick", 20, 10),
+                 slow = writeScene(dir, "slow", 30000, 1000, "checkpoint_every = 1\n");
   const pid_t batch = startMorphoflow(batchArgs({quick, slow}, out, {"--jobs", "2"}), dir / "log1.txt");
   // The batch has seen the quick scene's process end (its summary says so;
   // run.json alone is written just before the process exits, and a signal
@@ -224,8 +236,11 @@ TEST(Batch, SigintCheckpointsTheRunningScenesAndResumeFinishesOnlyWhatIsLeft) {
       return false;
     }
   };
-  ASSERT_TRUE(waitUntil([&] { return fs::exists(out / "slow" / "checkpoints") && countFiles(out / "slow" / "checkpoints") > 0 &&
-                                     quickDone(); }, 60));
+  ASSERT_TRUE(waitUntil(
+      [&] {
+        return fs::exists(out / "slow" / "checkpoints") && countFiles(out / "slow" / "checkpoints") > 0 && quickDone();
+      },
+      60));
   kill(batch, SIGINT);
   EXPECT_EQ(waitMorphoflow(batch), 130);
   nlohmann::json s = readJson(out / "batch.json");
@@ -237,7 +252,8 @@ TEST(Batch, SigintCheckpointsTheRunningScenesAndResumeFinishesOnlyWhatIsLeft) {
   const auto quickWritten = fs::last_write_time(out / "quick" / "run.json");
 
   // The completed scene is skipped (its run.json untouched); the interrupted one continues.
-  CommandResult r = runMorphoflow("batch " + quick.string() + " " + slow.string() + " --resume --quiet --out " + out.string());
+  CommandResult r =
+      runMorphoflow("batch " + quick.string() + " " + slow.string() + " --resume --quiet --out " + out.string());
   EXPECT_EQ(r.status, 0) << r.output;
   s = readJson(out / "batch.json");
   EXPECT_EQ(runNamed(s, "quick")["status"], "skipped");
@@ -318,7 +334,8 @@ TEST(Batch, GatherRefusesSummariesThatDoNotHold) {
     std::ofstream(file, std::ios::trunc) << j.dump();
     const CommandResult r = runMorphoflow("gather " + out.string());
     EXPECT_EQ(r.status, 2) << what << "\n" << r.output;
-    EXPECT_NE(r.output.find(what == "a run short" ? out.string() : file.string()), std::string::npos) << what << "\n" << r.output;
+    EXPECT_NE(r.output.find(what == "a run short" ? out.string() : file.string()), std::string::npos) << what << "\n"
+                                                                                                      << r.output;
   }
   std::ofstream(file, std::ios::trunc) << good.dump();
   const fs::path huge = out / "batch.shard-1-of-99999999999999999999.json", fifo = out / "batch.shard-3-of-4.json";
@@ -364,9 +381,10 @@ TEST(Batch, ShardsSplitTheScenesAndGatherMergesTheirSummaries) {
 TEST(Sweep, EveryCombinationInItsFolderWithACsvAndAContactSheet) {
   const fs::path dir = tempDir("sweep"), out = dir / "out";
   const fs::path scene = writeScene(dir, "gs", 200, 100);
-  CommandResult r = runMorphoflow("sweep " + scene.string() +
-                                  " --vary rd.parameters.F=0.02:0.04:2 --vary 'rd.parameters.k=[0.055,0.065]' --jobs 2 --quiet --out " +
-                                  out.string());
+  CommandResult r = runMorphoflow(
+      "sweep " + scene.string() +
+      " --vary rd.parameters.F=0.02:0.04:2 --vary 'rd.parameters.k=[0.055,0.065]' --jobs 2 --quiet --out " +
+      out.string());
   ASSERT_EQ(r.status, 0) << r.output;
   std::vector<std::string> folders;
   for (const char* F : {"0.02", "0.04"})
@@ -422,7 +440,8 @@ TEST(Sweep, EveryCombinationInItsFolderWithACsvAndAContactSheet) {
       double sum = 0;
       int n = 0;
       for (int y = rows[size_t(row)].first; y < rows[size_t(row)].second; ++y)
-        for (int x = cols[size_t(c)].first; x < cols[size_t(c)].second; ++x, ++n) sum += sheet.pixels[size_t(y) * size_t(sheet.width) + size_t(x)];
+        for (int x = cols[size_t(c)].first; x < cols[size_t(c)].second; ++x, ++n)
+          sum += sheet.pixels[size_t(y) * size_t(sheet.width) + size_t(x)];
       const morphoflow::GrayImage& f = frames[size_t(c) * 2 + size_t(row)];  // F slowest: column c, row k
       double fsum = 0;
       for (float v : f.pixels) fsum += v;

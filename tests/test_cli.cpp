@@ -85,7 +85,8 @@ INSTANTIATE_TEST_SUITE_P(
     Cases, BadScenes,
     ::testing::Values(
         BadScene{"unknown_key", "[fluid]\nviscosty = 0.1\n", "2:1", "did you mean 'fluid.viscosity'"},
-        BadScene{"video_without_png", "[output]\nformat = \"exr\"\nvideo = true\n", "3:9", "needs output.images = true"},
+        BadScene{"video_without_png", "[output]\nformat = \"exr\"\nvideo = true\n", "3:9",
+                 "needs output.images = true"},
         BadScene{"video_fps", "[output]\nvideo = true\nfps = 0\n", "3:7", "output.fps"},
         BadScene{"unknown_table", "[fluids]\nviscosity = 0.1\n", "1:1", "did you mean 'fluid'"},
         BadScene{"wrong_type", "[grid]\nresolution = \"big\"\n", "2:14", "expected an array of numbers"},
@@ -97,27 +98,32 @@ INSTANTIATE_TEST_SUITE_P(
                  "domain.size = [1, 0.5]"},
         BadScene{"both_re_and_nu", "[fluid]\nreynolds = 100\nviscosity = 0.01\n", "2:12", "not both"},
         BadScene{"inflow_no_outflow", "[boundary]\nx_min = \"inflow\"\n", "2:9", "needs an outflow"},
-        BadScene{"vdb_unknown_field", "[output]\nvdb = true\nvdb_fields = [\"sped\"]\n", "3:15", "did you mean 'speed'"},
+        BadScene{"vdb_unknown_field", "[output]\nvdb = true\nvdb_fields = [\"sped\"]\n", "3:15",
+                 "did you mean 'speed'"},
         BadScene{"vdb_density_not_a_field", "[output]\nvdb = true\nvdb_density = \"u\"\n", "3:15", "is not one of"},
-        BadScene{"vdb_fields_without_fluid", "[rd]\nmodel = \"gray-scott\"\n[output]\nvdb = true\nvdb_fields = [\"speed\"]\n",
-                 "5:14", "has no fluid"},
+        BadScene{"vdb_fields_without_fluid",
+                 "[rd]\nmodel = \"gray-scott\"\n[output]\nvdb = true\nvdb_fields = [\"speed\"]\n", "5:14",
+                 "has no fluid"},
         BadScene{"unknown_view", "[output]\nview = \"volum\"\n", "2:8", "did you mean 'volume'"},
         BadScene{"volume_view_in_2d", "[output]\nview = \"volume\"\n", "2:8", "for 3D scenes"},
-        BadScene{"vdb_option_without_vdb", "[output]\nvdb_half = true\n", "2:12", "only applies with output.vdb = true"},
+        BadScene{"vdb_option_without_vdb", "[output]\nvdb_half = true\n", "2:12",
+                 "only applies with output.vdb = true"},
         BadScene{"checkpoint_every_negative", "[output]\ncheckpoint_every = -1\n", "2:20", "output.checkpoint_every"},
         BadScene{"obstacle_outside", "[[obstacles]]\nshape = \"circle\"\ncenter = [2.0, 0.5]\nradius = 0.1\n", "3:10",
                  "outside the domain"},
         BadScene{"missing_radius", "[[obstacles]]\nshape = \"circle\"\n", "1:1", "needs a radius"},
         BadScene{"bad_palette", "[output]\ncolormap = \"virdis\"\n", "2:12", "did you mean 'viridis'"},
         BadScene{"missing_image", "[[obstacles]]\nshape = \"image\"\nfile = \"nope.png\"\n", "3:8", "cannot read"},
-        BadScene{"image_obstacle_center", "[[obstacles]]\nshape = \"image\"\ncenter = [0.5, 0.5]\nfile = \"nope.png\"\n", "3:10",
+        BadScene{"image_obstacle_center",
+                 "[[obstacles]]\nshape = \"image\"\ncenter = [0.5, 0.5]\nfile = \"nope.png\"\n", "3:10",
                  "a center does not apply"},
         BadScene{"rd_unknown_model", "[rd]\nmodel = \"grey-scott\"\n", "2:9", "did you mean 'gray-scott'"},
         BadScene{"rd_negative_diffusion", "[rd]\nmodel = \"gray-scott\"\ndiffusion = [1.0, -0.5]\n", "3:19",
                  "expected a number in [0,"},
         BadScene{"rd_unknown_parameter", "[rd]\nmodel = \"gray-scott\"\n[rd.parameters]\nf = 0.04\n", "4:5",
                  "did you mean 'rd.parameters.F'"},
-        BadScene{"rd_bad_palette", "[rd]\nmodel = \"barkley\"\n[output]\ncolormap = \"jet\"\n", "4:12", "is not one of"},
+        BadScene{"rd_bad_palette", "[rd]\nmodel = \"barkley\"\n[output]\ncolormap = \"jet\"\n", "4:12",
+                 "is not one of"},
         BadScene{"rd_bad_species", "[rd]\nmodel = \"barkley\"\n[output]\nfield = \"u\"\n", "4:9", "A, B"},
         BadScene{"rd_missing_model", "[rd]\nintegrator = \"kim-lin\"\n", "1:1", "needs rd.model"},
         BadScene{"rd_map_syntax", "[rd]\nmodel = \"turing-sanderson\"\n[rd.maps]\nbeta = \"16 - 0.5 * r /\"\n", "4:23",
@@ -126,79 +132,100 @@ INSTANTIATE_TEST_SUITE_P(
                  "unknown name 'rr'"},
         BadScene{"rd_map_unknown_parameter", "[rd]\nmodel = \"turing-sanderson\"\n[rd.maps]\nbetta = \"16\"\n", "4:9",
                  "did you mean 'beta'"},
-        BadScene{"rd_map_not_finite", "[grid]\nresolution = [8, 8]\n[rd]\nmodel = \"turing-sanderson\"\n[rd.maps]\nbeta = \"1 / (i - 3)\"\n",
+        BadScene{"rd_map_not_finite",
+                 "[grid]\nresolution = [8, 8]\n[rd]\nmodel = \"turing-sanderson\"\n[rd.maps]\nbeta = \"1 / (i - 3)\"\n",
                  "6:8", "not finite at cell (3, 0)"},
-        BadScene{"rd_map_missing_image", "[rd]\nmodel = \"turing-sanderson\"\n[rd.maps]\nbeta = { image = \"nope.png\" }\n",
-                 "4:18", "cannot read the image"},
+        BadScene{"rd_map_missing_image",
+                 "[rd]\nmodel = \"turing-sanderson\"\n[rd.maps]\nbeta = { image = \"nope.png\" }\n", "4:18",
+                 "cannot read the image"},
         BadScene{"rd_initial_map_species", "[rd]\nmodel = \"barkley\"\n[rd.initial.maps]\nu = \"x\"\n", "4:5",
                  "not a species of barkley"},
-        BadScene{"rd_fixed_empty", "[rd]\nmodel = \"brusselator\"\n[[rd.fixed]]\nwhere = \"j < 0\"\nvalues = [0, 5]\n", "4:9",
-                 "no cell is inside"},
-        BadScene{"rd_fixed_species", "[rd]\nmodel = \"brusselator\"\n[[rd.fixed]]\nwhere = \"j == 0\"\nspecies = [\"c\"]\nvalues = [0]\n",
+        BadScene{"rd_fixed_empty", "[rd]\nmodel = \"brusselator\"\n[[rd.fixed]]\nwhere = \"j < 0\"\nvalues = [0, 5]\n",
+                 "4:9", "no cell is inside"},
+        BadScene{"rd_fixed_species",
+                 "[rd]\nmodel = \"brusselator\"\n[[rd.fixed]]\nwhere = \"j == 0\"\nspecies = [\"c\"]\nvalues = [0]\n",
                  "5:12", "expected species names of brusselator: a, b"},
-        BadScene{"rd_fixed_values", "[rd]\nmodel = \"brusselator\"\n[[rd.fixed]]\nwhere = \"j == 0\"\nvalues = [0]\n", "5:10",
-                 "expected 2 numbers"},
-        BadScene{"rd_anisotropy_negative", "[grid]\nresolution = [8, 8]\n[rd]\nmodel = \"brusselator\"\n[rd.anisotropy]\nlambda2 = \"x - 0.5\"\n",
+        BadScene{"rd_fixed_values", "[rd]\nmodel = \"brusselator\"\n[[rd.fixed]]\nwhere = \"j == 0\"\nvalues = [0]\n",
+                 "5:10", "expected 2 numbers"},
+        BadScene{"rd_anisotropy_negative",
+                 "[grid]\nresolution = [8, 8]\n[rd]\nmodel = \"brusselator\"\n[rd.anisotropy]\nlambda2 = \"x - 0.5\"\n",
                  "6:11", "must be > 0"},
-        BadScene{"rd_anisotropy_both", "[rd]\nmodel = \"brusselator\"\n[rd.anisotropy]\ntheta = 0\ndirection = [\"x\", \"y\"]\n",
-                 "4:9", "not both"},
+        BadScene{"rd_anisotropy_both",
+                 "[rd]\nmodel = \"brusselator\"\n[rd.anisotropy]\ntheta = 0\ndirection = [\"x\", \"y\"]\n", "4:9",
+                 "not both"},
         BadScene{"rd_anisotropy_direction", "[rd]\nmodel = \"brusselator\"\n[rd.anisotropy]\ndirection = [\"x\"]\n",
                  "4:13", "array of 2 fields"},
-        BadScene{"rd_anisotropy_shape_species", "[rd]\nmodel = \"brusselator\"\n[rd.anisotropy]\nshape = 0.2\nshape_species = \"c\"\n",
-                 "5:17", "is not one of"},
+        BadScene{"rd_anisotropy_shape_species",
+                 "[rd]\nmodel = \"brusselator\"\n[rd.anisotropy]\nshape = 0.2\nshape_species = \"c\"\n", "5:17",
+                 "is not one of"},
         BadScene{"rd_lobes_missing_speeds", "[rd]\nmodel = \"gray-scott\"\n[rd.cosine_lobes]\ntheta0 = 0.5\n", "3:1",
                  "need speeds = [a_1, ..., a_j]"},
         BadScene{"rd_lobes_negative", "[rd]\nmodel = \"gray-scott\"\n[rd.cosine_lobes]\nspeeds = [1.0, -1.0]\n", "4:16",
                  "expected a number in [0,"},
         BadScene{"rd_lobes_all_zero", "[rd]\nmodel = \"gray-scott\"\n[rd.cosine_lobes]\nspeeds = [0, 0]\n", "4:10",
                  "give at least one lobe a positive speed"},
-        BadScene{"rd_lobes_witkin_kass", "[rd]\nmodel = \"gray-scott\"\n[rd.cosine_lobes]\nwitkin_kass = true\nspeeds = [1, 2, 3]\n",
-                 "5:10", "expected 2 numbers"},
-        BadScene{"rd_lobes_and_tensor", "[rd]\nmodel = \"gray-scott\"\n[rd.anisotropy]\nlambda1 = 2\n[rd.cosine_lobes]\nspeeds = [1]\n",
-                 "5:1", "use one"},
-        BadScene{"rd_lobes_unknown_key", "[rd]\nmodel = \"gray-scott\"\n[rd.cosine_lobes]\nspeeds = [1]\ntheta_0 = 1\n", "5:1",
-                 "did you mean 'rd.cosine_lobes.theta0'"},
-        BadScene{"stroke_outside", "[rd]\nmodel = \"gray-scott\"\n[[rd.strokes]]\npoints = [[1, 1], [900, 1]]\n", "4:19",
-                 "outside the domain"},
+        BadScene{"rd_lobes_witkin_kass",
+                 "[rd]\nmodel = \"gray-scott\"\n[rd.cosine_lobes]\nwitkin_kass = true\nspeeds = [1, 2, 3]\n", "5:10",
+                 "expected 2 numbers"},
+        BadScene{"rd_lobes_and_tensor",
+                 "[rd]\nmodel = \"gray-scott\"\n[rd.anisotropy]\nlambda1 = 2\n[rd.cosine_lobes]\nspeeds = [1]\n", "5:1",
+                 "use one"},
+        BadScene{"rd_lobes_unknown_key", "[rd]\nmodel = \"gray-scott\"\n[rd.cosine_lobes]\nspeeds = [1]\ntheta_0 = 1\n",
+                 "5:1", "did you mean 'rd.cosine_lobes.theta0'"},
+        BadScene{"stroke_outside", "[rd]\nmodel = \"gray-scott\"\n[[rd.strokes]]\npoints = [[1, 1], [900, 1]]\n",
+                 "4:19", "outside the domain"},
         BadScene{"stroke_one_point", "[rd]\nmodel = \"gray-scott\"\n[[rd.strokes]]\npoints = [[1, 1]]\n", "4:10",
                  "at least two points"},
-        BadScene{"stroke_point_length", "[rd]\nmodel = \"gray-scott\"\n[[rd.strokes]]\npoints = [[1, 1], [2]]\n", "4:19",
-                 "expected a point [x, y]"},
-        BadScene{"stroke_deposit_without_values", "[rd]\nmodel = \"gray-scott\"\n[[rd.strokes]]\npoints = [[1, 1], [2, 2]]\nspecies = [\"v\"]\n",
-                 "3:1", "needs values"},
-        BadScene{"strokes_theta0_without_strokes", "[rd]\nmodel = \"gray-scott\"\n[rd.cosine_lobes]\nspeeds = [1]\ntheta0 = \"strokes\"\n",
-                 "5:10", "but the scene has none"},
-        BadScene{"stroke_image_missing", "[rd]\nmodel = \"gray-scott\"\n[[rd.strokes]]\nimage = \"dark.png\"\n", "4:9", "cannot read"},
-        BadScene{"normal_map_3d", "[grid]\nresolution = [8, 8, 8]\n[output]\nnormal_map = true\n", "4:14", "this scene is 3D"},
-        BadScene{"normal_strength_zero", "[output]\nnormal_map = true\nnormal_strength = 0\n", "3:19", "output.normal_strength"},
-        BadScene{"generalized_unknown_preset", "[rd]\nmodel = \"gray-scott\"\n[rd.generalized]\npreset = \"g\"\n", "4:10",
-                 "is not one of"},
-        BadScene{"generalized_wrong_rank", "[rd]\nmodel = \"gray-scott\"\n[rd.generalized]\nd3 = [1, 0, 0, 1, 0]\n", "4:6",
-                 "rank-3 tensor: 4 unique components"},
-        BadScene{"generalized_3d", "[grid]\nresolution = [8, 8, 8]\n[rd]\nmodel = \"gray-scott\"\n[rd.generalized]\npreset = \"d\"\n",
+        BadScene{"stroke_point_length", "[rd]\nmodel = \"gray-scott\"\n[[rd.strokes]]\npoints = [[1, 1], [2]]\n",
+                 "4:19", "expected a point [x, y]"},
+        BadScene{"stroke_deposit_without_values",
+                 "[rd]\nmodel = \"gray-scott\"\n[[rd.strokes]]\npoints = [[1, 1], [2, 2]]\nspecies = [\"v\"]\n", "3:1",
+                 "needs values"},
+        BadScene{"strokes_theta0_without_strokes",
+                 "[rd]\nmodel = \"gray-scott\"\n[rd.cosine_lobes]\nspeeds = [1]\ntheta0 = \"strokes\"\n", "5:10",
+                 "but the scene has none"},
+        BadScene{"stroke_image_missing", "[rd]\nmodel = \"gray-scott\"\n[[rd.strokes]]\nimage = \"dark.png\"\n", "4:9",
+                 "cannot read"},
+        BadScene{"normal_map_3d", "[grid]\nresolution = [8, 8, 8]\n[output]\nnormal_map = true\n", "4:14",
+                 "this scene is 3D"},
+        BadScene{"normal_strength_zero", "[output]\nnormal_map = true\nnormal_strength = 0\n", "3:19",
+                 "output.normal_strength"},
+        BadScene{"generalized_unknown_preset", "[rd]\nmodel = \"gray-scott\"\n[rd.generalized]\npreset = \"g\"\n",
+                 "4:10", "is not one of"},
+        BadScene{"generalized_wrong_rank", "[rd]\nmodel = \"gray-scott\"\n[rd.generalized]\nd3 = [1, 0, 0, 1, 0]\n",
+                 "4:6", "rank-3 tensor: 4 unique components"},
+        BadScene{"generalized_3d",
+                 "[grid]\nresolution = [8, 8, 8]\n[rd]\nmodel = \"gray-scott\"\n[rd.generalized]\npreset = \"d\"\n",
                  "5:1", "this scene is 3D"},
-        BadScene{"generalized_walls", "[rd]\nmodel = \"gray-scott\"\nboundary = \"neumann\"\n[rd.generalized]\npreset = \"d\"\n", "4:1",
+        BadScene{"generalized_walls",
+                 "[rd]\nmodel = \"gray-scott\"\nboundary = \"neumann\"\n[rd.generalized]\npreset = \"d\"\n", "4:1",
                  "needs a periodic layer"},
         BadScene{"generalized_unstable",
-                 "[time]\ndt = 1.0\n[rd]\nmodel = \"gray-scott\"\nintegrator = \"explicit\"\ndiffusion = [0.2, 0.1]\n[rd.generalized]\npreset = \"d\"\n",
+                 "[time]\ndt = 1.0\n[rd]\nmodel = \"gray-scott\"\nintegrator = \"explicit\"\ndiffusion = [0.2, "
+                 "0.1]\n[rd.generalized]\npreset = \"d\"\n",
                  "7:1", "the largest step within the bound"},
         BadScene{"velocity_wrong_length", "[rd]\nmodel = \"gray-scott\"\n[velocity]\nfield = [\"1\"]\n", "4:9",
                  "expected two expressions"},
-        BadScene{"velocity_unknown_variable", "[rd]\nmodel = \"gray-scott\"\n[velocity]\nfield = [\"1\", \"q\"]\n", "4:16",
-                 "in the velocity expression"},
-        BadScene{"velocity_with_fluid", "[fluid]\nreynolds = 100\n[rd]\nmodel = \"gray-scott\"\n[velocity]\nfield = [\"1\", \"0\"]\n",
-                 "5:1", "has a [fluid]"},
-        BadScene{"velocity_both", "[rd]\nmodel = \"gray-scott\"\n[velocity]\nfield = [\"1\", \"0\"]\nvdb = \"a.vdb\"\n", "5:7",
-                 "not both"},
-        BadScene{"velocity_python_and_field", "[rd]\nmodel = \"gray-scott\"\n[velocity]\npython = true\nfield = [\"1\", \"0\"]\n",
-                 "5:9", "give no field or vdb"},
+        BadScene{"velocity_unknown_variable", "[rd]\nmodel = \"gray-scott\"\n[velocity]\nfield = [\"1\", \"q\"]\n",
+                 "4:16", "in the velocity expression"},
+        BadScene{"velocity_with_fluid",
+                 "[fluid]\nreynolds = 100\n[rd]\nmodel = \"gray-scott\"\n[velocity]\nfield = [\"1\", \"0\"]\n", "5:1",
+                 "has a [fluid]"},
+        BadScene{"velocity_both", "[rd]\nmodel = \"gray-scott\"\n[velocity]\nfield = [\"1\", \"0\"]\nvdb = \"a.vdb\"\n",
+                 "5:7", "not both"},
+        BadScene{"velocity_python_and_field",
+                 "[rd]\nmodel = \"gray-scott\"\n[velocity]\npython = true\nfield = [\"1\", \"0\"]\n", "5:9",
+                 "give no field or vdb"},
         BadScene{"speed_map_without_velocity", "[rd]\nmodel = \"turing-sanderson\"\n[rd.maps]\ns = \"speed\"\n", "4:5",
                  "has no [velocity]"},
-        BadScene{"coupling_without_rd", "[fluid]\nreynolds = 100\n[coupling]\nmode = \"ard\"\n", "3:1", "lacks one of them"},
-        BadScene{"coupling_bad_mode", "[fluid]\nreynolds = 100\n[rd]\nmodel = \"gray-scott\"\n[coupling]\nmode = \"pasive\"\n",
-                 "6:8", "did you mean 'passive'"},
-        BadScene{"coupling_boundary_mismatch", "[fluid]\nreynolds = 100\n[rd]\nmodel = \"gray-scott\"\nboundary = \"periodic\"\n",
-                 "5:12", "must wrap exactly where the fluid does"}),
+        BadScene{"coupling_without_rd", "[fluid]\nreynolds = 100\n[coupling]\nmode = \"ard\"\n", "3:1",
+                 "lacks one of them"},
+        BadScene{"coupling_bad_mode",
+                 "[fluid]\nreynolds = 100\n[rd]\nmodel = \"gray-scott\"\n[coupling]\nmode = \"pasive\"\n", "6:8",
+                 "did you mean 'passive'"},
+        BadScene{"coupling_boundary_mismatch",
+                 "[fluid]\nreynolds = 100\n[rd]\nmodel = \"gray-scott\"\nboundary = \"periodic\"\n", "5:12",
+                 "must wrap exactly where the fluid does"}),
     [](const ::testing::TestParamInfo<BadScene>& i) { return i.param.name; });
 
 // A scene whose velocity comes from Python validates, but the command line
@@ -240,13 +267,16 @@ TEST(Cli, AnOverrideErrorPointsAtTheElementWithinTheValue) {
   struct Case {
     std::string set, bad, key;
   };
-  for (const Case& c : {Case{"obstacles=[{shape=\"circle\", center=[0.5, \"q\"], radius=0.1}]", "\"q\"", "obstacles.0.center"},
-                        Case{"obstacles=[{shape=\"circle\", center=[0.5, 0.5], radius=-1}]", "-1", "obstacles.0.radius"},
-                        Case{"fluid.viscosity=-1", "-1", "fluid.viscosity"},
-                        Case{"output.vdb_density=\"speed * nope\"", "nope", "output.vdb_density"}}) {
-    const CommandResult r = runMorphoflow("run " + scene + " --quiet --out " + (dir / "o").string() + " --set '" + c.set + "'");
+  for (const Case& c :
+       {Case{"obstacles=[{shape=\"circle\", center=[0.5, \"q\"], radius=0.1}]", "\"q\"", "obstacles.0.center"},
+        Case{"obstacles=[{shape=\"circle\", center=[0.5, 0.5], radius=-1}]", "-1", "obstacles.0.radius"},
+        Case{"fluid.viscosity=-1", "-1", "fluid.viscosity"},
+        Case{"output.vdb_density=\"speed * nope\"", "nope", "output.vdb_density"}}) {
+    const CommandResult r =
+        runMorphoflow("run " + scene + " --quiet --out " + (dir / "o").string() + " --set '" + c.set + "'");
     EXPECT_EQ(r.status, 2) << r.output;
-    const std::string at = "--set " + c.set + ":1:" + std::to_string(c.set.find(c.bad) + 1) + ": error: '" + c.key + "'";
+    const std::string at =
+        "--set " + c.set + ":1:" + std::to_string(c.set.find(c.bad) + 1) + ": error: '" + c.key + "'";
     EXPECT_NE(r.output.find(at), std::string::npos) << "expected " << at << "\n" << r.output;
   }
   fs::remove_all(dir);
@@ -267,7 +297,8 @@ TEST(Cli, OverridesReachTheSimulationAndRunJsonIsComplete) {
   for (const char* stage : {"forces", "advect", "diffuse", "project"}) EXPECT_TRUE(j["stages"].contains(stage));
   EXPECT_GT(j["solvers"]["pressure_iterations_mean"].get<double>(), 0.0);
   // Frames 0, 2 and 4 (every 2 steps, the initial state included).
-  for (const char* f : {"000000.png", "000001.png", "000002.png"}) EXPECT_TRUE(fs::exists(dir / "out" / "frames" / f)) << f;
+  for (const char* f : {"000000.png", "000001.png", "000002.png"})
+    EXPECT_TRUE(fs::exists(dir / "out" / "frames" / f)) << f;
   EXPECT_FALSE(fs::exists(dir / "out" / "frames" / "000003.png"));
   fs::remove_all(dir);
 }
@@ -276,8 +307,9 @@ TEST(Cli, SerialAndTbbBackendsGiveIdenticalResults) {
   auto dir = tempDir("backends");
   fs::path p = writeScene(dir, "s.toml", kSmall);
   for (std::string b : {"serial", "tbb"}) {
-    CommandResult r = runMorphoflow("run " + p.string() + " --set probes.centerlines=true --set time.steps=30 --backend " +
-                                    b + " --quiet --out " + (dir / b).string());
+    CommandResult r =
+        runMorphoflow("run " + p.string() + " --set probes.centerlines=true --set time.steps=30 --backend " + b +
+                      " --quiet --out " + (dir / b).string());
     ASSERT_EQ(r.status, 0) << r.output;
   }
   auto read = [](const fs::path& f) {
@@ -302,9 +334,10 @@ TEST(Cli, ShippedScenesValidate) {
 // from the fluid's).
 TEST(Cli, CoupledScenesRunAndBackendsAgree) {
   auto dir = tempDir("coupled");
-  for (const char* s : {"cavity_gray_scott.toml", "cavity_passive.toml", "cavity_barkley.toml", "cavity_fitzhugh_nagumo.toml",
-                        "obstacle_passive.toml", "obstacle_gray_scott_ard.toml", "obstacle_gray_scott_rd_only.toml",
-                        "cavity_gray_scott_3d.toml", "obstacle_gray_scott_3d.toml"}) {
+  for (const char* s :
+       {"cavity_gray_scott.toml", "cavity_passive.toml", "cavity_barkley.toml", "cavity_fitzhugh_nagumo.toml",
+        "obstacle_passive.toml", "obstacle_gray_scott_ard.toml", "obstacle_gray_scott_rd_only.toml",
+        "cavity_gray_scott_3d.toml", "obstacle_gray_scott_3d.toml"}) {
     const std::string file = sceneFile(std::string("coupled/") + s);
     CommandResult v = runMorphoflow("validate " + file);
     EXPECT_EQ(v.status, 0) << s << ": " << v.output;
@@ -315,9 +348,10 @@ TEST(Cli, CoupledScenesRunAndBackendsAgree) {
     std::vector<morphoflow::FieldDump> dumps;
     for (std::string b : {"serial", "tbb"}) {
       const fs::path out = dir / (std::string(s) + b);
-      CommandResult r = runMorphoflow("run " + file + " --set grid.resolution=" + res + " --set rd.resolution=" + rdRes +
-                                      " --set time.steps=12 --set output.every=6 --set output.fields=true --backend " + b +
-                                      " --quiet --out " + out.string());
+      CommandResult r =
+          runMorphoflow("run " + file + " --set grid.resolution=" + res + " --set rd.resolution=" + rdRes +
+                        " --set time.steps=12 --set output.every=6 --set output.fields=true --backend " + b +
+                        " --quiet --out " + out.string());
       ASSERT_EQ(r.status, 0) << s << ": " << r.output;
       morphoflow::FieldDump d;
       std::string err;
@@ -336,8 +370,9 @@ TEST(Cli, ThreeDScenesRunAtLowResolution) {
   auto dir = tempDir("threed");
   for (const char* s : {"lid_driven_cavity_3d.toml", "flow_past_obstacle_3d.toml"}) {
     std::string res = std::string(s).find("obstacle") != std::string::npos ? "[24,8,8]" : "[12,12,12]";
-    CommandResult r = runMorphoflow("run " + sceneFile(s) + " --set grid.resolution=" + res +
-                                    " --set time.duration=0.5 --set output.every=5 --quiet --out " + (dir / s).string());
+    CommandResult r =
+        runMorphoflow("run " + sceneFile(s) + " --set grid.resolution=" + res +
+                      " --set time.duration=0.5 --set output.every=5 --quiet --out " + (dir / s).string());
     ASSERT_EQ(r.status, 0) << s << ": " << r.output;
     EXPECT_TRUE(fs::exists(dir / s / "run.json"));
     EXPECT_TRUE(fs::exists(dir / s / "frames" / "000000.png"));
@@ -395,7 +430,8 @@ TEST(Cli, ReactionDiffusionSceneRuns) {
 TEST(Cli, BlockedStepsGiveTheFramesOfSingleSteps) {
   auto dir = tempDir("rd_blocked");
   fs::path p = writeScene(dir, "gs.toml", std::string(kGrayScottScene) + "images = false\nfields = true\n");
-  const std::string blocks = " --set grid.resolution=[1536,1536] --set time.steps=16 --set 'rd.integrator=\"explicit\"' ";
+  const std::string blocks =
+      " --set grid.resolution=[1536,1536] --set time.steps=16 --set 'rd.integrator=\"explicit\"' ";
   std::vector<morphoflow::FieldDump> dumps;
   for (const char* run : {"--set output.every=8", "--set output.every=1 --frames 16:16"}) {
     const fs::path out = dir / (dumps.empty() ? "blocked" : "single");
@@ -406,7 +442,9 @@ TEST(Cli, BlockedStepsGiveTheFramesOfSingleSteps) {
     EXPECT_GT(j["resolved"]["steps_per_pass"].get<int>(), 1);
     morphoflow::FieldDump d;
     std::string err;
-    ASSERT_TRUE(morphoflow::readFieldDump((out / "fields" / (dumps.empty() ? "000002.exr" : "000016.exr")).string(), &d, &err)) << err;
+    ASSERT_TRUE(
+        morphoflow::readFieldDump((out / "fields" / (dumps.empty() ? "000002.exr" : "000016.exr")).string(), &d, &err))
+        << err;
     EXPECT_EQ(d.step, 16);
     dumps.push_back(d);
     if (dumps.size() == 1) {  // the frame between: its step too
@@ -416,7 +454,8 @@ TEST(Cli, BlockedStepsGiveTheFramesOfSingleSteps) {
   }
   ASSERT_EQ(dumps[0].channels.size(), 2u);
   EXPECT_EQ(dumps[0].channels, dumps[1].channels);
-  EXPECT_NE(dumps[0].channels[1], std::vector<float>(dumps[0].channels[1].size(), 0.0f)) << "the square's v must spread";
+  EXPECT_NE(dumps[0].channels[1], std::vector<float>(dumps[0].channels[1].size(), 0.0f))
+      << "the square's v must spread";
   fs::remove_all(dir);
 }
 
@@ -457,8 +496,9 @@ TEST(Cli, PaintedStrokesDepositAndSteerTheLobes) {
   std::vector<morphoflow::FieldDump> dumps;
   for (const char* name : {"kim_lin_paint_deposit", "kim_lin_paint_lobe"}) {
     const std::string file = sceneFile(std::string("rd/seeds/") + name + ".toml");
-    CommandResult r = runMorphoflow("run " + file + " --set grid.resolution=[64,64] --set time.steps=40 --set output.every=40" +
-                                    " --set output.fields=true --quiet --out " + (dir / name).string());
+    CommandResult r =
+        runMorphoflow("run " + file + " --set grid.resolution=[64,64] --set time.steps=40 --set output.every=40" +
+                      " --set output.fields=true --quiet --out " + (dir / name).string());
     ASSERT_EQ(r.status, 0) << name << ": " << r.output;
     morphoflow::FieldDump d;
     std::string err;
@@ -497,7 +537,8 @@ TEST(Cli, GeneralizedDiffusionReportsItsSpectralRadiusAndPlotsItsPropagator) {
   size_t ink = 0;
   for (float v : img.channels[0]) ink += v < 0.5f;
   EXPECT_GT(ink, 100u);
-  r = runMorphoflow("plot propagator " + sceneFile("rd/gray_scott_pearson.toml") + " --out " + (dir / "x.png").string());
+  r = runMorphoflow("plot propagator " + sceneFile("rd/gray_scott_pearson.toml") + " --out " +
+                    (dir / "x.png").string());
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("no [rd.generalized]"), std::string::npos) << r.output;
   r = runMorphoflow("run " + scene + " --backend gpu --quiet --out " + (dir / "gpu").string());
@@ -511,10 +552,11 @@ TEST(Cli, GeneralizedDiffusionReportsItsSpectralRadiusAndPlotsItsPropagator) {
 // periodic layer, at output.normal_strength.
 TEST(Cli, NormalMapsAgreeWithTheirHeightField) {
   auto dir = tempDir("normals");
-  CommandResult r = runMorphoflow("run " + sceneFile("rd/gray_scott_pearson.toml") +
-                                  " --set grid.resolution=[48,48] --set domain.size=[0.46875,0.46875] --set time.steps=200" +
-                                  " --set output.every=200 --set output.normal_map=true --set output.normal_strength=6 --quiet --out " +
-                                  (dir / "out").string());
+  CommandResult r = runMorphoflow(
+      "run " + sceneFile("rd/gray_scott_pearson.toml") +
+      " --set grid.resolution=[48,48] --set domain.size=[0.46875,0.46875] --set time.steps=200" +
+      " --set output.every=200 --set output.normal_map=true --set output.normal_strength=6 --quiet --out " +
+      (dir / "out").string());
   ASSERT_EQ(r.status, 0) << r.output;
   morphoflow::FieldDump height, normals;
   std::string err;
@@ -626,7 +668,8 @@ TEST(Cli, TextonAndAnalyze) {
   const std::string lattice = (dir / "lattice.exr").string(), walked = (dir / "walked.png").string();
   CommandResult a = runMorphoflow("texton --size 128 --elements 64 --steps 0 --start regular --out " + lattice);
   ASSERT_EQ(a.status, 0) << a.output;
-  CommandResult b = runMorphoflow("texton --size 128 --elements 64 --steps 400 --step-size 1 --start regular --out " + walked);
+  CommandResult b =
+      runMorphoflow("texton --size 128 --elements 64 --steps 400 --step-size 1 --start regular --out " + walked);
   ASSERT_EQ(b.status, 0) << b.output;
   CommandResult ra = runMorphoflow("analyze " + lattice + " --max-lag 32 --csv " + (dir / "v.csv").string());
   CommandResult rb = runMorphoflow("analyze " + walked + " --max-lag 32");
@@ -684,7 +727,8 @@ TEST(Cli, CouplingBenchWritesAChromeTrace) {
   EXPECT_EQ(runMorphoflow("bench fluid --size 32 --seconds 0 --trace " + trace.string()).status, 2);
   // A trace into a folder that is a file is refused before the benchmark runs.
   std::ofstream(dir / "file") << "x";
-  EXPECT_EQ(runMorphoflow("bench coupling --size 32 --seconds 0 --trace " + (dir / "file" / "t.json").string()).status, 2);
+  EXPECT_EQ(runMorphoflow("bench coupling --size 32 --seconds 0 --trace " + (dir / "file" / "t.json").string()).status,
+            2);
   fs::remove_all(dir);
 }
 
@@ -701,10 +745,11 @@ TEST(Cli, RooflineBenchRelatesEveryKernelToTheTriad) {
     names.insert(k["kernel"].get<std::string>());
     const double gbs = k["cell_updates_per_second"].get<double>() * k["bytes_per_cell_update"].get<double>() / 1e9;
     EXPECT_NEAR(k["gb_per_second"].get<double>(), gbs, 1e-9 * gbs);
-    EXPECT_NEAR(k["fraction_of_triad"].get<double>(), gbs / j["triad"][std::to_string(k["threads"].get<int>())].get<double>(), 1e-9);
+    EXPECT_NEAR(k["fraction_of_triad"].get<double>(),
+                gbs / j["triad"][std::to_string(k["threads"].get<int>())].get<double>(), 1e-9);
   }
-  for (const char* k : {"rd explicit (double)", "rd fused (float)", "rd fused 5x5 (float)", "coupling chemical advection",
-                        "fluid velocity advection"})
+  for (const char* k : {"rd explicit (double)", "rd fused (float)", "rd fused 5x5 (float)",
+                        "coupling chemical advection", "fluid velocity advection"})
     EXPECT_TRUE(names.count(k)) << k;
   fs::remove_all(dir);
 }

@@ -14,7 +14,7 @@
 #include "core/parallel.h"
 #include "core/simd_dispatch.h"
 #include "core/random.h"
-#include "coupling/coupled_stepper.h"
+#include "coupling/cpu_coupled_stepper.h"
 #include "rd/model_registry.h"
 
 using namespace morphoflow;
@@ -234,7 +234,7 @@ struct CoupledRun {
 };
 
 // A Gray-Scott layer in a lid-driven cavity, run with one backend.
-CoupledRun runCavity(CouplingBackend backend, int threads, int steps, double dt, int rdCells,
+CoupledRun runCavity(Backend backend, int threads, int steps, double dt, int rdCells,
                       StageTrace* trace = nullptr) {
   ThreadLimit limit(threads);
   FluidSolver<2> fluid(cavity(24, 400));
@@ -255,22 +255,23 @@ CoupledRun runCavity(CouplingBackend backend, int threads, int steps, double dt,
   d.cells = rd.cells();
   d.h = rd.h();
   ARDSolver<2> ard(&rd, ChemicalAdvector<2>(d, ChemicalInterpolation::Cubic), CouplingMode::ARD, 50.0);
-  CoupledStepper<2> stepper(&fluid, &ard, backend);
+  CpuCoupledStepper<2> stepper(&fluid, &ard, backend);
   stepper.setTrace(trace);
   for (int i = 0; i < steps; ++i) stepper.step(dt);
   CoupledRun r;
   for (int sp = 0; sp < 2; ++sp) r.species.push_back(rd.field(sp).values());
-  for (int a = 0; a < 2; ++a) r.velocity.insert(r.velocity.end(), fluid.velocity()[a].values().begin(), fluid.velocity()[a].values().end());
+  for (int a = 0; a < 2; ++a)
+    r.velocity.insert(r.velocity.end(), fluid.velocity()[a].values().begin(), fluid.velocity()[a].values().end());
   return r;
 }
 
 }  // namespace
 
 // Serial and tbb (overlapped) give the same bits, for 1 and 2 threads.
-TEST(CoupledStepper, SerialAndTbbAreBitwiseIdentical) {
-  const CoupledRun a = runCavity(CouplingBackend::Serial, 1, 30, 0.02, 40);
-  const CoupledRun b = runCavity(CouplingBackend::TBB, 2, 30, 0.02, 40);
-  const CoupledRun c = runCavity(CouplingBackend::TBB, 1, 30, 0.02, 40);
+TEST(CpuCoupledStepper, SerialAndTbbAreBitwiseIdentical) {
+  const CoupledRun a = runCavity(Backend::Serial, 1, 30, 0.02, 40);
+  const CoupledRun b = runCavity(Backend::TBB, 2, 30, 0.02, 40);
+  const CoupledRun c = runCavity(Backend::TBB, 1, 30, 0.02, 40);
   for (const CoupledRun* o : {&b, &c}) {
     EXPECT_EQ(a.velocity, o->velocity);
     for (int sp = 0; sp < 2; ++sp) EXPECT_EQ(a.species[size_t(sp)], o->species[size_t(sp)]) << "species " << sp;
@@ -282,8 +283,8 @@ TEST(CoupledStepper, SerialAndTbbAreBitwiseIdentical) {
 
 // At a time step far beyond the advective CFL limit (lid speed 1, h = 1/24:
 // CFL 6) and 50x the RD clock, the coupled layer stays bounded and finite.
-TEST(CoupledStepper, LargeTimeStepStaysBounded) {
-  const CoupledRun r = runCavity(CouplingBackend::TBB, 2, 300, 0.25, 48);
+TEST(CpuCoupledStepper, LargeTimeStepStaysBounded) {
+  const CoupledRun r = runCavity(Backend::TBB, 2, 300, 0.25, 48);
   for (int sp = 0; sp < 2; ++sp)
     for (double v : r.species[size_t(sp)]) {
       ASSERT_TRUE(std::isfinite(v));
@@ -301,8 +302,8 @@ TEST(CoupledStepper, LargeTimeStepStaysBounded) {
 // 160^2 keeps each stage long (a few ms) against scheduling jitter: at 96^2
 // the faster solvers left too short a window on a loaded machine (ctest -j2),
 // where 3 to 6 of 12 steps overlapped.
-TEST(CoupledStepper, TraceShowsTheOverlap) {
-  auto overlaps = [](CouplingBackend backend, int* threads) {
+TEST(CpuCoupledStepper, TraceShowsTheOverlap) {
+  auto overlaps = [](Backend backend, int* threads) {
     StageTrace trace;
     runCavity(backend, 2, 12, 0.02, 160, &trace);
     const std::vector<StageTrace::Event> events = trace.events();
@@ -323,10 +324,10 @@ TEST(CoupledStepper, TraceShowsTheOverlap) {
     return steps;
   };
   int serialThreads = 0, tbbThreads = 0;
-  EXPECT_EQ(overlaps(CouplingBackend::Serial, &serialThreads), 0);
+  EXPECT_EQ(overlaps(Backend::Serial, &serialThreads), 0);
   EXPECT_EQ(serialThreads, 1);
   if (std::thread::hardware_concurrency() >= 2) {
-    EXPECT_GT(overlaps(CouplingBackend::TBB, &tbbThreads), 6);
+    EXPECT_GT(overlaps(Backend::TBB, &tbbThreads), 6);
     EXPECT_EQ(tbbThreads, 2);
   }
 }

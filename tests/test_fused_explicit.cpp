@@ -139,7 +139,8 @@ TEST(FusedExplicit, TheGeneralizedKernelMatchesRDSolversOperator) {
       reference = {e->field(0), e->field(1)};
       for (int k = 0; k < 30; ++k) rd.step(0.5);
       for (int sp = 0; sp < 2; ++sp)
-        for (size_t i = 0; i < rd.field(sp).size(); ++i) ASSERT_NEAR(e->field(sp)[i], rd.field(sp)[i], 2e-5) << sp << " " << i;
+        for (size_t i = 0; i < rd.field(sp).size(); ++i)
+          ASSERT_NEAR(e->field(sp)[i], rd.field(sp)[i], 2e-5) << sp << " " << i;
     } else {
       for (int sp = 0; sp < 2; ++sp) ASSERT_EQ(e->field(sp), reference[size_t(sp)]) << "variant " << variant;
     }
@@ -185,7 +186,8 @@ std::vector<std::vector<float>> blocked(const std::string& model, const IVec<D>&
   const ModelInfo info = findModel(model)->info();
   auto e = FusedExplicitRD<D>::create(model, n, 1.0, periodic, info.diffusion, {});
   if constexpr (D == 2)
-    if (kernelSpecies >= 0) e->setKernel(GeneralizedDiffusion(*kramersMoyalPreset("d"), n[0], n[1], 1.0).kernel(), {kernelSpecies});
+    if (kernelSpecies >= 0)
+      e->setKernel(GeneralizedDiffusion(*kramersMoyalPreset("d"), n[0], n[1], 1.0).kernel(), {kernelSpecies});
   for (int s = 0; s < e->species(); ++s)
     for (size_t i = 0; i < e->field(s).size(); ++i)
       e->field(s)[i] = float(info.initial[size_t(s)] * (1.0 + 0.2 * (uniform01(19, uint64_t(s), i) - 0.5)));
@@ -232,9 +234,12 @@ TEST(FusedExplicit, TemporalBlockingGivesTheBitsOfSingleSteps) {
 // The automatic choice: no blocking while the state stays in cache, several
 // steps a pass beyond it (then the same bits as single steps).
 TEST(FusedExplicit, BlockingIsChosenForStatesBeyondTheCache) {
-  EXPECT_EQ(FusedExplicitRD<2>::create("gray-scott", IVec<2>(1024, 1024), 1.0, true, {0.2, 0.1}, {})->stepsPerPass(), 1);
-  EXPECT_EQ(FusedExplicitRD<3>::create("gray-scott", IVec<3>(128, 128, 128), 1.0, true, {0.2, 0.1}, {})->stepsPerPass(), 1);
+  EXPECT_EQ(FusedExplicitRD<2>::create("gray-scott", IVec<2>(1024, 1024), 1.0, true, {0.2, 0.1}, {})->stepsPerPass(),
+            1);
+  EXPECT_EQ(FusedExplicitRD<3>::create("gray-scott", IVec<3>(128, 128, 128), 1.0, true, {0.2, 0.1}, {})->stepsPerPass(),
+            1);
   const IVec<2> big(2048, 2048);
   EXPECT_GT(FusedExplicitRD<2>::create("gray-scott", big, 1.0, true, {0.2, 0.1}, {})->stepsPerPass(), 1);
-  EXPECT_EQ(blocked<2>("gray-scott", big, true, -1, 0, 0, 2, 0.5, 11), blocked<2>("gray-scott", big, true, -1, 1, 0, 2, 0.5, 11));
+  EXPECT_EQ(blocked<2>("gray-scott", big, true, -1, 0, 0, 2, 0.5, 11),
+            blocked<2>("gray-scott", big, true, -1, 1, 0, 2, 0.5, 11));
 }

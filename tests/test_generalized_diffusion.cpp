@@ -27,10 +27,12 @@ double fact(int n) { return std::tgamma(n + 1.0); }
 std::vector<double> propagatorPeaks(const KramersMoyalTensors& t) {
   const int n = 3600;
   std::vector<double> p(n);
-  for (int k = 0; k < n; ++k) p[size_t(k)] = gramCharlierPropagator(t, 0.1, std::cos(2 * M_PI * k / n), std::sin(2 * M_PI * k / n));
+  for (int k = 0; k < n; ++k)
+    p[size_t(k)] = gramCharlierPropagator(t, 0.1, std::cos(2 * M_PI * k / n), std::sin(2 * M_PI * k / n));
   std::vector<double> peaks;
   for (int k = 0; k < n; ++k)
-    if (p[size_t(k)] > p[size_t((k + n - 1) % n)] && p[size_t(k)] >= p[size_t((k + 1) % n)]) peaks.push_back(360.0 * k / n);
+    if (p[size_t(k)] > p[size_t((k + n - 1) % n)] && p[size_t(k)] >= p[size_t((k + 1) % n)])
+      peaks.push_back(360.0 * k / n);
   return peaks;
 }
 
@@ -139,11 +141,13 @@ TEST(GeneralizedDiffusion, RankTwoIsTheAnisotropicLaplacianOfEquation29) {
   const double h = 0.5;
   const GeneralizedDiffusion op(t, 16, 16, h);
   const double Dxx = 1.5, Dxy = 0.4, Dyy = 0.7, c = 0.5 / (h * h);
-  const double eq29[3][3] = {{Dxy, 2 * Dyy, -Dxy}, {2 * Dxx, -4 * (Dxx + Dyy), 2 * Dxx}, {-Dxy, 2 * Dyy, Dxy}};  // rows dy = -1, 0, 1
+  const double eq29[3][3] = {
+      {Dxy, 2 * Dyy, -Dxy}, {2 * Dxx, -4 * (Dxx + Dyy), 2 * Dxx}, {-Dxy, 2 * Dyy, Dxy}};  // rows dy = -1, 0, 1
   for (int dy = -2; dy <= 2; ++dy)
     for (int dx = -2; dx <= 2; ++dx) {
       const bool inner = std::abs(dx) <= 1 && std::abs(dy) <= 1;
-      EXPECT_NEAR(op.kernel()[size_t(dy + 2)][size_t(dx + 2)], inner ? c * eq29[dy + 1][dx + 1] : 0.0, 1e-12) << dx << "," << dy;
+      EXPECT_NEAR(op.kernel()[size_t(dy + 2)][size_t(dx + 2)], inner ? c * eq29[dy + 1][dx + 1] : 0.0, 1e-12)
+          << dx << "," << dy;
     }
   // On u = x^2 - 3 x y + 2 y^2 (wrapped far from the sampled cell): a u_xx + 2 b u_xy + c u_yy.
   std::vector<double> u(256), out;
@@ -195,7 +199,8 @@ TEST(GeneralizedDiffusion, PropagatorsPeakWhereTable2Says) {
   ASSERT_EQ(c.size(), 3u);
   for (double a : {45.0, 165.0, 285.0})
     EXPECT_TRUE(std::any_of(c.begin(), c.end(), [&](double p) { return angleGap(p, a, 360) < 1.0; })) << a;
-  const std::vector<double> d = propagatorPeaks(*kramersMoyalPreset("d")), e = propagatorPeaks(*kramersMoyalPreset("e"));
+  const std::vector<double> d = propagatorPeaks(*kramersMoyalPreset("d")),
+                            e = propagatorPeaks(*kramersMoyalPreset("e"));
   ASSERT_EQ(d.size(), 4u);
   ASSERT_EQ(e.size(), 4u);
   for (double p : d) EXPECT_LT(angleGap(p, 0.0, 90), 0.5) << p;
@@ -214,7 +219,8 @@ TEST(GeneralizedDiffusion, TexturesTakeThePropagatorsOrientations) {
   const std::complex<double> d = grayScottOrientation(*kramersMoyalPreset("d"), 2.2, 1.0, 6000);
   const std::complex<double> e = grayScottOrientation(*kramersMoyalPreset("e"), 1.5, 0.5, 12000);
   const double turn = 20.0;
-  const std::complex<double> r = grayScottOrientation(rotated(*kramersMoyalPreset("e"), turn * M_PI / 180), 1.5, 0.5, 12000);
+  const std::complex<double> r =
+      grayScottOrientation(rotated(*kramersMoyalPreset("e"), turn * M_PI / 180), 1.5, 0.5, 12000);
   EXPECT_GT(d.real(), 0.15) << d;
   EXPECT_LT(e.real(), -0.15) << e;
   EXPECT_GT(std::abs(r), 0.15) << r;

@@ -46,10 +46,11 @@ std::array<double, 3> centroid(const morphoflow::FieldDump& d, size_t c, double 
 // A passive blob of v in a [velocity] scene.
 std::string blobScene(const std::string& field, const std::string& boundary, double dt, int steps, int every,
                       const std::string& centre) {
-  return "name = \"blob\"\n[grid]\nresolution = [64, 64]\n[domain]\nsize = [1.0, 1.0]\n[time]\ndt = " + std::to_string(dt) +
-         "\nsteps = " + std::to_string(steps) + "\n[rd]\nmodel = \"gray-scott\"\nboundary = \"" + boundary +
-         "\"\n[rd.initial]\nvalues = [1.0, 0.0]\n[rd.initial.maps]\nv = \"exp(-(" + centre +
-         ") / 0.004)\"\n[velocity]\nfield = " + field + "\n[coupling]\nmode = \"passive\"\ninterpolation = \"cubic\"\n" +
+  return "name = \"blob\"\n[grid]\nresolution = [64, 64]\n[domain]\nsize = [1.0, 1.0]\n[time]\ndt = " +
+         std::to_string(dt) + "\nsteps = " + std::to_string(steps) + "\n[rd]\nmodel = \"gray-scott\"\nboundary = \"" +
+         boundary + "\"\n[rd.initial]\nvalues = [1.0, 0.0]\n[rd.initial.maps]\nv = \"exp(-(" + centre +
+         ") / 0.004)\"\n[velocity]\nfield = " + field +
+         "\n[coupling]\nmode = \"passive\"\ninterpolation = \"cubic\"\n" +
          "[output]\nevery = " + std::to_string(every) + "\nfields = true\nimages = false\n";
 }
 
@@ -58,12 +59,13 @@ std::string blobScene(const std::string& field, const std::string& boundary, dou
 TEST(GivenVelocity, ARigidRotationReturnsTheChemicalToItsStart) {
   const fs::path dir = tempDir("rotation");
   const int steps = 200;
-  const fs::path scene = write(dir / "rotation.toml",
-                               blobScene("[\"-(y - 0.5)\", \"x - 0.5\"]", "neumann", 2.0 * M_PI / steps, steps, steps / 2,
-                                         "(x - 0.72)^2 + (y - 0.5)^2"));
+  const fs::path scene =
+      write(dir / "rotation.toml", blobScene("[\"-(y - 0.5)\", \"x - 0.5\"]", "neumann", 2.0 * M_PI / steps, steps,
+                                             steps / 2, "(x - 0.72)^2 + (y - 0.5)^2"));
   CommandResult r = runMorphoflow("run " + scene.string() + " --quiet --out " + (dir / "out").string());
   ASSERT_EQ(r.status, 0) << r.output;
-  const morphoflow::FieldDump d0 = dump(dir / "out" / "fields" / "000000.exr"), dh = dump(dir / "out" / "fields" / "000001.exr"),
+  const morphoflow::FieldDump d0 = dump(dir / "out" / "fields" / "000000.exr"),
+                              dh = dump(dir / "out" / "fields" / "000001.exr"),
                               d1 = dump(dir / "out" / "fields" / "000002.exr");
   const double h = 1.0 / 64;
   const auto c0 = centroid(d0, 1, 1.0), ch = centroid(dh, 1, 1.0), c1 = centroid(d1, 1, 1.0);
@@ -122,21 +124,25 @@ TEST(GivenVelocity, AVdbSequenceWrittenByACoupledRunDrivesTheSameChemicals) {
   CommandResult r = runMorphoflow("run " + coupled.string() + " --quiet --out " + (dir / "coupled").string());
   ASSERT_EQ(r.status, 0) << r.output;
   ASSERT_TRUE(fs::exists(dir / "coupled" / "vdb" / "cavity.000012.vdb"));
-  const fs::path given = write(dir / "given.toml", cavityLayer("[velocity]\nvdb = \"coupled/vdb/cavity.######.vdb\"\n"));
+  const fs::path given =
+      write(dir / "given.toml", cavityLayer("[velocity]\nvdb = \"coupled/vdb/cavity.######.vdb\"\n"));
   r = runMorphoflow("run " + given.string() + " --quiet --out " + (dir / "given").string());
   ASSERT_EQ(r.status, 0) << r.output;
   for (const char* frame : {"000001.exr", "000012.exr"}) {
-    const morphoflow::FieldDump a = dump(dir / "coupled" / "fields" / frame), b = dump(dir / "given" / "fields" / frame);
+    const morphoflow::FieldDump a = dump(dir / "coupled" / "fields" / frame),
+                                b = dump(dir / "given" / "fields" / frame);
     ASSERT_EQ(a.channels.size(), b.channels.size());
     for (size_t c = 0; c < a.channels.size(); ++c) {
       double worst = 0, peak = 0;
       for (size_t i = 0; i < a.channels[c].size(); ++i)
-        worst = std::max(worst, double(std::abs(a.channels[c][i] - b.channels[c][i]))), peak = std::max(peak, double(a.channels[c][i]));
+        worst = std::max(worst, double(std::abs(a.channels[c][i] - b.channels[c][i]))),
+        peak = std::max(peak, double(a.channels[c][i]));
       EXPECT_LE(worst, 1e-6 * peak) << frame << " channel " << c;  // float rounding (measured: equal)
     }
   }
   // The flow visualisation's own volumes carry the velocity it read.
-  const fs::path again = write(dir / "again.toml", cavityLayer("[velocity]\nvdb = \"coupled/vdb/cavity.######.vdb\"\n") + "vdb = true\n");
+  const fs::path again =
+      write(dir / "again.toml", cavityLayer("[velocity]\nvdb = \"coupled/vdb/cavity.######.vdb\"\n") + "vdb = true\n");
   r = runMorphoflow("run " + again.string() + " --set time.steps=2 --quiet --out " + (dir / "again").string());
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_TRUE(fs::exists(dir / "again" / "vdb" / "cavity.000002.vdb"));
@@ -146,35 +152,42 @@ TEST(GivenVelocity, AVdbSequenceWrittenByACoupledRunDrivesTheSameChemicals) {
 TEST(GivenVelocity, VolumesThatCannotServeAreRefusedWithTheirPath) {
   const fs::path dir = tempDir("vdb_bad");
   // A reaction-diffusion run's volumes hold species, no velocity.
-  const std::string rd = "name = \"spots\"\n[grid]\nresolution = [16, 16]\n[time]\ndt = 1.0\nsteps = 2\n[rd]\nmodel = \"gray-scott\"\n"
-                         "[output]\nevery = 1\nimages = false\nvdb = true\n";
-  CommandResult r = runMorphoflow("run " + write(dir / "spots.toml", rd).string() + " --quiet --out " + (dir / "spots").string());
+  const std::string rd =
+      "name = \"spots\"\n[grid]\nresolution = [16, 16]\n[time]\ndt = 1.0\nsteps = 2\n[rd]\nmodel = \"gray-scott\"\n"
+      "[output]\nevery = 1\nimages = false\nvdb = true\n";
+  CommandResult r =
+      runMorphoflow("run " + write(dir / "spots.toml", rd).string() + " --quiet --out " + (dir / "spots").string());
   ASSERT_EQ(r.status, 0) << r.output;
-  const fs::path noVel = write(dir / "novel.toml", "[grid]\nresolution = [16, 16]\n[rd]\nmodel = \"gray-scott\"\n[velocity]\n"
-                                                   "vdb = \"spots/vdb/spots.######.vdb\"\n");
+  const fs::path noVel = write(dir / "novel.toml",
+                               "[grid]\nresolution = [16, 16]\n[rd]\nmodel = \"gray-scott\"\n[velocity]\n"
+                               "vdb = \"spots/vdb/spots.######.vdb\"\n");
   r = runMorphoflow("validate " + noVel.string());
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find(noVel.string() + ":6:7"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("no velocity grid 'vel'"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("spots.000000.vdb"), std::string::npos) << r.output;
   // A cavity of size 1 does not fit a domain of size 2.
-  const std::string cavity = "name = \"c\"\n[grid]\nresolution = [16, 16]\n[time]\ndt = 0.01\nsteps = 1\n[fluid]\nreynolds = 100\n"
-                             "[output]\nevery = 1\nimages = false\nvdb = true\n";
+  const std::string cavity =
+      "name = \"c\"\n[grid]\nresolution = [16, 16]\n[time]\ndt = 0.01\nsteps = 1\n[fluid]\nreynolds = 100\n"
+      "[output]\nevery = 1\nimages = false\nvdb = true\n";
   r = runMorphoflow("run " + write(dir / "c.toml", cavity).string() + " --quiet --out " + (dir / "c").string());
   ASSERT_EQ(r.status, 0) << r.output;
-  const fs::path other = write(dir / "other.toml", "[grid]\nresolution = [16, 16]\n[domain]\nsize = [2.0, 2.0]\n[rd]\n"
-                                                   "model = \"gray-scott\"\n[velocity]\nvdb = \"c/vdb/c.######.vdb\"\n");
+  const fs::path other = write(dir / "other.toml",
+                               "[grid]\nresolution = [16, 16]\n[domain]\nsize = [2.0, 2.0]\n[rd]\n"
+                               "model = \"gray-scott\"\n[velocity]\nvdb = \"c/vdb/c.######.vdb\"\n");
   r = runMorphoflow("validate " + other.string());
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("domain of size"), std::string::npos) << r.output;
   // No file matches the pattern.
-  const fs::path none = write(dir / "none.toml", "[rd]\nmodel = \"gray-scott\"\n[velocity]\nvdb = \"nothing/x.####.vdb\"\n");
+  const fs::path none =
+      write(dir / "none.toml", "[rd]\nmodel = \"gray-scott\"\n[velocity]\nvdb = \"nothing/x.####.vdb\"\n");
   r = runMorphoflow("validate " + none.string());
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("cannot list the folder"), std::string::npos) << r.output;
   // A frame number of 25 digits (a file there to match it) cannot be counted: exit 2, not an internal error.
   std::ofstream(dir / ("x." + std::string(25, '1') + ".vdb")) << "not a volume";
-  const fs::path longer = write(dir / "long.toml", "[rd]\nmodel = \"gray-scott\"\n[velocity]\nvdb = \"x." + std::string(25, '#') + ".vdb\"\n");
+  const fs::path longer = write(
+      dir / "long.toml", "[rd]\nmodel = \"gray-scott\"\n[velocity]\nvdb = \"x." + std::string(25, '#') + ".vdb\"\n");
   r = runMorphoflow("validate " + longer.string());
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("25 '#' make a frame number too long to count"), std::string::npos) << r.output;
@@ -195,9 +208,11 @@ TEST(GivenVelocity, AVolumeSpanningAHugeBoxIsRefusedBeforeItIsRead) {
   if (std::system(("/usr/bin/python3 " + (dir / "write.py").string() + " 2>/dev/null").c_str()) != 0)
     GTEST_SKIP() << "no pyopenvdb";
   ASSERT_LT(fs::file_size(dir / "far.0000.vdb"), 100000u);
-  const fs::path scene = write(dir / "far.toml", "[grid]\nresolution = [16, 16]\n[rd]\nmodel = \"gray-scott\"\n[velocity]\n"
-                                                 "vdb = \"far.####.vdb\"\nframe_time = 1.0\n");
-  for (const std::string& cmd : {"validate " + scene.string(), "run " + scene.string() + " --quiet --out " + (dir / "o").string()}) {
+  const fs::path scene = write(dir / "far.toml",
+                               "[grid]\nresolution = [16, 16]\n[rd]\nmodel = \"gray-scott\"\n[velocity]\n"
+                               "vdb = \"far.####.vdb\"\nframe_time = 1.0\n");
+  for (const std::string& cmd :
+       {"validate " + scene.string(), "run " + scene.string() + " --quiet --out " + (dir / "o").string()}) {
     const CommandResult r = runMorphoflow(cmd);
     EXPECT_EQ(r.status, 2) << cmd << "\n" << r.output;
     EXPECT_NE(r.output.find("far.0000.vdb"), std::string::npos) << r.output;
@@ -213,8 +228,9 @@ TEST(GivenVelocity, ShippedFlowScenesRunAndTheGpuBackendRefusesThem) {
   const fs::path dir = tempDir("flow_scenes");
   for (const char* name : {"sanderson_fig24_dipole", "cavity_vdb_gray_scott"}) {
     const std::string file = sceneFile(std::string("flow/") + name + ".toml");
-    CommandResult r = runMorphoflow("run " + file + " --set grid.resolution=[64,64] --set time.steps=50 --set output.every=50" +
-                                    " --set output.fields=true --quiet --out " + (dir / name).string());
+    CommandResult r =
+        runMorphoflow("run " + file + " --set grid.resolution=[64,64] --set time.steps=50 --set output.every=50" +
+                      " --set output.fields=true --quiet --out " + (dir / name).string());
     ASSERT_EQ(r.status, 0) << name << ": " << r.output;
     const morphoflow::FieldDump d = dump(dir / name / "fields" / "000001.exr");
     for (const std::vector<float>& c : d.channels)
@@ -226,9 +242,11 @@ TEST(GivenVelocity, ShippedFlowScenesRunAndTheGpuBackendRefusesThem) {
     EXPECT_NE(r.output.find("given [velocity]"), std::string::npos) << r.output;
   }
   // The speed map reaches the solver: a uniform s (an empty speed range) grows another pattern.
-  CommandResult r = runMorphoflow("run " + sceneFile("flow/sanderson_fig24_dipole.toml") +
-                                  " --set grid.resolution=[64,64] --set time.steps=50 --set output.every=50 --set output.fields=true"
-                                  " --set velocity.speed_range=[0.0078125,0.0078125] --quiet --out " + (dir / "uniform").string());
+  CommandResult r =
+      runMorphoflow("run " + sceneFile("flow/sanderson_fig24_dipole.toml") +
+                    " --set grid.resolution=[64,64] --set time.steps=50 --set output.every=50 --set output.fields=true"
+                    " --set velocity.speed_range=[0.0078125,0.0078125] --quiet --out " +
+                    (dir / "uniform").string());
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(dump(dir / "uniform" / "fields" / "000001.exr").channels,
             dump(dir / "sanderson_fig24_dipole" / "fields" / "000001.exr").channels);

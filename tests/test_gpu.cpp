@@ -29,7 +29,8 @@ std::string gpuUnavailable() {
 
 std::string explicitScene(const std::string& resolution, const std::string& size, const std::string& boundary) {
   return "name = \"gs\"\n[grid]\nresolution = " + resolution + "\n[domain]\nsize = " + size +
-         "\n[time]\ndt = 0.5\nsteps = 200\n[rd]\nmodel = \"gray-scott\"\nintegrator = \"explicit\"\nboundary = \"" + boundary +
+         "\n[time]\ndt = 0.5\nsteps = 200\n[rd]\nmodel = \"gray-scott\"\nintegrator = \"explicit\"\nboundary = \"" +
+         boundary +
          "\"\ndiffusion = [2e-5, 1e-5]\n[rd.parameters]\nF = 0.035\nk = 0.062\n[rd.initial]\nvalues = [1.0, 0.0]\n"
          "square = 0.1\nsquare_values = [0.5, 0.25]\nnoise = [0.01, 0.01]\n[output]\nevery = 100\nfield = \"v\"\n"
          "fields = true\nimage_size = 64\n";
@@ -59,9 +60,9 @@ TEST(Gpu, WithoutAnEglVendorTheGpuIsUnavailableNotACrash) {
   setenv("__EGL_VENDOR_LIBRARY_FILENAMES", "/nonexistent/vendor.json", 1);
   const CommandResult info = runMorphoflow("info");
   const fs::path dir = tempDir("gpu_no_vendor");
-  const CommandResult run = runMorphoflow("run " + sceneFile("rd/gray_scott_pearson.toml") +
-                                          " --set grid.resolution=[16,16] --set time.steps=2 --backend gpu --quiet --out " +
-                                          (dir / "out").string());
+  const CommandResult run = runMorphoflow(
+      "run " + sceneFile("rd/gray_scott_pearson.toml") +
+      " --set grid.resolution=[16,16] --set time.steps=2 --backend gpu --quiet --out " + (dir / "out").string());
   unsetenv("__EGL_VENDOR_LIBRARY_FILENAMES");
   EXPECT_EQ(info.status, 0) << info.output;
   EXPECT_NE(info.output.find("gpu: unavailable: "), std::string::npos) << info.output;
@@ -86,7 +87,8 @@ TEST(Gpu, ExplicitGrayScottMatchesTheCpuIn2DAnd3D) {
                                       (dir / backend).string());
       ASSERT_EQ(r.status, 0) << res << " " << backend << "\n" << r.output;
     }
-    const morphoflow::FieldDump g = dump(dir / "gpu" / "fields" / "000002.exr"), c = dump(dir / "tbb" / "fields" / "000002.exr");
+    const morphoflow::FieldDump g = dump(dir / "gpu" / "fields" / "000002.exr"),
+                                c = dump(dir / "tbb" / "fields" / "000002.exr");
     const morphoflow::FieldDump start = dump(dir / "tbb" / "fields" / "000000.exr");
     ASSERT_EQ(g.resolution, c.resolution);
     ASSERT_EQ(g.channels.size(), 2u);
@@ -115,12 +117,17 @@ TEST(Gpu, AStageWithNoGpuProgramIsRefusedNamingIt) {
   std::ofstream(scene) << explicitScene("[32, 32]", "[0.25, 0.25]", "periodic");
   const std::string out = " --out " + (dir / "o").string();
   for (const auto& [args, stage] :
-       {std::pair{sceneFile("coupled/cavity_gray_scott.toml") + " --set 'rd.lookup_table=true'", std::string("the reaction lookup table")},
+       {std::pair{sceneFile("coupled/cavity_gray_scott.toml") + " --set 'rd.lookup_table=true'",
+                  std::string("the reaction lookup table")},
 
-        std::pair{sceneFile("coupled/cavity_gray_scott.toml") + " --set 'rd.model=\"brusselator-coupled\"' --set 'rd.diffusion=[1,1,1,1]' --set 'rd.parameters={}' --set 'rd.initial={}' --set 'output.field=\"a1\"'", std::string("the chemicals' advection for a model of 4 species")}}) {
+        std::pair{sceneFile("coupled/cavity_gray_scott.toml") +
+                      " --set 'rd.model=\"brusselator-coupled\"' --set 'rd.diffusion=[1,1,1,1]' --set "
+                      "'rd.parameters={}' --set 'rd.initial={}' --set 'output.field=\"a1\"'",
+                  std::string("the chemicals' advection for a model of 4 species")}}) {
     CommandResult r = runMorphoflow("run " + args + " --backend gpu --quiet" + out);
     EXPECT_EQ(r.status, 2) << args << "\n" << r.output;
-    EXPECT_NE(r.output.find("the gpu backend has no program yet for " + stage), std::string::npos) << args << "\n" << r.output;
+    EXPECT_NE(r.output.find("the gpu backend has no program yet for " + stage), std::string::npos) << args << "\n"
+                                                                                                   << r.output;
     EXPECT_FALSE(fs::exists(dir / "o" / "frames")) << args;  // refused before anything ran
   }
   fs::remove_all(dir);
@@ -161,8 +168,8 @@ void expectScenesAgree(const std::string& folder, const std::vector<std::string>
   const fs::path dir = tempDir(folder);
   for (const std::string& scene : scenes) {
     for (const char* backend : {"gpu", "tbb"}) {
-      CommandResult r = runMorphoflow("run " + scene + " --set output.fields=true --quiet --backend " + backend + " --out " +
-                                      (dir / backend).string());
+      CommandResult r = runMorphoflow("run " + scene + " --set output.fields=true --quiet --backend " + backend +
+                                      " --out " + (dir / backend).string());
       ASSERT_EQ(r.status, 0) << scene << " " << backend << "\n" << r.output;
       if (checkRun) checkRun(dir / backend);
     }
@@ -196,18 +203,25 @@ TEST(Gpu, ShippedFluidScenesMatchTheCpu) {
     std::string scene, sets;
     double tolerance;  // relative to the field's largest magnitude
   };
-  for (const Case& c : {Case{"lid_driven_cavity.toml", "--set grid.resolution=[48,48] --set time.duration=1.0", 2e-4},
-                        Case{"flow_past_obstacle.toml", "--set grid.resolution=[220,41] --set time.duration=0.2", 2e-4},
-                        // an obstacle smaller than a cell, cut and voxel (measured 2.3e-4 and 1.7e-4 in pressure)
-                        Case{"flow_past_obstacle.toml", "--set grid.resolution=[220,41] --set time.duration=0.2"
-                                                        " --set 'obstacles=[{center=[0.2,0.205],radius=0.004}]'", 5e-4},
-                        Case{"flow_past_obstacle.toml", "--set grid.resolution=[220,41] --set time.duration=0.2"
-                                                        " --set 'obstacles=[{center=[0.2,0.2],radius=0.004,boundary=\"voxel\"}]'", 5e-4},
-                        Case{"lid_driven_cavity_3d.toml", "--set grid.resolution=[16,16,16] --set time.duration=0.4", 5e-4},
-                        Case{"flow_past_obstacle_3d.toml", "--set grid.resolution=[24,8,8] --set time.duration=0.6", 5e-4}}) {
+  for (const Case& c :
+       {Case{"lid_driven_cavity.toml", "--set grid.resolution=[48,48] --set time.duration=1.0", 2e-4},
+        Case{"flow_past_obstacle.toml", "--set grid.resolution=[220,41] --set time.duration=0.2", 2e-4},
+        // an obstacle smaller than a cell, cut and voxel (measured 2.3e-4 and 1.7e-4 in pressure)
+        Case{"flow_past_obstacle.toml",
+             "--set grid.resolution=[220,41] --set time.duration=0.2"
+             " --set 'obstacles=[{center=[0.2,0.205],radius=0.004}]'",
+             5e-4},
+        Case{"flow_past_obstacle.toml",
+             "--set grid.resolution=[220,41] --set time.duration=0.2"
+             " --set 'obstacles=[{center=[0.2,0.2],radius=0.004,boundary=\"voxel\"}]'",
+             5e-4},
+        Case{"lid_driven_cavity_3d.toml", "--set grid.resolution=[16,16,16] --set time.duration=0.4", 5e-4},
+        Case{"flow_past_obstacle_3d.toml", "--set grid.resolution=[24,8,8] --set time.duration=0.6", 5e-4}}) {
     for (const char* backend : {"gpu", "tbb"}) {
-      CommandResult r = runMorphoflow("run " + sceneFile(c.scene) + " " + c.sets + " --set output.fields=true --set output.every=10"
-                                      " --quiet --backend " + backend + " --out " + (dir / backend).string());
+      CommandResult r = runMorphoflow("run " + sceneFile(c.scene) + " " + c.sets +
+                                      " --set output.fields=true --set output.every=10"
+                                      " --quiet --backend " +
+                                      backend + " --out " + (dir / backend).string());
       ASSERT_EQ(r.status, 0) << c.scene << " " << backend << "\n" << r.output;
     }
     fs::path last;
@@ -288,10 +302,11 @@ TEST(Gpu, AKilledFluidRunResumesBitForBit) {
 TEST(Gpu, AKilledCoupledRunResumesBitForBit) {
   if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
   const fs::path dir = tempDir("gpu_coupled_resume");
-  EXPECT_GE(resumedRunMatches(dir, {"run", sceneFile("coupled/cavity_gray_scott.toml"), "--set", "grid.resolution=[32,32]",
-                                    "--set", "rd.resolution=[64,64]", "--set", "time.steps=240", "--set",
-                                    "output.every=20", "--set", "output.fields=true", "--set", "output.video=false",
-                                    "--set", "output.checkpoint_every=1", "--backend", "gpu", "--quiet"},
+  EXPECT_GE(resumedRunMatches(dir,
+                              {"run", sceneFile("coupled/cavity_gray_scott.toml"), "--set", "grid.resolution=[32,32]",
+                               "--set", "rd.resolution=[64,64]", "--set", "time.steps=240", "--set", "output.every=20",
+                               "--set", "output.fields=true", "--set", "output.video=false", "--set",
+                               "output.checkpoint_every=1", "--backend", "gpu", "--quiet"},
                               {"fields", "frames"}),
             20);
   fs::remove_all(dir);
@@ -303,7 +318,8 @@ TEST(Gpu, AKilledCoupledRunResumesBitForBit) {
 TEST(Gpu, CoupledCavityGrayScottMatchesTheCpuAfter100Steps) {
   if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
   expectScenesAgree("gpu_cavity_gs",
-                    {sceneFile("coupled/cavity_gray_scott.toml") + " --set time.steps=100 --set output.every=50 --set output.video=false"},
+                    {sceneFile("coupled/cavity_gray_scott.toml") +
+                     " --set time.steps=100 --set output.every=50 --set output.video=false"},
                     "000002.exr", {0.0, 1e-3, true});
 }
 
@@ -314,8 +330,10 @@ TEST(Gpu, CoupledCavityGrayScottMatchesTheCpuAfter100Steps) {
 // and solid values, 2D and 3D.
 TEST(Gpu, ShippedCoupledScenesMatchTheCpu) {
   if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
-  const std::string cavity = " --set grid.resolution=[32,32] --set rd.resolution=[64,64] --set time.steps=40 --set output.every=20";
-  const std::string channel = " --set grid.resolution=[32,64] --set rd.resolution=[48,96] --set time.steps=40 --set output.every=20";
+  const std::string cavity =
+      " --set grid.resolution=[32,32] --set rd.resolution=[64,64] --set time.steps=40 --set output.every=20";
+  const std::string channel =
+      " --set grid.resolution=[32,64] --set rd.resolution=[48,96] --set time.steps=40 --set output.every=20";
   auto scene = [](const char* name, const std::string& sets) {
     return sceneFile(std::string("coupled/") + name) + sets + " --set output.video=false";
   };
@@ -323,22 +341,26 @@ TEST(Gpu, ShippedCoupledScenesMatchTheCpu) {
                     {scene("cavity_barkley.toml", cavity), scene("cavity_fitzhugh_nagumo.toml", cavity),
                      scene("cavity_passive.toml", cavity), scene("obstacle_gray_scott_ard.toml", channel),
                      scene("obstacle_gray_scott_rd_only.toml", channel), scene("obstacle_passive.toml", channel),
-                     scene("cavity_gray_scott_3d.toml", " --set grid.resolution=[12,12,12] --set rd.resolution=[24,24,24]"
-                                                        " --set time.steps=10 --set output.every=5 --set output.vdb=false"),
+                     scene("cavity_gray_scott_3d.toml",
+                           " --set grid.resolution=[12,12,12] --set rd.resolution=[24,24,24]"
+                           " --set time.steps=10 --set output.every=5 --set output.vdb=false"),
                      // the B-spline transport: walls, inflow and solids, 3D
                      scene("cavity_gray_scott.toml", cavity + " --set 'coupling.interpolation=\"bspline\"'"),
                      scene("obstacle_gray_scott_ard.toml", channel + " --set 'coupling.interpolation=\"bspline\"'"),
-                     scene("cavity_gray_scott_3d.toml", " --set grid.resolution=[12,12,12] --set rd.resolution=[24,24,24]"
-                                                        " --set time.steps=10 --set output.every=5 --set output.vdb=false"
-                                                        " --set 'coupling.interpolation=\"bspline\"'"),
+                     scene("cavity_gray_scott_3d.toml",
+                           " --set grid.resolution=[12,12,12] --set rd.resolution=[24,24,24]"
+                           " --set time.steps=10 --set output.every=5 --set output.vdb=false"
+                           " --set 'coupling.interpolation=\"bspline\"'"),
                      // BFECC: walls, inflow and solids, 3D
                      scene("cavity_gray_scott.toml", cavity + " --set 'coupling.interpolation=\"bfecc\"'"),
                      scene("obstacle_gray_scott_ard.toml", channel + " --set 'coupling.interpolation=\"bfecc\"'"),
-                     scene("cavity_gray_scott_3d.toml", " --set grid.resolution=[12,12,12] --set rd.resolution=[24,24,24]"
-                                                        " --set time.steps=10 --set output.every=5 --set output.vdb=false"
-                                                        " --set 'coupling.interpolation=\"bfecc\"'"),
-                     scene("obstacle_gray_scott_3d.toml", " --set grid.resolution=[16,32,16] --set rd.resolution=[16,32,16]"
-                                                          " --set time.steps=10 --set output.every=5")},
+                     scene("cavity_gray_scott_3d.toml",
+                           " --set grid.resolution=[12,12,12] --set rd.resolution=[24,24,24]"
+                           " --set time.steps=10 --set output.every=5 --set output.vdb=false"
+                           " --set 'coupling.interpolation=\"bfecc\"'"),
+                     scene("obstacle_gray_scott_3d.toml",
+                           " --set grid.resolution=[16,32,16] --set rd.resolution=[16,32,16]"
+                           " --set time.steps=10 --set output.every=5")},
                     "000002.exr", {0.0, 1e-4, false});
 }
 
@@ -350,15 +372,16 @@ TEST(Gpu, ShippedCoupledScenesMatchTheCpu) {
 // having moved them.
 TEST(Gpu, ATimelineSceneChangesAtTheCpusSteps) {
   if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
-  expectScenesAgree("gpu_timeline",
-                    {sceneFile("coupled/cavity_timeline.toml") +
-                     " --set grid.resolution=[32,32] --set rd.resolution=[64,64] --set time.dt=0.04 --set time.steps=325"
-                     " --set output.every=100 --set output.video=false"
-                     " --set 'fluid.lid_velocity={keys=[[8.0,1.0],[12.0,0.4]],interpolation=\"step\"}'"},
-                    "000003.exr", {0.0, 1e-2, true}, [](const fs::path& run) {
-                      std::ifstream in(run / "run.json");
-                      EXPECT_EQ(nlohmann::json::parse(in)["timeline"]["rebuilds"], 5) << run;
-                    });
+  expectScenesAgree(
+      "gpu_timeline",
+      {sceneFile("coupled/cavity_timeline.toml") +
+       " --set grid.resolution=[32,32] --set rd.resolution=[64,64] --set time.dt=0.04 --set time.steps=325"
+       " --set output.every=100 --set output.video=false"
+       " --set 'fluid.lid_velocity={keys=[[8.0,1.0],[12.0,0.4]],interpolation=\"step\"}'"},
+      "000003.exr", {0.0, 1e-2, true}, [](const fs::path& run) {
+        std::ifstream in(run / "run.json");
+        EXPECT_EQ(nlohmann::json::parse(in)["timeline"]["rebuilds"], 5) << run;
+      });
 }
 
 // The pattern on the smoke (coupling.smoke_mask, sources' chemicals) on both
@@ -372,13 +395,16 @@ TEST(Gpu, PatternedPlumesMatchTheCpu) {
     return sceneFile(std::string("vfx/") + name) + sets + " --set output.video=false --set output.vdb=false";
   };
   expectScenesAgree("gpu_plumes",
-                    {scene("plume_gray_scott_2d.toml", " --set grid.resolution=[32,48] --set rd.resolution=[64,96]"
-                                                       " --set time.duration=1.0 --set output.every=50"),
-                     scene("plume_gray_scott_2d.toml", " --set grid.resolution=[32,48] --set rd.resolution=[64,96]"
-                                                       " --set time.duration=0.6 --set output.every=30"
-                                                       " --set 'sources.0.motion=[\"0.5 + 0.2 * t\", \"0.15\"]'"),
-                     scene("plume_gray_scott_3d.toml", " --set grid.resolution=[12,20,12] --set rd.resolution=[24,40,24]"
-                                                       " --set time.duration=0.4 --set output.every=20")},
+                    {scene("plume_gray_scott_2d.toml",
+                           " --set grid.resolution=[32,48] --set rd.resolution=[64,96]"
+                           " --set time.duration=1.0 --set output.every=50"),
+                     scene("plume_gray_scott_2d.toml",
+                           " --set grid.resolution=[32,48] --set rd.resolution=[64,96]"
+                           " --set time.duration=0.6 --set output.every=30"
+                           " --set 'sources.0.motion=[\"0.5 + 0.2 * t\", \"0.15\"]'"),
+                     scene("plume_gray_scott_3d.toml",
+                           " --set grid.resolution=[12,20,12] --set rd.resolution=[24,40,24]"
+                           " --set time.duration=0.4 --set output.every=20")},
                     "000002.exr", {0.0, 1e-5, true});
 }
 
@@ -389,9 +415,11 @@ TEST(Gpu, UntilSteadyStopsAtTheCpusStep) {
   const fs::path dir = tempDir("gpu_until_steady");
   std::map<std::string, nlohmann::json> got;
   for (const char* backend : {"gpu", "tbb"}) {
-    const CommandResult r = runMorphoflow("run " + sceneFile("lid_driven_cavity.toml") +
-                                          " --set grid.resolution=[24,24] --set output.images=false --set time.until_steady=5e-3"
-                                          " --quiet --backend " + backend + " --out " + (dir / backend).string());
+    const CommandResult r =
+        runMorphoflow("run " + sceneFile("lid_driven_cavity.toml") +
+                      " --set grid.resolution=[24,24] --set output.images=false --set time.until_steady=5e-3"
+                      " --quiet --backend " +
+                      backend + " --out " + (dir / backend).string());
     ASSERT_EQ(r.status, 0) << backend << "\n" << r.output;
     got[backend] = nlohmann::json::parse(std::ifstream(dir / backend / "run.json"))["until_steady"];
   }
@@ -449,7 +477,9 @@ TEST(Gpu, ShippedImplicitRDScenesMatchTheCpu) {
   std::vector<std::string> scenes;
   for (const char* s : {"rd/gray_scott_pearson.toml", "rd/turing_lawlor.toml", "rd/seeds/barkley_spiral.toml",
                         "rd/seeds/fitzhugh_nagumo_spiral.toml"})
-    scenes.push_back(sceneFile(s) + " --set grid.resolution=[96,96] --set rd.tolerance=1e-12 --set time.steps=100 --set output.every=50");
+    scenes.push_back(
+        sceneFile(s) +
+        " --set grid.resolution=[96,96] --set rd.tolerance=1e-12 --set time.steps=100 --set output.every=50");
   expectScenesAgree("gpu_rd_scenes", scenes, "000002.exr", {2e-4, 0.0, true});
 }
 
@@ -462,7 +492,8 @@ TEST(Gpu, BenchSuitesTimeTheFluidTheLayerAndTheCoupling) {
   const fs::path dir = tempDir("gpu_bench");
   for (const char* suite : {"rd", "fluid", "coupling"}) {
     const fs::path json = dir / (std::string(suite) + ".json");
-    CommandResult r = runMorphoflow(std::string("bench ") + suite + " --backend gpu --size 32 --seconds 0 --json " + json.string());
+    CommandResult r =
+        runMorphoflow(std::string("bench ") + suite + " --backend gpu --size 32 --seconds 0 --json " + json.string());
     ASSERT_EQ(r.status, 0) << suite << "\n" << r.output;
     EXPECT_NE(r.output.find("gpu: "), std::string::npos) << r.output;
     std::ifstream in(json);
@@ -495,9 +526,11 @@ TEST(Gpu, ShippedMapFixedAndMultiSpeciesScenesMatchTheCpu) {
   if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
   std::vector<std::string> scenes;
   for (const char* s : {"lawlor_image_growth", "pearson_map", "sanderson_fig20", "sanderson_fig10", "sanderson_fig21",
-                        "sanderson_fig06", "sanderson_fig07", "sanderson_fig18", "kim_lin_lobes3", "kim_lin_witkin_kass",
-                        "kim_lin_paint_deposit", "kim_lin_paint_lobe"})
-    scenes.push_back(sceneFile(std::string("rd/seeds/") + s + ".toml") + " --set grid.resolution=[64,64] --set rd.tolerance=1e-12 --set time.steps=40 --set output.every=20");
+                        "sanderson_fig06", "sanderson_fig07", "sanderson_fig18", "kim_lin_lobes3",
+                        "kim_lin_witkin_kass", "kim_lin_paint_deposit", "kim_lin_paint_lobe"})
+    scenes.push_back(
+        sceneFile(std::string("rd/seeds/") + s + ".toml") +
+        " --set grid.resolution=[64,64] --set rd.tolerance=1e-12 --set time.steps=40 --set output.every=20");
   expectScenesAgree("gpu_map_scenes", scenes, "000002.exr", {1e-6, 0.0, false});
 }
 
@@ -509,13 +542,15 @@ TEST(Gpu, ExplicitSceneWithDepositingStrokeHoldsItsCells) {
   if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
   const fs::path dir = tempDir("gpu_explicit_deposit");
   for (const char* backend : {"gpu", "tbb"}) {
-    CommandResult r = runMorphoflow("run " + sceneFile("rd/seeds/kim_lin_paint_deposit.toml") +
-                                    " --set rd.integrator='\"explicit\"' --set grid.resolution=[64,64] --set time.steps=40"
-                                    " --set output.every=20 --set output.fields=true --quiet --backend " + backend +
-                                    " --out " + (dir / backend).string());
+    CommandResult r =
+        runMorphoflow("run " + sceneFile("rd/seeds/kim_lin_paint_deposit.toml") +
+                      " --set rd.integrator='\"explicit\"' --set grid.resolution=[64,64] --set time.steps=40"
+                      " --set output.every=20 --set output.fields=true --quiet --backend " +
+                      backend + " --out " + (dir / backend).string());
     ASSERT_EQ(r.status, 0) << backend << "\n" << r.output;
   }
-  const morphoflow::FieldDump g = dump(dir / "gpu" / "fields" / "000002.exr"), c = dump(dir / "tbb" / "fields" / "000002.exr");
+  const morphoflow::FieldDump g = dump(dir / "gpu" / "fields" / "000002.exr"),
+                              c = dump(dir / "tbb" / "fields" / "000002.exr");
   ASSERT_EQ(g.names, c.names);
   size_t held = 0;
   for (size_t i = 0; i < c.channels[0].size(); ++i) {
@@ -543,7 +578,8 @@ TEST(Gpu, CoarseToFineStartAndClampedExplicitSpeciesMatchTheCpu) {
   for (const char* backend : {"gpu", "tbb"}) {
     CommandResult r = runMorphoflow("run " + sceneFile("rd/turing_coarse_to_fine.toml") +
                                     " --set rd.coarse_to_fine.steps=100 --set time.steps=20 --set output.every=20"
-                                    " --set output.fields=true --quiet --backend " + backend + " --out " + (dir / backend).string());
+                                    " --set output.fields=true --quiet --backend " +
+                                    backend + " --out " + (dir / backend).string());
     ASSERT_EQ(r.status, 0) << backend << "\n" << r.output;
   }
   for (const char* frame : {"000000.exr", "000001.exr"}) {
@@ -568,10 +604,14 @@ TEST(Gpu, CoarseToFineStartAndClampedExplicitSpeciesMatchTheCpu) {
 // within 1e-6 of its largest value (measured: equal, or float rounding).
 TEST(Gpu, ShippedSeedScenesMatchTheCpu) {
   if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
-  std::vector<std::string> scenes = {sceneFile("rd/turing_spots_sanderson.toml") + " --set grid.resolution=[64,64] --set rd.tolerance=1e-12 --set time.steps=40 --set output.every=20"};
-  for (const char* s : {"lawlor_parameter_map", "pearson_theta", "sanderson_fig03", "sanderson_fig04", "sanderson_fig05a",
-                        "sanderson_fig05b", "sanderson_fig12", "sanderson_fig15"})
-    scenes.push_back(sceneFile(std::string("rd/seeds/") + s + ".toml") + " --set grid.resolution=[64,64] --set rd.tolerance=1e-12 --set time.steps=40 --set output.every=20");
+  std::vector<std::string> scenes = {
+      sceneFile("rd/turing_spots_sanderson.toml") +
+      " --set grid.resolution=[64,64] --set rd.tolerance=1e-12 --set time.steps=40 --set output.every=20"};
+  for (const char* s : {"lawlor_parameter_map", "pearson_theta", "sanderson_fig03", "sanderson_fig04",
+                        "sanderson_fig05a", "sanderson_fig05b", "sanderson_fig12", "sanderson_fig15"})
+    scenes.push_back(
+        sceneFile(std::string("rd/seeds/") + s + ".toml") +
+        " --set grid.resolution=[64,64] --set rd.tolerance=1e-12 --set time.steps=40 --set output.every=20");
   expectScenesAgree("gpu_seed_scenes", scenes, "000002.exr", {1e-6, 0.0, false});
 }
 

@@ -141,7 +141,8 @@ int blockSystemActsAsItsBlocks(const FluidSettings& s) {
     const size_t at = block.blockStart(a);
     EXPECT_EQ(at, a == 0 ? 0 : block.blockStart(a - 1) + V[size_t(a - 1)].A.size());
     const GpuLaplace alone(A);
-    GpuBuffer ax = GpuBuffer::of(Vector(x.begin() + long(at), x.begin() + long(at + A.size()))), ay(A.size() * sizeof(double));
+    GpuBuffer ax = GpuBuffer::of(Vector(x.begin() + long(at), x.begin() + long(at + A.size()))),
+              ay(A.size() * sizeof(double));
     alone.apply(ax, &ay);
     const Vector ya = ay.read<double>(A.size());
     for (size_t i = 0; i < A.size(); ++i) differ += std::memcmp(&ya[i], &y[at + i], sizeof(double)) != 0;
@@ -245,7 +246,8 @@ TEST(GpuFluid, EveryBoundaryKindAndSchemeMatchesTheCpuToRounding) {
     s.pressureTolerance = s.viscosityTolerance = 1e-10;
     return s;
   };
-  for (AdvectionScheme scheme : {AdvectionScheme::SemiLagrangian, AdvectionScheme::MacCormack, AdvectionScheme::Bfecc}) {
+  for (AdvectionScheme scheme :
+       {AdvectionScheme::SemiLagrangian, AdvectionScheme::MacCormack, AdvectionScheme::Bfecc}) {
     FluidSettings s = tight(box({48, 48}, false, false, false), 1e-3);
     s.advection = scheme;
     const auto [du, dd] = fluidDifference<2>(s, 60, 0.01);
@@ -308,7 +310,8 @@ FluidSettings smoky(std::vector<int> res) {
   a.temperature = 4.0;
   SmokeSource b = a;
   b.region.radius = 0.08;
-  b.motion = three ? std::vector<std::string>{"0.3 + 0.3 * t", "0.3", "0.5"} : std::vector<std::string>{"0.3 + 0.3 * t", "0.3"};
+  b.motion = three ? std::vector<std::string>{"0.3 + 0.3 * t", "0.3", "0.5"}
+                   : std::vector<std::string>{"0.3 + 0.3 * t", "0.3"};
   b.start = 0.05;
   SmokeSource c = a;
   c.region.shape = ObstacleShape::Box;

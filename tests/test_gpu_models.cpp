@@ -17,7 +17,7 @@
 #include "gpu/compute_program.h"
 #include "gpu/gpu_buffer.h"
 #include "gpu/gpu_explicit_rd.h"
-#include "gpu/gpu_kernels.h"
+#include "gpu/gpu_programs.h"
 #include "gpu/gpu_models.h"
 #include "gpu/gpu_newton_check.h"
 #include "gpu/shader_source.h"
@@ -256,8 +256,8 @@ TEST(GpuModels, NewtonsPiecesAreBitwiseTheCpus) {
           cells += differs ? 1 : 0;
         }
         if (cells > 0)
-          report += fmt::format("  {}: {} of {} cells differ (largest relative difference {:.3g})\n", kPieces[piece], cells,
-                                kCells, worst);
+          report += fmt::format("  {}: {} of {} cells differ (largest relative difference {:.3g})\n", kPieces[piece],
+                                cells, kCells, worst);
       }
       EXPECT_TRUE(report.empty()) << info.name << " at " << factor << " x its fastest rate:\n" << report;
     }

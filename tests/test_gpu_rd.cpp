@@ -72,7 +72,8 @@ TEST(GpuRD, KimLinNewtonIsBitwiseTheCpusForEveryModel) {
       for (size_t c = 0; c < ns; ++c) row += std::abs(J[r * ns + c]);
       rate = std::max(rate, row);
     }
-    for (double factor : {10.0, 100.0}) EXPECT_EQ(relativeDifference<2>(s, *m, factor / rate, 10), 0.0) << m->info().name << " x" << factor;
+    for (double factor : {10.0, 100.0})
+      EXPECT_EQ(relativeDifference<2>(s, *m, factor / rate, 10), 0.0) << m->info().name << " x" << factor;
     ++checked;
   }
   EXPECT_GE(checked, 14);
@@ -126,7 +127,8 @@ TEST(GpuRD, MapsFixedCellsFrozenSpeciesAndDirichletWallsMatchTheCpu) {
         const double x = double(i % 32) / 32;
         F[i] = 0.02 + 0.04 * x;
         mask[i] = i % 32 == 5 ? 1 : 0;  // a fixed column
-        for (int k = 0; k < 2; ++k) cpu.field(k)[i] = (k == 0 ? 1.0 : 0.0) + 0.3 * (uniform01(5, uint64_t(k), i) - 0.5) * (k == 0 ? -1 : 1);
+        for (int k = 0; k < 2; ++k)
+          cpu.field(k)[i] = (k == 0 ? 1.0 : 0.0) + 0.3 * (uniform01(5, uint64_t(k), i) - 0.5) * (k == 0 ? -1 : 1);
       }
       if (variant == 1) {
         cpu.setParameterField(0, F);
@@ -248,7 +250,8 @@ TEST(GpuRD, AShapedDiffusionTensorRebuiltEachStepMatchesTheCpu) {
 namespace {
 
 template <int D>
-double lobeDifference(RDIntegrator integ, RDBoundary boundary, const IVec<D>& cells, bool witkinKass, double* fromIsotropic) {
+double lobeDifference(RDIntegrator integ, RDBoundary boundary, const IVec<D>& cells, bool witkinKass,
+                      double* fromIsotropic) {
   const RDSettings s = grayScottBox<D>(integ, boundary, cells);
   RDSolver<D> cpu(s, *findModel("gray-scott")), iso(s, *findModel("gray-scott"));
   randomStart(&cpu, 11);
@@ -294,8 +297,10 @@ TEST(GpuRD, CosineLobesMatchTheCpuIn2DAnd3D) {
     for (RDBoundary b : {RDBoundary::Periodic, RDBoundary::Neumann, RDBoundary::Dirichlet})
       for (bool wk : {false, true}) {
         double lobe2 = 0, lobe3 = 0;
-        EXPECT_LT(lobeDifference<2>(integ, b, IVec<2>(24, 20), wk, &lobe2), 1e-6) << int(integ) << " " << int(b) << " " << wk;
-        EXPECT_LT(lobeDifference<3>(integ, b, IVec<3>(10, 8, 6), wk, &lobe3), 1e-6) << int(integ) << " " << int(b) << " " << wk << " 3D";
+        EXPECT_LT(lobeDifference<2>(integ, b, IVec<2>(24, 20), wk, &lobe2), 1e-6)
+            << int(integ) << " " << int(b) << " " << wk;
+        EXPECT_LT(lobeDifference<3>(integ, b, IVec<3>(10, 8, 6), wk, &lobe3), 1e-6)
+            << int(integ) << " " << int(b) << " " << wk << " 3D";
         EXPECT_GT(lobe2, 1e-4) << "the lobes must matter";
         EXPECT_GT(lobe3, 1e-4) << "the lobes must matter";
       }

@@ -81,8 +81,11 @@ std::string pngHeader(uint32_t width, uint32_t height) {
     return c ^ 0xffffffffu;
   };
   auto be = [](uint32_t v) { return std::string{char(v >> 24), char(v >> 16), char(v >> 8), char(v)}; };
-  auto chunk = [&](const std::string& type, const std::string& data) { return be(uint32_t(data.size())) + type + data + be(crc(type + data)); };
-  return std::string("\x89PNG\r\n\x1a\n", 8) + chunk("IHDR", be(width) + be(height) + std::string("\x08\x00\x00\x00\x00", 5)) +
+  auto chunk = [&](const std::string& type, const std::string& data) {
+    return be(uint32_t(data.size())) + type + data + be(crc(type + data));
+  };
+  return std::string("\x89PNG\r\n\x1a\n", 8) +
+         chunk("IHDR", be(width) + be(height) + std::string("\x08\x00\x00\x00\x00", 5)) +
          chunk("IDAT", std::string("\x78\x9c\x03\x00\x00\x00\x00\x01", 8)) + chunk("IEND", "");
 }
 
@@ -108,7 +111,8 @@ TEST(HostileInput, ASceneThatIsAFolderADeviceOrAPipeIsRefusedAtOnce) {
 
 TEST(HostileInput, QuantitiesThatSizeWorkAreBoundedBeforeUse) {
   const fs::path dir = tempDir("hostile_bounds");
-  const std::string rd = write(dir / "rd.toml", kRdScene).string(), fluid = write(dir / "fluid.toml", kFluidScene).string();
+  const std::string rd = write(dir / "rd.toml", kRdScene).string(),
+                    fluid = write(dir / "fluid.toml", kFluidScene).string();
   // duration / dt steps
   const std::string o = " --quiet --out " + (dir / "o").string();
   expectUserError("run " + rd + o + " --set time.steps=0", "time.steps");
@@ -124,8 +128,8 @@ TEST(HostileInput, QuantitiesThatSizeWorkAreBoundedBeforeUse) {
   // memory that ulimit -v does not give: refused before allocating, with what is available
   std::string out;
   {
-    const std::string cmd = "ulimit -v 1200000; " + std::string(MORPHOFLOW_BINARY) + " run " + sceneFile("coupled/cavity_gray_scott_3d.toml") +
-                            " --set time.steps=2" + o + " 2>&1";
+    const std::string cmd = "ulimit -v 1200000; " + std::string(MORPHOFLOW_BINARY) + " run " +
+                            sceneFile("coupled/cavity_gray_scott_3d.toml") + " --set time.steps=2" + o + " 2>&1";
     FILE* p = popen(cmd.c_str(), "r");
     char buf[4096];
     for (size_t n; p && (n = fread(buf, 1, sizeof buf, p)) > 0;) out.append(buf, n);
@@ -135,13 +139,17 @@ TEST(HostileInput, QuantitiesThatSizeWorkAreBoundedBeforeUse) {
   EXPECT_NE(out.find("this run needs about 1.92 GiB of memory, and"), std::string::npos) << out;
   EXPECT_EQ(out.find("internal error"), std::string::npos) << out;
   // a viscosity from a tiny Reynolds number
-  expectUserError("run " + fluid + " --quiet --set fluid.reynolds=1e-300 --out " + (dir / "o").string(), "fluid.reynolds");
+  expectUserError("run " + fluid + " --quiet --set fluid.reynolds=1e-300 --out " + (dir / "o").string(),
+                  "fluid.reynolds");
   // cells so small that back-traces lose all precision, and back-traces a million cells long
-  expectUserError("run " + fluid + " --quiet --set domain.size=[1e-12,1e-12] --out " + (dir / "o").string(), "domain.size");
-  expectUserError("run " + fluid + " --quiet --set fluid.lid_velocity=1e6 --set time.dt=1 --out " + (dir / "o").string(),
-                  "time.dt");
+  expectUserError("run " + fluid + " --quiet --set domain.size=[1e-12,1e-12] --out " + (dir / "o").string(),
+                  "domain.size");
+  expectUserError(
+      "run " + fluid + " --quiet --set fluid.lid_velocity=1e6 --set time.dt=1 --out " + (dir / "o").string(),
+      "time.dt");
   // bench sizes
-  for (const char* size : {"0", "1", "-3", "2x", "16384"}) expectUserError(std::string("bench rd --size ") + size, "size");
+  for (const char* size : {"0", "1", "-3", "2x", "16384"})
+    expectUserError(std::string("bench rd --size ") + size, "size");
   // expressions: thousands of nested parentheses, and a very long one
   const std::string deep = std::string(2400, '(') + "x" + std::string(2400, ')');
   expectUserError("run " + rd + o + " --set 'rd.maps.F=\"" + deep + "\"'", "nested more than 200 deep");
@@ -156,15 +164,17 @@ TEST(HostileInput, AnImageIsCheckedByItsHeaderBeforeItIsDecoded) {
   const fs::path huge = write(dir / "huge.png", pngHeader(100000, 100000));
   expectUserError("analyze " + huge.string(), "claims 100000 x 100000", 5);
   const std::string rd = write(dir / "rd.toml", kRdScene).string();
-  expectUserError("run " + rd + " --out " + (dir / "o").string() + " --set 'rd.maps.F={image=\"" + huge.string() + "\",range=[0.02,0.05]}'",
+  expectUserError("run " + rd + " --out " + (dir / "o").string() + " --set 'rd.maps.F={image=\"" + huge.string() +
+                      "\",range=[0.02,0.05]}'",
                   "claims 100000 x 100000", 5);
   // Degenerate images for analyze: 1 x 1, and constant.
   const fs::path one = write(dir / "one.png", "");
   CommandResult made = runMorphoflow("texton --size 1 --elements 1 --steps 0 --out " + one.string());
   ASSERT_EQ(made.status, 0) << made.output;
   expectUserError("analyze " + one.string(), "at least 4 x 4");
-  CommandResult flat = runMorphoflow("run " + rd + " --quiet --set 'rd.initial={values=[1.0,0.0]}' --set output.every=20 --out " +
-                                     (dir / "flat").string());
+  CommandResult flat =
+      runMorphoflow("run " + rd + " --quiet --set 'rd.initial={values=[1.0,0.0]}' --set output.every=20 --out " +
+                    (dir / "flat").string());
   ASSERT_EQ(flat.status, 0) << flat.output;
   expectUserError("analyze " + (dir / "flat" / "frames" / "000000.png").string(), "constant");
   fs::remove_all(dir);
@@ -182,12 +192,15 @@ TEST(HostileInput, NoFluidLeftIsRefusedAndAnUnconvergedPressureIsAWarning) {
         std::tuple{sceneFile("coupled/obstacle_gray_scott_ard.toml") +
                        " --set grid.resolution=[32,64] --set rd.resolution=[32,64] --set time.steps=2",
                    std::string("center=[0.4,1.58],size=[2.0,0.04]"), std::string("(high y)")}})
-    expectUserError("run " + scene + " --quiet --set 'obstacles=[{shape=\"box\"," + box + "}]' --out " + (dir / "o").string(),
-                    "cover the whole inflow side " + side);
+    expectUserError(
+        "run " + scene + " --quiet --set 'obstacles=[{shape=\"box\"," + box + "}]' --out " + (dir / "o").string(),
+        "cover the whole inflow side " + side);
   const std::string cavity = write(dir / "cavity.toml", kFluidScene).string();
-  for (const std::string& args : {cavity, sceneFile("coupled/cavity_gray_scott.toml") +
-                                              " --set grid.resolution=[32,32] --set rd.resolution=[32,32] --set time.steps=3"}) {
-    CommandResult r = runMorphoflow("run " + args + " --quiet --set fluid.pressure_max_iterations=1 --out " + (dir / "u").string());
+  for (const std::string& args :
+       {cavity, sceneFile("coupled/cavity_gray_scott.toml") +
+                    " --set grid.resolution=[32,32] --set rd.resolution=[32,32] --set time.steps=3"}) {
+    CommandResult r =
+        runMorphoflow("run " + args + " --quiet --set fluid.pressure_max_iterations=1 --out " + (dir / "u").string());
     EXPECT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("warning: step 1: pressure solve stopped"), std::string::npos) << r.output;
     std::ifstream in(dir / "u" / "run.json");
@@ -205,13 +218,17 @@ TEST(HostileInput, ADivergingRunStopsNamingTheStepAndStageAndKeepsItsFrames) {
   const std::string rd = write(dir / "rd.toml", kRdScene).string();
   for (const auto& [scene, sets, stage] :
        {std::tuple{rd, std::string(" --set time.dt=50"), std::string("in the explicit reaction-diffusion step")},
-        std::tuple{sceneFile("coupled/cavity_gray_scott.toml"),
-                   std::string(" --set grid.resolution=[32,32] --set rd.resolution=[32,32] --set time.dt=0.2 --set time.steps=100"),
-                   std::string("in the advection-reaction-diffusion step")}}) {
+        std::tuple{
+            sceneFile("coupled/cavity_gray_scott.toml"),
+            std::string(
+                " --set grid.resolution=[32,32] --set rd.resolution=[32,32] --set time.dt=0.2 --set time.steps=100"),
+            std::string("in the advection-reaction-diffusion step")}}) {
     const fs::path out = dir / "o";
     fs::remove_all(out);
-    CommandResult r = runMorphoflow("run " + scene + sets + " --quiet --set 'rd.integrator=\"explicit\"' --set output.every=1"
-                                    " --set output.checkpoint_every=1 --out " + out.string());
+    CommandResult r = runMorphoflow("run " + scene + sets +
+                                    " --quiet --set 'rd.integrator=\"explicit\"' --set output.every=1"
+                                    " --set output.checkpoint_every=1 --out " +
+                                    out.string());
     ASSERT_EQ(r.status, 2) << r.output;
     EXPECT_NE(r.output.find("diverged"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find(stage), std::string::npos) << r.output;
@@ -234,16 +251,19 @@ TEST(HostileInput, ADivergingRunStopsNamingTheStepAndStageAndKeepsItsFrames) {
 TEST(HostileInput, ARunThatBlowsUpWhileFiniteStopsNamingTheForces) {
   const fs::path dir = tempDir("hostile_blowup");
   for (const auto& [scene, sets, key] :
-       {std::tuple{sceneFile("vfx/plume_3d.toml"), std::string(" --set grid.resolution=[12,20,12] --set smoke.vorticity=1e6"),
+       {std::tuple{sceneFile("vfx/plume_3d.toml"),
+                   std::string(" --set grid.resolution=[12,20,12] --set smoke.vorticity=1e6"),
                    std::string("smoke.vorticity = 1e+06")},
-        std::tuple{sceneFile("vfx/plume_2d.toml"), std::string(" --set grid.resolution=[32,48] --set smoke.buoyancy=1e9"),
+        std::tuple{sceneFile("vfx/plume_2d.toml"),
+                   std::string(" --set grid.resolution=[32,48] --set smoke.buoyancy=1e9"),
                    std::string("smoke.buoyancy = 1e+09")},
-        std::tuple{sceneFile("vfx/plume_2d.toml"), std::string(" --set grid.resolution=[32,48] --set smoke.weight=-1e9"),
+        std::tuple{sceneFile("vfx/plume_2d.toml"),
+                   std::string(" --set grid.resolution=[32,48] --set smoke.weight=-1e9"),
                    std::string("smoke.weight = -1e+09")}}) {
     const fs::path out = dir / "o";
     fs::remove_all(out);
-    CommandResult r = runMorphoflow("run " + scene + sets + " --quiet --set time.duration=0.5 --set output.every=2 --out " +
-                                    out.string());
+    CommandResult r = runMorphoflow("run " + scene + sets +
+                                    " --quiet --set time.duration=0.5 --set output.every=2 --out " + out.string());
     ASSERT_EQ(r.status, 2) << r.output;
     EXPECT_NE(r.output.find("blew up"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("in the fluid step"), std::string::npos) << r.output;
@@ -266,13 +286,15 @@ TEST(HostileInput, CommandLineNumbersOutsideTheirRangeAreRefused) {
     cases.push_back({"plot propagator " + gen + " --tau " + v + png, "--tau"});
     cases.push_back({"plot propagator " + gen + " --radius " + v + png, "--radius"});
   }
-  for (const char* v : {"inf", "nan", "1e9", "-1"}) cases.push_back({std::string("bench roofline --seconds ") + v, "--seconds"});
+  for (const char* v : {"inf", "nan", "1e9", "-1"})
+    cases.push_back({std::string("bench roofline --seconds ") + v, "--seconds"});
   for (const char* v : {"inf", "nan", "1e300", "-1"}) {
     cases.push_back({std::string("texton --lifetime ") + v + png, "--lifetime"});
     cases.push_back({std::string("texton --radius ") + v + png, "--radius"});
     cases.push_back({std::string("texton -p ") + v + png, "-p"});
   }
-  for (const char* v : {"''", "+0/2", "0/+2", "-0/2", "0/2/3"}) cases.push_back({"batch " + rd + " --shard " + v + out, "--shard"});
+  for (const char* v : {"''", "+0/2", "0/+2", "-0/2", "0/2/3"})
+    cases.push_back({"batch " + rd + " --shard " + v + out, "--shard"});
   for (const auto& [args, option] : cases) {
     CommandResult r = runMorphoflow(args);
     EXPECT_EQ(r.status, 2) << args << "\n" << r.output;
@@ -304,31 +326,38 @@ TEST(HostileInput, ARunThatWouldDoNothingSaysSo) {
   EXPECT_NE(r.output.find("time.duration"), std::string::npos) << r.output;
   // A source that covers no fluid cell (far smaller than a cell, or inside an
   // obstacle) runs, and says it emits nothing; the plume as shipped does not.
-  const std::string plume = "run " + sceneFile("vfx/plume_2d.toml") + " --quiet --set grid.resolution=[32,48] --set time.duration=0.1" + out;
+  const std::string plume =
+      "run " + sceneFile("vfx/plume_2d.toml") + " --quiet --set grid.resolution=[32,48] --set time.duration=0.1" + out;
   // An obstacle between the faces of one cell is not seen by the flow: said; one smaller than a cell
   // that holds a cell's centre or crosses a face is seen, and nothing is said.
-  const std::string channel = "run " + sceneFile("flow_past_obstacle.toml") + " --quiet --set grid.resolution=[220,41] --set time.duration=0.02" + out;
-  for (const auto& [obstacle, unseen] : {std::pair{std::string("{center=[0.203,0.203],radius=0.002}"), true},
-                                         std::pair{std::string("{center=[0.203,0.203],radius=0.002,boundary=\"voxel\"}"), true},
-                                         std::pair{std::string("{center=[0.205,0.205],radius=0.003}"), false},
-                                         std::pair{std::string("{center=[0.2,0.205],radius=0.004}"), false}}) {
+  const std::string channel = "run " + sceneFile("flow_past_obstacle.toml") +
+                              " --quiet --set grid.resolution=[220,41] --set time.duration=0.02" + out;
+  for (const auto& [obstacle, unseen] :
+       {std::pair{std::string("{center=[0.203,0.203],radius=0.002}"), true},
+        std::pair{std::string("{center=[0.203,0.203],radius=0.002,boundary=\"voxel\"}"), true},
+        std::pair{std::string("{center=[0.205,0.205],radius=0.003}"), false},
+        std::pair{std::string("{center=[0.2,0.205],radius=0.004}"), false}}) {
     r = runMorphoflow(channel + " --set 'obstacles=[" + obstacle + "]'");
     EXPECT_EQ(r.status, 0) << obstacle << ": " << r.output;
-    EXPECT_EQ(r.output.find("obstacles.0 meets no cell centre or face") != std::string::npos, unseen) << obstacle << ": " << r.output;
+    EXPECT_EQ(r.output.find("obstacles.0 meets no cell centre or face") != std::string::npos, unseen)
+        << obstacle << ": " << r.output;
   }
   // An image source's motion or center would move nothing: refused where it is written.
   const std::string fish = sceneFile("rd/seeds/images/fish.png");
   for (const std::string& extra : {std::string("center=[0.3,0.3]"), std::string("motion=[\"0.5\",\"t\"]")}) {
     r = runMorphoflow(plume + " --set 'sources=[{shape=\"image\",file=\"" + fish + "\",density=1.0," + extra + "}]'");
     EXPECT_EQ(r.status, 2) << extra << ": " << r.output;
-    EXPECT_NE(r.output.find(extra.substr(0, extra.find('=')) == "center" ? "a center does not apply" : "a motion would move nothing"),
-              std::string::npos) << r.output;
+    EXPECT_NE(r.output.find(extra.substr(0, extra.find('=')) == "center" ? "a center does not apply"
+                                                                         : "a motion would move nothing"),
+              std::string::npos)
+        << r.output;
   }
   for (const std::string& sets : {std::string(" --set sources.0.radius=0.001"),
                                   std::string(" --set 'obstacles=[{center=[0.5,0.15],radius=0.2}]'"), std::string()}) {
     r = runMorphoflow(plume + sets);
     EXPECT_EQ(r.status, 0) << sets << ": " << r.output;
-    EXPECT_EQ(r.output.find("sources.0 covers no fluid cell") != std::string::npos, !sets.empty()) << sets << ": " << r.output;
+    EXPECT_EQ(r.output.find("sources.0 covers no fluid cell") != std::string::npos, !sets.empty())
+        << sets << ": " << r.output;
   }
   fs::remove_all(dir);
 }
@@ -339,10 +368,12 @@ TEST(HostileInput, ARunThatWouldDoNothingSaysSo) {
 TEST(HostileInput, AnSdfIsFiniteOrRefusedAndOneSolidEverywhereLeavesNoFluid) {
   const fs::path dir = tempDir("hostile_sdf");
   const std::string cavity = "run " + sceneFile("lid_driven_cavity.toml") +
-                             " --quiet --set grid.resolution=[16,16] --set time.duration=0.02 --out " + (dir / "o").string();
-  for (const auto& [value, expect] : {std::pair{-std::numeric_limits<float>::infinity(), std::string("the sdf holds -inf at pixel (0, 0)")},
-                                      std::pair{std::numeric_limits<float>::quiet_NaN(), std::string("the sdf holds nan at pixel (0, 0)")},
-                                      std::pair{-1.0f, std::string("the obstacles cover every cell")}}) {
+                             " --quiet --set grid.resolution=[16,16] --set time.duration=0.02 --out " +
+                             (dir / "o").string();
+  for (const auto& [value, expect] :
+       {std::pair{-std::numeric_limits<float>::infinity(), std::string("the sdf holds -inf at pixel (0, 0)")},
+        std::pair{std::numeric_limits<float>::quiet_NaN(), std::string("the sdf holds nan at pixel (0, 0)")},
+        std::pair{-1.0f, std::string("the obstacles cover every cell")}}) {
     morphoflow::FieldDump d;
     d.resolution = {16, 16};
     d.names = {"Y"};
@@ -385,10 +416,12 @@ TEST(HostileInput, AStrokeFromAUniformImageDepositsButGivesNoDirection) {
   const fs::path dir = tempDir("hostile_uniform_stroke");
   std::ofstream(dir / "bright.pgm", std::ios::binary) << "P5 16 16 255\n" << std::string(256, char(255));
   const std::string base = std::string(kRdScene) + "[[rd.strokes]]\nimage = \"bright.pgm\"\n";
-  CommandResult r = runMorphoflow("run " + write(dir / "deposit.toml", base + "species = [\"v\"]\nvalues = [0.5]\n").string() +
-                                  " --quiet --out " + (dir / "a").string());
+  CommandResult r =
+      runMorphoflow("run " + write(dir / "deposit.toml", base + "species = [\"v\"]\nvalues = [0.5]\n").string() +
+                    " --quiet --out " + (dir / "a").string());
   EXPECT_EQ(r.status, 0) << r.output;
-  const std::string lobes = write(dir / "lobes.toml", base + "[rd.cosine_lobes]\nspeeds = [1]\ntheta0 = \"strokes\"\n").string();
+  const std::string lobes =
+      write(dir / "lobes.toml", base + "[rd.cosine_lobes]\nspeeds = [1]\ntheta0 = \"strokes\"\n").string();
   r = runMorphoflow("run " + lobes + " --quiet --out " + (dir / "b").string());
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find(lobes + ":"), std::string::npos) << r.output;
@@ -403,7 +436,8 @@ TEST(HostileInput, AStrokeFromAUniformImageDepositsButGivesNoDirection) {
 TEST(HostileInput, ASceneThatReadsFromItsOutputFolderIsRefused) {
   const fs::path dir = tempDir("hostile_inputs_inside");
   const fs::path out = dir / "o";
-  ASSERT_EQ(runMorphoflow("run " + write(dir / "rd.toml", kRdScene).string() + " --quiet --out " + out.string()).status, 0);
+  ASSERT_EQ(runMorphoflow("run " + write(dir / "rd.toml", kRdScene).string() + " --quiet --out " + out.string()).status,
+            0);
   ASSERT_TRUE(fs::exists(out / "frames" / "000000.png"));
   const std::string mapped = write(dir / "mapped.toml", std::string(kRdScene) + "[rd.maps]\nF = { image = \"" +
                                                             (out / "frames" / "000000.png").string() +
@@ -433,16 +467,17 @@ TEST(HostileInput, EveryWriterRefusesFoldersPipesAndDevices) {
   const std::string png = (dir / "t.png").string();
   ASSERT_EQ(runMorphoflow("texton --size 32 --elements 4 --steps 4 --out " + png).status, 0);
   auto commands = [&](const std::string& target) {
-    return std::vector<std::string>{"bench roofline --json " + target, "plot propagator " + gen + " --size 64 --out " + target,
-                                    "texton --size 32 --elements 4 --steps 4 --out " + target,
-                                    "analyze " + png + " --csv " + target};
+    return std::vector<std::string>{
+        "bench roofline --json " + target, "plot propagator " + gen + " --size 64 --out " + target,
+        "texton --size 32 --elements 4 --steps 4 --out " + target, "analyze " + png + " --csv " + target};
   };
   for (const std::string& target : {folder.string(), fifo.string(), std::string("/dev/morphoflow_test_file")})
     for (const std::string& cmd : commands(target)) {
       const CommandResult r = runMorphoflow(cmd);
       EXPECT_EQ(r.status, 2) << cmd << "\n" << r.output;
-      EXPECT_NE(r.output.find(target.rfind("/dev/", 0) == 0 ? std::string("/dev") : target), std::string::npos) << cmd << "\n"
-                                                                                                             << r.output;
+      EXPECT_NE(r.output.find(target.rfind("/dev/", 0) == 0 ? std::string("/dev") : target), std::string::npos)
+          << cmd << "\n"
+          << r.output;
     }
   EXPECT_FALSE(fs::exists("/dev/morphoflow_test_file"));
   struct stat st;
@@ -469,7 +504,9 @@ TEST(HostileInput, ARunLimitedByFramesResumesWithTheNextFrame) {
   ASSERT_EQ(runMorphoflow("run " + rd + (dir / "cut").string() + " --frames 0:2").status, 0);
   EXPECT_FALSE(fs::exists(dir / "cut" / "frames" / "000003.png"));
   ASSERT_EQ(runMorphoflow("run " + rd + (dir / "cut").string() + " --resume").status, 0);
-  auto bytes = [](const fs::path& p) { return std::string(std::istreambuf_iterator<char>(std::ifstream(p, std::ios::binary).rdbuf()), {}); };
+  auto bytes = [](const fs::path& p) {
+    return std::string(std::istreambuf_iterator<char>(std::ifstream(p, std::ios::binary).rdbuf()), {});
+  };
   for (const char* f : {"000000.png", "000002.png", "000003.png", "000004.png", "000005.png"}) {
     ASSERT_TRUE(fs::exists(dir / "cut" / "frames" / f)) << f << " lost";
     EXPECT_EQ(bytes(dir / "cut" / "frames" / f), bytes(dir / "whole" / "frames" / f)) << f;

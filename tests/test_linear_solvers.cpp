@@ -149,7 +149,8 @@ TEST(LinearSolvers, ObstaclesAndPeriodicAxes) {
   SolverResult r1 = solveWith<2>(Method::MGPCG, A, b, &x1, 1e-8);
   SolverResult r2 = solveWith<2>(Method::ICPCG, A, b, &x2, 1e-8);
   SolverResult r3 = solveWith<2>(Method::Multigrid, A, b, &x3, 1e-8);
-  ASSERT_TRUE(r1.converged && r2.converged && r3.converged) << r1.iterations << " " << r1.residual << " / " << r3.iterations << " " << r3.residual;
+  ASSERT_TRUE(r1.converged && r2.converged && r3.converged)
+      << r1.iterations << " " << r1.residual << " / " << r3.iterations << " " << r3.residual;
   double scale = 0, d12 = 0, d13 = 0;
   for (size_t i = 0; i < b.size(); ++i) {
     scale = std::max(scale, std::abs(x1[i]));

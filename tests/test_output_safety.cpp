@@ -92,7 +92,8 @@ TEST(OutputSafety, AnOutThatCannotHoldARunIsExitTwoNamingIt) {
   }
   EXPECT_EQ(fs::file_size(dir / "a_file"), 12u);  // untouched
   // An empty --out names no folder: exit 2 saying so, for run and batch.
-  for (const std::string& command : {"run " + kScene + kSmall + " --out ''", "batch " + kScene + kSmall + " --out ''"}) {
+  for (const std::string& command :
+       {"run " + kScene + kSmall + " --out ''", "batch " + kScene + kSmall + " --out ''"}) {
     CommandResult r = runMorphoflow(command);
     EXPECT_EQ(r.status, 2) << command << ": " << r.output;
     EXPECT_NE(r.output.find("--out"), std::string::npos) << r.output;
@@ -161,7 +162,10 @@ TEST(OutputSafety, ANonRegularFileAtAnOutputPathIsNeverReplaced) {
 TEST(OutputSafety, ANewRunRemovesTheEarlierRunsOutputsOnly) {
   const fs::path dir = tempDir("safety_rerun");
   const fs::path out = dir / "out";
-  ASSERT_EQ(runMorphoflow("run " + kScene + kSmall + " --set output.every=2 --set output.fields=true --out " + out.string()).status, 0);
+  ASSERT_EQ(
+      runMorphoflow("run " + kScene + kSmall + " --set output.every=2 --set output.fields=true --out " + out.string())
+          .status,
+      0);
   std::ofstream(out / "notes.txt") << "mine";
   std::ofstream(out / "frames" / "reference.png") << "mine too";
   ASSERT_EQ(runMorphoflow("run " + kScene + kSmall + " --set output.every=8 --out " + out.string()).status, 0);
@@ -204,14 +208,16 @@ TEST(OutputSafety, EveryKindOfEarlierOutputIsRemoved) {
 TEST(OutputSafety, AFolderInUseIsRefusedToASecondRun) {
   const fs::path dir = tempDir("safety_lock");
   const fs::path out = dir / "out";
-  const pid_t first = startMorphoflow({"run", kScene, "--set", "grid.resolution=[24,24]", "--set", "rd.resolution=[24,24]",
-                                       "--set", "time.steps=1000000", "--set", "output.every=20", "--set",
-                                       "output.video=false", "--quiet", "--out", out.string()},
-                                      dir / "log");
+  const pid_t first =
+      startMorphoflow({"run", kScene, "--set", "grid.resolution=[24,24]", "--set", "rd.resolution=[24,24]", "--set",
+                       "time.steps=1000000", "--set", "output.every=20", "--set", "output.video=false", "--quiet",
+                       "--out", out.string()},
+                      dir / "log");
   ASSERT_TRUE(waitUntil([&] { return fs::exists(out / "frames" / "000001.png"); }, 60));
   const CommandResult second = runMorphoflow("run " + kScene + kSmall + " --out " + out.string());
   EXPECT_EQ(second.status, 2) << second.output;
-  EXPECT_NE(second.output.find("in use by another morphoflow run (pid " + std::to_string(first) + ")"), std::string::npos)
+  EXPECT_NE(second.output.find("in use by another morphoflow run (pid " + std::to_string(first) + ")"),
+            std::string::npos)
       << second.output;
   EXPECT_TRUE(fs::exists(out / "frames" / "000000.png")) << "the second run deleted the first run's frames";
   kill(first, SIGINT);
@@ -234,12 +240,13 @@ TEST(OutputSafety, SigtermStopsFfmpegAndLeavesNoPartFile) {
   const std::string path = bin.string() + ":" + std::getenv("PATH");
   setenv("PATH", path.c_str(), 1);
   const fs::path out = dir / "out";
-  const pid_t pid = startMorphoflow({"run", kScene, "--set", "grid.resolution=[24,24]", "--set", "rd.resolution=[24,24]",
-                                     "--set", "time.steps=8", "--set", "output.every=4", "--set", "output.video=true",
-                                     "--quiet", "--out", out.string()},
-                                    dir / "log");
+  const pid_t pid = startMorphoflow(
+      {"run", kScene, "--set", "grid.resolution=[24,24]", "--set", "rd.resolution=[24,24]", "--set", "time.steps=8",
+       "--set", "output.every=4", "--set", "output.video=true", "--quiet", "--out", out.string()},
+      dir / "log");
   ASSERT_TRUE(waitUntil([&] { return fs::exists(dir / "ffmpeg.pid") && fs::file_size(dir / "ffmpeg.pid") > 0; }, 60));
-  const pid_t ffmpeg = std::stoi(std::string(std::istreambuf_iterator<char>(std::ifstream(dir / "ffmpeg.pid").rdbuf()), {}));
+  const pid_t ffmpeg =
+      std::stoi(std::string(std::istreambuf_iterator<char>(std::ifstream(dir / "ffmpeg.pid").rdbuf()), {}));
   kill(pid, SIGTERM);
   EXPECT_EQ(waitMorphoflow(pid), 143);
   EXPECT_TRUE(waitUntil([&] { return kill(ffmpeg, 0) != 0; }, 10)) << "ffmpeg still runs";

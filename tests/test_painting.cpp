@@ -162,7 +162,8 @@ TEST(BrushStrokes, AnImageStrokeGivesItsOrientation) {
   const PaintedStrokes<2> p = paintStrokes<2>({s}, IVec<2>(w, w), {1.0, 1.0}, false);
   double worst = 0;
   for (int j = 20; j < w - 20; ++j)
-    for (int i = 20; i < w - 20; ++i) worst = std::max(worst, angleDifference(2.0 * p.angle[size_t(j * w + i)], 0.5 * M_PI));
+    for (int i = 20; i < w - 20; ++i)
+      worst = std::max(worst, angleDifference(2.0 * p.angle[size_t(j * w + i)], 0.5 * M_PI));
   EXPECT_LT(worst, 0.05);
 }
 

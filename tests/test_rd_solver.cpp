@@ -302,7 +302,8 @@ TEST(RDSolver, NeumannDiffusionConservesMass) {
 TEST(CoarseToFine, ProlongationIsLinearExactAndConservative) {
   Grid<double, 2> coarse(IVec<2>(8, 6)), fine(IVec<2>(16, 12));
   auto linear = [](double x, double y) { return 2.0 + 0.5 * x - 0.25 * y; };
-  forEachCell<2>(coarse.dims(), [&](const IVec<2>& k, size_t i) { coarse[i] = linear(2 * (k[0] + 0.5), 2 * (k[1] + 0.5)); });
+  forEachCell<2>(coarse.dims(),
+                 [&](const IVec<2>& k, size_t i) { coarse[i] = linear(2 * (k[0] + 0.5), 2 * (k[1] + 0.5)); });
   prolongate<2>(coarse, &fine, false);
   for (int j = 1; j < 11; ++j)
     for (int i = 1; i < 15; ++i) EXPECT_NEAR(fine(IVec<2>(i, j)), linear(i + 0.5, j + 0.5), 1e-12);

@@ -123,8 +123,8 @@ INSTANTIATE_TEST_SUITE_P(
                          "output.video=false"},
                         kCheckpointOften)},
         ResumeCase{"coupled_3d", "coupled/cavity_gray_scott_3d.toml",
-                   with({"grid.resolution=[16,16,16]", "rd.resolution=[16,16,16]", "time.steps=1500", "output.every=50", "output.video=false",
-                         "output.vdb=true", "output.nanovdb=true"},
+                   with({"grid.resolution=[16,16,16]", "rd.resolution=[16,16,16]", "time.steps=1500", "output.every=50",
+                         "output.video=false", "output.vdb=true", "output.nanovdb=true"},
                         kCheckpointOften)},
         ResumeCase{"rd_only_2d", "rd/seeds/kim_lin_lobes3.toml",
                    with({"grid.resolution=[64,64]", "time.steps=3000", "output.every=100"}, kCheckpointOften)},
@@ -132,8 +132,8 @@ INSTANTIATE_TEST_SUITE_P(
                    with({"grid.resolution=[24,24,24]", "domain.size=[24,24,24]", "time.steps=1500", "output.every=50"},
                         kCheckpointOften)},
         ResumeCase{"rd_fused_explicit", "rd/turing_lawlor.toml",
-                   with({"grid.resolution=[128,128]", "domain.size=[128,128]", "rd.integrator=\"explicit\"", "time.dt=0.5",
-                         "time.steps=100000", "output.every=5000"},
+                   with({"grid.resolution=[128,128]", "domain.size=[128,128]", "rd.integrator=\"explicit\"",
+                         "time.dt=0.5", "time.steps=100000", "output.every=5000"},
                         kCheckpointOften)},
         ResumeCase{"fluid_probes", "flow_past_obstacle.toml",
                    with({"grid.resolution=[220,41]", "time.duration=4", "output.every=40"}, kCheckpointOften)},
@@ -262,9 +262,19 @@ void rewriteHeader(const fs::path& file, const std::string& header) {
 // section must fit), with a warning naming both versions.
 TEST(Resume, AMalformedHeaderOrAHugeFileIsUnusableAndAnotherVersionIsSaidSo) {
   const fs::path dir = tempDir("resume_header");
-  const std::vector<std::string> run = {"run", sceneFile("rd/gray_scott_pearson.toml"), "--set", "grid.resolution=[24,24]",
-                                        "--set", "time.steps=6", "--set", "output.every=2", "--set",
-                                        "output.checkpoint_every=1", "--quiet", "--out", (dir / "out").string()};
+  const std::vector<std::string> run = {"run",
+                                        sceneFile("rd/gray_scott_pearson.toml"),
+                                        "--set",
+                                        "grid.resolution=[24,24]",
+                                        "--set",
+                                        "time.steps=6",
+                                        "--set",
+                                        "output.every=2",
+                                        "--set",
+                                        "output.checkpoint_every=1",
+                                        "--quiet",
+                                        "--out",
+                                        (dir / "out").string()};
   ASSERT_EQ(runMorphoflow(join(run)).status, 0);
   std::vector<fs::path> cps = checkpoints(dir / "out");
   ASSERT_GE(cps.size(), 2u);
@@ -323,9 +333,19 @@ TEST(Resume, AMalformedHeaderOrAHugeFileIsUnusableAndAnotherVersionIsSaidSo) {
 // naming the file and the section or output: never a crash or a NaN run.
 TEST(Resume, AStateHoldingNaNOrAnOutputStateLackingAKeyIsRefusedNamingIt) {
   const fs::path dir = tempDir("resume_state");
-  const std::vector<std::string> run = {"run", sceneFile("rd/gray_scott_pearson.toml"), "--set", "grid.resolution=[24,24]",
-                                        "--set", "time.steps=4", "--set", "output.every=2", "--set",
-                                        "output.checkpoint_every=1", "--quiet", "--out", (dir / "out").string()};
+  const std::vector<std::string> run = {"run",
+                                        sceneFile("rd/gray_scott_pearson.toml"),
+                                        "--set",
+                                        "grid.resolution=[24,24]",
+                                        "--set",
+                                        "time.steps=4",
+                                        "--set",
+                                        "output.every=2",
+                                        "--set",
+                                        "output.checkpoint_every=1",
+                                        "--quiet",
+                                        "--out",
+                                        (dir / "out").string()};
   ASSERT_EQ(runMorphoflow(join(run)).status, 0);
   std::vector<fs::path> cps = checkpoints(dir / "out");
   ASSERT_FALSE(cps.empty());

@@ -61,10 +61,11 @@ TEST(RunRecords, OnATerminalProgressIsOneLineRedrawnInPlace) {
 
 TEST(RunRecords, RunJsonSaysHowItEndedAndWhatItWrote) {
   const fs::path dir = tempDir("records_json");
-  CommandResult r = runMorphoflow("run " + sceneFile("coupled/cavity_gray_scott.toml") +
-                                  " --set grid.resolution=[24,24] --set rd.resolution=[24,24] --set time.steps=8"
-                                  " --set output.every=4 --set output.fields=true --set output.vdb=true --quiet --out " +
-                                  (dir / "out").string());
+  CommandResult r =
+      runMorphoflow("run " + sceneFile("coupled/cavity_gray_scott.toml") +
+                    " --set grid.resolution=[24,24] --set rd.resolution=[24,24] --set time.steps=8"
+                    " --set output.every=4 --set output.fields=true --set output.vdb=true --quiet --out " +
+                    (dir / "out").string());
   ASSERT_EQ(r.status, 0) << r.output;
   const nlohmann::json j = runJson(dir / "out");
   EXPECT_EQ(j["exit_state"], "completed");
@@ -83,7 +84,8 @@ TEST(RunRecords, RunJsonSaysHowItEndedAndWhatItWrote) {
   // A run that diverges records it, with the message (exit 2: the scene's dt is the cause).
   CommandResult bad = runMorphoflow("run " + sceneFile("rd/turing_lawlor.toml") +
                                     " --set grid.resolution=[32,32] --set 'rd.integrator=\"explicit\"' --set time.dt=50"
-                                    " --set time.steps=40 --set output.every=10 --quiet --out " + (dir / "bad").string());
+                                    " --set time.steps=40 --set output.every=10 --quiet --out " +
+                                    (dir / "bad").string());
   EXPECT_EQ(bad.status, 2) << bad.output;
   const nlohmann::json f = runJson(dir / "bad");
   EXPECT_EQ(f["exit_state"], "diverged");
@@ -96,10 +98,12 @@ TEST(RunRecords, RunJsonSaysHowItEndedAndWhatItWrote) {
 // drawn at its ends, counted in run.json and said in one line.
 TEST(RunRecords, AFixedRangeSaysHowMuchOfTheFieldLayBeyondIt) {
   const fs::path dir = tempDir("records_range");
-  for (const auto& [range, beyond] : {std::pair{std::string("[-1.0,1.0]"), true}, std::pair{std::string("[-1e9,1e9]"), false}}) {
-    CommandResult r = runMorphoflow("run " + sceneFile("lid_driven_cavity.toml") +
-                                    " --set grid.resolution=[32,32] --set time.duration=0.5 --set output.range=" + range +
-                                    " --out " + (dir / "o").string());
+  for (const auto& [range, beyond] :
+       {std::pair{std::string("[-1.0,1.0]"), true}, std::pair{std::string("[-1e9,1e9]"), false}}) {
+    CommandResult r =
+        runMorphoflow("run " + sceneFile("lid_driven_cavity.toml") +
+                      " --set grid.resolution=[32,32] --set time.duration=0.5 --set output.range=" + range + " --out " +
+                      (dir / "o").string());
     ASSERT_EQ(r.status, 0) << r.output;
     std::ifstream in(dir / "o" / "run.json");
     const nlohmann::json f = nlohmann::json::parse(in)["frames_range"];
@@ -117,13 +121,15 @@ TEST(RunRecords, TheMemoryEstimateMatchesThePeakAndATooLargeRunIsRefused) {
   GTEST_SKIP() << "under AddressSanitizer the peak includes its shadow memory and redzones (scripts/asan)";
 #endif
   const fs::path dir = tempDir("records_memory");
-  for (const std::string& sets : {std::string(" --set grid.resolution=[64,64,64] --set rd.resolution=[64,64,64] --set time.steps=4"),
-                                  std::string(" --set grid.resolution=[48,48,48] --set rd.resolution=[96,96,96] --set time.steps=4")}) {
-    CommandResult r = runMorphoflow("run " + sceneFile("coupled/cavity_gray_scott_3d.toml") + sets +
-                                    // a frame after each step, as a run writes them (an initial
-                                    // frame alone meets no solver's work vectors)
-                                    " --set output.every=1 --set output.video=false --set output.images=false --quiet --out " +
-                                    (dir / "out").string());
+  for (const std::string& sets :
+       {std::string(" --set grid.resolution=[64,64,64] --set rd.resolution=[64,64,64] --set time.steps=4"),
+        std::string(" --set grid.resolution=[48,48,48] --set rd.resolution=[96,96,96] --set time.steps=4")}) {
+    CommandResult r =
+        runMorphoflow("run " + sceneFile("coupled/cavity_gray_scott_3d.toml") + sets +
+                      // a frame after each step, as a run writes them (an initial
+                      // frame alone meets no solver's work vectors)
+                      " --set output.every=1 --set output.video=false --set output.images=false --quiet --out " +
+                      (dir / "out").string());
     ASSERT_EQ(r.status, 0) << r.output;
     const nlohmann::json j = runJson(dir / "out");
     const double peak = j["peak_memory_bytes"].get<double>(), estimate = j["memory_estimate_bytes"].get<double>();
@@ -145,9 +151,11 @@ TEST(RunRecords, TheMemoryEstimateMatchesThePeakAndATooLargeRunIsRefused) {
 // its newest frame.
 TEST(RunRecords, ARunEndsByNamingWhatToOpenAndHow) {
   const fs::path dir = tempDir("where_to_look");
-  const CommandResult vol = runMorphoflow("run " + sceneFile("lid_driven_cavity_3d.toml") +
-                                          " --set grid.resolution=[8,8,8] --set time.duration=0.05 --set output.vdb=true"
-                                          " --set output.video=false --out " + (dir / "3d").string());
+  const CommandResult vol =
+      runMorphoflow("run " + sceneFile("lid_driven_cavity_3d.toml") +
+                    " --set grid.resolution=[8,8,8] --set time.duration=0.05 --set output.vdb=true"
+                    " --set output.video=false --out " +
+                    (dir / "3d").string());
   ASSERT_EQ(vol.status, 0) << vol.output;
   const fs::path first = dir / "3d" / "vdb" / "lid_driven_cavity_3d.000000.vdb";
   ASSERT_TRUE(fs::exists(first));
@@ -155,9 +163,11 @@ TEST(RunRecords, ARunEndsByNamingWhatToOpenAndHow) {
             std::string::npos) << vol.output;
   EXPECT_NE(vol.output.find("bpy.ops.object.volume_import(filepath='" + first.string() + "')"), std::string::npos)
       << vol.output;
-  const CommandResult flat = runMorphoflow("run " + sceneFile("rd/gray_scott_pearson.toml") +
-                                           " --set grid.resolution=[32,32] --set time.steps=20 --set output.every=10 --set output.video=true"
-                                           " --out " + (dir / "2d").string());
+  const CommandResult flat =
+      runMorphoflow("run " + sceneFile("rd/gray_scott_pearson.toml") +
+                    " --set grid.resolution=[32,32] --set time.steps=20 --set output.every=10 --set output.video=true"
+                    " --out " +
+                    (dir / "2d").string());
   ASSERT_EQ(flat.status, 0) << flat.output;
   EXPECT_NE(flat.output.find("newest frame: " + (dir / "2d" / "frames" / "000002.png").string()), std::string::npos)
       << flat.output;

@@ -37,7 +37,8 @@ std::vector<float> allFields(const Simulation<D>& sim) {
   return out;
 }
 
-const std::vector<std::string> kSmallCoupled = {"grid.resolution=[32,32]", "rd.resolution=[64,64]", "output.video=false"};
+const std::vector<std::string> kSmallCoupled = {"grid.resolution=[32,32]", "rd.resolution=[64,64]",
+                                                "output.video=false"};
 
 // A checkpoint of `sim` after `before` steps, read into a fresh simulation of
 // the scene; both then take `after` more: the fields must stay bitwise equal.
@@ -61,11 +62,13 @@ void expectResumesBitwise(const Scene& scene, Backend backend, int before, int a
 }
 
 const std::vector<std::pair<std::string, std::vector<std::string>>> kEveryKind = {
-    {"rd/turing_coarse_to_fine.toml", {"grid.resolution=[32,32]", "rd.coarse_to_fine.steps=3"}},  // the fused explicit step
+    {"rd/turing_coarse_to_fine.toml",
+     {"grid.resolution=[32,32]", "rd.coarse_to_fine.steps=3"}},  // the fused explicit step
     {"rd/gray_scott_pearson.toml", {"grid.resolution=[32,32]"}},
     {"lid_driven_cavity.toml", {"grid.resolution=[32,32]"}},
     {"coupled/cavity_gray_scott.toml", kSmallCoupled},
-    {"vfx/plume_2d.toml", {"grid.resolution=[32,48]", "sources.0.motion=[\"0.5 + 0.1 * t\", \"0.15\"]"}},  // smoke, a moving source
+    {"vfx/plume_2d.toml",
+     {"grid.resolution=[32,48]", "sources.0.motion=[\"0.5 + 0.1 * t\", \"0.15\"]"}},         // smoke, a moving source
     {"vfx/plume_gray_scott_2d.toml", {"grid.resolution=[32,48]", "rd.resolution=[64,96]"}},  // the pattern on the smoke
 };
 
@@ -77,15 +80,18 @@ TEST(SceneLoad, ANumberGivenForAnExpressionKeepsEveryDigit) {
   const std::string base = "[grid]\nresolution = [16, 16]\n[time]\ndt = 0.01\nsteps = 2\n";
   const Scene given = parseScene(base + "[rd]\nmodel = \"gray-scott\"\n[rd.maps]\nF = 0.0123456789\n"
                                         "[velocity]\nfield = [0.123456789, 1e-7]\n", "v.toml");
-  const Scene smoke = parseScene(base + "[fluid]\nviscosity = 0.0\n[[sources]]\nshape = \"circle\"\ncenter = [0.5, 0.5]\n"
-                                        "radius = 0.1\ndensity = 1.0\nmotion = [0.123456789, 0.5]\n", "s.toml");
+  const Scene smoke = parseScene(base +
+                                     "[fluid]\nviscosity = 0.0\n[[sources]]\nshape = \"circle\"\ncenter = [0.5, 0.5]\n"
+                                     "radius = 0.1\ndensity = 1.0\nmotion = [0.123456789, 0.5]\n",
+                                 "s.toml");
   const double at[4] = {0.3, 0.7, 0.0, 0.0};
   ASSERT_EQ(given.velocity.field.size(), 2u);
   EXPECT_EQ(Expression(given.velocity.field[0], {"x", "y", "z", "t"}).evaluate(at), 0.123456789);
   EXPECT_EQ(Expression(given.velocity.field[1], {"x", "y", "z", "t"}).evaluate(at), 1e-7);
   EXPECT_EQ(Expression(smoke.fluid.smoke.sources.at(0).motion.at(0), {"t"}).evaluate(at), 0.123456789);
   ASSERT_EQ(given.rd.parameterMaps.size(), 1u);
-  EXPECT_EQ(Expression(given.rd.parameterMaps[0].second.field.expression, {"x", "y", "z", "t"}).evaluate(at), 0.0123456789);
+  EXPECT_EQ(Expression(given.rd.parameterMaps[0].second.field.expression, {"x", "y", "z", "t"}).evaluate(at),
+            0.0123456789);
 }
 
 TEST(SimulationFactory, BackendNamesAreTheCommandLinesAndOthersAreRefused) {
@@ -155,7 +161,8 @@ TEST(RunDriver, WritesEveryFrameAndTheFinalStateInProcess) {
   std::string error;
   ASSERT_TRUE(readFieldDump((dir / "fields" / "000003.exr").string(), &d, &error)) << error;
   EXPECT_EQ(d.step, 12);
-  for (size_t c = 0; c < d.names.size(); ++c) EXPECT_EQ(d.channels[c], sim->field(d.names[c]).front().values()) << d.names[c];
+  for (size_t c = 0; c < d.names.size(); ++c)
+    EXPECT_EQ(d.channels[c], sim->field(d.names[c]).front().values()) << d.names[c];
   std::ifstream in(dir / "run.json");
   const nlohmann::json j = nlohmann::json::parse(in);
   EXPECT_EQ(j["exit_state"], "completed");
@@ -166,8 +173,9 @@ TEST(RunDriver, WritesEveryFrameAndTheFinalStateInProcess) {
 // and reports its bytes.
 TEST(OutputSinks, TheSceneChoosesTheSinksAndEachReportsWhatItWrote) {
   const fs::path dir = tempDir("sinks_in_process");
-  const Scene scene = loadScene(sceneFile("rd/gray_scott_pearson.toml"),
-                                {"grid.resolution=[32,32]", "output.fields=true", "output.normal_map=true", "output.video=false"});
+  const Scene scene =
+      loadScene(sceneFile("rd/gray_scott_pearson.toml"),
+                {"grid.resolution=[32,32]", "output.fields=true", "output.normal_map=true", "output.video=false"});
   auto sim = makeSimulation<2>(scene, Backend::TBB, quietLog, quietLog);
   auto sinks = makeOutputSinks<2>(dir, scene, [] { return false; });
   EXPECT_EQ(sinks.size(), 3u) << "frames, field dumps and normal maps";
@@ -206,7 +214,8 @@ TEST(HostCopy, RefreshesOnlyAfterAStepAndOnce) {
 // checkpoint bitwise: the steppers' state and the hosts' together are the
 // whole state.
 TEST(Steppers, EveryKindOfSceneResumesBitwiseOnTheCpu) {
-  for (const auto& [file, sets] : kEveryKind) expectResumesBitwise<2>(loadScene(sceneFile(file), sets), Backend::TBB, 3, 3);
+  for (const auto& [file, sets] : kEveryKind)
+    expectResumesBitwise<2>(loadScene(sceneFile(file), sets), Backend::TBB, 3, 3);
 }
 
 TEST(Steppers, EveryKindOfSceneResumesBitwiseOnTheGpu) {
@@ -222,7 +231,8 @@ TEST(Steppers, EveryKindOfSceneResumesBitwiseOnTheGpu) {
 // CPU (float species) and in float on the GPU, every other step in double;
 // the same simulation class on both backends says which it took.
 TEST(Steppers, TheLayerStepperFollowsTheSceneAndTheBackend) {
-  const Scene plain = loadScene(sceneFile("rd/turing_coarse_to_fine.toml"), {"grid.resolution=[32,32]", "rd.coarse_to_fine.steps=3"});
+  const Scene plain =
+      loadScene(sceneFile("rd/turing_coarse_to_fine.toml"), {"grid.resolution=[32,32]", "rd.coarse_to_fine.steps=3"});
   const Scene implicit = loadScene(sceneFile("rd/gray_scott_pearson.toml"), {"grid.resolution=[32,32]"});
   ASSERT_TRUE(plain.rd.plainExplicit());
   ASSERT_FALSE(implicit.rd.plainExplicit());

@@ -290,7 +290,9 @@ void expectConfinementIsEq11(const std::array<bool, D>& periodic) {
     for (size_t i = 0; i < u[a].size(); ++i) {
       const Vec<D> x = u.layout(a).toWorld(u[a].coord(i));
       const double z = D == 3 ? x[D - 1] : 0.0, p = 2 * 3.14159265358979 * (x[0] + 0.3 * x[1] + 0.6 * z);
-      u[a][i] = float(a == 0 ? std::sin(p) * std::cos(7.0 * x[1]) : a == 1 ? std::cos(3.0 * p) * (1 + z) : 0.5 * std::sin(p + x[1]));
+      u[a][i] = float(a == 0   ? std::sin(p) * std::cos(7.0 * x[1])
+                      : a == 1 ? std::cos(3.0 * p) * (1 + z)
+                               : 0.5 * std::sin(p + x[1]));
     }
   SmokeSettings s;
   s.enabled = true;

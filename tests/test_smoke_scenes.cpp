@@ -68,7 +68,8 @@ TEST(SmokeScenes, BadSourcesAndSmokeWithoutAFluidAreLocatedErrors) {
       {"density = 2.0", "density = -2.0", "sources.0.density", "expected a number in [0"},
       {"radius = 0.08", "radius = 0.08\nstart = 1.0\nend = 0.5", "sources.0.end", "before it starts"},
       {"density = 2.0\ntemperature = 4.0", "", "sources.0", "emits nothing"},
-      {"radius = 0.08", "radius = 0.08\nmotion = [\"0.3 + * t\", \"0.2\"]", "sources.0.motion.0", "in the motion expression"},
+      {"radius = 0.08", "radius = 0.08\nmotion = [\"0.3 + * t\", \"0.2\"]", "sources.0.motion.0",
+       "in the motion expression"},
   };
   for (const Case& c : cases) {
     std::string source = kSource;
@@ -88,7 +89,8 @@ TEST(SmokeScenes, BadSourcesAndSmokeWithoutAFluidAreLocatedErrors) {
     EXPECT_EQ(r.status, 2) << r.output;
     EXPECT_NE(r.output.find("sources.0.chemicals"), std::string::npos) << r.output;
     const std::string cavity = sceneFile("coupled/cavity_gray_scott.toml");
-    const CommandResult m = runMorphoflow("run " + cavity + " --set coupling.smoke_mask=0.1 --quiet --out " + (dir / "o").string());
+    const CommandResult m =
+        runMorphoflow("run " + cavity + " --set coupling.smoke_mask=0.1 --quiet --out " + (dir / "o").string());
     EXPECT_EQ(m.status, 2) << m.output;
     EXPECT_NE(m.output.find("no smoke to mask"), std::string::npos) << m.output;
   }
@@ -102,8 +104,9 @@ TEST(SmokeScenes, BadSourcesAndSmokeWithoutAFluidAreLocatedErrors) {
     EXPECT_NE(r.output.find("neither a field nor an expression"), std::string::npos) << r.output;
   }
   // A scene whose layer is carried by a given velocity has no fluid for smoke.
-  const std::string given = "[grid]\nresolution = [16, 16]\n[time]\ndt = 0.01\nsteps = 2\n[rd]\nmodel = \"gray-scott\"\n"
-                            "[velocity]\nfield = [\"0\", \"0\"]\n[smoke]\nbuoyancy = 1.0\n";
+  const std::string given =
+      "[grid]\nresolution = [16, 16]\n[time]\ndt = 0.01\nsteps = 2\n[rd]\nmodel = \"gray-scott\"\n"
+      "[velocity]\nfield = [\"0\", \"0\"]\n[smoke]\nbuoyancy = 1.0\n";
   const fs::path scene = write(dir / "given.toml", given);
   const CommandResult r = runMorphoflow("validate " + scene.string());
   EXPECT_EQ(r.status, 2) << r.output;
@@ -137,7 +140,8 @@ TEST(SmokeScenes, TheGpuBackendRunsSmokeAndThePatternOnIt) {
   CommandResult r = runMorphoflow("run " + scene.string() + " --backend gpu --quiet --out " + (dir / "o").string());
   if (r.output.find("no usable GPU context") != std::string::npos) GTEST_SKIP() << r.output;
   EXPECT_EQ(r.status, 0) << r.output;
-  r = runMorphoflow("run " + sceneFile("vfx/plume_gray_scott_2d.toml") + " --set grid.resolution=[16,24] --set rd.resolution=[32,48]" +
+  r = runMorphoflow("run " + sceneFile("vfx/plume_gray_scott_2d.toml") +
+                    " --set grid.resolution=[16,24] --set rd.resolution=[32,48]" +
                     " --set time.duration=0.05 --backend gpu --quiet --out " + (dir / "p").string());
   EXPECT_EQ(r.status, 0) << r.output;
   fs::remove_all(dir);
@@ -149,8 +153,8 @@ TEST(SmokeScenes, TheGpuBackendRunsSmokeAndThePatternOnIt) {
 TEST(SmokeScenes, ARunDumpsTheSmokeItsSourceEmittedAndItsTemperature) {
   const fs::path dir = tempDir("smoke_run");
   const fs::path scene = write(dir / "plume.toml", std::string(kPlume) + kSource);
-  const CommandResult r = runMorphoflow("run " + scene.string() + " --quiet --set output.fields=true --set output.every=3 --out " +
-                                        (dir / "o").string());
+  const CommandResult r = runMorphoflow(
+      "run " + scene.string() + " --quiet --set output.fields=true --set output.every=3 --out " + (dir / "o").string());
   ASSERT_EQ(r.status, 0) << r.output;
   morphoflow::FieldDump d;
   std::string err;

@@ -80,7 +80,8 @@ template <int D>
 std::map<std::string, std::vector<float>> fieldsOf(const Simulation<D>& sim) {
   std::map<std::string, std::vector<float>> out;
   for (const std::string& name : sim.fieldNames())
-    for (const Grid<float, D>& g : sim.field(name)) out[name].insert(out[name].end(), g.values().begin(), g.values().end());
+    for (const Grid<float, D>& g : sim.field(name))
+      out[name].insert(out[name].end(), g.values().begin(), g.values().end());
   return out;
 }
 
@@ -135,7 +136,8 @@ TEST(Timeline, EveryKeyframeValueGoesThroughTheReadersChecksAtItsPlace) {
     FAIL() << "a keyframe out of range was accepted";
   } catch (const UserError& e) {
     EXPECT_EQ(e.key(), "coupling.rd_time_scale");
-    EXPECT_NE(std::string(e.what()).find("at t = 2: expected a number in (0, 1e+09], found -1"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("at t = 2: expected a number in (0, 1e+09], found -1"), std::string::npos)
+        << e.what();
   } catch (...) {
   }
   // A structural key takes no keyframes, and says which keys do.
@@ -148,13 +150,15 @@ TEST(Timeline, EveryKeyframeValueGoesThroughTheReadersChecksAtItsPlace) {
   }
   // Times must increase; a deposit names a field the scene has.
   EXPECT_THROW(parseScene(kScene, kPath, {"rd.parameters.F={keys=[[1, 0.04], [1, 0.05]]}"}), UserError);
-  EXPECT_THROW(parseScene(kScene + "[[deposits]]\nfield = \"w\"\ncenter = [0.5, 0.5]\nradius = 0.1\nvalue = 1.0\n", kPath),
-               UserError);
+  EXPECT_THROW(
+      parseScene(kScene + "[[deposits]]\nfield = \"w\"\ncenter = [0.5, 0.5]\nradius = 0.1\nvalue = 1.0\n", kPath),
+      UserError);
 }
 
 TEST(Timeline, KeyframesEnterTheSettingsHashAndAKeyedSceneRebuildsOnlyWhereAValueChanges) {
   const Scene plain = parseScene(kScene, kPath);
-  const Scene keyed = parseScene(kScene, kPath, {"rd.parameters.F={keys=[[0, 0.04], [0.05, 0.05]], interpolation=\"step\"}"});
+  const Scene keyed =
+      parseScene(kScene, kPath, {"rd.parameters.F={keys=[[0, 0.04], [0.05, 0.05]], interpolation=\"step\"}"});
   EXPECT_NE(plain.resolvedJson, keyed.resolvedJson);
   EXPECT_TRUE(plain.timeline.empty());
   ASSERT_EQ(keyed.timeline.keyed.size(), 1u);
@@ -165,8 +169,9 @@ TEST(Timeline, KeyframesEnterTheSettingsHashAndAKeyedSceneRebuildsOnlyWhereAValu
 }
 
 TEST(Timeline, ACheckpointOfATimelineContinuesBitForBit) {
-  const Scene scene = parseScene(kScene + "[[deposits]]\nt = 0.08\nfield = \"v\"\ncenter = [0.5, 0.5]\nradius = 0.1\nvalue = 0.3\n",
-                                 kPath, {"rd.parameters.k={keys=[[0, 0.06], [0.05, 0.062], [0.12, 0.058]], interpolation=\"linear\"}"});
+  const Scene scene =
+      parseScene(kScene + "[[deposits]]\nt = 0.08\nfield = \"v\"\ncenter = [0.5, 0.5]\nradius = 0.1\nvalue = 0.3\n",
+                 kPath, {"rd.parameters.k={keys=[[0, 0.06], [0.05, 0.062], [0.12, 0.058]], interpolation=\"linear\"}"});
   auto whole = makeSimulation<2>(scene, Backend::TBB, quiet, quiet);
   for (int k = 0; k < 16; ++k) whole->step(0.01);
   auto first = makeSimulation<2>(scene, Backend::TBB, quiet, quiet);
@@ -263,7 +268,8 @@ TEST(Studio, ABadEditChangesNothingAndSaysTheReadersMessage) {
   EXPECT_THROW(s.set({{"grid.resolution", {64, 64}}}), UserError);
   EXPECT_THROW(s.set({{"rd.parameters.F", "much"}}), UserError);
   EXPECT_THROW(s.paint({{"kind", "erase"}, {"target", "obstacles.9"}}), UserError);
-  EXPECT_THROW(s.paint({{"kind", "deposit"}, {"field", "v"}, {"center", {5.0, 0.5}}, {"radius", 0.1}, {"value", 1.0}}), UserError);
+  EXPECT_THROW(s.paint({{"kind", "deposit"}, {"field", "v"}, {"center", {5.0, 0.5}}, {"radius", 0.1}, {"value", 1.0}}),
+               UserError);
   EXPECT_THROW(s.control({{"action", "explode"}}), UserError);
   EXPECT_THROW(s.fieldNpy("nothing"), UserError);
   EXPECT_EQ(s.sceneText(), before);
@@ -326,7 +332,8 @@ TEST(StudioServer, RefusesRequestsWithoutTheTokenOrFromAnotherSite) {
   EXPECT_NE(s.server.url().find("?token=" + s.server.token()), std::string::npos);
   EXPECT_GE(s.server.token().size(), 32u);
   EXPECT_EQ(s.call(http::verb::get, "/api/state").result(), http::status::ok);
-  EXPECT_EQ(s.call(http::verb::get, "/?token=" + s.server.token(), "", {{"Authorization", ""}}).result(), http::status::ok);
+  EXPECT_EQ(s.call(http::verb::get, "/?token=" + s.server.token(), "", {{"Authorization", ""}}).result(),
+            http::status::ok);
   // No token, a wrong one, a token of another length: 401, and nothing served.
   for (const std::string& auth : {std::string(), std::string("Bearer x"), "Bearer " + std::string(32, '0')}) {
     const auto r = s.call(http::verb::get, "/api/state", "", {{"Authorization", auth}});
@@ -335,10 +342,12 @@ TEST(StudioServer, RefusesRequestsWithoutTheTokenOrFromAnotherSite) {
   }
   EXPECT_EQ(s.call(http::verb::get, "/", "", {{"Authorization", ""}}).result(), http::status::unauthorized);
   // DNS rebinding: another Host; another site's page: another Origin. Both 403, token or not.
-  EXPECT_EQ(s.call(http::verb::get, "/api/state", "", {{"Host", "evil.example:" + std::to_string(s.server.port())}}).result(),
-            http::status::forbidden);
-  EXPECT_EQ(s.call(http::verb::post, "/api/control", R"({"action":"play"})", {{"Origin", "http://evil.example"}}).result(),
-            http::status::forbidden);
+  EXPECT_EQ(
+      s.call(http::verb::get, "/api/state", "", {{"Host", "evil.example:" + std::to_string(s.server.port())}}).result(),
+      http::status::forbidden);
+  EXPECT_EQ(
+      s.call(http::verb::post, "/api/control", R"({"action":"play"})", {{"Origin", "http://evil.example"}}).result(),
+      http::status::forbidden);
   EXPECT_FALSE(s.server.session()->state()["running"].get<bool>());
   EXPECT_EQ(s.call(http::verb::post, "/api/control", R"({"action":"pause"})",
                    {{"Origin", "http://127.0.0.1:" + std::to_string(s.server.port())}})
@@ -379,8 +388,10 @@ TEST(StudioServer, BadCallsGetAMessageAndTheSimulationGoesOn) {
   EXPECT_EQ(f.result(), http::status::ok);
   EXPECT_NE(f.body().find("'shape': (64, 64)"), std::string::npos);
   EXPECT_EQ(s.call(http::verb::post, "/api/set", R"({"rd.parameters.k": 0.061})").result(), http::status::ok);
-  EXPECT_DOUBLE_EQ(nlohmann::json::parse(s.call(http::verb::get, "/api/state").body())["keys"]["rd.parameters.k"]["value"].get<double>(),
-                   0.061);
+  EXPECT_DOUBLE_EQ(
+      nlohmann::json::parse(s.call(http::verb::get, "/api/state").body())["keys"]["rd.parameters.k"]["value"]
+          .get<double>(),
+      0.061);
 }
 
 // A client that reads one frame in 200 ms while the simulation steps

@@ -26,8 +26,9 @@ const std::string kCavity = " --set grid.resolution=[32,32] --set output.images=
 TEST(UntilSteady, ARunStopsAtSteadyStateAndHasStoppedChanging) {
   const fs::path dir = tempDir("until_steady");
   const double tol = 1e-3;
-  CommandResult r = runMorphoflow("run " + sceneFile("lid_driven_cavity.toml") + kCavity +
-                                  " --set time.until_steady=1e-3 --set time.duration=100 --out " + (dir / "a").string());
+  CommandResult r =
+      runMorphoflow("run " + sceneFile("lid_driven_cavity.toml") + kCavity +
+                    " --set time.until_steady=1e-3 --set time.duration=100 --out " + (dir / "a").string());
   ASSERT_EQ(r.status, 0) << r.output;
   const nlohmann::json a = runJson(dir / "a");
   const nlohmann::json& s = a["until_steady"];
@@ -41,8 +42,9 @@ TEST(UntilSteady, ARunStopsAtSteadyStateAndHasStoppedChanging) {
   // The same scene run 5 time units further without the criterion: the
   // centreline profile moves by at most 5 x tol of the lid speed (x 2 for
   // the decay not being exactly exponential).
-  r = runMorphoflow("run " + sceneFile("lid_driven_cavity.toml") + kCavity + " --set time.until_steady=0 --set time.duration=" +
-                    std::to_string(t + 5.0) + " --out " + (dir / "b").string());
+  r = runMorphoflow("run " + sceneFile("lid_driven_cavity.toml") + kCavity +
+                    " --set time.until_steady=0 --set time.duration=" + std::to_string(t + 5.0) + " --out " +
+                    (dir / "b").string());
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_FALSE(runJson(dir / "b").contains("until_steady"));
   const auto pa = readCsv2(dir / "a" / "profiles" / "u_vertical_centerline.csv");
@@ -57,9 +59,11 @@ TEST(UntilSteady, ARunStopsAtSteadyStateAndHasStoppedChanging) {
 
 TEST(UntilSteady, ACappedRunSaysItIsNotSteadyAndWhatStoppedIt) {
   const fs::path dir = tempDir("until_steady_cap");
-  CommandResult r = runMorphoflow("run " + sceneFile("lid_driven_cavity.toml") +
-                                  " --set grid.resolution=[32,32] --set output.images=false --set time.until_steady=1e-9"
-                                  " --set time.duration=2 --out " + (dir / "o").string());
+  CommandResult r =
+      runMorphoflow("run " + sceneFile("lid_driven_cavity.toml") +
+                    " --set grid.resolution=[32,32] --set output.images=false --set time.until_steady=1e-9"
+                    " --set time.duration=2 --out " +
+                    (dir / "o").string());
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("warning: not steady by t = 2"), std::string::npos) << r.output;
   const nlohmann::json s = runJson(dir / "o")["until_steady"];
@@ -74,9 +78,11 @@ TEST(UntilSteady, ACappedRunSaysItIsNotSteadyAndWhatStoppedIt) {
 // inf"), with the output.every that would measure it, and why in run.json.
 TEST(UntilSteady, ARunWithNoFrameToMeasureAtSaysSo) {
   const fs::path dir = tempDir("until_steady_unmeasured");
-  CommandResult r = runMorphoflow("run " + sceneFile("lid_driven_cavity.toml") +
-                                  " --set grid.resolution=[16,16] --set output.images=false --set time.until_steady=1e-3"
-                                  " --set time.duration=0.5 --set output.every=1000 --out " + (dir / "o").string());
+  CommandResult r =
+      runMorphoflow("run " + sceneFile("lid_driven_cavity.toml") +
+                    " --set grid.resolution=[16,16] --set output.images=false --set time.until_steady=1e-3"
+                    " --set time.duration=0.5 --set output.every=1000 --out " +
+                    (dir / "o").string());
   ASSERT_EQ(r.status, 0) << r.output;
   EXPECT_NE(r.output.find("steadiness not measured"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("give output.every <= 50"), std::string::npos) << r.output;
@@ -89,14 +95,16 @@ TEST(UntilSteady, ARunWithNoFrameToMeasureAtSaysSo) {
 
 TEST(UntilSteady, IsRefusedWithoutAFluidAndOutOfRange) {
   const fs::path dir = tempDir("until_steady_bad");
-  const std::string rd = "[grid]\nresolution = [16, 16]\n[time]\ndt = 0.5\nuntil_steady = 1e-4\n[rd]\nmodel = \"gray-scott\"\n";
+  const std::string rd =
+      "[grid]\nresolution = [16, 16]\n[time]\ndt = 0.5\nuntil_steady = 1e-4\n[rd]\nmodel = \"gray-scott\"\n";
   const fs::path scene = dir / "rd.toml";
   std::ofstream(scene) << rd;
   CommandResult r = runMorphoflow("validate " + scene.string());
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find(scene.string() + ":5:"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("has no fluid"), std::string::npos) << r.output;
-  r = runMorphoflow("run " + sceneFile("lid_driven_cavity.toml") + " --set time.until_steady=-1 --out " + (dir / "o").string());
+  r = runMorphoflow("run " + sceneFile("lid_driven_cavity.toml") + " --set time.until_steady=-1 --out " +
+                    (dir / "o").string());
   EXPECT_EQ(r.status, 2) << r.output;
   EXPECT_NE(r.output.find("time.until_steady"), std::string::npos) << r.output;
   fs::remove_all(dir);

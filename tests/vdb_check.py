@@ -85,8 +85,10 @@ def check_volume(name, out, sets_fluid_fields, tolerance, obstacle, dims3):
         check(meta.get("scene") == scene_name, f"{name} {f}: scene metadata")
         check(meta.get("settings_hash") == rj["settings_hash"], f"{name} {f}: settings hash")
         check(meta.get("morphoflow_version") == rj["version"], f"{name} {f}: version")
-        check(abs(meta.get("time") - time) <= 1e-6 * max(1.0, abs(time)), f"{name} {f}: time {meta.get('time')} vs {time}")
-        check(isinstance(meta.get("step"), int) and meta.get("dt", 0) > 0 and "units" in meta, f"{name} {f}: step, dt, units")
+        check(abs(meta.get("time") - time) <= 1e-6 * max(1.0, abs(time)),
+              f"{name} {f}: time {meta.get('time')} vs {time}")
+        check(isinstance(meta.get("step"), int) and meta.get("dt", 0) > 0 and "units" in meta,
+              f"{name} {f}: step, dt, units")
         for g in grids:
             # Transform: voxel = cell, index 0 at the first cell's centre, the volume fills [0, size].
             n = dims3
@@ -100,7 +102,8 @@ def check_volume(name, out, sets_fluid_fields, tolerance, obstacle, dims3):
         for s in species + ["density"]:
             g = by[s]
             check(g.valueTypeName == "float", f"{name} {f} {s}: float")
-            check(g.gridClass == ("fog volume" if s == "density" else "unknown"), f"{name} {f} {s}: class {g.gridClass}")
+            check(g.gridClass == ("fog volume" if s == "density" else "unknown"),
+                  f"{name} {f} {s}: class {g.gridClass}")
             ref = dump[shown if s == "density" else s].transpose(2, 1, 0)  # [x, y, z]
             got = dense(g, ref.shape)
             # Background inactive: a voxel is active exactly where |value| > tolerance,
@@ -136,8 +139,9 @@ def check_volume(name, out, sets_fluid_fields, tolerance, obstacle, dims3):
 
 # 3D: a coupled scene with an obstacle, fluid scalars, a tolerance.
 d3 = run("coupled_3d", "coupled/obstacle_gray_scott_3d.toml",
-         ["grid.resolution=[10,20,10]", "rd.resolution=[10,20,10]", "time.steps=6", "output.every=3", "output.vdb=true", "output.nanovdb=true",
-          "output.fields=true", "output.video=false", 'output.vdb_fields=["speed","vorticity","pressure","dye"]',
+         ["grid.resolution=[10,20,10]", "rd.resolution=[10,20,10]", "time.steps=6", "output.every=3",
+          "output.vdb=true", "output.nanovdb=true", "output.fields=true", "output.video=false",
+          'output.vdb_fields=["speed","vorticity","pressure","dye"]',
           "output.vdb_tolerance=0.05"])
 check_volume("coupled_3d", d3, ["speed", "vorticity", "pressure", "dye"], 0.05, True, (10, 20, 10))
 # 2D: one voxel thick, default tolerance 0.
@@ -180,14 +184,16 @@ def check_smoke(out, dims, tolerance):
         got = dense(by[name], smoke.shape)
         check(np.array_equal(got[want], ref[want]), f"smoke {name}: active values equal the dump")
     col = by["color"]
-    check(col.valueTypeName == "vec3s" and col.vectorType == "invariant", f"smoke: color is an invariant Vec3 ({col.vectorType})")
+    check(col.valueTypeName == "vec3s" and col.vectorType == "invariant",
+          f"smoke: color is an invariant Vec3 ({col.vectorType})")
     c = np.zeros(tuple(dims) + (3,), dtype=np.float32)
     col.copyToArray(c, ijk=(0, 0, 0))
     check(c.min() >= 0 and c.max() <= 1 and len(np.unique(c[want][:, 0])) > 3, "smoke: colours in [0, 1] that vary")
     return f, want.mean()
 
 
-sets = ["grid.resolution=[24,40,24]", "time.duration=0.6", "output.every=20", "output.fields=true", "output.images=false"]
+sets = ["grid.resolution=[24,40,24]", "time.duration=0.6", "output.every=20", "output.fields=true",
+        "output.images=false"]
 ds = run("smoke", "vfx/plume_3d.toml", sets)
 f, filled = check_smoke(ds, (24, 40, 24), 1e-3)
 # The same frame with every voxel active (output.vdb_sparse = false), for the size.
@@ -207,7 +213,8 @@ last = sorted(x for x in os.listdir(os.path.join(dp, "vdb")) if x.endswith(".vdb
 grids, _ = vdb.readAll(os.path.join(dp, "vdb", last))
 counts = {g.name: g.activeVoxelCount() for g in grids}
 check(set(counts) == {"u", "v", "color", "density", "temperature", "vel"}, f"smoke pattern: grids {sorted(counts)}")
-check(counts["u"] == counts["v"] == counts["color"] > 0, f"smoke pattern: the chemicals' grids share a topology {counts}")
+check(counts["u"] == counts["v"] == counts["color"] > 0,
+      f"smoke pattern: the chemicals' grids share a topology {counts}")
 check(counts["temperature"] == counts["vel"] > 0, f"smoke pattern: the fluid's grids share one {counts}")
 # density = dye * v / 0.25 lives on the chemicals' grid: 0 where v is, positive where both are.
 check(counts["density"] == counts["u"], f"smoke pattern: the density expression is on the chemicals' grid {counts}")
@@ -222,7 +229,8 @@ do = run("smoke_overflow", "vfx/plume_3d.toml", ["grid.resolution=[12,20,12]", "
 last = sorted(x for x in os.listdir(os.path.join(do, "vdb")) if x.endswith(".vdb"))[-1]
 d = vdb.read(os.path.join(do, "vdb", last), "density")
 vals = np.array([v.value for v in d.citerOnValues()], dtype=np.float64)
-check(vals.size > 0 and np.all(vals == 0), f"smoke overflow: a density past a float is 0 ({vals.size} active, {np.unique(vals)[:4]})")
+check(vals.size > 0 and np.all(vals == 0),
+      f"smoke overflow: a density past a float is 0 ({vals.size} active, {np.unique(vals)[:4]})")
 
 # output.vdb_half: a temperature past half's range (ambient 70000) is written
 # at 65504, never read back as inf, and the run says so (warning, run.json).
@@ -240,7 +248,8 @@ check(clamped.get("temperature", 0) > 0 and "density" not in clamped, f"smoke ha
 last = sorted(x for x in os.listdir(os.path.join(dh, "vdb")) if x.endswith(".vdb"))[-1]
 t = vdb.read(os.path.join(dh, "vdb", last), "temperature")
 vals = np.array([v.value for v in t.citerOnValues()], dtype=np.float64)
-check(vals.size > 0 and np.all(np.isfinite(vals)) and vals.max() == 65504.0, f"smoke half: finite, at most 65504 ({vals.max() if vals.size else None})")
+check(vals.size > 0 and np.all(np.isfinite(vals)) and vals.max() == 65504.0,
+      f"smoke half: finite, at most 65504 ({vals.max() if vals.size else None})")
 
 print(f"vdb_check: {'FAILED' if failures else 'ok'} ({len(failures)} failures)")
 sys.exit(1 if failures else 0)

@@ -3,7 +3,9 @@
 // more than 2^24 samples fits the dispatch limits.
 layout(local_size_x = 256) in;
 
-int flatIndex() { return int((gl_WorkGroupID.x + gl_NumWorkGroups.x * gl_WorkGroupID.y) * 256u + gl_LocalInvocationID.x); }
+int flatIndex() {
+  return int((gl_WorkGroupID.x + gl_NumWorkGroups.x * gl_WorkGroupID.y) * 256u + gl_LocalInvocationID.x);
+}
 // x fastest, as core/grid.h
 ivec3 coordsOf(int i, ivec3 d) { return ivec3(i % d.x, (i / d.x) % d.y, i / (d.x * d.y)); }
 int indexOf(ivec3 c, ivec3 d) { return c.x + d.x * (c.y + d.y * c.z); }

@@ -126,6 +126,7 @@ void main() {
   d1[blockOff + i] = held ? 0.0lf : u;
 #elif defined(MODE_VISCOUS_STORE)  // d1 = x
   const int gi = indexOf(coordsOf(i, udims), faceDims());
-  if (fixedFace[velOff[axis] + gi] == 0u) vel[velOff[axis] + gi] = float(d1[blockOff + i]);  // (or the viscosity's held flags)
+  // (or the viscosity's held flags)
+  if (fixedFace[velOff[axis] + gi] == 0u) vel[velOff[axis] + gi] = float(d1[blockOff + i]);
 #endif
 }

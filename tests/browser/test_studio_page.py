@@ -155,8 +155,9 @@ def browser():
     options = webdriver.ChromeOptions()
     options.binary_location = shutil.which("chromium") or "/usr/bin/chromium"
     profile = tempfile.mkdtemp(prefix="morphoflow-chromium-")
-    for a in ["--headless=new", "--no-sandbox", "--disable-gpu", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
-              "--disable-quic", "--no-first-run", "--disable-background-networking", "--disable-component-update",
+    for a in ["--headless=new", "--no-sandbox", "--disable-gpu", "--use-angle=swiftshader",
+              "--enable-unsafe-swiftshader", "--disable-quic", "--no-first-run", "--disable-background-networking",
+              "--disable-component-update",
               "--disable-sync", "--window-size=1100,760", "--user-data-dir=" + profile]:
         options.add_argument(a)
     options.set_capability("goog:loggingPrefs", {"browser": "ALL"})
@@ -196,7 +197,8 @@ def canvas_cells(driver, n):
         const c = document.getElementById('view'), n = arguments[0];
         const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data, out = [];
         for (let j = 0; j < n; ++j) for (let i = 0; i < n; ++i) {
-          const x = Math.floor((i + 0.5) * c.width / n), y = Math.floor((n - 1 - j + 0.5) * c.height / n), o = 4 * (y * c.width + x);
+          const x = Math.floor((i + 0.5) * c.width / n), y = Math.floor((n - 1 - j + 0.5) * c.height / n);
+          const o = 4 * (y * c.width + x);
           out.push(d[o], d[o + 1], d[o + 2]);
         }
         return out;""", n)
@@ -210,7 +212,8 @@ def click_at(driver, x, y):
     """A click on the view at domain point (x, y) of a unit square domain."""
     view = driver.find_element(By.ID, "view")
     w, h = view.size["width"], view.size["height"]
-    ActionChains(driver).move_to_element_with_offset(view, int(x * w - w / 2), int((1 - y) * h - h / 2)).click().perform()
+    ActionChains(driver).move_to_element_with_offset(view, int(x * w - w / 2), int((1 - y) * h - h / 2)) \
+        .click().perform()
 
 
 def choose_tool(driver, name):
@@ -306,7 +309,8 @@ def test_paint_lands_where_it_is_drawn(browser, studio2d):
     wait_for(lambda: studio2d.state()["elements"], "the obstacle")
     choose_tool(browser, "move")
     ActionChains(browser).move_to_element_with_offset(view, *at(0.3, 0.3)).click_and_hold() \
-        .move_to_element_with_offset(view, *at(0.45, 0.5)).move_to_element_with_offset(view, *at(0.6, 0.7)).release().perform()
+        .move_to_element_with_offset(view, *at(0.45, 0.5)).move_to_element_with_offset(view, *at(0.6, 0.7)) \
+        .release().perform()
     moved = lambda: [e for e in studio2d.state()["elements"] if e["active"] and abs(e["center"][0] - 0.6) < 0.01]
     wait_for(moved, "the obstacle at its new place")
     assert abs(moved()[0]["center"][1] - 0.7) < 0.01
@@ -391,7 +395,8 @@ def test_the_page_needs_the_token_once(browser):
 @pytest.mark.skipif(not SHOTS, reason="MORPHOFLOW_SCREENSHOTS names no folder")
 def test_picture_of_a_shipped_scene_being_painted(browser):
     """docs/images/studio_2d.png: the shipped Gray-Scott cavity, a stroke painted into it."""
-    s = Studio(open(os.path.join(os.path.dirname(__file__), "..", "..", "scenes", "coupled", "cavity_gray_scott.toml")).read())
+    scene = os.path.join(os.path.dirname(__file__), "..", "..", "scenes", "coupled", "cavity_gray_scott.toml")
+    s = Studio(open(scene).read())
     try:
         open_page(browser, s)
         browser.find_element(By.ID, "play").click()

@@ -29,13 +29,15 @@ def test_an_empty_out_is_a_value_error():
         morphoflow.batch([PEARSON], out="")
 
 
-@pytest.mark.parametrize("key", ["fluid.reynolds=5", "rd.parameters.F\nfluid.reynolds", "a b", "", ".rd", "rd..F", "rd.F]"])
+@pytest.mark.parametrize("key",
+                         ["fluid.reynolds=5", "rd.parameters.F\nfluid.reynolds", "a b", "", ".rd", "rd..F", "rd.F]"])
 def test_a_key_that_could_set_another_is_refused(key):
     with pytest.raises(ValueError, match="set= takes dotted keys"):
         morphoflow.load_scene(PEARSON, set={key: 1})
 
 
-@pytest.mark.parametrize("value", ['v"\nrd.parameters.F = 0.09\nx = "', "v\nrd.parameters.F = 0.09", 'v\\" rd.parameters.F = 0.09', "v\x00"])
+@pytest.mark.parametrize("value", ['v"\nrd.parameters.F = 0.09\nx = "', "v\nrd.parameters.F = 0.09",
+                                   'v\\" rd.parameters.F = 0.09', "v\x00"])
 def test_a_string_value_stays_in_its_key(value):
     # Whatever the string holds, it is output.field's value: refused as a field name, never another key.
     with pytest.raises(ValueError, match="output.field"):

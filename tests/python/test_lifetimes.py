@@ -81,7 +81,8 @@ def test_a_call_from_a_callback_is_refused_naming_the_call_in_progress(tmp_path)
     errors = []
 
     def progress(p):
-        for call in (lambda: sim.step(), lambda: sim.field("v"), lambda: sim.set_field("v", np.zeros((48, 48), np.float32)),
+        for call in (lambda: sim.step(), lambda: sim.field("v"),
+                     lambda: sim.set_field("v", np.zeros((48, 48), np.float32)),
                      lambda: sim.save(str(tmp_path / "x.ckpt")), lambda: sim.steps):
             try:
                 call()

@@ -140,7 +140,8 @@ def test_render_runs_the_saved_scene_with_morphoflow_run_to_the_studios_fields_b
         call(s, "/api/paint", {"kind": "deposit", "field": "v", "center": [0.6, 0.6], "radius": 0.1, "value": 0.4})
         call(s, "/api/paint", {"kind": "obstacle", "shape": "box", "center": [0.7, 0.3], "size": [0.1, 0.2]})
         step_to(13)
-        call(s, "/api/paint", {"kind": "stroke", "points": [[0.2, 0.2], [0.4, 0.3]], "width": 0.03, "values": [0.5, 0.25]})
+        call(s, "/api/paint",
+             {"kind": "stroke", "points": [[0.2, 0.2], [0.4, 0.3]], "width": 0.03, "values": [0.5, 0.25]})
         call(s, "/api/paint", {"kind": "move", "target": "obstacles.0", "center": [0.3, 0.7]})
         step_to(20)
         fields = {name: np.load(io.BytesIO(call(s, f"/api/field?name={name}")[1])) for name in ("u", "v")}

@@ -1,4 +1,4 @@
-#include "gpu/gpu_coupled_steps.h"
+#include "gpu/gpu_coupled_stepper.h"
 
 #include <cstring>
 
@@ -8,13 +8,14 @@
 #include "core/stage_trace.h"
 #include "gpu/compute_program.h"
 #include "gpu/gl_context.h"
-#include "gpu/gpu_kernels.h"
+#include "gpu/gpu_programs.h"
 
 namespace morphoflow {
 
 template <int D>
-GpuCoupledSteps<D>::GpuCoupledSteps(const FluidSolver<D>& fluid, const RDSolver<D>& rd, const ChemicalDomain<D>& domain,
-                                    ChemicalInterpolation interpolation, CouplingMode mode, double rdTimeScale)
+GpuCoupledStepper<D>::GpuCoupledStepper(const FluidSolver<D>& fluid, const RDSolver<D>& rd,
+                                        const ChemicalDomain<D>& domain, ChemicalInterpolation interpolation,
+                                        CouplingMode mode, double rdTimeScale)
     : fluid_(fluid.settings(), fluid.constraints()),
       layer_(layerUpload(rd)),
       ard_(&layer_, domain, interpolation, mode, rdTimeScale, fluid.cells(), fluid.h()),
@@ -27,7 +28,7 @@ GpuCoupledSteps<D>::GpuCoupledSteps(const FluidSolver<D>& fluid, const RDSolver<
 }
 
 template <int D>
-void GpuCoupledSteps<D>::step(double dt) {
+void GpuCoupledStepper<D>::step(double dt) {
   const double t0 = traceClock();
   counts_.add([&] {
     fluid_.step(dt);
@@ -42,31 +43,31 @@ void GpuCoupledSteps<D>::step(double dt) {
 }
 
 template <int D>
-void GpuCoupledSteps<D>::toHost(FluidSolver<D>* fluid, RDSolver<D>* rd) const {
+void GpuCoupledStepper<D>::toHost(FluidSolver<D>* fluid, RDSolver<D>* rd) const {
   fluid_.toHost(fluid);
   for (int s = 0; s < layer_.species(); ++s) rd->field(s).values() = layer_.download(s);
 }
 
 template <int D>
-void GpuCoupledSteps<D>::fromHost(const FluidSolver<D>& fluid, const RDSolver<D>& rd) {
+void GpuCoupledStepper<D>::fromHost(const FluidSolver<D>& fluid, const RDSolver<D>& rd) {
   fluid_.fromHost(fluid);
   for (int s = 0; s < layer_.species(); ++s) layer_.upload(s, rd.field(s).values());
 }
 
 template <int D>
-void GpuCoupledSteps<D>::save(StateWriter* out) const {
+void GpuCoupledStepper<D>::save(StateWriter* out) const {
   fluid_.save(out);
   layer_.save(out);
 }
 
 template <int D>
-void GpuCoupledSteps<D>::load(const StateReader& in) {
+void GpuCoupledStepper<D>::load(const StateReader& in) {
   fluid_.load(in);
   layer_.load(in);
 }
 
 template <int D>
-void GpuCoupledSteps<D>::report(nlohmann::json* run) const {
+void GpuCoupledStepper<D>::report(nlohmann::json* run) const {
   recordGlContext(run);
   nlohmann::json g = counts_.perStep();
   g["stages"] = fluid_.stageTimer().countsPerStep(FluidStepStats::kStageNames);
@@ -76,11 +77,12 @@ void GpuCoupledSteps<D>::report(nlohmann::json* run) const {
 
 // shaders/smoke_layer.comp over every layer cell, all species.
 template <int D>
-void GpuCoupledSteps<D>::layerKernel(bool blend, const GpuBuffer& cover, const std::vector<double>& values,
+void GpuCoupledStepper<D>::layerKernel(bool blend, const GpuBuffer& cover, const std::vector<double>& values,
                                      double threshold) {
   const int ns = layer_.species();
-  const ComputeProgram& p = useKernel("smoke_layer.comp", fmt::format("#define DIM {}\n#define NSPECIES {}\n#define {}", D,
-                                                                        ns, blend ? "MODE_BLEND" : "MODE_MASK"));
+  const ComputeProgram& p = useProgram(
+      "smoke_layer.comp",
+      fmt::format("#define DIM {}\n#define NSPECIES {}\n#define {}", D, ns, blend ? "MODE_BLEND" : "MODE_MASK"));
   setUniform(p, "n", int(layer_.cells()));
   setUniform(p, "rdCells", rdCells_);
   setUniform(p, "cells", fluidCells_);
@@ -96,7 +98,7 @@ void GpuCoupledSteps<D>::layerKernel(bool blend, const GpuBuffer& cover, const s
 }
 
 template <int D>
-void GpuCoupledSteps<D>::blendLayer(int id, const Grid<float, D>& cover, const std::vector<double>& values) {
+void GpuCoupledStepper<D>::blendLayer(int id, const Grid<float, D>& cover, const std::vector<double>& values) {
   auto it = covers_.find(id);
   if (it == covers_.end())
     it = covers_.emplace(id, GpuBuffer::of(cover.values())).first;
@@ -106,7 +108,7 @@ void GpuCoupledSteps<D>::blendLayer(int id, const Grid<float, D>& cover, const s
 }
 
 template <int D>
-void GpuCoupledSteps<D>::maskLayer(const SmokeTaps<D>& taps, double threshold, const std::vector<double>& rest) {
+void GpuCoupledStepper<D>::maskLayer(const SmokeTaps<D>& taps, double threshold, const std::vector<double>& rest) {
   if (taps_.bytes() == 0) {
     std::vector<int> flat;
     for (int a = 0; a < D; ++a) {
@@ -122,7 +124,7 @@ void GpuCoupledSteps<D>::maskLayer(const SmokeTaps<D>& taps, double threshold, c
   counts_.add([&] { layerKernel(false, none_, rest, threshold); });
 }
 
-template class GpuCoupledSteps<2>;
-template class GpuCoupledSteps<3>;
+template class GpuCoupledStepper<2>;
+template class GpuCoupledStepper<3>;
 
 }  // namespace morphoflow

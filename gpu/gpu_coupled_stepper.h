@@ -1,14 +1,14 @@
-// GpuCoupledSteps<D>: the coupled step (coupling/coupled_steps.h) on the GPU:
+// GpuCoupledStepper<D>: the coupled step (coupling/coupled_stepper.h) on the GPU:
 // the fluid's step, then the ARD step through the velocity the fluid
 // advected through (velocity n with step n + 1's forces), the CPU's serial
-// order (coupling/coupled_stepper.h) with no copy of the velocity.
+// order (coupling/cpu_coupled_stepper.h) with no copy of the velocity.
 // The fluid (GpuFluid), the layer (GpuRDLayer) and the chemicals' advection
 // (GpuARDSolver) stay on the device.
 #pragma once
 
 #include <map>
 
-#include "coupling/coupled_steps.h"
+#include "coupling/coupled_stepper.h"
 #include "gpu/gpu_ard_solver.h"
 #include "gpu/gpu_counts.h"
 #include "gpu/gpu_fluid.h"
@@ -17,10 +17,10 @@
 namespace morphoflow {
 
 template <int D>
-class GpuCoupledSteps final : public CoupledSteps<D> {
+class GpuCoupledStepper final : public CoupledStepper<D> {
  public:
   // From the hosts' current state; `rd` must outlive this (gpu_rd_layer.h).
-  GpuCoupledSteps(const FluidSolver<D>& fluid, const RDSolver<D>& rd, const ChemicalDomain<D>& domain,
+  GpuCoupledStepper(const FluidSolver<D>& fluid, const RDSolver<D>& rd, const ChemicalDomain<D>& domain,
                   ChemicalInterpolation interpolation, CouplingMode mode, double rdTimeScale);
 
   void step(double dt) override;

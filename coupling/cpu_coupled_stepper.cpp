@@ -1,4 +1,4 @@
-#include "coupling/coupled_stepper.h"
+#include "coupling/cpu_coupled_stepper.h"
 
 #include <tbb/task_group.h>
 
@@ -27,11 +27,11 @@ void recordStages(StageTrace* trace, const char* category, const char* const (&n
 }  // namespace
 
 template <int D>
-CoupledStepper<D>::CoupledStepper(FluidSolver<D>* fluid, ARDSolver<D>* ard, CouplingBackend backend)
+CpuCoupledStepper<D>::CpuCoupledStepper(FluidSolver<D>* fluid, ARDSolver<D>* ard, Backend backend)
     : fluid_(fluid), fluidStepper_(fluid), ard_(ard), backend_(backend) {}
 
 template <int D>
-void CoupledStepper<D>::step(double dt) {
+void CpuCoupledStepper<D>::step(double dt) {
   const double t0 = traceClock();
   auto fluidStep = [&](const std::function<void()>& afterAdvection) {
     const double b = traceClock();
@@ -48,7 +48,7 @@ void CoupledStepper<D>::step(double dt) {
   auto reactDiffuse = [&] { ardStage(0, [&] { ard_->reactDiffuse(dt); }); };
   // The fluid's step keeps the velocity it advected through until the next step.
   auto advect = [&] { ardStage(1, [&] { ard_->advect(dt, fluid_->advectedVelocity()); }); };
-  if (backend_ == CouplingBackend::Serial) {
+  if (backend_ == Backend::Serial) {
     fluidStep({});
     reactDiffuse();
     advect();
@@ -75,7 +75,7 @@ void CoupledStepper<D>::step(double dt) {
   stepSeconds_ = traceClock() - t0;
 }
 
-template class CoupledStepper<2>;
-template class CoupledStepper<3>;
+template class CpuCoupledStepper<2>;
+template class CpuCoupledStepper<3>;
 
 }  // namespace morphoflow

@@ -1,4 +1,4 @@
-#include "gpu/gpu_kernels.h"
+#include "gpu/gpu_programs.h"
 
 #include <map>
 #include <memory>
@@ -34,14 +34,17 @@ std::string expandIncludes(const std::string& text) {
 }
 }  // namespace
 
-const ComputeProgram& useKernel(const std::string& shader, const std::string& defines) {
+const ComputeProgram& useProgram(const std::string& shader, const std::string& defines) {
   // Kept to the process's end and never freed (no GL call at exit, when the
   // context may be current on no thread).
   static auto& programs = *new std::map<std::string, std::unique_ptr<ComputeProgram>>;
   const std::string key = shader + "\n" + defines;
   auto it = programs.find(key);
   if (it == programs.end())
-    it = programs.emplace(key, std::make_unique<ComputeProgram>(shader, defines + "\n" + shaderSource("common.glsl"), expandIncludes)).first;
+    it = programs
+             .emplace(key, std::make_unique<ComputeProgram>(shader, defines + "\n" + shaderSource("common.glsl"),
+                                                            expandIncludes))
+             .first;
   it->second->use();
   return *it->second;
 }

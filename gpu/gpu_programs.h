@@ -1,4 +1,4 @@
-// The flat compute kernels (shaders/common.glsl prepended): each compiled
+// The flat compute programs (shaders/common.glsl prepended): each compiled
 // once per process for its #defines, and dispatched one invocation a sample.
 #pragma once
 
@@ -12,8 +12,8 @@ class ComputeProgram;
 
 // The program of shaders/SHADER with `defines` (lines of #define), made
 // current (glUseProgram).
-const ComputeProgram& useKernel(const std::string& shader, const std::string& defines);
-// Dispatches the current kernel over `samples` invocations, each of which
+const ComputeProgram& useProgram(const std::string& shader, const std::string& defines);
+// Dispatches the current program over `samples` invocations, each of which
 // must read or write `bytes` of the buffers at least once (the traffic model
 // the benchmarks divide by time: a lower bound of the memory traffic).
 void dispatchFlat(size_t samples, double bytes);
@@ -29,13 +29,13 @@ class DispatchRoute {
 // Sets the route dispatchGroups takes (null: glDispatchCompute); returns the
 // one set before.
 DispatchRoute* routeDispatches(DispatchRoute* route);
-// Dispatches gx x gy groups of the current kernel, through the route if one is set.
+// Dispatches gx x gy groups of the current program, through the route if one is set.
 void dispatchGroups(unsigned gx, unsigned gy);
-// Counts dispatched traffic (dispatchFlat's, and kernels that call it directly).
+// Counts dispatched traffic (dispatchFlat's, and programs that call it directly).
 void countGpuTraffic(double bytes);
 // The traffic counted since the process started.
 double gpuTrafficBytes();
-// The barrier between a kernel and the next one that reads what it wrote
+// The barrier between a program and the next one that reads what it wrote
 // through storage buffers.
 void storageBarrier();
 
