@@ -9,7 +9,7 @@
 
 #include "core/parallel.h"
 #include "core/random.h"
-#include "gpu_context.h"
+#include "tests/gpu/gpu_context.h"
 #include "gpu/gpu_layer_difference.h"
 #include "gpu/gpu_models.h"
 #include "gpu/gpu_rd_layer.h"

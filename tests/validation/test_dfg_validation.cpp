@@ -10,7 +10,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "test_support.h"
+#include "tests/test_support.h"
 
 using namespace morphoflow::testing;
 

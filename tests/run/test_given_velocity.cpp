@@ -12,7 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "render/field_dump.h"
-#include "test_support.h"
+#include "tests/test_support.h"
 
 using namespace morphoflow::testing;
 namespace fs = std::filesystem;

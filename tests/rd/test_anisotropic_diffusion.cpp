@@ -17,7 +17,7 @@
 #include "rd/diffusion_tensor.h"
 #include "rd/model_registry.h"
 #include "rd/rd_solver.h"
-#include "tests/rd_test_support.h"
+#include "tests/rd/rd_test_support.h"
 
 using namespace morphoflow;
 

@@ -14,7 +14,7 @@
 #include <nlohmann/json.hpp>
 #include <xxhash.h>
 
-#include "test_support.h"
+#include "tests/test_support.h"
 
 using namespace morphoflow::testing;
 namespace fs = std::filesystem;

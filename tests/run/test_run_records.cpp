@@ -9,7 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "test_support.h"
+#include "tests/test_support.h"
 
 using namespace morphoflow::testing;
 namespace fs = std::filesystem;

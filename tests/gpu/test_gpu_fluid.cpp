@@ -14,7 +14,7 @@
 #include "fluid/fluid_solver.h"
 #include "fluid/pressure_projection.h"
 #include "fluid/viscosity.h"
-#include "gpu_context.h"
+#include "tests/gpu/gpu_context.h"
 #include "gpu/gpu_fluid.h"
 #include "gpu/gpu_laplace.h"
 #include "gpu/gpu_multigrid.h"

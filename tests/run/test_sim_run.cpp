@@ -18,7 +18,7 @@
 #include "run/run_options.h"
 #include "scenes/scene_loader.h"
 #include "sim/simulation_factory.h"
-#include "test_support.h"
+#include "tests/test_support.h"
 
 using namespace morphoflow;
 using namespace morphoflow::testing;

@@ -13,7 +13,7 @@
 #include <fmt/format.h>
 
 #include "core/random.h"
-#include "gpu_context.h"
+#include "tests/gpu/gpu_context.h"
 #include "gpu/compute_program.h"
 #include "gpu/gpu_buffer.h"
 #include "gpu/gpu_explicit_rd.h"

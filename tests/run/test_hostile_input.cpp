@@ -17,7 +17,7 @@
 #include "render/field_dump.h"
 #include "render/image_io.h"
 #include "render/vdb_volume.h"
-#include "test_support.h"
+#include "tests/test_support.h"
 
 using namespace morphoflow::testing;
 namespace fs = std::filesystem;
