@@ -1,10 +1,12 @@
-// `morphoflow bench SUITE`: the benchmark suites (bench/), the memory benchmark (run/) and the studio's (studio/).
+// `morphoflow bench SUITE`: the benchmark suites (bench/), the memory benchmark, the studio's (studio/), and
+// after `bench coupling --backend gpu`'s cases the GPU's dispatch budget.
 #include <memory>
 
 #include <CLI/CLI.hpp>
 
-#include "app/commands.h"
 #include "app/bench_arguments.h"
+#include "app/commands.h"
+#include "app/dispatch_budget.h"
 #include "app/memory_bench.h"
 #include "studio/studio_bench.h"
 
@@ -18,6 +20,10 @@ void addBenchCommand(CLI::App& app, Commands* commands) {
       if (b.suite == "studio" && b.bench.backend != "gpu") {
         runStudioBench(MORPHOFLOW_SCENE_DIR, b.bench.minSeconds, b.bench.json);
         return 0;
+      }
+      if (b.suite == "coupling" && b.bench.backend == "gpu") {
+        const int status = runBench(b);  // the library's cases, then the budget
+        return status != 0 ? status : reportDispatchBudget(MORPHOFLOW_SCENE_DIR, b.bench.json);
       }
       if (b.suite != "memory" || b.bench.backend == "gpu") return -1;
       return runMemoryBench(b.bench) ? 0 : 1;

@@ -430,20 +430,13 @@ TEST(Gpu, UntilSteadyStopsAtTheCpusStep) {
   fs::remove_all(dir);
 }
 
-// The dispatches and host waits of the shipped coupled cavity's step (fluid
-// 128^2, chemicals 256^2, 20 steps, no frame after the first), pinned at
-// what they are (measured 1.75 and 226.5), so that a change that adds one
-// is seen: at most 1.8 host waits a step (the speed's reduction for the CFL
-// step and the finiteness check, every step; the solves' tallies at steps
-// 1, 2, 4, 8 and 16, and the first solves' calibration: the Krylov solves
-// decide their convergence on the device, gpu_gate.h) and 230 dispatches
-// (the PCG's reductions fused into the kernels around them, the p update
-// and the stopping test into the next iteration's operator, the V-cycle's
-// levels of at most 64^2 in one dispatch and its fine level's passes fused,
-// the viscosity's components one block system; the queued iterations past
-// convergence are empty dispatches); the stages' counts add up to the
-// step's.
-TEST(Gpu, TheCoupledCavityStepsDispatchesAndHostWaitsArePinned) {
+// The dispatches and host waits a step that run.json reports for the shipped
+// coupled cavity (fluid 128^2, chemicals 256^2, 20 steps, no frame after the
+// first): some of each (the speed's reduction for the CFL step and the
+// finiteness check wait every step), and the stages' counts add up to the
+// step's. Their budget is a benchmark's (`bench coupling --backend gpu`,
+// app/dispatch_budget.h), not this test's.
+TEST(Gpu, TheCoupledCavityStepsDispatchesAndHostWaitsAddUpOverItsStages) {
   if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
   const fs::path dir = tempDir("gpu_counts");
   const CommandResult r = runMorphoflow("run " + sceneFile("coupled/cavity_gray_scott.toml") +
@@ -452,8 +445,7 @@ TEST(Gpu, TheCoupledCavityStepsDispatchesAndHostWaitsArePinned) {
   ASSERT_EQ(r.status, 0) << r.output;
   const nlohmann::json g = nlohmann::json::parse(std::ifstream(dir / "run.json"))["gpu"];
   const double dispatches = g["dispatches_per_step"], waits = g["host_waits_per_step"];
-  EXPECT_LE(dispatches, 230.0 + 1e-9) << g.dump(1);
-  EXPECT_LE(waits, 1.8 + 1e-9) << g.dump(1);
+  EXPECT_GT(dispatches, 0.0);
   EXPECT_GT(waits, 0.0);
   double sumD = 0, sumW = 0;
   for (const char* stage : {"forces", "advect", "diffuse", "project", "reaction-diffusion", "advect chemicals"}) {
@@ -500,6 +492,14 @@ TEST(Gpu, BenchSuitesTimeTheFluidTheLayerAndTheCoupling) {
     const nlohmann::json j = nlohmann::json::parse(in);
     ASSERT_FALSE(j.empty()) << suite;
     for (const nlohmann::json& c : j) {
+      if (c.value("case", "") == "dispatch budget") {  // (coupling's last row: counts, not times)
+        EXPECT_GT(c["dispatches_per_step"].get<double>(), 0.0) << c;
+        EXPECT_GT(c["host_waits_per_step"].get<double>(), 0.0) << c;
+        EXPECT_EQ(c["within_budget"].get<bool>(), c["dispatches_per_step"].get<double>() <= c["dispatch_budget"] &&
+                                                      c["host_waits_per_step"].get<double>() <= c["host_wait_budget"])
+            << c;
+        continue;
+      }
       EXPECT_GT(c.contains("ms") ? c["ms"].get<double>() : c["ms_per_step_median"].get<double>(), 0.0) << c;
       EXPECT_GT(c["gb_per_second"].get<double>(), 0.0) << c;
       if (c.contains("pressure_converged")) {
@@ -511,6 +511,10 @@ TEST(Gpu, BenchSuitesTimeTheFluidTheLayerAndTheCoupling) {
     }
     if (std::string(suite) == "rd") {
       EXPECT_EQ(j.size(), 2u) << "the explicit and the Kim & Lin rows";
+    }
+    if (std::string(suite) == "coupling") {
+      EXPECT_EQ(j.back().value("case", ""), "dispatch budget") << "the budget's row, last";
+      EXPECT_NE(r.output.find("dispatch budget (the shipped coupled cavity"), std::string::npos) << r.output;
     }
   }
   fs::remove_all(dir);
