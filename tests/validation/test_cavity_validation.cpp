@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/test_support.h"
+#include "tests/validation/run_in_process.h"
 
 using namespace morphoflow::testing;
 
@@ -19,11 +20,10 @@ namespace {
 
 void expectGhia(int reynolds, int n) {
   auto out = tempDir("cavity_" + std::to_string(reynolds));
-  const std::string sets = " --set fluid.reynolds=" + std::to_string(reynolds) + " --set grid.resolution=[" +
-                           std::to_string(n) + "," + std::to_string(n) + "]";
-  CommandResult r = runMorphoflow("run " + sceneFile("lid_driven_cavity.toml") + sets +
-                                  " --set output.images=false --quiet --out " + out.string());
-  ASSERT_EQ(r.status, 0) << r.output;
+  const std::string grid = "grid.resolution=[" + std::to_string(n) + "," + std::to_string(n) + "]";
+  ASSERT_EQ(runInProcess(sceneFile("lid_driven_cavity.toml"),
+                         {"fluid.reynolds=" + std::to_string(reynolds), grid, "output.images=false"}, out),
+            0);
   std::ifstream in(out / "run.json");
   const nlohmann::json run = nlohmann::json::parse(in);
   EXPECT_TRUE(run["until_steady"]["steady"].get<bool>()) << run["until_steady"].dump();

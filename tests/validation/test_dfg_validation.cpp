@@ -11,6 +11,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/test_support.h"
+#include "tests/validation/run_in_process.h"
 
 using namespace morphoflow::testing;
 
@@ -19,9 +20,8 @@ namespace {
 // The mean drag and lift coefficients of the steady end of a shipped scene's run.
 std::pair<double, double> coefficients(const std::string& scene) {
   auto out = tempDir(scene);
-  CommandResult r = runMorphoflow("run " + sceneFile("validation/" + scene + ".toml") +
-                                  " --set output.images=false --set output.video=false --quiet --out " + out.string());
-  EXPECT_EQ(r.status, 0) << r.output;
+  EXPECT_EQ(runInProcess(sceneFile("validation/" + scene + ".toml"), {"output.images=false", "output.video=false"}, out),
+            0);
   std::ifstream in(out / "run.json");
   const nlohmann::json run = nlohmann::json::parse(in);
   std::filesystem::remove_all(out);

@@ -4,9 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <vector>
+
 #include <nlohmann/json.hpp>
 
 #include "tests/test_support.h"
+#include "tests/validation/run_in_process.h"
 
 using namespace morphoflow::testing;
 
@@ -14,10 +18,9 @@ TEST(ObstacleShedding, Re100LiftIsPeriodicWithStableStrouhal) {
   auto out = tempDir("shedding");
   // Default: half the scene's resolution (D = 5 cells) for CI;
   // MORPHOFLOW_FULL_VALIDATION=1 runs the shipped 440 x 82 grid.
-  std::string grid = fullValidation() ? "" : " --set grid.resolution=[220,41] --set time.dt=0.008";
-  CommandResult r = runMorphoflow("run " + sceneFile("flow_past_obstacle.toml") + grid +
-                                  " --set output.images=false --quiet --out " + out.string());
-  ASSERT_EQ(r.status, 0) << r.output;
+  std::vector<std::string> sets = {"output.images=false"};
+  if (!fullValidation()) sets.insert(sets.end(), {"grid.resolution=[220,41]", "time.dt=0.008"});
+  ASSERT_EQ(runInProcess(sceneFile("flow_past_obstacle.toml"), sets, out), 0);
   std::ifstream in(out / "run.json");
   nlohmann::json j = nlohmann::json::parse(in);
   ASSERT_FALSE(j["strouhal"].is_null()) << "no lift oscillation detected";
