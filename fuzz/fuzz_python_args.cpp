@@ -26,11 +26,6 @@ using namespace morphoflow;
 
 namespace {
 
-[[noreturn]] void finding(const std::string& what) {
-  std::fprintf(stderr, "%s\n", what.c_str());
-  std::abort();
-}
-
 // The value's TOML text, as python/module.cpp writes it, and a check of what the override set.
 struct Value {
   std::string toml;
@@ -94,14 +89,14 @@ void checkSetsOnlyItsKey(const std::string& key, int kind, const Value& v) {
   try {
     applyOverride(root, key + "=" + v.toml, &locs);
   } catch (const UserError&) {
-    if (kind == 2) finding("a bool override was refused: " + key);
+    if (kind == 2) fuzz::finding("a bool override was refused: " + key);
     return;  // (a string that is not UTF-8, a number TOML cannot hold)
   }
   const toml::node* at = &root;
   std::stringstream parts(key);
   for (std::string p; at && std::getline(parts, p, '.');) at = at->as_table() ? at->as_table()->get(p) : nullptr;
   if (!at || leaves(root) != 1 || !sameValue(kind, v, *at))
-    finding("set={'" + key + "': ...} as '" + key + "=" + v.toml + "' set something else");
+    fuzz::finding("set={'" + key + "': ...} as '" + key + "=" + v.toml + "' set something else");
 }
 
 void writeSeeds(const std::filesystem::path& dir) {

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "fuzz/fuzz_support.h"
 #include "scenes/scene_loader.h"
 #include "scenes/vary.h"
 
@@ -19,12 +20,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   std::vector<std::string> overrides;
   if (const size_t at = input.find("\n--set\n"); at != std::string::npos) {
     text = input.substr(0, at);
-    size_t start = at + 7;
-    while (start <= input.size()) {
-      const size_t end = std::min(input.find('\n', start), input.size());
-      if (end > start) overrides.push_back(input.substr(start, end - start));
-      start = end + 1;
-    }
+    overrides = morphoflow::fuzz::nonEmptyLines(std::string_view(input).substr(at + 7));
   }
   try {
     // The scene's folder is the corpus's: relative image paths find nothing.

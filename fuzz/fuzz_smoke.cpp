@@ -25,19 +25,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-[[noreturn]] void finding(const std::string& what) {
-  std::fprintf(stderr, "%s\n", what.c_str());
-  std::abort();
-}
-
 std::vector<std::string> overridesOf(std::string_view text, bool three) {
-  std::vector<std::string> out;
-  size_t start = 0;
-  while (start < text.size()) {
-    const size_t end = std::min(text.find('\n', start), text.size());
-    if (end > start) out.emplace_back(text.substr(start, end - start));
-    start = end + 1;
-  }
+  std::vector<std::string> out = fuzz::nonEmptyLines(text);
   // Last, so that they win: five steps on a small grid.
   for (const char* s : {"time={dt=0.01, duration=0.05}", "output.video=false", "output.image_size=64", "output.every=2",
                         "output.checkpoint_every=0"})
@@ -63,7 +52,7 @@ void runToTheEnd(const std::vector<std::string>& overrides) {
   try {
     sim->checkFinite("after a run that ended with exit 0");
   } catch (const NonFiniteError& e) {
-    finding(e.what());
+    fuzz::finding(e.what());
   }
   for (const auto& e : fs::directory_iterator(out)) {
     if (e.path().extension() != ".vdb") continue;
@@ -72,7 +61,7 @@ void runToTheEnd(const std::vector<std::string>& overrides) {
     if (!readVdbVelocity(e.path().string(), &v, &error)) continue;  // (no velocity grid written)
     for (const std::vector<float>& c : v.values)
       for (const float x : c)
-        if (!std::isfinite(x)) finding(e.path().filename().string() + " holds a velocity of " + std::to_string(x));
+        if (!std::isfinite(x)) fuzz::finding(e.path().filename().string() + " holds a velocity of " + std::to_string(x));
   }
 }
 
