@@ -20,6 +20,7 @@
 #include "run/memory_estimate.h"
 #include "run/version.h"
 #include "scenes/scene_loader.h"
+#include "sim/scene_inputs.h"
 
 namespace fs = std::filesystem;
 
@@ -43,6 +44,7 @@ std::vector<fs::path> shippedScenes() {
 int validate(const std::vector<std::string>& scenes) {
   for (const std::string& s : scenes) {
     Scene sc = loadScene(s);
+    checkSceneInputs(sc);
     const std::string memory = "needs about " + humanBytes(estimateRunBytes(sc)) + " of memory";
     if (sc.hasFluid)
       std::cout << fmt::format("{}: ok ({}D, {} steps, Re = {:.4g}, {})\n", s, sc.dimension, sc.totalSteps(),

@@ -17,16 +17,17 @@
 
 #include "batch/batch_plan.h"
 #include "batch/batch_summary.h"
+#include "core/error.h"
+#include "core/number_text.h"
+#include "core/output_file.h"
+#include "core/parallel.h"
 #include "run/checkpoint.h"
 #include "run/child_process.h"
 #include "run/folder_lock.h"
 #include "run/scene_hash.h"
 #include "run/stop_signal.h"
-#include "core/error.h"
-#include "core/number_text.h"
-#include "core/output_file.h"
-#include "core/parallel.h"
 #include "scenes/scene_loader.h"
+#include "sim/scene_inputs.h"
 
 namespace fs = std::filesystem;
 
@@ -97,7 +98,9 @@ class BatchRunner {
     std::vector<std::string> errors;
     for (size_t i = 0; i < records_.size(); ++i) {
       try {
-        prepared_[i].hash = sceneHash(loadScene(records_[i].run.scene, records_[i].run.overrides));
+        const Scene scene = loadScene(records_[i].run.scene, records_[i].run.overrides);
+        checkSceneInputs(scene);
+        prepared_[i].hash = sceneHash(scene);
       } catch (const UserError& e) {
         records_[i].status = "invalid";
         records_[i].exitCode = 2;

@@ -36,6 +36,12 @@ std::vector<uint8_t> paint(int nx, int ny, size_t offset, Colour colour) {
 }  // namespace
 
 // The value range mapped to [0, 1]: fixed, or the finite min..max of the slice.
+size_t countOutside(const float* values, size_t n, double lo, double hi) {
+  size_t out = 0;
+  for (size_t i = 0; i < n; ++i) out += (values[i] < lo || values[i] > hi) ? 1 : 0;
+  return out;
+}
+
 std::array<double, 2> valueRange(const float* v, size_t n, const FieldImageOptions& o) {
   if (!o.autoRange) return {o.range[0], o.range[1]};
   double lo = 1e300, hi = -1e300;

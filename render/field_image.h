@@ -23,6 +23,9 @@ struct FieldImageOptions {
 // values (centred on 0 when symmetric).
 std::array<double, 2> valueRange(const float* values, size_t n, const FieldImageOptions& options);
 
+// How many of the n values lie outside [lo, hi] (drawn at the range's ends).
+size_t countOutside(const float* values, size_t n, double lo, double hi);
+
 // Nearest-neighbour enlargement by the smallest whole factor that makes the
 // image at least `minWidth` pixels wide (cells stay crisp squares).
 std::vector<uint8_t> upscaleToWidth(const std::vector<uint8_t>& rgb, int* width, int* height, int minWidth);

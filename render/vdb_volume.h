@@ -9,6 +9,7 @@
 
 #include <array>
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -50,6 +51,14 @@ struct VolumeOptions {
   };
   std::vector<ActiveMask> active;
 };
+
+// A mask grid's active voxels: those whose first component is nonzero.
+VolumeOptions::ActiveMask activeWhere(const VolumeGrid& mask);
+
+// Half's range (65504) for output.vdb_half: a value beyond it would be read
+// back as infinity, so it is set at the limit instead. The count of values
+// set, per grid that had any (level sets are left as they are).
+std::map<std::string, uintmax_t> clampToHalf(std::vector<VolumeGrid>* grids);
 
 // The .vdb file's bytes. Its UUID is derived from its content, so the same
 // fields give the same bytes (a resumed run writes what an uninterrupted one does).

@@ -5,14 +5,16 @@
 
 #include <fmt/format.h>
 
-#include "run/output_kinds.h"
-#include "run/vdb_sink.h"
 #include "core/output_file.h"
 #include "render/field_dump.h"
 #include "render/field_image.h"
 #include "render/image_io.h"
 #include "render/normal_map.h"
 #include "render/volume_preview.h"
+#include "run/output_kinds.h"
+#include "run/vdb_sink.h"
+#include "scenes/field_catalogue.h"
+#include "sim/frame_palette.h"
 
 namespace morphoflow {
 
@@ -27,17 +29,6 @@ std::filesystem::path endFile(const std::filesystem::path& dir, const std::strin
     if (found.empty() || (last ? e.path() > found : e.path() < found)) found = e.path();
   }
   return found;
-}
-
-FieldImageOptions frameImageOptions(const OutputSettings& o, bool symmetric) {
-  FieldImageOptions io;
-  io.palette = o.gradient.empty() ? namedPalette(o.colormap) : Palette{o.gradient};
-  io.autoRange = o.autoRange;
-  io.symmetric = symmetric;
-  io.range[0] = o.range[0];
-  io.range[1] = o.range[1];
-  io.slice = o.slice;
-  return io;
 }
 
 uintmax_t fileBytes(const std::filesystem::path& file) {
@@ -66,9 +57,9 @@ void ImageSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
   std::vector<uint8_t> rgb;
   const bool two = o.colormap == kTwoSpeciesPalette;
   const std::vector<std::string> sp = sim.species();
-  const Grid<float, D> shown = sim.field(two ? sp[0] : o.field).front();
+  const Grid<float, D> shown = sim.field(shownField(o, sp)).front();
   if (!o.autoRange) {  // 8-bit colours of a fixed range: what lies beyond it is drawn at its ends, and counted
-    for (float v : shown.values()) clipped_ += (v < o.range[0] || v > o.range[1]) ? 1 : 0;
+    clipped_ += countOutside(shown.data(), shown.size(), o.range[0], o.range[1]);
     cells_ += shown.size();
   }
   if constexpr (D == 3) {
@@ -201,12 +192,7 @@ template <int D>
 void NormalMapSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
   if constexpr (D == 2) {
     const OutputSettings& o = scene_.output;
-    const std::string name = o.colormap == kTwoSpeciesPalette ? sim.species()[0] : o.field;
-    Grid<float, 2> height = sim.field(name).front();
-    const std::array<double, 2> range =
-        valueRange(height.data(), height.size(), frameImageOptions(o, sim.symmetric(name)));
-    const double span = range[1] > range[0] ? range[1] - range[0] : 1.0;
-    for (float& v : height.values()) v = float(std::clamp((double(v) - range[0]) / span, 0.0, 1.0));
+    const Grid<float, 2> height = sim.field(fields::kHeight).front();
     const bool periodic = scene_.rd.enabled ? scene_.rd.settings.boundary == RDBoundary::Periodic
                                             : scene_.fluid.boundaries.sides[0].kind == BoundaryKind::Periodic;
     const std::vector<uint8_t> rgb = normalMapRgb(height, {o.normalStrength, periodic});
@@ -216,7 +202,7 @@ void NormalMapSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
       throw std::runtime_error("writing " + png.string() + ": " + err);
     FieldDump d;
     d.resolution = {height.dim(0), height.dim(1)};
-    d.names = {"height"};
+    d.names = {fields::kHeight};
     d.channels = {height.values()};
     d.time = sim.time();
     d.step = at.step;

@@ -118,8 +118,6 @@ std::filesystem::path endFile(const std::filesystem::path& dir, const std::strin
 uintmax_t fileBytes(const std::filesystem::path& file);
 // Adds `bytes` to run["bytes_written"][kind].
 void addBytes(nlohmann::json* run, const std::string& kind, uintmax_t bytes);
-// The frames' palette and range for a shown field (symmetric: centred on 0).
-FieldImageOptions frameImageOptions(const OutputSettings& o, bool symmetric);
 // A count kept in a sink's checkpoint state: an integer at least `lowest`
 // that fits T, else std::invalid_argument naming the key.
 template <class T>

@@ -23,14 +23,14 @@ class SteadyState {
 
   // Takes the simulation's velocity now as the reference.
   void reference(const Simulation<D>& sim) {
-    reference_ = sim.field("velocity");
+    reference_ = sim.field(fields::kVelocity);
     time_ = sim.time();
   }
 
   // The change since the reference; the velocity now becomes the reference.
   // Returns whether the run is steady.
   bool check(const Simulation<D>& sim) {
-    std::vector<Grid<float, D>> u = sim.field("velocity");
+    std::vector<Grid<float, D>> u = sim.field(fields::kVelocity);
     double diff2 = 0.0, norm2 = 0.0;
     for (size_t c = 0; c < u.size(); ++c)
       for (size_t i = 0; i < u[c].size(); ++i) {
@@ -59,7 +59,7 @@ class SteadyState {
   }
   // After the simulation's own state: its velocity's shape says what to read.
   void load(const StateReader& in, const Simulation<D>& sim) {
-    reference_ = sim.field("velocity");
+    reference_ = sim.field(fields::kVelocity);
     uint64_t n = 0;
     in.get("steady.components", &n);
     if (n != reference_.size()) throw StateError("section 'steady.components' does not match the velocity");

@@ -31,9 +31,7 @@ class VdbSink : public OutputSink<D> {
  private:
   // The grids of the simulation's current state.
   std::vector<VolumeGrid> grids(const Simulation<D>& sim) const;
-  VolumeGrid colorGrid(const Simulation<D>& sim, double width) const;
-  std::vector<Grid<float, D>> densityField(const Simulation<D>& sim) const;
-  VolumeOptions::ActiveMask smokeMask(const Simulation<D>& sim, const IVec<D>& cells) const;
+  bool smoke() const;  // the scene has [smoke]
   std::filesystem::path dir_;
   const Scene& scene_;
   const std::string hash_;  // the scene's settings hash, for the metadata

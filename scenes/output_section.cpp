@@ -3,6 +3,7 @@
 #include <cctype>
 
 #include "core/expression.h"
+#include "scenes/field_catalogue.h"
 #include "scenes/scene_reader.h"
 
 #include "render/colormap.h"
@@ -38,17 +39,14 @@ std::string parseVdbDensity(Reader& r, const toml::table* out, const std::string
 // output.vdb and its options: every named field must be one the scene has.
 void parseVdbOutput(SceneContext& c, const toml::table* out, Scene& s) {
   Reader& r = c.r;
-  const std::vector<std::string>& species = c.species;
   OutputSettings& o = s.output;
   o.vdb = r.boolean(out, "output.", "vdb", false);
   // With [smoke]: the smoke is the density, and the frame is sparse where
   // there is none (every grid active where the smoke exceeds the tolerance).
   const bool smoke = s.hasFluid && s.fluid.smoke.enabled;
-  std::vector<std::string> fluidScalars = {"speed", "vorticity", "pressure", "dye"};
-  if (smoke) fluidScalars.push_back("temperature");
-  std::vector<std::string> fields = species;
-  if (s.hasFluid) fields.insert(fields.end(), fluidScalars.begin(), fluidScalars.end());
-  o.vdbDensity = parseVdbDensity(r, out, smoke ? "dye" : o.field, fields);
+  const FieldCatalogue catalogue(s);
+  const std::vector<std::string> fluidScalars = catalogue.fluidOutputNames();
+  o.vdbDensity = parseVdbDensity(r, out, smoke ? fields::kDye : o.field, catalogue.outputNames());
   if (const toml::node* vf = r.node(out, "output.", "vdb_fields")) {
     const toml::array* arr = vf->as_array();
     if (!arr) r.fail(vf, "output.vdb_fields", "expected an array of field names, e.g. [\"speed\", \"vorticity\"]");
@@ -88,7 +86,8 @@ void parseVdbOutput(SceneContext& c, const toml::table* out, Scene& s) {
 // The frames' palette: output.colormap or output.gradient, and output.range.
 void parsePalette(const SceneContext& c, const toml::table* out, OutputSettings& o) {
   Reader& r = c.r;
-  o.colormap = r.string(out, "output.", "colormap", o.field == "vorticity" ? "coolwarm" : "viridis", colormapNames());
+  o.colormap =
+      r.string(out, "output.", "colormap", o.field == fields::kVorticity ? "coolwarm" : "viridis", colormapNames());
   if (o.colormap == kTwoSpeciesPalette && c.species.size() < 2)
     r.fail(r.node(out, "output.", "colormap"), "output.colormap",
            std::string(kTwoSpeciesPalette) +
@@ -155,17 +154,9 @@ void parseOutput(SceneContext& c, Scene* sp) {
     r.fail(r.node(out, "output.", "video"), "output.video",
            "the video is made from PNG frames, so it needs output.images = true and output.format = \"png\"",
            "turn the PNG frames on, or set output.video = false");
-  std::vector<std::string> fluidFields = {"speed", "vorticity", "dye", "pressure"};
   const bool smoke = s.hasFluid && s.fluid.smoke.enabled;
-  if (smoke) fluidFields.push_back("temperature");
-  if (s.rd.enabled && s.hasFluid) {
-    std::vector<std::string> choices = species;
-    choices.insert(choices.end(), fluidFields.begin(), fluidFields.end());
-    s.output.field = r.string(out, "output.", "field", species.front(), choices);
-  } else if (s.rd.enabled)
-    s.output.field = r.string(out, "output.", "field", species.front(), species);
-  else
-    s.output.field = r.string(out, "output.", "field", smoke ? "dye" : "vorticity", fluidFields);
+  const std::string byDefault = s.rd.enabled ? species.front() : smoke ? fields::kDye : fields::kVorticity;
+  s.output.field = r.string(out, "output.", "field", byDefault, FieldCatalogue(s).outputNames());
   parseVdbOutput(c, out, s);
   parsePalette(c, out, s.output);
   parseView(c, out, s.output);

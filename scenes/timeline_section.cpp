@@ -3,6 +3,7 @@
 // (scenes/timeline.h).
 #include <fmt/format.h>
 
+#include "scenes/field_catalogue.h"
 #include "scenes/scene_reader.h"
 
 namespace morphoflow {
@@ -98,9 +99,7 @@ void parseDeposits(SceneContext& c, Scene* s) {
   Reader& r = c.r;
   const toml::array* arr = tableArray(r, c.root, "deposits");
   if (!arr) return;
-  std::vector<std::string> fields = c.species;
-  if (s->hasFluid && !s->velocity.enabled) fields.push_back("dye");
-  if (s->hasFluid && s->fluid.smoke.enabled) fields.push_back("temperature");
+  const std::vector<std::string> fields = FieldCatalogue(*s).settableNames();
   for (size_t i = 0; i < arr->size(); ++i) {
     const toml::table* t = arr->get(i)->as_table();
     const std::string p = "deposits." + std::to_string(i) + ".";

@@ -1,30 +1,12 @@
 // [velocity]: a given velocity field carrying the [rd] layer in place of a
 // fluid (seed 004 sec. 3, fig. 24): analytic expressions, or a VDB sequence
-// whose frames are found and whose first frame is read and checked here.
-#include <array>
-
+// whose frames are found and recorded here (sim/scene_inputs.h reads them).
 #include "coupling/given_velocity.h"
 #include "scenes/scene_reader.h"
 
 namespace morphoflow {
 
 namespace {
-
-// The first frame read and resampled, so that a missing grid or another
-// domain stops `validate` rather than the run.
-template <int D>
-void checkFirstFrame(const std::vector<VelocityFrame>& frames, const Scene& s) {
-  std::array<double, D> domain{};
-  IVec<D> cells;
-  std::array<bool, D> periodic{};
-  for (int a = 0; a < D; ++a) {
-    domain[size_t(a)] = s.rd.settings.size[size_t(a)];
-    cells[a] = s.rd.settings.resolution[size_t(a)];
-  }
-  VdbVelocitySequence<D> seq({frames.front()}, domain);
-  MacVelocity<D> u(cells, domain[0] / cells[0], periodic);
-  seq.sample(frames.front().time, &u);
-}
 
 // velocity.field: one expression per axis in x, y, z (domain units) and t.
 void parseVelocityField(SceneContext& c, const toml::node* fn, VelocityScene& V) {
@@ -44,8 +26,7 @@ void parseVelocityField(SceneContext& c, const toml::node* fn, VelocityScene& V)
                            "the variables are x, y, z (domain units) and t");
 }
 
-// velocity.vdb: a sequence of volumes, each frame noted as an input and the
-// first checked against the scene's domain.
+// velocity.vdb: a sequence of volumes, each frame noted as an input.
 void parseVelocityVdb(SceneContext& c, const toml::table* vt, const toml::node* vn, Scene& s) {
   Reader& r = c.r;
   const std::string p = "velocity.";
@@ -59,8 +40,6 @@ void parseVelocityVdb(SceneContext& c, const toml::table* vt, const toml::node* 
   try {
     const std::vector<VelocityFrame> frames = findVelocityFrames(V.vdb, V.frameTime);
     for (const VelocityFrame& f : frames) r.noteInput(f.path, vn, p + "vdb");
-    if (c.D == 2) checkFirstFrame<2>(frames, s);
-    else checkFirstFrame<3>(frames, s);
   } catch (const VelocityFileError& e) {
     r.fail(vn, p + "vdb", e.path() + ": " + e.what(),
            "give a sequence of .vdb files with a Vec3 grid 'vel' over the scene's domain, e.g. written by "

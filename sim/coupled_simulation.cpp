@@ -121,13 +121,6 @@ void CoupledSimulation<D>::step(double dt) {
 }
 
 template <int D>
-std::vector<std::string> CoupledSimulation<D>::fieldNames() const {
-  std::vector<std::string> names = species();
-  for (const std::string& f : fluidFieldNames()) names.push_back(f);
-  return names;
-}
-
-template <int D>
 void CoupledSimulation<D>::setField(const std::string& name, const Grid<float, D>& values) {
   host_.refresh();
   if (!setSpeciesField<D>(&rd_, name, values) && !setFluidField<D>(&fluid_, name, values))
@@ -136,7 +129,7 @@ void CoupledSimulation<D>::setField(const std::string& name, const Grid<float, D
 }
 
 template <int D>
-std::vector<Grid<float, D>> CoupledSimulation<D>::field(const std::string& name) const {
+std::vector<Grid<float, D>> CoupledSimulation<D>::ownField(const std::string& name) const {
   host_.refresh();
   const std::vector<std::string> sp = species();
   if (std::find(sp.begin(), sp.end(), name) != sp.end()) return speciesField<D>(rd_, name);

@@ -33,18 +33,18 @@ class CoupledSimulation : public Simulation<D> {
   double cflTimeStep(double cfl, double dtMax) const override;
   double time() const override { return stepper_->fluid().time(); }
   long steps() const override { return stepper_->fluid().steps(); }
-  std::vector<std::string> fieldNames() const override;
+  const Scene& scene() const override { return scene_; }
   std::vector<std::string> species() const override { return rd_.model().info().species; }
-  std::vector<std::string> dumpFieldNames() const override { return species(); }
-  std::vector<Grid<float, D>> field(const std::string& name) const override;
   void setField(const std::string& name, const Grid<float, D>& values) override;
-  bool symmetric(const std::string& name) const override { return name == "vorticity" && D == 2; }
   bool hasObstacles() const override { return !scene_.fluid.obstacles.empty(); }
   void checkFinite(const std::string& when) const override;
   void save(StateWriter* out) const override;
   void load(const StateReader& in) override;
   nlohmann::json resolved() const override;
   void report(nlohmann::json* run) const override;
+
+ protected:
+  std::vector<Grid<float, D>> ownField(const std::string& name) const override;
 
  private:
   const Scene& scene_;

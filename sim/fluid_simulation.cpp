@@ -30,24 +30,20 @@ void initialiseDye(const Scene& scene, FluidSolver<D>* f) {
   });
 }
 
-std::vector<std::string> fluidFieldNames() {
-  return {"speed", "vorticity", "pressure", "dye", "temperature", "velocity", "obstacle"};
-}
-
 template <int D>
 std::vector<Grid<float, D>> fluidField(const FluidSolver<D>& f, const std::string& name) {
-  if (name == "speed") return {speedField(f)};
-  if (name == "vorticity") return {vorticityField(f)};
-  if (name == "dye") return {f.dye()};
-  if (name == "temperature")  // (without [smoke]: 0 everywhere)
+  if (name == fields::kSpeed) return {speedField(f)};
+  if (name == fields::kVorticity) return {vorticityField(f)};
+  if (name == fields::kDye) return {f.dye()};
+  if (name == fields::kTemperature)  // (without [smoke]: 0 everywhere)
     return {f.temperature().empty() ? Grid<float, D>(f.cells(), 0.0f) : f.temperature()};
-  if (name == "pressure") return {f.pressure()};
-  if (name == "obstacle") {
+  if (name == fields::kPressure) return {f.pressure()};
+  if (name == fields::kObstacle) {
     Grid<float, D> s(f.cells(), 0.0f);
     for (size_t i = 0; i < s.size(); ++i) s[i] = f.solid()[i] ? 1.0f : 0.0f;
     return {s};
   }
-  if (name == "velocity") {
+  if (name == fields::kVelocity) {
     std::vector<Grid<float, D>> v(static_cast<size_t>(D), Grid<float, D>(f.cells(), 0.0f));
     forEachCell<D>(f.cells(), [&](const IVec<D>& k, size_t i) {
       const Vec<D> u = f.velocity().atCell(k);
@@ -55,7 +51,7 @@ std::vector<Grid<float, D>> fluidField(const FluidSolver<D>& f, const std::strin
     });
     return v;
   }
-  if (name == "velocity_mac") {  // component a on the faces normal to a, padded to cells + 1 per axis (zeros)
+  if (name == fields::kVelocityMac) {  // component a on the faces normal to a, padded to cells + 1 per axis (zeros)
     std::vector<Grid<float, D>> v(static_cast<size_t>(D), Grid<float, D>(f.cells() + IVec<D>(1), 0.0f));
     for (int a = 0; a < D; ++a) {
       const Grid<float, D>& u = f.velocity()[a];
@@ -367,8 +363,8 @@ template void initialiseDye<2>(const Scene&, FluidSolver<2>*);
 template void initialiseDye<3>(const Scene&, FluidSolver<3>*);
 template <int D>
 bool setFluidField(FluidSolver<D>* fluid, const std::string& name, const Grid<float, D>& values) {
-  const bool temperature = name == "temperature" && !fluid->temperature().empty();
-  if (name != "dye" && !temperature) return false;
+  const bool temperature = name == fields::kTemperature && !fluid->temperature().empty();
+  if (name != fields::kDye && !temperature) return false;
   Grid<float, D>& g = temperature ? fluid->temperature() : fluid->dye();
   if (values.dims() != g.dims())
     throw UserError({"set_field", 0, 0}, "", "the values of '" + name + "' are not on its grid",

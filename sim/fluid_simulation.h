@@ -38,8 +38,7 @@ void warnOfEmptySources(const Scene& scene, const FluidSolver<D>& fluid,
 template <int D>
 void checkFluidFinite(const FluidSolver<D>& fluid, const std::string& where);
 
-// The fluid fields every fluid simulation offers.
-std::vector<std::string> fluidFieldNames();
+// A field of the fluid's (scenes/field_catalogue.h).
 template <int D>
 std::vector<Grid<float, D>> fluidField(const FluidSolver<D>& fluid, const std::string& name);
 // Sets the dye (the smoke) or, in a smoke scene, the temperature from values
@@ -57,22 +56,12 @@ class FluidSimulation : public Simulation<D> {
   double cflTimeStep(double cfl, double dtMax) const override;
   double time() const override { return stepper_->time(); }
   long steps() const override { return stepper_->steps(); }
-  std::vector<std::string> fieldNames() const override { return fluidFieldNames(); }
-  std::vector<std::string> dumpFieldNames() const override {
-    std::vector<std::string> names = {"speed", "vorticity", "pressure", "dye"};
-    if (scene_.fluid.smoke.enabled) names.push_back("temperature");
-    return names;
-  }
-  std::vector<Grid<float, D>> field(const std::string& name) const override {
-    host_.refresh();
-    return fluidField<D>(fluid_, name);
-  }
+  const Scene& scene() const override { return scene_; }
   void setField(const std::string& name, const Grid<float, D>& values) override {
     host_.refresh();
     if (!setFluidField<D>(&fluid_, name, values)) Simulation<D>::setField(name, values);
     stepper_->fromHost(fluid_);
   }
-  bool symmetric(const std::string& name) const override { return name == "vorticity" && D == 2; }
   bool hasObstacles() const override { return !scene_.fluid.obstacles.empty(); }
   void checkFinite(const std::string& when) const override {
     host_.refresh();
@@ -84,6 +73,12 @@ class FluidSimulation : public Simulation<D> {
   void report(nlohmann::json* run) const override;
   // The probes' files: profiles/*.csv, forces.csv.
   std::vector<std::pair<std::string, std::string>> measurementFiles() const override;
+
+ protected:
+  std::vector<Grid<float, D>> ownField(const std::string& name) const override {
+    host_.refresh();
+    return fluidField<D>(fluid_, name);
+  }
 
  private:
   const Scene& scene_;

@@ -152,22 +152,15 @@ void GivenFlowSimulation<D>::step(double dt) {
 }
 
 template <int D>
-std::vector<std::string> GivenFlowSimulation<D>::fieldNames() const {
-  std::vector<std::string> names = species();
-  names.push_back("speed");
-  names.push_back("velocity");
-  return names;
-}
-
-template <int D>
-std::vector<Grid<float, D>> GivenFlowSimulation<D>::field(const std::string& name) const {
-  if (name != "speed" && name != "velocity") return speciesField<D>(rd_, name);
-  std::vector<Grid<float, D>> v(name == "speed" ? 1 : size_t(D), Grid<float, D>(rd_.cells(), 0.0f));
+std::vector<Grid<float, D>> GivenFlowSimulation<D>::ownField(const std::string& name) const {
+  const bool speed = name == fields::kSpeed;
+  if (!speed && name != fields::kVelocity) return speciesField<D>(rd_, name);
+  std::vector<Grid<float, D>> v(speed ? 1 : size_t(D), Grid<float, D>(rd_.cells(), 0.0f));
   forEachCell<D>(rd_.cells(), [&](const IVec<D>& k, size_t i) {
     const Vec<D> c = velocityAt(k);
     double s2 = 0;
     for (int a = 0; a < D; ++a) s2 += c[a] * c[a];
-    if (name == "speed") v[0][i] = float(std::sqrt(s2));
+    if (speed) v[0][i] = float(std::sqrt(s2));
     else
       for (int a = 0; a < D; ++a) v[size_t(a)][i] = float(c[a]);
   });

@@ -28,10 +28,8 @@ class GivenFlowSimulation : public Simulation<D> {
   void step(double dt) override;
   double time() const override { return time_; }
   long steps() const override { return steps_; }
-  std::vector<std::string> fieldNames() const override;
+  const Scene& scene() const override { return scene_; }
   std::vector<std::string> species() const override { return rd_.model().info().species; }
-  std::vector<std::string> dumpFieldNames() const override { return species(); }
-  std::vector<Grid<float, D>> field(const std::string& name) const override;
   // The source's field changed (Python's set_velocity): sampled again now.
   void velocityChanged() {
     sampled_ = false;
@@ -45,6 +43,9 @@ class GivenFlowSimulation : public Simulation<D> {
   void load(const StateReader& in) override;
   nlohmann::json resolved() const override;
   void report(nlohmann::json* run) const override;
+
+ protected:
+  std::vector<Grid<float, D>> ownField(const std::string& name) const override;
 
  private:
   void sampleVelocity(double t);

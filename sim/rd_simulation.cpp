@@ -58,7 +58,7 @@ void RDSimulation<D>::advance(double dt, long count) {
 }
 
 template <int D>
-std::vector<Grid<float, D>> RDSimulation<D>::field(const std::string& name) const {
+std::vector<Grid<float, D>> RDSimulation<D>::ownField(const std::string& name) const {
   host_.refresh();
   return speciesField<D>(rd_, name);
 }

@@ -47,16 +47,17 @@ class RDSimulation : public Simulation<D> {
   long stepsTogether() const override { return stepper_->stepsTogether(); }
   double time() const override { return stepper_->time(); }
   long steps() const override { return stepper_->steps(); }
-  std::vector<std::string> fieldNames() const override { return species(); }
+  const Scene& scene() const override { return scene_; }
   std::vector<std::string> species() const override { return rd_.model().info().species; }
-  std::vector<std::string> dumpFieldNames() const override { return species(); }
-  std::vector<Grid<float, D>> field(const std::string& name) const override;
   void setField(const std::string& name, const Grid<float, D>& values) override;
   void checkFinite(const std::string& when) const override;
   void save(StateWriter* out) const override;
   void load(const StateReader& in) override;
   nlohmann::json resolved() const override;
   void report(nlohmann::json* run) const override;
+
+ protected:
+  std::vector<Grid<float, D>> ownField(const std::string& name) const override;
 
  private:
   const Scene& scene_;

@@ -15,6 +15,8 @@
 #include "core/error.h"
 #include "core/grid.h"
 #include "core/state_archive.h"
+#include "scenes/field_catalogue.h"
+#include "scenes/scene.h"
 
 namespace morphoflow {
 
@@ -38,17 +40,21 @@ class Simulation {
   virtual double time() const = 0;
   virtual long steps() const = 0;
 
-  // Every field field() can return: species, then speed, vorticity,
-  // pressure, dye, velocity, obstacle where the simulation has a fluid.
-  virtual std::vector<std::string> fieldNames() const = 0;
+  // The scene it runs: its fields' catalogue (scenes/field_catalogue.h) and
+  // the settings of its derived fields.
+  virtual const Scene& scene() const = 0;
+  FieldCatalogue fields() const { return FieldCatalogue(scene()); }
+  // Every field field() can return, in the catalogue's order.
+  std::vector<std::string> fieldNames() const { return fields().names(); }
   // The reaction-diffusion species (empty without a layer).
   virtual std::vector<std::string> species() const { return {}; }
   // The fields a field dump holds, in order.
-  virtual std::vector<std::string> dumpFieldNames() const = 0;
-  // A named field at cell centres: one grid, or D (x, y[, z]) for "velocity".
-  // Each field is on its own grid (species on the RD grid, the rest on the
-  // fluid's); all of them span the same domain.
-  virtual std::vector<Grid<float, D>> field(const std::string& name) const = 0;
+  std::vector<std::string> dumpFieldNames() const { return fields().dumpNames(); }
+  // A named field of the catalogue: one grid, or D (x, y[, z]) for a
+  // vector, 3 for a colour. Each field is on its own grid (species on the RD
+  // grid, the rest on the fluid's); all of them span the same domain. A
+  // derived field is computed from the others (sim/derived_fields.h).
+  std::vector<Grid<float, D>> field(const std::string& name) const;
   // Sets a field from values on its grid (field()'s shape): a species, the
   // dye (the smoke) or the temperature; throws UserError (key "set_field")
   // for a field computed from the state (speed, vorticity, ...) or one this
@@ -60,7 +66,11 @@ class Simulation {
 
   // Whether the field is signed around 0 (an automatic image range is then
   // centred on 0).
-  virtual bool symmetric(const std::string& name) const { return false; }
+  bool symmetric(const std::string& name) const {
+    const FieldCatalogue catalogue = fields();
+    const FieldInfo* f = catalogue.find(name);
+    return f && f->symmetric;
+  }
   // Whether the scene has solid cells (the "obstacle" field is then nonzero
   // inside them).
   virtual bool hasObstacles() const { return false; }
@@ -81,6 +91,10 @@ class Simulation {
   // statistics (solver iterations, stage times) under their own keys.
   virtual nlohmann::json resolved() const = 0;
   virtual void report(nlohmann::json* run) const = 0;
+
+ protected:
+  // A field the simulation holds or computes per cell (not a derived one).
+  virtual std::vector<Grid<float, D>> ownField(const std::string& name) const = 0;
 };
 
 }  // namespace morphoflow

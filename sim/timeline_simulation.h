@@ -31,12 +31,9 @@ class TimelineSimulation : public Simulation<D> {
   double cflTimeStep(double cfl, double dtMax) const override { return inner_->cflTimeStep(cfl, dtMax); }
   double time() const override { return inner_->time(); }
   long steps() const override { return inner_->steps(); }
-  std::vector<std::string> fieldNames() const override { return inner_->fieldNames(); }
+  const Scene& scene() const override { return *scene_; }
   std::vector<std::string> species() const override { return inner_->species(); }
-  std::vector<std::string> dumpFieldNames() const override { return inner_->dumpFieldNames(); }
-  std::vector<Grid<float, D>> field(const std::string& name) const override { return inner_->field(name); }
   void setField(const std::string& name, const Grid<float, D>& values) override { inner_->setField(name, values); }
-  bool symmetric(const std::string& name) const override { return inner_->symmetric(name); }
   bool hasObstacles() const override { return inner_->hasObstacles(); }
   std::vector<std::pair<std::string, std::string>> measurementFiles() const override {
     return inner_->measurementFiles();
@@ -58,6 +55,9 @@ class TimelineSimulation : public Simulation<D> {
   const Scene& current() const { return *built_; }
   // How many times the simulation was built again.
   long rebuilds() const { return rebuilds_; }
+
+ protected:
+  std::vector<Grid<float, D>> ownField(const std::string& name) const override { return inner_->field(name); }
 
  private:
   std::vector<double> signatureAt(double t) const;

@@ -11,6 +11,7 @@
 #include "gpu/gl_context.h"
 #include "run/memory_estimate.h"
 #include "run/run_clock.h"
+#include "sim/frame_palette.h"
 #include "sim/simulation_factory.h"
 #include "studio/frame_encoding.h"
 
@@ -22,11 +23,6 @@ namespace {
 
 const SourceLocation kStudio{"studio", 0, 0};
 using Clock = std::chrono::steady_clock;
-
-Palette paletteOf(const OutputSettings& out) {
-  if (!out.gradient.empty()) return Palette{out.gradient};
-  return namedPalette(out.colormap);
-}
 
 nlohmann::json region(const ObstacleSpec& r, int D) {
   nlohmann::json j;
@@ -227,7 +223,8 @@ void StudioSession::publish() {
       const bool autoRange = field != out.field || out.autoRange;
       const nlohmann::json meta = {
           {"field", field}, {"t", sim.time()}, {"step", sim.steps()}, {"dimension", dimension_}};
-      return encodeFrame(sim.field(field), paletteOf(out), autoRange, out.range, sim.symmetric(field), meta);
+      return encodeFrame(sim.field(field), frameImageOptions(out, false).palette, autoRange, out.range,
+                         sim.symmetric(field), meta);
     });
   } catch (const std::exception& e) {
     std::lock_guard<std::mutex> lk(mutex_);
