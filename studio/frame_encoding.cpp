@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -57,11 +58,18 @@ void putU32(std::string* out, uint32_t v) {
 template <int D>
 std::string encodeFrame(const std::vector<Grid<float, D>>& field, const Palette& palette, bool autoRange,
                         const double range[2], bool symmetric, nlohmann::json meta) {
-  const Grid<float, D> g = downsampled<D>(magnitude<D>(field));
+  // The values shown: the field itself (one component, a grid small enough),
+  // else its magnitude and box average, made once.
+  Grid<float, D> made;
+  const Grid<float, D>* shown = &field.front();
+  if (field.size() > 1) made = magnitude<D>(field), shown = &made;
+  if (D == 3) made = downsampled<D>(*shown), shown = &made;
+  const Grid<float, D>& g = *shown;
   double lo = range[0], hi = range[1];
   if (autoRange) {
-    lo = 1e300, hi = -1e300;
-    for (float v : g.values()) lo = std::min(lo, double(v)), hi = std::max(hi, double(v));
+    float l = std::numeric_limits<float>::infinity(), u = -l;
+    for (float v : g.values()) l = std::min(l, v), u = std::max(u, v);
+    lo = l <= u ? l : 1e300, hi = l <= u ? u : -1e300;  // (no number: the empty range)
     if (symmetric) hi = std::max(std::abs(lo), std::abs(hi)), lo = -hi;
   }
   if (!(hi > lo)) hi = lo + 1.0;

@@ -311,6 +311,7 @@ struct StudioServer::Impl {
     beast::get_lowest_layer(w.ws).expires_never();
     w.ws.set_option(websocket::stream_base::timeout::suggested(beast::role_type::server));
     w.ws.read_message_max(4096);
+    w.ws.auto_fragment(false);  // a frame goes as one WebSocket frame in one write, not in 4 KiB pieces
     beast::error_code ec;
     co_await w.ws.async_accept(req, asio::redirect_error(use_awaitable, ec));
     if (ec) co_return;
