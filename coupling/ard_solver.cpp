@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "core/stage_trace.h"
+#include "coupling/ard_step.h"
 
 namespace morphoflow {
 
@@ -22,6 +23,16 @@ std::vector<Grid<double, D>*> ARDSolver<D>::species() {
   return s;
 }
 
+// The CPU's stages of the ARD step, whose order is coupling/ard_step.h's.
+template <int D>
+struct ARDSolver<D>::Stages {
+  ARDSolver& s;
+  const MacVelocity<D>* u = nullptr;
+  void reactDiffuse(double dt) { s.rd_->step(dt); }
+  void emptySolids() { s.advector_.emptySolids(s.species()); }
+  void advect(double dt) { s.advector_.advect(*u, dt, s.species(), s.pool_.get()); }
+};
+
 template <int D>
 void ARDSolver<D>::step(double dt, const MacVelocity<D>& u) {
   reactDiffuse(dt);
@@ -31,15 +42,16 @@ void ARDSolver<D>::step(double dt, const MacVelocity<D>& u) {
 template <int D>
 void ARDSolver<D>::reactDiffuse(double dt) {
   const double t0 = traceClock();
-  if (mode_ != CouplingMode::Passive) rd_->step(rdTimeScale_ * dt);  // eq. 6 then eq. 13
-  if (mode_ == CouplingMode::ARD) advector_.emptySolids(species());  // obstacles hold no chemical
+  Stages stages{*this};
+  reactDiffuseChemicals(stages, mode_, rdTimeScale_, dt);
   stageSeconds_[0] = traceClock() - t0;
 }
 
 template <int D>
 void ARDSolver<D>::advect(double dt, const MacVelocity<D>& u) {
   const double t0 = traceClock();
-  if (mode_ != CouplingMode::RDOnly) advector_.advect(u, dt, species(), pool_.get());  // eq. 19-20
+  Stages stages{*this, &u};
+  advectChemicals(stages, mode_, dt);
   stageSeconds_[1] = traceClock() - t0;
   time_ += dt;
   ++steps_;

@@ -41,6 +41,7 @@ class ARDSolver {
   const std::array<double, kStages>& stageSeconds() const { return stageSeconds_; }
 
  private:
+  struct Stages;  // the step's stages (coupling/ard_step.h)
   std::vector<Grid<double, D>*> species();
 
   RDSolver<D>* rd_;

@@ -6,9 +6,10 @@
 
 #include "core/parallel.h"
 #include "core/sampling.h"
-#include "coupling/interpolation_weights.h"
 #include "core/simd_dispatch.h"
+#include "coupling/ard_step.h"
 #include "coupling/bspline.h"
+#include "coupling/interpolation_weights.h"
 #include "fluid/advection.h"
 
 #if MORPHOFLOW_AVX2_KERNELS
@@ -335,21 +336,29 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
     const double in = inflow ? d.inflowValues[s] : 0.0;
     const double* phi = species[s]->data();
     coefficients_.reshape(d.cells);
-    linearPass(feet_, inflowWeight, in, phi, scratch_.data());
-    linearPass(backFeet_, inflow ? backFromInflow_.data() : nullptr, in, scratch_.data(), coefficients_.data());
+    auto forward = [&] { linearPass(feet_, inflowWeight, in, phi, scratch_.data()); };
+    auto backward = [&] {
+      linearPass(backFeet_, inflow ? backFromInflow_.data() : nullptr, in, scratch_.data(), coefficients_.data());
+    };
     const double* back = coefficients_.data();
-    pass(feet_, inflowWeight, in, scratch_.data(), [&](const Vec<D>& c) {
-      size_t index[1 << D];
-      double weight[1 << D];
-      linearStencil<D>(d.cells, d.periodic, c, index, weight);
-      double v = 0.0, lo = INFINITY, hi = -INFINITY;
-      for (int k = 0; k < (1 << D); ++k) {
-        const double p = phi[index[k]];
-        v += weight[k] * (1.5 * p - 0.5 * back[index[k]]);
-        lo = std::min(lo, p), hi = std::max(hi, p);
-      }
-      return std::clamp(v, lo, hi);
-    }, scalar);
+    auto compensated = [&] {
+      pass(
+          feet_, inflowWeight, in, scratch_.data(),
+          [&](const Vec<D>& c) {
+            size_t index[1 << D];
+            double weight[1 << D];
+            linearStencil<D>(d.cells, d.periodic, c, index, weight);
+            double v = 0.0, lo = INFINITY, hi = -INFINITY;
+            for (int k = 0; k < (1 << D); ++k) {
+              const double p = phi[index[k]];
+              v += weight[k] * (1.5 * p - 0.5 * back[index[k]]);
+              lo = std::min(lo, p), hi = std::max(hi, p);
+            }
+            return std::clamp(v, lo, hi);
+          },
+          scalar);
+    };
+    bfeccPasses(forward, backward, compensated);
   };
   // One species at a time through one scratch (the species are independent):
   // after the swap it holds the old values' storage, the next one's scratch.

@@ -7,6 +7,7 @@
 
 #include "core/parallel.h"
 #include "fluid/advection.h"
+#include "fluid/fluid_step.h"
 #include "fluid/forces.h"
 #include "fluid/obstacle.h"
 #include "fluid/smoke.h"
@@ -65,51 +66,62 @@ FluidSolver<D>::FluidSolver(const FluidSettings& s)
   }
 }
 
+// The CPU's stages of the fluid step, whose order is fluid/fluid_step.h's.
+template <int D>
+struct FluidSolver<D>::Stages {
+  using Clock = std::chrono::steady_clock;
+  FluidSolver& f;
+  Clock::time_point t0{};
+
+  void mark(int stage) {
+    const Clock::time_point t1 = Clock::now();
+    if (stage > 0) f.stats_.seconds[size_t(stage - 1)] = std::chrono::duration<double>(t1 - t0).count();
+    t0 = t1;
+  }
+  bool smoke() const { return f.settings_.smoke.enabled; }
+  void emitSmoke(double dt) {
+    morphoflow::emitSmoke<D>(f.settings_.smoke, f.sourceCoverage_, f.constraints_.solid, f.time_, dt, &f.dye(),
+                             &f.temperature_, &f.u_);
+  }
+  void forces(double dt) { applyForces<D>(f.settings_, f.dye_.empty() ? nullptr : &f.dye_, dt, &f.u_); }
+  void smokeForces(double dt) {
+    applySmokeForces<D>(f.settings_.smoke, f.settings_.buoyancyDirection, f.dye(), f.temperature_, dt, &f.u_, &f.pool_);
+  }
+  void constrain() { f.constraints_.apply(&f.u_); }
+  void advect(double dt) {
+    f.advectionScratch_.borrow(&f.pool_, f.settings_.advection);
+    advectVelocity<D>(f.u_, dt, f.settings_.advection, &f.scratch_, &f.advectionScratch_);
+    // An all-zero dye (no dye in the scene yet) advects to zero: skip the work.
+    const Grid<float, D>& dye = f.dye_;
+    const bool dyed =
+        !dye.empty() && std::any_of(dye.values().begin(), dye.values().end(), [](float v) { return v != 0.0f; });
+    if (dyed || !f.temperature_.empty()) {
+      // The scalars skip the rows of empty space (fluid/advection.h).
+      const std::optional<std::array<int, D>> reach = traceReach<D>(f.u_, dt);
+      if (dyed) f.advectScalar(&f.dye_, dt, reach);
+      if (!f.temperature_.empty()) f.advectScalar(&f.temperature_, dt, reach);
+    }
+    f.advectionScratch_.giveBack(&f.pool_);
+    std::swap(f.u_, f.scratch_);  // scratch_ keeps the velocity advected through (advectedVelocity())
+  }
+  void injectInflowDye() { f.injectInflowDye(); }
+  void decaySmoke(double dt) { morphoflow::decaySmoke<D>(f.settings_.smoke, dt, &f.dye(), &f.temperature_); }
+  void diffuse(double dt) {
+    f.stats_.viscosity = f.viscosity_->diffuse(&f.u_, f.settings_.viscosity, dt, &f.pool_);
+    f.stats_.viscosityCellUpdates = f.viscosity_->lastCellUpdates();
+    f.stats_.viscosityUsedCG = f.viscosity_->lastUsedCG();
+  }
+  void project(double dt) { f.stats_.pressure = f.projection_->project(&f.u_, dt, f.settings_.density, &f.pool_); }
+  void advanceClock(double dt) {
+    f.time_ += dt;
+    ++f.steps_;
+  }
+};
+
 template <int D>
 void FluidSolver<D>::step(double dt, const std::function<void()>& afterAdvection) {
-  using Clock = std::chrono::steady_clock;
-  auto t0 = Clock::now();
-  auto lap = [&](int stage) {
-    auto t1 = Clock::now();
-    stats_.seconds[size_t(stage)] = std::chrono::duration<double>(t1 - t0).count();
-    t0 = t1;
-  };
-  // 1. forces (with [smoke]: the sources' emission, buoyancy, confinement)
-  const SmokeSettings& smoke = settings_.smoke;
-  if (smoke.enabled) emitSmoke<D>(smoke, sourceCoverage_, constraints_.solid, time_, dt, &dye(), &temperature_, &u_);
-  applyForces<D>(settings_, dye_.empty() ? nullptr : &dye_, dt, &u_);
-  if (smoke.enabled) applySmokeForces<D>(smoke, settings_.buoyancyDirection, dye(), temperature_, dt, &u_, &pool_);
-  constraints_.apply(&u_);
-  lap(0);
-  // 2. advect (velocity through itself, dye and temperature through the same field)
-  advectionScratch_.borrow(&pool_, settings_.advection);
-  advectVelocity<D>(u_, dt, settings_.advection, &scratch_, &advectionScratch_);
-  // An all-zero dye (no dye in the scene yet) advects to zero: skip the work.
-  const bool dyed =
-      !dye_.empty() && std::any_of(dye_.values().begin(), dye_.values().end(), [](float v) { return v != 0.0f; });
-  if (dyed || !temperature_.empty()) {
-    // The scalars skip the rows of empty space (fluid/advection.h).
-    const std::optional<std::array<int, D>> reach = traceReach<D>(u_, dt);
-    if (dyed) advectScalar(&dye_, dt, reach);
-    if (!temperature_.empty()) advectScalar(&temperature_, dt, reach);
-  }
-  advectionScratch_.giveBack(&pool_);
-  std::swap(u_, scratch_);  // scratch_ keeps the velocity advected through (advectedVelocity())
-  constraints_.apply(&u_);
-  injectInflowDye();
-  if (smoke.enabled) decaySmoke<D>(smoke, dt, &dye(), &temperature_);
-  lap(1);
-  if (afterAdvection) afterAdvection();
-  // 3. diffuse (implicit viscosity)
-  stats_.viscosity = viscosity_->diffuse(&u_, settings_.viscosity, dt, &pool_);
-  stats_.viscosityCellUpdates = viscosity_->lastCellUpdates();
-  stats_.viscosityUsedCG = viscosity_->lastUsedCG();
-  lap(2);
-  // 4. project
-  stats_.pressure = projection_->project(&u_, dt, settings_.density, &pool_);
-  lap(3);
-  time_ += dt;
-  ++steps_;
+  Stages stages{*this};
+  stepFluid(stages, dt, afterAdvection);
 }
 
 // A cell-centred scalar carried through u_ (before the swap) with the

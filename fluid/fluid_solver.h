@@ -83,6 +83,7 @@ class FluidSolver {
   Layout<D> cellLayout() const { return Layout<D>::cellCentred(h_, cells_, constraints_.periodic()); }
 
  private:
+  struct Stages;  // the step's stages (fluid/fluid_step.h)
   void injectInflowDye();
   void advectScalar(Grid<float, D>* field, double dt, const std::optional<std::array<int, D>>& reach);
   Grid<float, D>& materialisedDye() const {

@@ -6,9 +6,10 @@
 #include <epoxy/gl.h>
 #include <fmt/format.h>
 
-#include "gpu/gpu_stage_timer.h"
+#include "coupling/ard_step.h"
 #include "gpu/compute_program.h"
 #include "gpu/gpu_programs.h"
+#include "gpu/gpu_stage_timer.h"
 
 namespace morphoflow {
 
@@ -126,9 +127,11 @@ void GpuARDSolver<D>::advect(double dt, const GpuFluid<D>& fluid) {
   if (bfecc_) {
     // BFECC (chemical_advection.cpp): forward into scratch_, backward into
     // coefficients_, then the compensated forward step into scratch_.
-    advectPass(dt, fluid, species, scratch, false);
-    advectPass(-dt, fluid, scratch, {&coefficients_[0], &coefficients_[1]}, false);
-    advectPass(dt, fluid, species, scratch, true);
+    bfeccPasses([&] { advectPass(dt, fluid, species, scratch, false); },
+                [&] {
+                  advectPass(-dt, fluid, scratch, {&coefficients_[0], &coefficients_[1]}, false);
+                },
+                [&] { advectPass(dt, fluid, species, scratch, true); });
   } else {
     advectPass(dt, fluid, species, scratch, false);
   }
@@ -138,11 +141,18 @@ void GpuARDSolver<D>::advect(double dt, const GpuFluid<D>& fluid) {
 
 template <int D>
 void GpuARDSolver<D>::step(double dt, const GpuFluid<D>& fluid) {
+  // The GPU's stages of the ARD step, whose order is coupling/ard_step.h's.
+  struct Stages {
+    GpuARDSolver& s;
+    const GpuFluid<D>& fluid;
+    void reactDiffuse(double t) { s.layer_->step(t); }
+    void emptySolids() { s.emptySolids(); }
+    void advect(double t) { s.advect(t, fluid); }
+  } stages{*this, fluid};
   timer_->mark(0);
-  if (mode_ != CouplingMode::Passive) layer_->step(rdTimeScale_ * dt);  // eq. 6 then eq. 13
-  if (mode_ == CouplingMode::ARD) emptySolids();                      // obstacles hold no chemical
+  reactDiffuseChemicals(stages, mode_, rdTimeScale_, dt);
   timer_->mark(1);
-  if (mode_ != CouplingMode::RDOnly) advect(dt, fluid);  // eq. 19-20
+  advectChemicals(stages, mode_, dt);
   timer_->mark(2);
   const std::vector<double> seconds = timer_->endStep();
   stageSeconds_ = {seconds[0], seconds[1]};

@@ -7,17 +7,18 @@
 #include <fmt/format.h>
 
 #include "core/multigrid.h"
+#include "fluid/fluid_step.h"
 #include "fluid/pressure_projection.h"
 #include "fluid/smoke.h"
 #include "gpu/compute_program.h"
 #include "gpu/gl_context.h"
-#include "gpu/gpu_programs.h"
-#include "gpu/kernel_modes.h"
 #include "gpu/gpu_laplace.h"
 #include "gpu/gpu_multigrid.h"
 #include "gpu/gpu_pcg.h"
+#include "gpu/gpu_programs.h"
 #include "gpu/gpu_reduction.h"
 #include "gpu/gpu_stage_timer.h"
+#include "gpu/kernel_modes.h"
 
 namespace morphoflow {
 
@@ -176,7 +177,7 @@ void GpuFluid<D>::applyConstraints(const GpuBuffer& vel) {
   for (FluidOp mode : {FluidOp::Fixed, FluidOp::Periodic})
     for (int a = 0; a < D; ++a) {
       if (mode == FluidOp::Periodic && !periodic_[size_t(a)]) continue;
-      const ComputeProgram& p = useProgram("fluid_ops.comp", dimDefine(D, mode));
+      const ComputeProgram& p = useProgram(shader(mode), dimDefine(D, mode));
       setUniform(p, "cells", cells_);
       setUniform(p, "axis", a);
       setUniform(p, "n", int(faces(a)));
@@ -195,7 +196,7 @@ void GpuFluid<D>::forces(double dt) {
     const float f = float(dt * settings_.force[size_t(a)]);
     const float b = dyeActive_ ? float(dt * settings_.buoyancy * settings_.buoyancyDirection[size_t(a)]) : 0.0f;
     if (f == 0.0f && b == 0.0f) continue;
-    const ComputeProgram& p = useProgram("fluid_ops.comp", dimDefine(D, FluidOp::Forces));
+    const ComputeProgram& p = useProgram(shader(FluidOp::Forces), dimDefine(D, FluidOp::Forces));
     setUniform(p, "cells", cells_);
     setUniform(p, "axis", a);
     setUniform(p, "n", int(faces(a)));
@@ -320,7 +321,7 @@ void GpuFluid<D>::advectField(const GpuBuffer& src, size_t srcOff, const std::ar
   };
   auto combine = [&](FluidOp mode, const GpuBuffer& f0, size_t f0Off, const GpuBuffer& f1, size_t f1Off,
                      const GpuBuffer& f2, const GpuBuffer& f3, const GpuBuffer& f4) {
-    const ComputeProgram& p = useProgram("fluid_ops.comp", dimDefine(D, mode));
+    const ComputeProgram& p = useProgram(shader(mode), dimDefine(D, mode));
     setUniform(p, "n", int(n));
     setUniform(p, "dstOff", int(f0Off));
     setUniform(p, "f1Off", int(f1Off));
@@ -374,11 +375,14 @@ void GpuFluid<D>::advect(double dt) {
     std::swap(temp_, tempScratch_);
   }
   std::swap(vel_, velScratch_);
-  applyConstraints(vel_);
+}
+
+template <int D>
+void GpuFluid<D>::injectInflowDye() {
   for (int a = 0; a < D; ++a)
     for (bool high : {false, true}) {
       if (settings_.inflowDyeStripes <= 0 || settings_.boundaries.side(a, high).kind != BoundaryKind::Inflow) continue;
-      const ComputeProgram& p = useProgram("fluid_ops.comp", dimDefine(D, FluidOp::InflowDye));
+      const ComputeProgram& p = useProgram(shader(FluidOp::InflowDye), dimDefine(D, FluidOp::InflowDye));
       setUniform(p, "cells", cells_);
       setUniform(p, "n", int(cellCount_));
       setUniform(p, "inflow", std::array<int, 4>{a, high ? 1 : 0, a == 0 ? 1 : 0, settings_.inflowDyeStripes});
@@ -400,7 +404,7 @@ void GpuFluid<D>::diffuse(double dt) {
     const Viscous& V = *viscous_[size_t(a)];
     std::array<int, 3> udims{1, 1, 1};
     for (int b = 0; b < D; ++b) udims[size_t(b)] = V.host.dims[b];
-    const ComputeProgram& p = useProgram("fluid_ops.comp", dimDefine(D, mode));
+    const ComputeProgram& p = useProgram(shader(mode), dimDefine(D, mode));
     setUniform(p, "cells", cells_);
     setUniform(p, "axis", a);
     setUniform(p, "n", int(V.host.A.size()));
@@ -438,7 +442,7 @@ template <int D>
 void GpuFluid<D>::project(double dt) {
   auto run = [&](FluidOp mode, int axis, size_t n) {
     const bool cut = mode == FluidOp::Divergence && viscousHeld_.bytes() > 0;  // (made for cut obstacles only)
-    const ComputeProgram& p = useProgram("fluid_ops.comp", dimDefine(D, mode) + (cut ? "\n#define CUT_FACES" : ""));
+    const ComputeProgram& p = useProgram(shader(mode), dimDefine(D, mode) + (cut ? "\n#define CUT_FACES" : ""));
     setUniform(p, "cells", cells_);
     setUniform(p, "periodic", periodic_);
     setUniform(p, "axis", axis);
@@ -469,34 +473,40 @@ void GpuFluid<D>::project(double dt) {
   if (statsDue(steps_ + 1)) readSolverStats();  // (steps_ counts this step at its end)
 }
 
+// The GPU's stages of the fluid step, whose order is fluid/fluid_step.h's.
+template <int D>
+struct GpuFluid<D>::Stages {
+  GpuFluid& f;
+  void mark(int stage) {
+    f.timer_->mark(stage);
+    if (stage < FluidStepStats::kStages) return;
+    const std::vector<double> seconds = f.timer_->endStep();
+    for (int k = 0; k < FluidStepStats::kStages; ++k) f.stats_.seconds[size_t(k)] = seconds[size_t(k)];
+  }
+  bool smoke() const { return f.settings_.smoke.enabled; }
+  void emitSmoke(double dt) { f.emitSmoke(dt); }
+  void forces(double dt) { f.forces(dt); }
+  void smokeForces(double dt) { f.smokeForces(dt); }
+  void constrain() { f.applyConstraints(f.vel_); }
+  void advect(double dt) { f.advect(dt); }
+  void injectInflowDye() { f.injectInflowDye(); }
+  void decaySmoke(double dt) { f.decaySmoke(dt); }
+  void diffuse(double dt) { f.diffuse(dt); }
+  void project(double dt) { f.project(dt); }
+  void advanceClock(double dt) {
+    f.time_ += dt;
+    ++f.steps_;
+  }
+};
+
 template <int D>
 void GpuFluid<D>::step(double dt) {
   counts_.add([&] {
-    stepStages(dt);
+    Stages stages{*this};
+    stepFluid(stages, dt);
     speed_cached_ = -1.0;
   });
   ++counts_.steps;
-}
-
-template <int D>
-void GpuFluid<D>::stepStages(double dt) {
-  timer_->mark(0);
-  if (settings_.smoke.enabled) emitSmoke(dt);
-  forces(dt);
-  if (settings_.smoke.enabled) smokeForces(dt);
-  applyConstraints(vel_);
-  timer_->mark(1);
-  advect(dt);
-  if (settings_.smoke.enabled) decaySmoke(dt);
-  timer_->mark(2);
-  diffuse(dt);
-  timer_->mark(3);
-  project(dt);
-  timer_->mark(4);
-  const std::vector<double> seconds = timer_->endStep();
-  for (int k = 0; k < FluidStepStats::kStages; ++k) stats_.seconds[size_t(k)] = seconds[size_t(k)];
-  time_ += dt;
-  ++steps_;
 }
 
 template <int D>

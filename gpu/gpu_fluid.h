@@ -145,7 +145,8 @@ class GpuFluid final : public FluidStepper<D> {
   std::unique_ptr<class GpuReduction> speed_;
   std::unique_ptr<class GpuStageTimer> timer_;
   StepCounts counts_;
-  void stepStages(double dt);
+  struct Stages;  // the step's stages (fluid/fluid_step.h)
+  void injectInflowDye();
 };
 
 }  // namespace morphoflow

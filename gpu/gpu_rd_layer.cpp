@@ -6,14 +6,15 @@
 #include <cmath>
 
 #include "core/multigrid.h"
-#include "rd/cosine_lobe.h"
-#include "rd/diffusion_tensor.h"
 #include "gpu/compute_program.h"
-#include "gpu/gpu_programs.h"
 #include "gpu/gpu_laplace.h"
 #include "gpu/gpu_models.h"
 #include "gpu/gpu_multigrid.h"
 #include "gpu/gpu_pcg.h"
+#include "gpu/gpu_programs.h"
+#include "rd/cosine_lobe.h"
+#include "rd/diffusion_tensor.h"
+#include "rd/rd_step.h"
 
 namespace morphoflow {
 
@@ -203,43 +204,61 @@ SolverResult GpuRDLayer<D>::diffuse(int s, double thetaDt) {
   return r;
 }
 
+// The GPU's stages of the layer's step, whose order is rd/rd_step.h's.
+template <int D>
+struct GpuRDLayer<D>::Stages {
+  GpuRDLayer& l;
+  bool implicitReaction = false;
+
+  void begin() {
+    l.stats_ = RDStepStats{};
+    l.stats_.diffusion.converged = true;
+    if (l.frozenTaken_) return;  // frozen species keep the values they start the run with
+    for (int s = 0; s < l.species_; ++s)
+      if (l.isFrozen_[size_t(s)]) {
+        l.frozen_[size_t(s)] = GpuBuffer(l.n_ * sizeof(double));
+        l.frozen_[size_t(s)].copyFrom(l.x_[size_t(s)], l.n_ * sizeof(double));
+      }
+    l.frozenTaken_ = true;
+  }
+  bool dynamicTensor() const { return l.up_.tensor && l.up_.tensor->dynamic(); }
+  void buildTensor() { l.buildTensor(); }
+  bool lobes() const { return bool(l.up_.lobes); }
+  void buildLobes() { l.buildLobes(); }
+  void react(double dt, bool implicit) {
+    implicitReaction = implicit;
+    l.react(dt, implicit);
+  }
+  void lendWork() {}
+  void giveWork() {}
+  int species() const { return l.species_; }
+  double diffusion(int s) const { return l.up_.diffusion[size_t(s)]; }
+  void explicitPart(int s, double dt, double explicitD, bool implicit) {
+    const size_t k = size_t(s);
+    if (explicitD > 0) l.operator_[k]->apply(l.x_[k], &l.work_[k]);  // A x = -lap x (less the ghosts)
+    if (implicit) return;
+    const bool dirichlet = l.up_.settings.boundary == RDBoundary::Dirichlet;
+    const double ghost = dirichlet ? 2.0 * l.up_.settings.dirichletValues[k] / (l.up_.h * l.up_.h) : 0.0;
+    l.thetaStep(l.rates_[k], &l.x_[k], l.work_[k], dirichlet ? l.faces_[k] : l.work_[k], dt, explicitD, ghost);
+  }
+  SolverResult diffuse(int s, double thetaDt) { return l.diffuse(s, thetaDt); }
+  void fold(const SolverResult& r) { foldWorst(&l.stats_.diffusion, r); }
+  void clampSpecies() {
+    for (int s = 0; s < l.species_; ++s)
+      if ((l.clamped_ >> s) & 1u) l.vectorOp(VectorOp::ClampZero, l.x_[size_t(s)], &l.x_[size_t(s)], 0.0, 0.0);
+  }
+  void holdFixed() { l.holdFixed(); }
+  void advanceClock(double) {
+    ++l.steps_;
+    if (implicitReaction) l.stats_.newton.cells = long(l.n_);
+    if (statsDue(l.steps_)) l.readStats();
+  }
+};
+
 template <int D>
 void GpuRDLayer<D>::step(double dt) {
-  stats_ = RDStepStats{};
-  stats_.diffusion.converged = true;
-  const RDIntegrator integ = up_.settings.integrator;
-  const bool implicitReaction = integ == RDIntegrator::KimLin;
-  const double theta = diffusionTheta(integ);
-  ++steps_;
-  if (!frozenTaken_) {  // frozen species keep the values they start the run with
-    for (int s = 0; s < species_; ++s)
-      if (isFrozen_[size_t(s)]) {
-        frozen_[size_t(s)] = GpuBuffer(n_ * sizeof(double));
-        frozen_[size_t(s)].copyFrom(x_[size_t(s)], n_ * sizeof(double));
-      }
-    frozenTaken_ = true;
-  }
-  if (up_.lobes) buildLobes();  // eq. 17: a(theta) from the state at the step's start
-  if (const DiffusionTensorSpec<D>* t = up_.tensor; t && t->dynamic()) buildTensor();  // eq. 18-19
-  react(dt, implicitReaction);
-  for (int s = 0; s < species_; ++s) {
-    // the theta scheme's explicit part: x += dt R + (1 - theta) dt d lap x
-    const double explicitD = (1.0 - theta) * dt * up_.diffusion[size_t(s)];
-    if (explicitD > 0) operator_[size_t(s)]->apply(x_[size_t(s)], &work_[size_t(s)]);  // A x = -lap x (less the ghosts)
-    if (!implicitReaction) {
-      const bool dirichlet = up_.settings.boundary == RDBoundary::Dirichlet;
-      const double ghost = dirichlet ? 2.0 * up_.settings.dirichletValues[size_t(s)] / (up_.h * up_.h) : 0.0;
-      thetaStep(rates_[size_t(s)], &x_[size_t(s)], work_[size_t(s)], dirichlet ? faces_[size_t(s)] : work_[size_t(s)],
-                dt, explicitD, ghost);
-    }
-    const SolverResult r = diffuse(s, theta * dt);
-    foldWorst(&stats_.diffusion, r);
-  }
-  for (int s = 0; s < species_; ++s)
-    if ((clamped_ >> s) & 1u) vectorOp(VectorOp::ClampZero, x_[size_t(s)], &x_[size_t(s)], 0.0, 0.0);
-  holdFixed();
-  if (implicitReaction) stats_.newton.cells = long(n_);
-  if (statsDue(steps_)) readStats();
+  Stages stages{*this};
+  stepReactionDiffusion(stages, up_.settings.integrator, dt);
 }
 
 template <int D>

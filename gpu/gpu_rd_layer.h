@@ -57,6 +57,7 @@ class GpuRDLayer {
 
  private:
   struct Diffusion;
+  struct Stages;  // the step's stages (rd/rd_step.h)
   void react(double dt, bool implicit);
   SolverResult diffuse(int s, double thetaDt);
   void vectorOp(VectorOp op, const GpuBuffer& x, GpuBuffer* y, double a, double b,

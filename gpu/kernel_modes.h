@@ -5,7 +5,7 @@
 
 namespace morphoflow {
 
-// shaders/fluid_ops.comp
+// The fluid's stage shaders, one a CPU file (shader() names each mode's)
 enum class FluidOp {
   Forces, InflowDye, Fixed, Periodic, MacCormack, BfeccCorrect, BfeccLimit,
   ViscousSetup, ViscousStore, Divergence, WarmStart, Gradient
@@ -38,6 +38,30 @@ constexpr const char* define(FluidOp m) {
     case FluidOp::Divergence: return "MODE_DIVERGENCE";
     case FluidOp::WarmStart: return "MODE_WARM_START";
     case FluidOp::Gradient: return "MODE_GRADIENT";
+  }
+  return "";
+}
+
+// The shader of a fluid stage: named after the CPU file of the same stage.
+constexpr const char* shader(FluidOp m) {
+  switch (m) {
+    case FluidOp::Forces:
+    case FluidOp::InflowDye:
+      return "fluid_forces.comp";
+    case FluidOp::Fixed:
+    case FluidOp::Periodic:
+      return "velocity_constraints.comp";
+    case FluidOp::MacCormack:
+    case FluidOp::BfeccCorrect:
+    case FluidOp::BfeccLimit:
+      return "advection_correction.comp";
+    case FluidOp::ViscousSetup:
+    case FluidOp::ViscousStore:
+      return "viscosity.comp";
+    case FluidOp::Divergence:
+    case FluidOp::WarmStart:
+    case FluidOp::Gradient:
+      return "pressure_projection.comp";
   }
   return "";
 }

@@ -5,11 +5,12 @@
 #include <stdexcept>
 
 #include "core/bfloat16.h"
+#include "core/chebyshev.h"
 #include "core/jacobi.h"
 #include "core/mic0.h"
-#include "core/chebyshev.h"
 #include "core/multigrid.h"
 #include "core/parallel.h"
+#include "rd/rd_step.h"
 
 namespace morphoflow {
 
@@ -386,59 +387,80 @@ void RDSolver<D>::holdFixed() {
   }
 }
 
+// The CPU's stages of the layer's step, whose order is rd/rd_step.h's.
 template <int D>
-void RDSolver<D>::step(double dt) {
-  if (!(dt > 0)) throw std::invalid_argument("rd: dt must be > 0");
-  const int n = species();
-  if (steps_ == 0) {
-    frozenValues_.assign(size_t(n), {});
-    for (int s : settings_.frozen) frozenValues_[size_t(s)] = x_[size_t(s)].values();
+struct RDSolver<D>::Stages {
+  RDSolver& r;
+  // f(doubles, floats) on the solvers' work vectors, which the pool lends
+  // for the species' solves.
+  template <class F>
+  void work(F&& f) {
+    if (!r.pool_) return;
+    const std::initializer_list<Vector*> doubles = {&r.solveX_, &r.pcgWork_.b, &r.pcgWork_.r, &r.pcgWork_.p,
+                                                    &r.pcgWork_.q};
+    const std::initializer_list<std::vector<float>*> floats = {&r.chebyshevWork_.e[0], &r.chebyshevWork_.e[1],
+                                                               &r.chebyshevWork_.g};
+    f(doubles, floats);
   }
-  stats_ = RDStepStats{};
-  stats_.diffusion.converged = true;
-  if (tensorSpec_ && tensorSpec_->dynamic()) buildTensor();  // eq. 18-19 from the state at the step's start
-  if (lobeSpec_) buildLobes();  // eq. 17: a(theta) from the state at the step's start
-  const size_t cells = cellCount_;
-  // Every integrator is a theta scheme on the diffusion,
-  //   (1 - theta dt d lap) x' = x + dt R + (1 - theta) dt d lap x,
-  // with R = R(x) lagged, or for Kim & Lin the implicit reaction step first.
-  const RDIntegrator integ = settings_.integrator;
-  const bool implicitReaction = integ == RDIntegrator::KimLin;
-  const double theta = diffusionTheta(integ);
-  react(dt, implicitReaction);  // Kim & Lin: updates x in place (projected per cell)
-  const std::initializer_list<Vector*> doubles = {&solveX_, &pcgWork_.b, &pcgWork_.r, &pcgWork_.p, &pcgWork_.q};
-  const std::initializer_list<std::vector<float>*> floats = {&chebyshevWork_.e[0], &chebyshevWork_.e[1],
-                                                             &chebyshevWork_.g};
-  if (pool_) pool_->lend(doubles), pool_->lend(floats);
-  // The species are independent from here on: one after another (each
-  // splits into row tasks), sharing the solvers' work vectors.
-  std::vector<SolverResult> solves(size_t(n), SolverResult{true, 0, 0.0});
-  for (size_t si = 0; si < size_t(n); ++si) {
-    const int s = int(si);
-    Vector& x = x_[si].values();
-    const Vector &L = scratch_, &R = rates_[si];
-    const double explicitD = (1.0 - theta) * dt * d_[size_t(s)];
-    // The explicit part carries its Dirichlet term inside L; the implicit
-    // part adds its own through solveDiffusion.
+
+  void begin() {
+    if (r.steps_ == 0) {
+      r.frozenValues_.assign(size_t(r.species()), {});
+      for (int s : r.settings_.frozen) r.frozenValues_[size_t(s)] = r.x_[size_t(s)].values();
+    }
+    r.stats_ = RDStepStats{};
+    r.stats_.diffusion.converged = true;
+  }
+  bool dynamicTensor() const { return r.tensorSpec_ && r.tensorSpec_->dynamic(); }
+  void buildTensor() { r.buildTensor(); }
+  bool lobes() const { return bool(r.lobeSpec_); }
+  void buildLobes() { r.buildLobes(); }
+  void react(double dt, bool implicit) { r.react(dt, implicit); }  // Kim & Lin: x in place (projected per cell)
+  void lendWork() {
+    work([&](auto doubles, auto floats) { r.pool_->lend(doubles), r.pool_->lend(floats); });
+  }
+  void giveWork() {
+    work([&](auto doubles, auto floats) { r.pool_->give(doubles), r.pool_->give(floats); });
+  }
+  int species() const { return r.species(); }
+  double diffusion(int s) const { return r.d_[size_t(s)]; }
+  // The explicit part carries its Dirichlet term inside L; the implicit part
+  // adds its own through solveDiffusion.
+  void explicitPart(int s, double dt, double explicitD, bool implicitReaction) {
+    const size_t cells = r.cellCount_;
+    Vector& x = r.x_[size_t(s)].values();
+    const Vector &L = r.scratch_, &R = r.rates_[size_t(s)];
     if (explicitD > 0) {
-      scratch_.resize(cells);
-      applyLaplacian(s, x, &scratch_);
+      r.scratch_.resize(cells);
+      r.applyLaplacian(s, x, &r.scratch_);
     }
     if (!implicitReaction && explicitD > 0)
       parallelFor(cells, [&](size_t i) { x[i] += dt * R[i] + explicitD * L[i]; }, kChunk);
     else if (!implicitReaction)
-      parallelFor(cells, [&](size_t i) { x[i] += dt * R[i]; }, kChunk);
-    solves[si] = solveDiffusion(s, theta * dt, &x);
+      parallelFor(
+          cells, [&](size_t i) { x[i] += dt * R[i]; }, kChunk);
   }
-  if (pool_) pool_->give(doubles), pool_->give(floats);
-  for (const SolverResult& r : solves) foldWorst(&stats_.diffusion, r);
-  for (int s : model_.info().clamped) {
-    Grid<double, D>& g = x_[size_t(s)];
-    parallelFor(cells, [&](size_t i) { g[i] = std::max(g[i], 0.0); }, kChunk);
+  SolverResult diffuse(int s, double thetaDt) { return r.solveDiffusion(s, thetaDt, &r.x_[size_t(s)].values()); }
+  void fold(const SolverResult& result) { foldWorst(&r.stats_.diffusion, result); }
+  void clampSpecies() {
+    for (int s : r.model_.info().clamped) {
+      Grid<double, D>& g = r.x_[size_t(s)];
+      parallelFor(
+          r.cellCount_, [&](size_t i) { g[i] = std::max(g[i], 0.0); }, kChunk);
+    }
   }
-  holdFixed();
-  time_ += dt;
-  ++steps_;
+  void holdFixed() { r.holdFixed(); }
+  void advanceClock(double dt) {
+    r.time_ += dt;
+    ++r.steps_;
+  }
+};
+
+template <int D>
+void RDSolver<D>::step(double dt) {
+  if (!(dt > 0)) throw std::invalid_argument("rd: dt must be > 0");
+  Stages stages{*this};
+  stepReactionDiffusion(stages, settings_.integrator, dt);
 }
 
 template <int D>

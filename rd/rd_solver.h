@@ -112,6 +112,7 @@ class RDSolver {
   double explicitDiffusionLimit() const;
 
  private:
+  struct Stages;     // the step's stages (rd/rd_step.h)
   struct Diffusion;  // per-species implicit system and its solver state
   // The isotropic -h^2 lap, or with a shift s the implicit system I + s lap
   // as AnisotropicSystem::shifted(s) makes it, built directly.

@@ -15,6 +15,7 @@
 #include "rd/brush_strokes.h"
 #include "rd/generalized_diffusion.h"
 #include "rd/rd_settings.h"
+#include "scenes/field_catalogue.h"
 #include "scenes/timeline.h"
 
 namespace morphoflow {
@@ -51,7 +52,7 @@ struct OutputSettings {
   bool vdbMacVelocity = false;      // also `vel_mac`: the MAC face velocities exactly (staggered)
   bool video = false;               // encode the PNG frames into OUT/<name>.mp4 (ffmpeg)
   int fps = 30;                     // video frames per second
-  std::string field = "vorticity"; // speed | vorticity | dye | pressure
+  std::string field = fields::kVorticity;  // a name of the catalogue (scenes/field_catalogue.h)
   std::string colormap = "coolwarm"; // a named palette, or "red-green" (two species)
   std::vector<std::array<uint8_t, 3>> gradient;  // custom palette stops (overrides colormap)
   std::string format = "png";      // image frames: png | exr

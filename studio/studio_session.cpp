@@ -143,12 +143,16 @@ void StudioSession::loop() {
       tasks.swap(tasks_);
     }
     for (auto& t : tasks) t();
+    bool behind = false;  // stopped with a step whose frame was not made (paused between two steps)
     {
       std::lock_guard<std::mutex> lk(mutex_);
       go = running_ || stepsToDo_ > 0;
       if (!running_ && stepsToDo_ > 0) --stepsToDo_;
+      behind = !go && sinceFrame_ > 0;
+      if (behind) sinceFrame_ = 0, lastFrame_ = Clock::now();
     }
     if (!go) {
+      if (behind) publish();
       rateStart = Clock::now(), rateSteps = 0;
       continue;
     }

@@ -234,8 +234,9 @@ def test_the_canvas_shows_the_field_and_follows_the_run(browser, studio2d):
     wait_for(lambda: studio2d.state()["steps"] > 600, "the run to go on")
     browser.find_element(By.ID, "pause").click()
     wait_for(lambda: not studio2d.state()["running"], "the pause")
-    step = studio2d.state()["steps"]
-    wait_for(lambda: browser.execute_script("return frame.header.step") == step, "the frame of the paused step")
+    # (a step under way when the pause came still ends: the paused step is read again until the frame shows it)
+    wait_for(lambda: browser.execute_script("return frame.header.step") == studio2d.state()["steps"],
+             "the frame of the paused step")
     shown = canvas_cells(browser, 64)
     assert np.count_nonzero(shown != before) > 100, "the canvas did not change as the run went on"
     # What is drawn is the field: each cell's palette index is its value in the frame's range, y up.

@@ -276,6 +276,35 @@ TEST(Studio, ABadEditChangesNothingAndSaysTheReadersMessage) {
   stepTo(s, 4);  // and the simulation goes on
 }
 
+// The step of a frame (its JSON header).
+long frameStep(const std::shared_ptr<const std::string>& frame) {
+  if (!frame || frame->size() < 8) return -1;
+  uint32_t n = 0;
+  std::memcpy(&n, frame->data() + 4, 4);
+  return nlohmann::json::parse(frame->substr(8, n))["step"].get<long>();
+}
+
+// A pause shows the step the run stopped at, wherever it lands (during a
+// step or between two), though no frame was due while running.
+TEST(Studio, APausedRunShowsTheStepItStoppedAt) {
+  StudioSession s(kScene, kPath, StudioOptions{});
+  s.view({{"steps_per_frame", 10000}});
+  auto steps = [&] { return s.state()["steps"].get<long>(); };
+  for (int round = 0; round < 8; ++round) {
+    const long from = steps();
+    s.control({{"action", "play"}});
+    for (int k = 0; k < 2000 && steps() < from + 2 + round; ++k)
+      std::this_thread::sleep_for(std::chrono::microseconds(500));
+    s.control({{"action", "pause"}});
+    bool shown = false;
+    for (int k = 0; k < 1000 && !shown; ++k) {
+      shown = !s.state()["running"].get<bool>() && frameStep(s.frame()) == steps();
+      if (!shown) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    EXPECT_TRUE(shown) << "round " << round << ": the frame shows step " << frameStep(s.frame()) << " of " << steps();
+  }
+}
+
 TEST(Studio, ResetStartsAgainWithTheEditsAsTheScene) {
   StudioSession s(kScene, kPath, StudioOptions{});
   stepTo(s, 3);
