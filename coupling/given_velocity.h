@@ -65,6 +65,11 @@ class VelocityFileError : public std::runtime_error {
   std::string path_;
 };
 
+// What to do about a VelocityFileError, for a scene's message.
+inline constexpr const char* kVelocityFilesHint =
+    "give a sequence of .vdb files with a Vec3 grid 'vel' over the scene's domain, e.g. written by `morphoflow run` "
+    "with output.vdb = true";
+
 // The frames of `pattern` (a path whose run of '#' stands for the frame
 // number, zero-padded to its length, or one file), in frame order. A frame's
 // time is its `time` metadata, or frame number x frameTime when the file has

@@ -208,7 +208,6 @@ SolverResult GpuRDLayer<D>::diffuse(int s, double thetaDt) {
 template <int D>
 struct GpuRDLayer<D>::Stages {
   GpuRDLayer& l;
-  bool implicitReaction = false;
 
   void begin() {
     l.stats_ = RDStepStats{};
@@ -225,10 +224,7 @@ struct GpuRDLayer<D>::Stages {
   void buildTensor() { l.buildTensor(); }
   bool lobes() const { return bool(l.up_.lobes); }
   void buildLobes() { l.buildLobes(); }
-  void react(double dt, bool implicit) {
-    implicitReaction = implicit;
-    l.react(dt, implicit);
-  }
+  void react(double dt, bool implicit) { l.react(dt, implicit); }
   void lendWork() {}
   void giveWork() {}
   int species() const { return l.species_; }
@@ -250,7 +246,7 @@ struct GpuRDLayer<D>::Stages {
   void holdFixed() { l.holdFixed(); }
   void advanceClock(double) {
     ++l.steps_;
-    if (implicitReaction) l.stats_.newton.cells = long(l.n_);
+    if (l.up_.settings.integrator == RDIntegrator::KimLin) l.stats_.newton.cells = long(l.n_);
     if (statsDue(l.steps_)) l.readStats();
   }
 };

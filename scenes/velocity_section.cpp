@@ -41,9 +41,7 @@ void parseVelocityVdb(SceneContext& c, const toml::table* vt, const toml::node* 
     const std::vector<VelocityFrame> frames = findVelocityFrames(V.vdb, V.frameTime);
     for (const VelocityFrame& f : frames) r.noteInput(f.path, vn, p + "vdb");
   } catch (const VelocityFileError& e) {
-    r.fail(vn, p + "vdb", e.path() + ": " + e.what(),
-           "give a sequence of .vdb files with a Vec3 grid 'vel' over the scene's domain, e.g. written by "
-           "`morphoflow run` with output.vdb = true");
+    r.fail(vn, p + "vdb", e.path() + ": " + e.what(), kVelocityFilesHint);
   }
 }
 

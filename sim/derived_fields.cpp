@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 
 #include "core/expression.h"
@@ -60,16 +61,19 @@ std::vector<Grid<float, D>> density(const Simulation<D>& sim) {
   if (std::find(names.begin(), names.end(), text) != names.end()) return sim.field(text);
   const Expression e(text, names);
   const double width = scene.fluid.size[0];
-  IVec<D> cells = sim.field(names.back()).front().dims();
-  for (const std::string& s : catalogue.species())
-    if (usesName(text, s)) cells = sim.field(s).front().dims();
+  // The fields it uses; its grid is a species' when it uses one, else theirs.
   std::vector<Grid<float, D>> fields(names.size());
-  std::vector<std::unique_ptr<OnCells<D>>> at(names.size());
+  std::optional<IVec<D>> grid, speciesGrid;
   for (size_t v = 0; v < names.size(); ++v)
     if (usesName(text, names[v])) {
       fields[v] = sim.field(names[v]).front();
-      at[v] = std::make_unique<OnCells<D>>(fields[v], cells, width);
+      if (!grid) grid = fields[v].dims();
+      if (v < catalogue.species().size()) speciesGrid = fields[v].dims();  // (the species come first)
     }
+  const IVec<D> cells = speciesGrid ? *speciesGrid : grid ? *grid : sim.field(names.back()).front().dims();
+  std::vector<std::unique_ptr<OnCells<D>>> at(names.size());
+  for (size_t v = 0; v < names.size(); ++v)
+    if (!fields[v].empty()) at[v] = std::make_unique<OnCells<D>>(fields[v], cells, width);
   constexpr size_t kMaxNames = 32;  // species (at most five) and five fluid fields
   if (names.size() > kMaxNames) throw std::logic_error("too many fields for output.vdb_density");
   Grid<float, D> out(cells, 0.0f);
@@ -84,17 +88,33 @@ std::vector<Grid<float, D>> density(const Simulation<D>& sim) {
   return {out};
 }
 
+// The shown field (output.field) and where each value lies in the frames'
+// range: (v - lo) / span.
+template <int D>
+struct Shown {
+  Grid<float, D> f;
+  FieldImageOptions io;
+  double lo = 0.0, span = 1.0;
+  double at(size_t i) const { return (double(f[i]) - lo) / span; }
+};
+
+template <int D>
+Shown<D> shown(const Simulation<D>& sim) {
+  const OutputSettings& o = sim.scene().output;
+  const std::string name = shownField(o, sim.species());
+  Shown<D> s{sim.field(name).front(), frameImageOptions(o, sim.symmetric(name))};
+  const std::array<double, 2> range = valueRange(s.f.data(), s.f.size(), s.io);
+  s.lo = range[0];
+  s.span = range[1] > range[0] ? range[1] - range[0] : 1.0;
+  return s;
+}
+
 template <int D>
 std::vector<Grid<float, D>> color(const Simulation<D>& sim) {
-  const OutputSettings& o = sim.scene().output;
-  const std::string shown = shownField(o, sim.species());
-  const Grid<float, D> f = sim.field(shown).front();
-  const FieldImageOptions io = frameImageOptions(o, sim.symmetric(shown));
-  const std::array<double, 2> range = valueRange(f.data(), f.size(), io);
-  const double span = range[1] > range[0] ? range[1] - range[0] : 1.0;
-  std::vector<Grid<float, D>> rgb(3, Grid<float, D>(f.dims(), 0.0f));
-  for (size_t i = 0; i < f.size(); ++i) {
-    const Rgb8 c = io.palette((double(f[i]) - range[0]) / span);
+  const Shown<D> s = shown(sim);
+  std::vector<Grid<float, D>> rgb(3, Grid<float, D>(s.f.dims(), 0.0f));
+  for (size_t i = 0; i < s.f.size(); ++i) {
+    const Rgb8 c = s.io.palette(s.at(i));
     for (int k = 0; k < 3; ++k) rgb[size_t(k)][i] = srgbToLinear(c[size_t(k)]);
   }
   return rgb;
@@ -102,13 +122,17 @@ std::vector<Grid<float, D>> color(const Simulation<D>& sim) {
 
 template <int D>
 std::vector<Grid<float, D>> height(const Simulation<D>& sim) {
-  const OutputSettings& o = sim.scene().output;
-  const std::string shown = shownField(o, sim.species());
-  Grid<float, D> h = sim.field(shown).front();
-  const std::array<double, 2> range = valueRange(h.data(), h.size(), frameImageOptions(o, sim.symmetric(shown)));
-  const double span = range[1] > range[0] ? range[1] - range[0] : 1.0;
-  for (float& v : h.values()) v = float(std::clamp((double(v) - range[0]) / span, 0.0, 1.0));
-  return {h};
+  Shown<D> s = shown(sim);
+  for (size_t i = 0; i < s.f.size(); ++i) s.f[i] = float(std::clamp(s.at(i), 0.0, 1.0));
+  return {std::move(s.f)};
+}
+
+// The cells of a grid of the scene's (its resolution per axis).
+template <int D>
+IVec<D> cellsOf(const std::vector<int>& resolution) {
+  IVec<D> c;
+  for (int a = 0; a < D; ++a) c[a] = resolution[size_t(a)];
+  return c;
 }
 
 template <int D>
@@ -129,8 +153,8 @@ std::vector<Grid<float, D>> derivedField(const Simulation<D>& sim, const std::st
   if (name == fields::kDensity) return density(sim);
   if (name == fields::kColor) return color(sim);
   if (name == fields::kHeight) return height(sim);
-  if (name == fields::kActive) return smokeMask(sim, sim.field(fields::kDye).front().dims());
-  if (name == fields::kActiveChemicals) return smokeMask(sim, sim.field(sim.species().front()).front().dims());
+  if (name == fields::kActive) return smokeMask(sim, cellsOf<D>(sim.scene().fluid.resolution));
+  if (name == fields::kActiveChemicals) return smokeMask(sim, cellsOf<D>(sim.scene().rd.settings.resolution));
   throw std::invalid_argument("no derived field '" + name + "'");
 }
 

@@ -32,9 +32,7 @@ void checkSceneInputs(const Scene& s) {
     if (s.dimension == 2) readFirstFrame<2>(s);
     else readFirstFrame<3>(s);
   } catch (const VelocityFileError& e) {
-    throw UserError(s.velocity.where, s.velocity.key, e.path() + ": " + e.what(),
-                    "give a sequence of .vdb files with a Vec3 grid 'vel' over the scene's domain, e.g. written by "
-                    "`morphoflow run` with output.vdb = true");
+    throw UserError(s.velocity.where, s.velocity.key, e.path() + ": " + e.what(), kVelocityFilesHint);
   }
 }
 
