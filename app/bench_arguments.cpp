@@ -19,6 +19,9 @@ CLI::App* addBenchSubcommand(CLI::App& app, BenchArguments* a, const std::string
   cmd->add_option("--json", bench.json, "also write results as JSON");
   cmd->add_option("--seconds", bench.minSeconds, "minimum timed seconds per case")->check(finiteIn(0.0, 3600.0));
   cmd->add_option("--backend", bench.backend, "cpu | gpu")->check(CLI::IsMember({"cpu", "gpu"}))->capture_default_str();
+  cmd->add_option("--precision", bench.precision, "gpu: float | double (a scene's gpu.precision)")
+      ->check(CLI::IsMember({"float", "double"}))
+      ->capture_default_str();
   cmd->add_option("--interpolation", bench.interpolation,
                   "coupling: the chemicals' sample, linear | cubic | bspline | bfecc")
       ->check(CLI::IsMember({"linear", "cubic", "bspline", "bfecc"}))

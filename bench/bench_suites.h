@@ -11,6 +11,7 @@ struct BenchOptions {
   double minSeconds = 1.0; // time each case for at least this long (after warm-up)
   std::string trace;       // coupling: write a Chrome trace of the stages here
   std::string backend = "cpu";  // cpu | gpu
+  std::string precision = "float";       // gpu: the solver vectors' and layer's, float | double (gpu.precision)
   std::string interpolation = "linear";  // coupling: the chemicals' back-trace sample (coupling_choices.h)
 };
 

@@ -8,6 +8,7 @@
 
 #include <fmt/format.h>
 
+#include "bench/bench_suites.h"
 #include "core/error.h"
 #include "gpu/gl_context.h"
 #include "gpu/gpu_newton_check.h"
@@ -25,7 +26,7 @@ inline double peakBandwidth(const std::string& renderer) {
 }
 
 // The context (exit 2 without one), after printing the device and its peak; returns the peak (0: unknown).
-inline double announceGpu() {
+inline double announceGpu(GpuPrecision real) {
   const GlContext* context = nullptr;
   try {
     context = &GlContext::instance();
@@ -36,11 +37,17 @@ inline double announceGpu() {
   std::cout << fmt::format(
       "gpu: {}, OpenGL {}; peak bandwidth {}\n", context->renderer(), context->version(),
       peak > 0 ? fmt::format("{:.0f} GB/s", peak) : std::string("unknown (set MORPHOFLOW_GPU_PEAK_GBS)"));
-  // The suites' Kim & Lin rows step Gray-Scott's Newton: say when this driver cannot (gpu/gpu_newton_check.h).
-  if (const std::string defect = gpuNewtonDefect("gray-scott"); !defect.empty())
-    std::cout << "warning: this driver does not run Kim & Lin's Newton in double precision (" << defect
+  std::cout << "precision: " << precisionName(real) << " (--precision)\n";
+  // The suites' Kim & Lin rows step Gray-Scott's Newton: say when this driver gets it wrong (gpu/gpu_newton_check.h).
+  if (const std::string defect = gpuNewtonDefect("gray-scott", real); !defect.empty())
+    std::cout << "warning: this driver computes Kim & Lin's Newton wrongly in " << precisionName(real) << " (" << defect
               << "): its kim-lin and coupling rows time a failing Newton\n";
   return peak;
+}
+
+// The GPU suites' precision (--precision; float unless double).
+inline GpuPrecision benchPrecision(const BenchOptions& o) {
+  return o.precision == "double" ? GpuPrecision::Double : GpuPrecision::Float;
 }
 
 inline std::string ofPeak(double gbs, double peak) {

@@ -53,9 +53,9 @@ Timed timeGpu(double minSeconds, Step&& step, After&& after) {
 }
 
 template <int D>
-nlohmann::json benchGpuFluid(int n, double minSeconds, double peak) {
+nlohmann::json benchGpuFluid(int n, double minSeconds, double peak, GpuPrecision real) {
   FluidSolver<D> host(benchCavity<D>(n));  // the constraints; never stepped
-  GpuFluid<D> gpu(host.settings(), host.constraints());
+  GpuFluid<D> gpu(host.settings(), host.constraints(), real);
   const double dt = host.h();
   for (int i = 0; i < kWarmup; ++i) gpu.step(dt);
   double pit = 0, vit = 0;
@@ -70,11 +70,19 @@ nlohmann::json benchGpuFluid(int n, double minSeconds, double peak) {
     for (int k = 0; k < FluidStepStats::kStages; ++k) stage[size_t(k)] += st.seconds[size_t(k)];
     ++steps;
   });
-  nlohmann::json j = {{"dim", D}, {"n", n}, {"backend", "gpu"}, {"steps", steps},
-                      {"ms_per_step_median", 1e3 * t.seconds}, {"steps_per_second", 1.0 / t.seconds},
-                      {"pressure_iterations_mean", pit / steps}, {"viscosity_iterations_mean", vit / steps},
-                      {"pressure_converged", converged}, {"gb_per_second", t.bytes / t.seconds * 1e-9},
-                      {"dispatches_per_step", t.dispatches}, {"host_waits_per_step", t.hostWaits}};
+  nlohmann::json j = {{"dim", D},
+                      {"n", n},
+                      {"backend", "gpu"},
+                      {"precision", precisionName(real)},
+                      {"steps", steps},
+                      {"ms_per_step_median", 1e3 * t.seconds},
+                      {"steps_per_second", 1.0 / t.seconds},
+                      {"pressure_iterations_mean", pit / steps},
+                      {"viscosity_iterations_mean", vit / steps},
+                      {"pressure_converged", converged},
+                      {"gb_per_second", t.bytes / t.seconds * 1e-9},
+                      {"dispatches_per_step", t.dispatches},
+                      {"host_waits_per_step", t.hostWaits}};
   for (int k = 0; k < FluidStepStats::kStages; ++k)
     j["ms_" + std::string(FluidStepStats::kStageNames[k])] = 1e3 * stage[size_t(k)] / steps;
   if (peak > 0) j["fraction_of_peak_bandwidth"] = j["gb_per_second"].get<double>() / peak;
@@ -82,8 +90,9 @@ nlohmann::json benchGpuFluid(int n, double minSeconds, double peak) {
 }
 
 template <int D>
-nlohmann::json benchGpuCoupling(int n, ChemicalInterpolation interpolation, double minSeconds, double peak) {
-  const nlohmann::json fluid = benchGpuFluid<D>(n, minSeconds, peak);
+nlohmann::json benchGpuCoupling(int n, ChemicalInterpolation interpolation, double minSeconds, double peak,
+                                GpuPrecision real) {
+  const nlohmann::json fluid = benchGpuFluid<D>(n, minSeconds, peak, real);
   FluidSolver<D> host(benchCavity<D>(n));
   RDSolver<D> rd(benchGrayScott<D>(n, 1.0 / n, RDIntegrator::KimLin), *findModel("gray-scott"));
   pearsonStart(&rd);
@@ -92,8 +101,8 @@ nlohmann::json benchGpuCoupling(int n, ChemicalInterpolation interpolation, doub
   ChemicalDomain<D> domain;
   domain.cells = rd.cells();
   domain.h = rd.h();
-  GpuFluid<D> gf(host.settings(), host.constraints());
-  GpuRDLayer<D> layer(layerUpload(rd));
+  GpuFluid<D> gf(host.settings(), host.constraints(), real);
+  GpuRDLayer<D> layer(layerUpload(rd), real);
   GpuARDSolver<D> ard(&layer, domain, interpolation, CouplingMode::ARD, rdScale, host.cells(), host.h());
   auto step = [&] {
     gf.step(dt);  // then the chemicals through the velocity it advected through
@@ -104,12 +113,20 @@ nlohmann::json benchGpuCoupling(int n, ChemicalInterpolation interpolation, doub
   const Timed t =
       timeGpu(minSeconds, step, [&] { ardSeconds.push_back(ard.stageSeconds()[0] + ard.stageSeconds()[1]); });
   const double alone = 1e-3 * fluid["ms_per_step_median"].get<double>();
-  nlohmann::json j = {{"dim", D}, {"n", n}, {"backend", "gpu"}, {"fluid_only_ms", 1e3 * alone},
-                      {"fluid_only_steps_per_second", 1.0 / alone}, {"ms", 1e3 * t.seconds},
-                      {"steps_per_second", 1.0 / t.seconds}, {"ard_part_ms", 1e3 * median(ardSeconds)},
+  nlohmann::json j = {{"dim", D},
+                      {"n", n},
+                      {"backend", "gpu"},
+                      {"precision", precisionName(real)},
+                      {"fluid_only_ms", 1e3 * alone},
+                      {"fluid_only_steps_per_second", 1.0 / alone},
+                      {"ms", 1e3 * t.seconds},
+                      {"steps_per_second", 1.0 / t.seconds},
+                      {"ard_part_ms", 1e3 * median(ardSeconds)},
                       {"interpolation", interpolationName(interpolation)},
-                      {"overhead", t.seconds / alone}, {"gb_per_second", t.bytes / t.seconds * 1e-9},
-                      {"dispatches_per_step", t.dispatches}, {"host_waits_per_step", t.hostWaits}};
+                      {"overhead", t.seconds / alone},
+                      {"gb_per_second", t.bytes / t.seconds * 1e-9},
+                      {"dispatches_per_step", t.dispatches},
+                      {"host_waits_per_step", t.hostWaits}};
   if (peak > 0) j["fraction_of_peak_bandwidth"] = j["gb_per_second"].get<double>() / peak;
   return j;
 }
@@ -117,14 +134,15 @@ nlohmann::json benchGpuCoupling(int n, ChemicalInterpolation interpolation, doub
 }  // namespace
 
 bool runGpuFluidBench(const BenchOptions& o) {
-  const double peak = announceGpu();
+  const GpuPrecision real = benchPrecision(o);
+  const double peak = announceGpu(real);
   std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>8} {:>7} {:>10} {:>7}\n",
                            "dim", "n", "backend", "ms/step(med)", "p-iters", "v-iters", "forces", "advect", "diffuse",
                            "project", "GB/s", "of peak", "dispatches", "waits");
   nlohmann::json all = nlohmann::json::array();
   for (BenchCase c : selectBenchCases(kCases, o.size)) {
     const nlohmann::json j =
-        c.dim == 2 ? benchGpuFluid<2>(c.n, o.minSeconds, peak) : benchGpuFluid<3>(c.n, o.minSeconds, peak);
+        c.dim == 2 ? benchGpuFluid<2>(c.n, o.minSeconds, peak, real) : benchGpuFluid<3>(c.n, o.minSeconds, peak, real);
     std::cout << fmt::format(
                      "{:>4} {:>6} {:>7} {:>12.3f} {:>8.1f} {:>8.1f} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.3f} {:>8.1f} {:>7} "
                      "{:>10.1f} {:>7.1f}{}\n",
@@ -143,7 +161,8 @@ bool runGpuFluidBench(const BenchOptions& o) {
 }
 
 bool runGpuCouplingBench(const BenchOptions& o) {
-  const double peak = announceGpu();
+  const GpuPrecision real = benchPrecision(o);
+  const double peak = announceGpu(real);
   const ChemicalInterpolation interpolation = interpolationNamed(o.interpolation);
   std::cout
       << "overhead = (fluid + ARD) / fluid only; targets: >= 1000 steps/s at 1024^2, >= 30 at 256^3, overhead <= 1.10; "
@@ -154,9 +173,8 @@ bool runGpuCouplingBench(const BenchOptions& o) {
                            "waits");
   nlohmann::json all = nlohmann::json::array();
   for (BenchCase c : selectBenchCases(kCases, o.size)) {
-    const nlohmann::json j =
-        c.dim == 2 ? benchGpuCoupling<2>(c.n, interpolation, o.minSeconds, peak)
-                   : benchGpuCoupling<3>(c.n, interpolation, o.minSeconds, peak);
+    const nlohmann::json j = c.dim == 2 ? benchGpuCoupling<2>(c.n, interpolation, o.minSeconds, peak, real)
+                                        : benchGpuCoupling<3>(c.n, interpolation, o.minSeconds, peak, real);
     std::cout << fmt::format(
                      "{:>4} {:>6} {:>10.1f} {:>10.1f} {:>10.3f} {:>10.3f} {:>9.2f} {:>8.1f} {:>7} {:>10.1f} {:>7.1f}\n",
                      c.dim, c.n, j["fluid_only_steps_per_second"].get<double>(), j["steps_per_second"].get<double>(),

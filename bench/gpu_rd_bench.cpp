@@ -60,11 +60,11 @@ nlohmann::json benchGpuRD(int n, double minSeconds) {
 }
 
 template <int D>
-nlohmann::json benchGpuKimLin(int n, double minSeconds) {
+nlohmann::json benchGpuKimLin(int n, double minSeconds, GpuPrecision real) {
   RDSolver<D> rd(benchGrayScott<D>(n, 1.0, RDIntegrator::KimLin), *findModel("gray-scott"));
   pearsonStart(&rd);
   const double dt = 10.0 * 0.9 * rd.explicitDiffusionLimit();
-  GpuRDLayer<D> gpu(layerUpload(rd));
+  GpuRDLayer<D> gpu(layerUpload(rd), real);
   gpu.step(dt);  // warm-up: the programs, the diffusion systems
   double diffusionIterations = 0;
   const double traffic0 = gpuTrafficBytes();
@@ -77,9 +77,16 @@ nlohmann::json benchGpuKimLin(int n, double minSeconds) {
   for (int a = 0; a < D; ++a) cells *= n;
   const double med = median(times), bytes = (gpuTrafficBytes() - traffic0) / double(times.size());
   const GpuCounts c = gpuCounts() - counts0;
-  return {{"dim", D}, {"n", n}, {"integrator", "kim-lin"}, {"backend", "gpu"}, {"dt", dt},
-          {"ms_per_step_median", 1e3 * med}, {"cell_updates_per_second", cells / med},
-          {"bytes_per_cell_update", bytes / cells}, {"gb_per_second", bytes / med * 1e-9},
+  return {{"dim", D},
+          {"n", n},
+          {"integrator", "kim-lin"},
+          {"backend", "gpu"},
+          {"precision", precisionName(real)},
+          {"dt", dt},
+          {"ms_per_step_median", 1e3 * med},
+          {"cell_updates_per_second", cells / med},
+          {"bytes_per_cell_update", bytes / cells},
+          {"gb_per_second", bytes / med * 1e-9},
           {"diffusion_iterations_mean", diffusionIterations / double(times.size())},
           {"dispatches_per_step", double(c.dispatches) / double(times.size())},
           {"host_waits_per_step", double(c.hostWaits) / double(times.size())}};
@@ -88,15 +95,16 @@ nlohmann::json benchGpuKimLin(int n, double minSeconds) {
 }  // namespace
 
 bool runGpuRDBench(const BenchOptions& o) {
-  const double peak = announceGpu();
+  const GpuPrecision real = benchPrecision(o);
+  const double peak = announceGpu(real);
   std::cout << fmt::format("{:>4} {:>6} {:>10} {:>12} {:>14} {:>9} {:>7} {:>10} {:>7}\n", "dim", "n", "integrator",
                            "ms/step(med)", "Mcell-updates/s", "GB/s", "of peak", "dispatches", "waits");
   nlohmann::json all = nlohmann::json::array();
   for (BenchCase c : selectBenchCases({{2, 256}, {2, 1024}, {2, 4096}, {3, 128}, {3, 256}}, o.size)) {
     for (bool implicit : {false, true}) {
-      nlohmann::json j =
-          implicit ? (c.dim == 2 ? benchGpuKimLin<2>(c.n, o.minSeconds) : benchGpuKimLin<3>(c.n, o.minSeconds))
-                   : (c.dim == 2 ? benchGpuRD<2>(c.n, o.minSeconds) : benchGpuRD<3>(c.n, o.minSeconds));
+      nlohmann::json j = implicit ? (c.dim == 2 ? benchGpuKimLin<2>(c.n, o.minSeconds, real)
+                                                : benchGpuKimLin<3>(c.n, o.minSeconds, real))
+                                  : (c.dim == 2 ? benchGpuRD<2>(c.n, o.minSeconds) : benchGpuRD<3>(c.n, o.minSeconds));
       const double gbs = j["gb_per_second"];
       if (peak > 0) j["fraction_of_peak_bandwidth"] = gbs / peak;
       std::cout << fmt::format("{:>4} {:>6} {:>10} {:>12.3f} {:>14.1f} {:>9.1f} {:>7} {:>10.1f} {:>7.1f}\n", c.dim, c.n,

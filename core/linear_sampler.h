@@ -59,20 +59,16 @@ inline float interpolate(const float* data, const size_t* s, const AxisTap* tap,
     const float* r0 = b + size_t(tap[1].lo) * s[1];
     const float* r1 = b + size_t(tap[1].hi) * s[1];
     float v00 = r0[0], v10 = r0[dx], v01 = r1[0], v11 = r1[dx];
-    float a0 = v00 + tx * (v10 - v00), a1 = v01 + tx * (v11 - v01);
     if (lo) {
       *lo = std::min(std::min(v00, v10), std::min(v01, v11));
       *hi = std::max(std::max(v00, v10), std::max(v01, v11));
     }
-    return a0 + tap[1].t * (a1 - a0);
+    return bilinear(v00, v10, v01, v11, tx, tap[1].t);
   } else {
     const size_t y0 = size_t(tap[1].lo) * s[1], y1 = size_t(tap[1].hi) * s[1];
     const size_t z0 = size_t(tap[2].lo) * s[2], z1 = size_t(tap[2].hi) * s[2];
     const float *r00 = b + y0 + z0, *r10 = b + y1 + z0, *r01 = b + y0 + z1, *r11 = b + y1 + z1;
     float v[8] = {r00[0], r00[dx], r10[0], r10[dx], r01[0], r01[dx], r11[0], r11[dx]};
-    float x00 = v[0] + tx * (v[1] - v[0]), x10 = v[2] + tx * (v[3] - v[2]);
-    float x01 = v[4] + tx * (v[5] - v[4]), x11 = v[6] + tx * (v[7] - v[6]);
-    float y0v = x00 + tap[1].t * (x10 - x00), y1v = x01 + tap[1].t * (x11 - x01);
     if (lo) {
       float mn = v[0], mx = v[0];
       for (int k = 1; k < 8; ++k) {
@@ -82,7 +78,7 @@ inline float interpolate(const float* data, const size_t* s, const AxisTap* tap,
       *lo = mn;
       *hi = mx;
     }
-    return y0v + tap[2].t * (y1v - y0v);
+    return trilinear(v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], tx, tap[1].t, tap[2].t);
   }
 }
 

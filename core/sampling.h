@@ -11,6 +11,7 @@
 #include <cmath>
 
 #include "core/grid.h"
+#include "core/multilinear.h"
 
 namespace morphoflow {
 
@@ -88,9 +89,7 @@ T interpolateStencil(const Grid<T, D>& g, const int* i0, const int* i1, const do
   if constexpr (D == 2) {
     T v00 = at(i0[0], i0[1], 0), v10 = at(i1[0], i0[1], 0);
     T v01 = at(i0[0], i1[1], 0), v11 = at(i1[0], i1[1], 0);
-    T a = v00 + T(t[0]) * (v10 - v00);
-    T b = v01 + T(t[0]) * (v11 - v01);
-    result = a + T(t[1]) * (b - a);
+    result = bilinear(v00, v10, v01, v11, T(t[0]), T(t[1]));
     if (lo) {
       mn = std::min({v00, v10, v01, v11});
       mx = std::max({v00, v10, v01, v11});
@@ -99,13 +98,7 @@ T interpolateStencil(const Grid<T, D>& g, const int* i0, const int* i1, const do
     T v[8];
     for (int k = 0; k < 8; ++k)
       v[k] = at((k & 1) ? i1[0] : i0[0], (k & 2) ? i1[1] : i0[1], (k & 4) ? i1[2] : i0[2]);
-    T x00 = v[0] + T(t[0]) * (v[1] - v[0]);
-    T x10 = v[2] + T(t[0]) * (v[3] - v[2]);
-    T x01 = v[4] + T(t[0]) * (v[5] - v[4]);
-    T x11 = v[6] + T(t[0]) * (v[7] - v[6]);
-    T y0 = x00 + T(t[1]) * (x10 - x00);
-    T y1 = x01 + T(t[1]) * (x11 - x01);
-    result = y0 + T(t[2]) * (y1 - y0);
+    result = trilinear(v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], T(t[0]), T(t[1]), T(t[2]));
     if (lo) {
       mn = *std::min_element(v, v + 8);
       mx = *std::max_element(v, v + 8);

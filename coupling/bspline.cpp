@@ -14,36 +14,16 @@ namespace {
 
 const double kPole = std::sqrt(3.0) - 2.0;
 
-// One line of n samples p[k * stride], in place: causal, then anti-causal.
-void prefilterLine(double* p, size_t stride, int n, bool periodic) {
-  if (n < 2) return;
-  const double z = kPole;
-  auto at = [&](int k) -> double& { return p[size_t(k) * stride]; };
-  // c+[0]: the causal filter's start, summed over the whole (mirrored or wrapped) line.
-  double zk = 1.0, sum = 0.0;
-  if (periodic) {
-    for (int k = 0; k < n; ++k, zk *= z) sum += zk * at((n - k) % n);
-    at(0) = sum / (1.0 - std::pow(z, n));
-  } else {
-    const double z2n = std::pow(z, 2 * n - 2);
-    for (int k = 0; k < n; ++k, zk *= z) sum += zk * at(k);
-    double back = 0.0, zb = std::pow(z, n);  // z^(2n-2-k) for k = n-2 .. 1
-    for (int k = n - 2; k >= 1; --k, zb *= z) back += zb * at(k);
-    at(0) = (sum + back) / (1.0 - z2n);
-  }
-  for (int k = 1; k < n; ++k) at(k) += z * at(k - 1);
-  // c-[n-1]: the anti-causal filter's start.
-  if (periodic) {
-    double s = 0.0;
-    zk = 1.0;
-    for (int k = 0; k < n; ++k, zk *= z) s += zk * at((n - 1 + k) % n);
-    at(n - 1) = -z * s / (1.0 - std::pow(z, n));
-  } else {
-    at(n - 1) = z / (z * z - 1.0) * (at(n - 1) + z * at(n - 2));
-  }
-  for (int k = n - 2; k >= 0; --k) at(k) = z * (at(k + 1) - at(k));
-  for (int k = 0; k < n; ++k) at(k) *= 6.0;
-}
+// One line of n samples p[k * stride], in place (kernels/bspline_prefilter.inc, shared with the GPU).
+#define BS_REAL double
+#define BS_LINE double *p, size_t stride
+#define BS_AT(k) p[size_t(k) * stride]
+#define PRECISE
+#include "kernels/bspline_prefilter.inc"
+#undef BS_REAL
+#undef BS_LINE
+#undef BS_AT
+#undef PRECISE
 
 // The four coefficient indices along an axis (mirrored at walls, wrapped on
 // periodic axes), the linear neighbours i0, i1, and the fraction t.
@@ -97,7 +77,8 @@ void bsplineCoefficients(const Grid<double, D>& f, const std::array<bool, D>& pe
         base += (rest % size_t(n[b])) * f.stride(b);
         rest /= size_t(n[b]);
       }
-      prefilterLine(c->data() + base, stride, n[a], periodic[size_t(a)]);
+      bsplinePrefilterLine(c->data() + base, stride, n[a], periodic[size_t(a)], kPole, std::pow(kPole, n[a]),
+                           std::pow(kPole, 2 * n[a] - 2));
     }, 16);
   }
 }

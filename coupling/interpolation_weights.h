@@ -6,8 +6,10 @@ namespace morphoflow {
 
 #define WEIGHTS4(name, t, w) inline void name(double t, double* w)
 #define PRECISE
+#define W_REAL double
 #include "kernels/interpolation.inc"
 #undef WEIGHTS4
 #undef PRECISE
+#undef W_REAL
 
 }  // namespace morphoflow

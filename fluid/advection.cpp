@@ -8,6 +8,7 @@
 #include <cstring>
 
 #include "core/linear_sampler.h"
+#include "core/multilinear.h"
 #include "core/parallel.h"
 #include "core/simd4.h"
 #include "core/simd_dispatch.h"
@@ -96,23 +97,19 @@ MF_INLINE V blendCorners(At&& at, size_t sy, size_t sz, const V* t, V* lo = null
   const V t0 = t[0], t1 = t[1];
   if constexpr (D == 2) {
     V v00 = at(0), v10 = at(1), v01 = at(sy), v11 = at(sy + 1);
-    V a0 = v00 + t0 * (v10 - v00), a1 = v01 + t0 * (v11 - v01);
     if (lo) {
       *lo = vmin(vmin(v00, v10), vmin(v01, v11));
       *hi = vmax(vmax(v00, v10), vmax(v01, v11));
     }
-    return a0 + t1 * (a1 - a0);
+    return bilinear(v00, v10, v01, v11, t0, t1);
   } else {
     V v0 = at(0), v1 = at(1), v2 = at(sy), v3 = at(sy + 1);
     V v4 = at(sz), v5 = at(sz + 1), v6 = at(sz + sy), v7 = at(sz + sy + 1);
-    V x00 = v0 + t0 * (v1 - v0), x10 = v2 + t0 * (v3 - v2);
-    V x01 = v4 + t0 * (v5 - v4), x11 = v6 + t0 * (v7 - v6);
-    V y0v = x00 + t1 * (x10 - x00), y1v = x01 + t1 * (x11 - x01);
     if (lo) {
       *lo = vmin(vmin(vmin(v0, v1), vmin(v2, v3)), vmin(vmin(v4, v5), vmin(v6, v7)));
       *hi = vmax(vmax(vmax(v0, v1), vmax(v2, v3)), vmax(vmax(v4, v5), vmax(v6, v7)));
     }
-    return y0v + t[2] * (y1v - y0v);
+    return trilinear(v0, v1, v2, v3, v4, v5, v6, v7, t0, t1, t[2]);
   }
 }
 

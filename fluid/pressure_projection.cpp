@@ -7,6 +7,15 @@
 
 namespace morphoflow {
 
+namespace {
+// kernels/pressure_projection.inc, shared with the GPU (kernels/README.md)
+#define PP_FN inline double
+#define PP_REAL double
+#include "kernels/pressure_projection.inc"
+#undef PP_FN
+#undef PP_REAL
+}  // namespace
+
 template <int D>
 LaplaceSystem<D> pressureSystem(const VelocityConstraints<D>& vc) {
   const IVec<D>& n = vc.cells;
@@ -87,7 +96,7 @@ void PressureProjection<D>::divergenceTimes(const MacVelocity<D>& u, double fact
     for (size_t x = 0; x < nx; ++x) {
       double d = 0.0;
       for (int a = 0; a < D; ++a)
-        d += double(openHi[a][x]) * double(hi[a][x]) - double(openLo[a][x]) * double(lo[a][x]);
+        d += ppAxisFlux(double(openHi[a][x]), double(hi[a][x]), double(openLo[a][x]), double(lo[a][x]));
       out[x] = active[x] == 0.0f ? 0.0 : d * factor;
     }
   });
@@ -111,7 +120,7 @@ SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double
     ratePrev_.resize(phi_.size());
     parallelFor(phi_.size(), [&](size_t i) {
       const double rate = phi_[i] * inv;
-      phi_[i] = dt * (extrapolate ? 2.0 * rate - double(ratePrev_[i]) : rate);
+      phi_[i] = ppWarmStart(rate, double(ratePrev_[i]), dt, extrapolate);
       ratePrev_[i] = float(rate);
     }, 4096);
   }
@@ -158,7 +167,7 @@ SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double
         pl = phi_[A_.diag.index(lo)];
         ph = phi_[A_.diag.index(hi)];
       }
-      g[i] = float(double(g[i]) - (ph - pl) * invH);
+      g[i] = float(ppProjectedFace(double(g[i]), pl, ph, invH));
     };
     // Rows of faces between two cells inside the domain take their cells'
     // phi from two rows of cells (one row shifted by one along x); the
@@ -188,7 +197,7 @@ SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double
       const uint8_t* fr = fixed.data() + base;
       const int x0 = a == 0 ? 1 : 0, x1 = n[0];
       for (int x = x0; x < x1; ++x)
-        if (!fr[x]) gr[x] = float(double(gr[x]) - (ph[x] - pl[x]) * invH);
+        if (!fr[x]) gr[x] = float(ppProjectedFace(double(gr[x]), pl[x], ph[x], invH));
       for (int x : {0, gd[0] - 1})
         if (x < x0 || x >= x1) {
           k[0] = x;

@@ -6,6 +6,8 @@
 //   decay      rho *= exp(-k dt), T - T_amb *= exp(-c dt)  (exact for the step)
 #pragma once
 
+#include <cmath>
+
 #include <vector>
 
 #include "core/grid.h"
@@ -18,8 +20,14 @@ namespace morphoflow {
 
 // The per-cell formulas, shared with the GPU (kernels/README.md).
 #define SMOKE_FN(name) inline double name
+#define SMOKE_F(name) inline float name
+#define SMOKE_REAL double
+#define SMOKE_SQRT std::sqrt
 #include "kernels/smoke_physics.inc"
 #undef SMOKE_FN
+#undef SMOKE_F
+#undef SMOKE_REAL
+#undef SMOKE_SQRT
 
 // A source's covered fraction of every cell (4^D samples a cell), solid
 // cells excluded, with its region centred where its motion puts it at time

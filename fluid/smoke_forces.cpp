@@ -73,14 +73,14 @@ struct CurlRow {
   float *w[W], *mag;
 };
 
-MF_INLINE float centre(const float* p, size_t up, int x) { return 0.5f * (p[x] + p[size_t(x) + up]); }
+MF_INLINE float centre(const float* p, size_t up, int x) { return faceMean(p[x], p[size_t(x) + up]); }
 
 template <int D>
 MF_INLINE void curlCell(const CurlRow<D>& r, int x, int xl, int xh, double denx) {
   // d u_c / d x_axis by central differences (one-sided at walls)
   auto d = [&](int c, int axis) {
-    if (axis == 0) return (double(centre(r.u[c][0], r.up[c], xh)) - centre(r.u[c][0], r.up[c], xl)) / denx;
-    return (double(centre(r.u[c][2 * axis], r.up[c], x)) - centre(r.u[c][2 * axis - 1], r.up[c], x)) / r.den[axis];
+    if (axis == 0) return smokeDifference(centre(r.u[c][0], r.up[c], xl), centre(r.u[c][0], r.up[c], xh), denx);
+    return smokeDifference(centre(r.u[c][2 * axis - 1], r.up[c], x), centre(r.u[c][2 * axis], r.up[c], x), r.den[axis]);
   };
   if constexpr (D == 2) {
     const double o = d(1, 0) - d(0, 1);
@@ -89,7 +89,7 @@ MF_INLINE void curlCell(const CurlRow<D>& r, int x, int xl, int xh, double denx)
   } else {
     const double o0 = d(2, 1) - d(1, 2), o1 = d(0, 2) - d(2, 0), o2 = d(1, 0) - d(0, 1);
     r.w[0][x] = float(o0), r.w[1][x] = float(o1), r.w[2][x] = float(o2);
-    r.mag[x] = float(std::sqrt(o0 * o0 + o1 * o1 + o2 * o2));
+    r.mag[x] = float(vectorLength(o0, o1, o2));
   }
 }
 
@@ -120,10 +120,10 @@ MF_INLINE void forceCell(const ForceRow<D>& r, int x, int xl, int xh, double den
   for (int a = 0; a < D; ++a) f[a] = float(b * r.up[a]);
   if constexpr (Confine) {
     double eta[3] = {0, 0, 0}, len2 = 0;
-    eta[0] = (double(r.mag[0][xh]) - r.mag[0][xl]) / denx;
-    for (int a = 1; a < D; ++a) eta[a] = (double(r.mag[2 * a][x]) - r.mag[2 * a - 1][x]) / r.den[a];
+    eta[0] = smokeDifference(r.mag[0][xl], r.mag[0][xh], denx);
+    for (int a = 1; a < D; ++a) eta[a] = smokeDifference(r.mag[2 * a - 1][x], r.mag[2 * a][x], r.den[a]);
     for (int a = 0; a < D; ++a) len2 += eta[a] * eta[a];
-    const double inv = 1.0 / std::sqrt(len2);
+    const double inv = inverseLength(len2);
     const double N[3] = {eta[0] * inv, eta[1] * inv, eta[2] * inv};
     float g[D];
     if constexpr (D == 2) {
@@ -261,15 +261,15 @@ void addToFaces(const std::array<Grid<float, D>, D>& f, double dt, MacVelocity<D
       float* out = g.values().data() + row * size_t(g.dims()[0]);
       if (a == 0) {
         const float* c = fa + rowStart<D>(n, k);
-        for (int x = 1; x < n[0]; ++x) out[x] += half * (c[x - 1] + c[x]);
-        out[0] += half * (c[below(0)] + c[0]);
-        out[n[0]] += half * (c[n[0] - 1] + c[above(n[0])]);
+        for (int x = 1; x < n[0]; ++x) out[x] += faceForce(half, c[x - 1], c[x]);
+        out[0] += faceForce(half, c[below(0)], c[0]);
+        out[n[0]] += faceForce(half, c[n[0] - 1], c[above(n[0])]);
         return;
       }
       IVec<D> lo = k, hi = k;
       lo[a] = below(k[a]), hi[a] = above(k[a]);
       const float *cl = fa + rowStart<D>(n, lo), *ch = fa + rowStart<D>(n, hi);
-      for (int x = 0; x < n[0]; ++x) out[x] += half * (cl[x] + ch[x]);
+      for (int x = 0; x < n[0]; ++x) out[x] += faceForce(half, cl[x], ch[x]);
     });
   }
 }

@@ -50,4 +50,17 @@ void ComputeProgram::use() const { glUseProgram(id_); }
 
 int ComputeProgram::uniform(const char* name) const { return glGetUniformLocation(id_, name); }
 
+bool ComputeProgram::singlePrecision(const char* name) const {
+  auto it = single_.find(name);
+  if (it != single_.end()) return it->second;
+  const GLuint index = glGetProgramResourceIndex(id_, GL_UNIFORM, name);
+  GLint type = 0;
+  if (index != GL_INVALID_INDEX) {
+    const GLenum property = GL_TYPE;
+    glGetProgramResourceiv(id_, GL_UNIFORM, index, 1, &property, 1, nullptr, &type);
+  }
+  const bool single = type == GL_FLOAT || type == GL_FLOAT_VEC2 || type == GL_FLOAT_VEC3 || type == GL_FLOAT_VEC4;
+  return single_.emplace(name, single).first->second;
+}
+
 }  // namespace morphoflow

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <functional>
+#include <map>
 #include <string>
 
 namespace morphoflow {
@@ -18,10 +19,14 @@ class ComputeProgram {
 
   void use() const;
   int uniform(const char* name) const;  // its location (-1 when the compiler removed it)
+  // Whether the uniform is declared in single precision (float, vecN; REAL
+  // in float); false for double ones and those the compiler removed.
+  bool singlePrecision(const char* name) const;
   unsigned id() const { return id_; }
 
  private:
   unsigned id_ = 0;
+  mutable std::map<std::string, bool> single_;
 };
 
 }  // namespace morphoflow

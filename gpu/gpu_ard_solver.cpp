@@ -9,6 +9,7 @@
 #include "coupling/ard_step.h"
 #include "gpu/compute_program.h"
 #include "gpu/gpu_programs.h"
+#include "gpu/gpu_reals.h"
 #include "gpu/gpu_stage_timer.h"
 
 namespace morphoflow {
@@ -34,8 +35,8 @@ GpuARDSolver<D>::GpuARDSolver(GpuRDLayer<D>* layer, const ChemicalDomain<D>& dom
   hasSolids_ = !domain.solid.empty();
   solid_ = GpuBuffer::of(hasSolids_ ? std::vector<uint32_t>(domain.solid.begin(), domain.solid.end())
                                     : std::vector<uint32_t>{0});
-  for (GpuBuffer& b : scratch_) b = GpuBuffer(layer->cells() * sizeof(double));
-  for (GpuBuffer& b : coefficients_) b = GpuBuffer((spline_ || bfecc_ ? layer->cells() : 1) * sizeof(double));
+  for (GpuBuffer& b : scratch_) b = realBuffer(layer->cells(), layer->precision());
+  for (GpuBuffer& b : coefficients_) b = realBuffer(spline_ || bfecc_ ? layer->cells() : 1, layer->precision());
   if (mode_ != CouplingMode::RDOnly) emptySolids();
   timer_ = std::make_unique<GpuStageTimer>(ARDSolver<D>::kStages);
 }
@@ -43,14 +44,16 @@ GpuARDSolver<D>::GpuARDSolver(GpuRDLayer<D>* layer, const ChemicalDomain<D>& dom
 template <int D>
 void GpuARDSolver<D>::emptySolids() {
   if (!hasSolids_) return;
-  const ComputeProgram& p = useProgram("chem_advect.comp", fmt::format("#define DIM {}\n#define MODE_SOLIDS", D));
+  const ComputeProgram& p =
+      useProgram("chem_advect.comp", fmt::format("#define DIM {}\n#define MODE_SOLIDS", D), layer_->precision());
   setUniform(p, "rdCells", rdCells_);
   auto value = [&](size_t s) { return s < domain_.solidValues.size() ? domain_.solidValues[s] : 0.0; };
-  glUniform2d(p.uniform("solidValue"), value(0), value(1));
+  const std::array<double, 2> solid{value(0), value(1)};
+  setUniformDoubles(p, "solidValue", solid.data(), 1, 2);
   layer_->field(0).bind(3);
   layer_->field(1).bind(4);
   solid_.bind(5);
-  dispatchFlat(layer_->cells(), 4.0 + 16.0);  // the mask, both species written
+  dispatchFlat(layer_->cells(), 4.0 + 2.0 * double(realBytes(layer_->precision())));  // the mask, both species written
   storageBarrier();
 }
 
@@ -60,11 +63,11 @@ template <int D>
 void GpuARDSolver<D>::prefilter() {
   const double z = std::sqrt(3.0) - 2.0;
   for (int s = 0; s < 2; ++s) {
-    coefficients_[size_t(s)].copyFrom(layer_->field(s), layer_->cells() * sizeof(double));
+    coefficients_[size_t(s)].copyFrom(layer_->field(s), layer_->cells() * realBytes(layer_->precision()));
     for (int a = 0; a < D; ++a) {
       const int n = rdCells_[size_t(a)];
       const ComputeProgram& p =
-          useProgram("chem_advect.comp", fmt::format("#define DIM {}\n#define MODE_PREFILTER", D));
+          useProgram("chem_advect.comp", fmt::format("#define DIM {}\n#define MODE_PREFILTER", D), layer_->precision());
       setUniform(p, "rdCells", rdCells_);
       setUniform(p, "periodic", periodic_);
       setUniform(p, "axis", a);
@@ -74,7 +77,8 @@ void GpuARDSolver<D>::prefilter() {
       setUniform(p, "zn", std::pow(z, n));
       setUniform(p, "z2n", std::pow(z, 2 * n - 2));
       coefficients_[size_t(s)].bind(3);
-      dispatchFlat(size_t(lines), 4.0 * 8.0 * n);  // each line read and written twice
+      dispatchFlat(size_t(lines),
+                   4.0 * double(realBytes(layer_->precision())) * n);  // each line read and written twice
       storageBarrier();
     }
   }
@@ -85,7 +89,8 @@ void GpuARDSolver<D>::prefilter() {
 // (reading the backward step from coefficients_).
 template <int D>
 void GpuARDSolver<D>::advectPass(double dt, const GpuFluid<D>& fluid, Pair from, Pair into, bool correct) {
-  const ComputeProgram& p = useProgram("chem_advect.comp", fmt::format("#define DIM {}\n#define MODE_ADVECT", D));
+  const ComputeProgram& p =
+      useProgram("chem_advect.comp", fmt::format("#define DIM {}\n#define MODE_ADVECT", D), layer_->precision());
   setUniform(p, "cells", fluidCells_);
   setUniform(p, "periodic", periodic_);
   setUniform(p, "velOff",
@@ -103,7 +108,8 @@ void GpuARDSolver<D>::advectPass(double dt, const GpuFluid<D>& fluid, Pair from,
   const bool inflow = !domain_.inflowValues.empty();
   setUniform(p, "inflow", inflow ? 1 : 0);
   auto in = [&](size_t s) { return inflow && s < domain_.inflowValues.size() ? domain_.inflowValues[s] : 0.0; };
-  glUniform2d(p.uniform("inValue"), in(0), in(1));
+  const std::array<double, 2> inValue{in(0), in(1)};
+  setUniformDoubles(p, "inValue", inValue.data(), 1, 2);
   setUniform(p, "cubic", cubic_ ? 1 : 0);
   setUniform(p, "spline", spline_ ? 1 : 0);
   setUniform(p, "bfecc", correct ? 1 : 0);
@@ -116,7 +122,7 @@ void GpuARDSolver<D>::advectPass(double dt, const GpuFluid<D>& fluid, Pair from,
   into[1]->bind(4);
   solid_.bind(5);
   // both species read and written, the velocity once (the fluid's grid, here per chemical cell at most)
-  dispatchFlat(layer_->cells(), (correct ? 48.0 : 32.0) + 4.0 * D);
+  dispatchFlat(layer_->cells(), (correct ? 6 : 4) * double(realBytes(layer_->precision())) + 4.0 * D);
   storageBarrier();
 }
 

@@ -1,5 +1,6 @@
 #include "gpu/gpu_buffer.h"
 
+#include <algorithm>
 #include <utility>
 
 #include <epoxy/gl.h>
@@ -9,12 +10,21 @@
 
 namespace morphoflow {
 
+namespace {
+size_t live = 0, peak = 0;
+}  // namespace
+
+size_t GpuBuffer::liveBytes() { return live; }
+size_t GpuBuffer::peakBytes() { return peak; }
+
 GpuBuffer::GpuBuffer(size_t bytes, const void* data) : bytes_(bytes) {
   GlContext::instance();  // every GPU object starts with a buffer: the context exists from here
   glCreateBuffers(1, &id_);
   // At least one word: GL refuses empty storage.
   glNamedBufferStorage(id_, GLsizeiptr(bytes ? bytes : 4), data, GL_DYNAMIC_STORAGE_BIT);
   GlContext::check("allocating a GPU buffer");
+  live += bytes_;
+  peak = std::max(peak, live);
 }
 
 GpuBuffer& GpuBuffer::operator=(GpuBuffer&& o) noexcept {
@@ -24,7 +34,9 @@ GpuBuffer& GpuBuffer::operator=(GpuBuffer&& o) noexcept {
 }
 
 GpuBuffer::~GpuBuffer() {
-  if (id_) glDeleteBuffers(1, &id_);
+  if (!id_) return;
+  glDeleteBuffers(1, &id_);
+  live -= bytes_;
 }
 
 void GpuBuffer::upload(const void* data, size_t bytes, size_t offset) {

@@ -38,6 +38,9 @@ class GpuBuffer {
   void copyFrom(const GpuBuffer& src, size_t bytes, size_t srcOffset = 0, size_t dstOffset = 0);
   void bind(int binding) const;
   size_t bytes() const { return bytes_; }
+  // The bytes of every buffer alive now, and at most so far, in this process (run.json's gpu.device_bytes).
+  static size_t liveBytes();
+  static size_t peakBytes();
   unsigned id() const { return id_; }
 
  private:

@@ -9,15 +9,16 @@
 #include "gpu/compute_program.h"
 #include "gpu/gl_context.h"
 #include "gpu/gpu_programs.h"
+#include "gpu/gpu_reals.h"
 
 namespace morphoflow {
 
 template <int D>
 GpuCoupledStepper<D>::GpuCoupledStepper(const FluidSolver<D>& fluid, const RDSolver<D>& rd,
                                         const ChemicalDomain<D>& domain, ChemicalInterpolation interpolation,
-                                        CouplingMode mode, double rdTimeScale)
-    : fluid_(fluid.settings(), fluid.constraints()),
-      layer_(layerUpload(rd)),
+                                        CouplingMode mode, double rdTimeScale, GpuPrecision real)
+    : fluid_(fluid.settings(), fluid.constraints(), real),
+      layer_(layerUpload(rd), real),
       ard_(&layer_, domain, interpolation, mode, rdTimeScale, fluid.cells(), fluid.h()),
       none_(sizeof(int)) {
   fluid_.fromHost(fluid);
@@ -72,6 +73,11 @@ void GpuCoupledStepper<D>::report(nlohmann::json* run) const {
   nlohmann::json g = counts_.perStep();
   g["stages"] = fluid_.stageTimer().countsPerStep(FluidStepStats::kStageNames);
   g["stages"].update(ard_.stageTimer().countsPerStep(ARDSolver<D>::kStageNames));
+  g["precision"] = precisionName(layer_.precision());
+  g["device_bytes"] = {
+      {"fluid", fluid_.deviceBytes()}, {"layer", layer_.deviceBytes()}, {"allocated_peak", GpuBuffer::peakBytes()}};
+  g["tolerances"] = fluid_.tolerances();
+  g["tolerances"]["rd"] = layer_.tolerance();
   (*run)["gpu"] = g;
 }
 
@@ -82,18 +88,19 @@ void GpuCoupledStepper<D>::layerKernel(bool blend, const GpuBuffer& cover, const
   const int ns = layer_.species();
   const ComputeProgram& p = useProgram(
       "smoke_layer.comp",
-      fmt::format("#define DIM {}\n#define NSPECIES {}\n#define {}", D, ns, blend ? "MODE_BLEND" : "MODE_MASK"));
+      fmt::format("#define DIM {}\n#define NSPECIES {}\n#define {}", D, ns, blend ? "MODE_BLEND" : "MODE_MASK"),
+      layer_.precision());
   setUniform(p, "n", int(layer_.cells()));
   setUniform(p, "rdCells", rdCells_);
   setUniform(p, "cells", fluidCells_);
   setUniform(p, "tapOff", tapOff_);
-  glUniform1dv(p.uniform("values"), ns, values.data());
+  setUniformDoubles(p, "values", values.data(), ns);
   setUniform(p, "threshold", threshold);
   for (int s = 0; s < ns; ++s) layer_.field(s).bind(s);
   cover.bind(8);
   fluid_.dye().bind(9);
   (taps_.bytes() ? taps_ : none_).bind(10);
-  dispatchFlat(layer_.cells(), 16.0 * ns + 4.0 * (blend ? 1 : 1 << D));
+  dispatchFlat(layer_.cells(), 2.0 * double(realBytes(layer_.precision())) * ns + 4.0 * (blend ? 1 : 1 << D));
   storageBarrier();
 }
 

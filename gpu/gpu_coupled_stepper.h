@@ -21,7 +21,7 @@ class GpuCoupledStepper final : public CoupledStepper<D> {
  public:
   // From the hosts' current state; `rd` must outlive this (gpu_rd_layer.h).
   GpuCoupledStepper(const FluidSolver<D>& fluid, const RDSolver<D>& rd, const ChemicalDomain<D>& domain,
-                  ChemicalInterpolation interpolation, CouplingMode mode, double rdTimeScale);
+                    ChemicalInterpolation interpolation, CouplingMode mode, double rdTimeScale, GpuPrecision real);
 
   void step(double dt) override;
   const FluidStepper<D>& fluid() const override { return fluid_; }

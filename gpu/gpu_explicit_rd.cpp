@@ -28,7 +28,7 @@ GpuExplicitRD::GpuExplicitRD(const RDSettings& s, const std::vector<double>& dif
   for (size_t k = 0; k < params.size() && k < params_.size(); ++k) params_[k] = float(params[k]);
   periodic_ = s.boundary == RDBoundary::Periodic;
   for (int k : clamped) clamped_ |= 1u << k;
-  const std::string reaction = gpuReaction(s.model);
+  const std::string reaction = gpuReaction(s.model, GpuPrecision::Float);
   program_ = std::make_unique<ComputeProgram>(
       "rd_explicit.comp", fmt::format("#define DIM {}\n{}\nlayout(local_size_x = {}, local_size_y = {}, "
                                       "local_size_z = {}) in;",

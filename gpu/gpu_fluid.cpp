@@ -16,6 +16,7 @@
 #include "gpu/gpu_multigrid.h"
 #include "gpu/gpu_pcg.h"
 #include "gpu/gpu_programs.h"
+#include "gpu/gpu_reals.h"
 #include "gpu/gpu_reduction.h"
 #include "gpu/gpu_stage_timer.h"
 #include "gpu/kernel_modes.h"
@@ -32,6 +33,11 @@ struct GpuFluid<D>::Viscous {
 };
 
 namespace {
+// The pressure's phi: double in either precision. Its float rounding alone
+// leaves a relative residual of eps_float times the system's condition
+// (4.5e-4 in the 220 x 41 channel), while the solve's other vectors in float
+// still reach 1e-6 (docs/gpu.md, "Precision").
+constexpr GpuPrecision kPhi = GpuPrecision::Double;
 std::string dimDefine(int D, FluidOp mode) { return fmt::format("#define DIM {}\n#define {}", D, define(mode)); }
 }  // namespace
 
@@ -48,7 +54,10 @@ size_t GpuFluid<D>::faces(int a) const {
 }
 
 template <int D>
-GpuFluid<D>::GpuFluid(const FluidSettings& s, const VelocityConstraints<D>& vc) : settings_(s), h_(vc.h) {
+GpuFluid<D>::GpuFluid(const FluidSettings& s, const VelocityConstraints<D>& vc, GpuPrecision real)
+    : settings_(s), real_(real), h_(vc.h) {
+  for (double* tol : {&settings_.pressureTolerance, &settings_.viscosityTolerance})
+    *tol = std::max(*tol, toleranceFloor(real));
   cellCount_ = 1;
   for (int a = 0; a < D; ++a) {
     cells_[size_t(a)] = vc.cells[a];
@@ -66,7 +75,7 @@ GpuFluid<D>::GpuFluid(const FluidSettings& s, const VelocityConstraints<D>& vc) 
     value.insert(value.end(), v.begin(), v.end());
     open.insert(open.end(), o.begin(), o.end());
   }
-  open_ = GpuBuffer::of(open);
+  open_ = vc.cut.empty() ? GpuBuffer(sizeof(float)) : GpuBuffer::of(open);  // (read for cut obstacles only)
   vel_ = GpuBuffer(faceCount_ * sizeof(float));
   velScratch_ = GpuBuffer(faceCount_ * sizeof(float));
   vel_.zero();
@@ -85,24 +94,30 @@ GpuFluid<D>::GpuFluid(const FluidSettings& s, const VelocityConstraints<D>& vc) 
   for (size_t i = 0; i < diag.size(); ++i) inactive[i] = diag[i] == 0.0f ? 1u : 0u;
   inactive_ = GpuBuffer::of(inactive);
   pressure_ = std::make_unique<GpuLaplace>(P);
+  pressure_->setPrecision(real_, kPhi);
   multigrid_ = std::make_unique<GpuMultigrid>(Multigrid<D>(P), *pressure_, MultigridOptions{});
-  pressurePcg_ = std::make_unique<GpuPcg>(*pressure_);
-  for (GpuBuffer* b : {&phi_, &rhs_, &ratePrev_}) *b = GpuBuffer(cellCount_ * sizeof(double));
-  phi_.zero();
+  rhs_ = realBuffer(cellCount_, real_);
+  ratePrev_ = realBuffer(cellCount_, GpuPrecision::Float);  // (float, as the CPU keeps it)
+  phi_ = realBuffer(cellCount_, kPhi);
   std::vector<const LaplaceSystem<D>*> blocks;
   for (int a = 0; a < D; ++a) {
     auto v = std::make_unique<Viscous>();
     v->host = viscousSystem<D>(vc, a);
     v->host.setRate(1.0);
-    const std::vector<float> rhs = v->host.boundaryRhs.expanded();  // the shader reads doubles
-    v->boundaryRhs = GpuBuffer::of(std::vector<double>(rhs.begin(), rhs.end()));
+    const std::vector<float> rhs = v->host.boundaryRhs.expanded();  // (the shader reads reals)
+    v->boundaryRhs = realBuffer(rhs.size(), real_);
+    uploadReals(&v->boundaryRhs, std::vector<double>(rhs.begin(), rhs.end()), real_);
     blocks.push_back(&v->host.A);
     viscous_[size_t(a)] = std::move(v);
   }
   viscousA_ = std::make_unique<GpuLaplace>(blocks);
-  viscousPcg_ = std::make_unique<GpuPcg>(*viscousA_);
-  viscousB_ = GpuBuffer(viscousA_->size() * sizeof(double));
-  viscousX_ = GpuBuffer(viscousA_->size() * sizeof(double));
+  viscousA_->setPrecision(real_);
+  // the pressure's and the viscosity's solves (never at once) share their work vectors
+  auto work = std::make_shared<GpuPcgWork>(std::max(cellCount_, viscousA_->size()), real_);
+  pressurePcg_ = std::make_unique<GpuPcg>(*pressure_, work);
+  viscousPcg_ = std::make_unique<GpuPcg>(*viscousA_, work);
+  viscousB_ = realBuffer(viscousA_->size(), real_);
+  viscousX_ = realBuffer(viscousA_->size(), real_);
   if (!vc.cut.empty()) {  // the viscosity holds the faces inside cut obstacles too
     std::vector<uint32_t> held(fixed);
     for (int a = 0; a < D; ++a) {
@@ -128,7 +143,7 @@ GpuFluid<D>::GpuFluid(const FluidSettings& s, const VelocityConstraints<D>& vc) 
 }
 
 template <int D>
-size_t GpuFluid<D>::deviceBytes(const IVec<D>& cells) {
+size_t GpuFluid<D>::deviceBytes(const IVec<D>& cells, GpuPrecision real) {
   size_t c = 1, f = 0, g = 0;
   for (int a = 0; a < D; ++a) c *= size_t(cells[a]);
   for (int a = 0; a < D; ++a) {
@@ -138,14 +153,23 @@ size_t GpuFluid<D>::deviceBytes(const IVec<D>& cells) {
   }
   const double system = (D + 1) * 4.0;       // face weights and diagonal, float
   const double coarse = 1.0 / ((1 << D) - 1);  // the multigrid levels below the fine one, relative to it
+  const double r = double(realBytes(real)), phi = double(realBytes(kPhi));
   const double bytes =
-      4.0 * 6 * double(f)  // u, its scratch, fixed flags, prescribed values, open fractions, held flags
+      4.0 * 6 *
+          double(f)  // u, its scratch, fixed flags, prescribed values; a cut obstacle's open fractions, held flags
       + 4.0 * 4 * double(c) +
       4.0 * 4 * double(g)  // dye, its scratch, solid, inactive; the schemes' scratch
-      // pressure: system, phi, rhs, rate; PCG vectors; each level's x and b
-      + double(c) * (system + 3 * 8 + 5 * 8 + 2 * 4 + coarse * (system + 2 * 4)) +
-      double(f) * (system + 3 * 8 + 5 * 8);  // viscosity: system, b, x, rhs, PCG vectors
+      // pressure: system, phi, rhs, rate (float); each level's x and b
+      + double(c) * (system + phi + r + 4 + 2 * 4 + coarse * (system + 2 * 4)) +
+      double(f) * (system + 3 * r + 5 * r);  // viscosity: system, b, x, rhs; the PCG vectors (the pressure's too)
   return size_t(bytes);
+}
+
+template <int D>
+size_t GpuFluid<D>::deviceBytes() const {
+  IVec<D> cells;
+  for (int a = 0; a < D; ++a) cells[a] = cells_[size_t(a)];
+  return deviceBytes(cells, real_);
 }
 
 template <int D>
@@ -177,7 +201,7 @@ void GpuFluid<D>::applyConstraints(const GpuBuffer& vel) {
   for (FluidOp mode : {FluidOp::Fixed, FluidOp::Periodic})
     for (int a = 0; a < D; ++a) {
       if (mode == FluidOp::Periodic && !periodic_[size_t(a)]) continue;
-      const ComputeProgram& p = useProgram(shader(mode), dimDefine(D, mode));
+      const ComputeProgram& p = useProgram(shader(mode), dimDefine(D, mode), real_, kPhi);
       setUniform(p, "cells", cells_);
       setUniform(p, "axis", a);
       setUniform(p, "n", int(faces(a)));
@@ -196,7 +220,7 @@ void GpuFluid<D>::forces(double dt) {
     const float f = float(dt * settings_.force[size_t(a)]);
     const float b = dyeActive_ ? float(dt * settings_.buoyancy * settings_.buoyancyDirection[size_t(a)]) : 0.0f;
     if (f == 0.0f && b == 0.0f) continue;
-    const ComputeProgram& p = useProgram(shader(FluidOp::Forces), dimDefine(D, FluidOp::Forces));
+    const ComputeProgram& p = useProgram(shader(FluidOp::Forces), dimDefine(D, FluidOp::Forces), real_, kPhi);
     setUniform(p, "cells", cells_);
     setUniform(p, "axis", a);
     setUniform(p, "n", int(faces(a)));
@@ -213,7 +237,7 @@ void GpuFluid<D>::forces(double dt) {
 template <int D>
 void GpuFluid<D>::runSmoke(SmokeOp mode, size_t n, int axis,
                            const std::function<void(const ComputeProgram&)>& uniforms) {
-  const ComputeProgram& p = useProgram("smoke.comp", fmt::format("#define DIM {}\n#define {}", D, define(mode)));
+  const ComputeProgram& p = useProgram("smoke.comp", fmt::format("#define DIM {}\n#define {}", D, define(mode)), real_);
   setUniform(p, "cells", cells_);
   setUniform(p, "periodic", periodic_);
   setUniform(p, "velOff", velocityOffsets());
@@ -268,8 +292,7 @@ void GpuFluid<D>::smokeForces(double dt) {
       setUniform(p, "alpha", sm.weight);
       setUniform(p, "beta", sm.heat);
       setUniform(p, "ambient", sm.ambient);
-      glUniform3d(p.uniform("up"), settings_.buoyancyDirection[0], settings_.buoyancyDirection[1],
-                  settings_.buoyancyDirection[2]);
+      setUniformDoubles(p, "up", settings_.buoyancyDirection.data(), 1, 3);
     });
   if (sm.vorticity != 0.0) {
     auto hs = [&](const ComputeProgram& p) {
@@ -321,7 +344,7 @@ void GpuFluid<D>::advectField(const GpuBuffer& src, size_t srcOff, const std::ar
   };
   auto combine = [&](FluidOp mode, const GpuBuffer& f0, size_t f0Off, const GpuBuffer& f1, size_t f1Off,
                      const GpuBuffer& f2, const GpuBuffer& f3, const GpuBuffer& f4) {
-    const ComputeProgram& p = useProgram(shader(mode), dimDefine(D, mode));
+    const ComputeProgram& p = useProgram(shader(mode), dimDefine(D, mode), real_, kPhi);
     setUniform(p, "n", int(n));
     setUniform(p, "dstOff", int(f0Off));
     setUniform(p, "f1Off", int(f1Off));
@@ -382,7 +405,7 @@ void GpuFluid<D>::injectInflowDye() {
   for (int a = 0; a < D; ++a)
     for (bool high : {false, true}) {
       if (settings_.inflowDyeStripes <= 0 || settings_.boundaries.side(a, high).kind != BoundaryKind::Inflow) continue;
-      const ComputeProgram& p = useProgram(shader(FluidOp::InflowDye), dimDefine(D, FluidOp::InflowDye));
+      const ComputeProgram& p = useProgram(shader(FluidOp::InflowDye), dimDefine(D, FluidOp::InflowDye), real_, kPhi);
       setUniform(p, "cells", cells_);
       setUniform(p, "n", int(cellCount_));
       setUniform(p, "inflow", std::array<int, 4>{a, high ? 1 : 0, a == 0 ? 1 : 0, settings_.inflowDyeStripes});
@@ -404,7 +427,7 @@ void GpuFluid<D>::diffuse(double dt) {
     const Viscous& V = *viscous_[size_t(a)];
     std::array<int, 3> udims{1, 1, 1};
     for (int b = 0; b < D; ++b) udims[size_t(b)] = V.host.dims[b];
-    const ComputeProgram& p = useProgram(shader(mode), dimDefine(D, mode));
+    const ComputeProgram& p = useProgram(shader(mode), dimDefine(D, mode), real_, kPhi);
     setUniform(p, "cells", cells_);
     setUniform(p, "axis", a);
     setUniform(p, "n", int(V.host.A.size()));
@@ -442,7 +465,8 @@ template <int D>
 void GpuFluid<D>::project(double dt) {
   auto run = [&](FluidOp mode, int axis, size_t n) {
     const bool cut = mode == FluidOp::Divergence && viscousHeld_.bytes() > 0;  // (made for cut obstacles only)
-    const ComputeProgram& p = useProgram(shader(mode), dimDefine(D, mode) + (cut ? "\n#define CUT_FACES" : ""));
+    const ComputeProgram& p =
+        useProgram(shader(mode), dimDefine(D, mode) + (cut ? "\n#define CUT_FACES" : ""), real_, kPhi);
     setUniform(p, "cells", cells_);
     setUniform(p, "periodic", periodic_);
     setUniform(p, "axis", axis);
@@ -450,7 +474,7 @@ void GpuFluid<D>::project(double dt) {
     setUniform(p, "velOff", velocityOffsets());
     setUniform(p, "invH", 1.0 / h_);
     setUniform(p, "dt", dt);
-    setUniform(p, "lastDt", lastDt_);
+    setUniform(p, "invLastDt", lastDt_ > 0 ? 1.0 / lastDt_ : 0.0);
     setUniform(p, "extrapolate", solves_ >= 2 ? 1 : 0);
     vel_.bind(0);
     fixed_.bind(1);
@@ -529,6 +553,9 @@ void GpuFluid<D>::report(nlohmann::json* run) const {
   (*run)["pressure_solver"] = "mgpcg";
   nlohmann::json g = counts_.perStep();
   g["stages"] = timer_->countsPerStep(FluidStepStats::kStageNames);
+  g["precision"] = precisionName(real_);
+  g["tolerances"] = tolerances();
+  g["device_bytes"] = {{"fluid", deviceBytes()}, {"allocated_peak", GpuBuffer::peakBytes()}};
   (*run)["gpu"] = g;
 }
 
@@ -551,13 +578,13 @@ void GpuFluid<D>::download(MacVelocity<D>* u, Grid<float, D>* dye, Grid<float, D
 
 template <int D>
 std::vector<double> GpuFluid<D>::phi() const {
-  return phi_.read<double>(cellCount_);
+  return readReals(phi_, cellCount_, kPhi);
 }
 
 template <int D>
 void GpuFluid<D>::save(StateWriter* out) const {
-  out->putVector("gpu.fluid.phi", phi_.read<double>(cellCount_));
-  out->putVector("gpu.fluid.rate_prev", ratePrev_.read<double>(cellCount_));
+  out->putVector("gpu.fluid.phi", readReals(phi_, cellCount_, kPhi));
+  out->putVector("gpu.fluid.rate_prev", readReals(ratePrev_, cellCount_, GpuPrecision::Float));
   out->put("gpu.fluid.last_dt", lastDt_);
   out->put("gpu.fluid.solves", solves_);
 }
@@ -566,9 +593,9 @@ template <int D>
 void GpuFluid<D>::load(const StateReader& in) {
   std::vector<double> v(cellCount_);
   in.getVector("gpu.fluid.phi", &v);
-  phi_.upload(v);
+  uploadReals(&phi_, v, kPhi);
   in.getVector("gpu.fluid.rate_prev", &v);
-  ratePrev_.upload(v);
+  uploadReals(&ratePrev_, v, GpuPrecision::Float);
   in.get("gpu.fluid.last_dt", &lastDt_);
   in.get("gpu.fluid.solves", &solves_);
 }

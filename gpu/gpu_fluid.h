@@ -17,6 +17,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/backend.h"
 #include "core/mac_velocity.h"
 #include "core/solver_result.h"
 #include "core/state_archive.h"
@@ -40,7 +41,9 @@ class GpuPcg;
 template <int D>
 class GpuFluid final : public FluidStepper<D> {
  public:
-  GpuFluid(const FluidSettings& settings, const VelocityConstraints<D>& constraints);
+  // `real`: the pressure, the viscosity's vectors and their solvers' (gpu.precision); the velocity is float.
+  GpuFluid(const FluidSettings& settings, const VelocityConstraints<D>& constraints,
+           GpuPrecision real = GpuPrecision::Double);
   ~GpuFluid() override;
   GpuFluid(const GpuFluid&) = delete;
   GpuFluid& operator=(const GpuFluid&) = delete;
@@ -65,7 +68,13 @@ class GpuFluid final : public FluidStepper<D> {
   // Largest dt with maxSpeed() dt <= cfl h (dtMax when the fluid is at rest), as FluidSolver's.
   double cflTimeStep(double cfl, double dtMax) const override;
   // Bytes of device memory a fluid of these cells allocates.
-  static size_t deviceBytes(const IVec<D>& cells);
+  static size_t deviceBytes(const IVec<D>& cells, GpuPrecision real);
+  size_t deviceBytes() const;  // this fluid's (its cells and precision)
+  GpuPrecision precision() const { return real_; }
+  // The solves' tolerances (the scene's, raised to the precision's floor): {"pressure", "viscosity"}.
+  nlohmann::json tolerances() const {
+    return {{"pressure", settings_.pressureTolerance}, {"viscosity", settings_.viscosityTolerance}};
+  }
 
   void upload(const MacVelocity<D>& u, const Grid<float, D>& dye, const Grid<float, D>* temperature = nullptr);
   void download(MacVelocity<D>* u, Grid<float, D>* dye, Grid<float, D>* temperature = nullptr) const;
@@ -110,6 +119,7 @@ class GpuFluid final : public FluidStepper<D> {
   std::array<int, 3> velocityOffsets() const;  // the components' offsets in the velocity buffer (uniform velOff)
 
   FluidSettings settings_;
+  GpuPrecision real_;
   double time_ = 0.0;
   long steps_ = 0;
   std::array<int, 3> cells_{1, 1, 1}, periodic_{};

@@ -6,6 +6,7 @@
 #include "gpu/compute_program.h"
 #include "gpu/gl_context.h"
 #include "gpu/gpu_programs.h"
+#include "gpu/gpu_reals.h"
 
 namespace morphoflow {
 
@@ -60,7 +61,7 @@ void GpuLaplace::setBlockUniforms(const ComputeProgram& p) const {
   }
   setUniform(p, "blockStart", start);
   glUniform3iv(p.uniform("blockDims"), 4, dims.data());
-  glUniform1dv(p.uniform("blockScale"), 4, scale.data());
+  setUniformDoubles(p, "blockScale", scale.data(), 4);
   setUniform(p, "cells", int(n_));
 }
 
@@ -155,8 +156,8 @@ void GpuLaplace::run(LaplaceMode mode, bool single, const GpuBuffer& x, const Gp
   const bool block = !blocks_.empty();
   if (block && (mode == LaplaceMode::Smooth || mode == LaplaceMode::Jacobi))
     throw GpuError("a block system is not smoothed (no multigrid)");
-  std::string defines =
-      fmt::format("#define DIM {}\n#define REAL {}\n#define {}", dim_, single ? "float" : "double", define(mode));
+  const GpuPrecision real = single ? GpuPrecision::Float : real_, solution = single ? real : solution_;
+  std::string defines = fmt::format("#define DIM {}\n#define {}", dim_, define(mode));
   const auto add = [&](bool on, const char* name) {
     if (on) defines += std::string("\n#define ") + name;
   };
@@ -166,7 +167,7 @@ void GpuLaplace::run(LaplaceMode mode, bool single, const GpuBuffer& x, const Gp
   add(dot, "DOT_PARTIAL");
   add(pUpdate, "P_UPDATE");
   add(pUpdate && pUpdate->first, "P_FIRST");
-  const ComputeProgram& p = useProgram("laplace.comp", defines);
+  const ComputeProgram& p = useProgram("laplace.comp", defines, real, solution);
   if (block) {
     setBlockUniforms(p);
   } else {
@@ -185,9 +186,9 @@ void GpuLaplace::run(LaplaceMode mode, bool single, const GpuBuffer& x, const Gp
   for (int k = 0; k < crossBuffers; ++k) cross_[size_t(k)].bind(8 + k);
   // x and y (and b), the face weights, c and the diagonal (and the mixed
   // terms); a smoothing pass touches half the cells
-  const double real = single ? 4.0 : 8.0, coefficients = 4.0 * (dim_ + 2 + crossBuffers);
-  const double bytes = mode == LaplaceMode::Smooth ? 0.5 * (3 * real + coefficients)
-                                                   : (y ? 2 : 1) * real + (b ? real : 0) + coefficients;
+  const double realSize = double(realBytes(real)), coefficients = 4.0 * (dim_ + 2 + crossBuffers);
+  const double bytes = mode == LaplaceMode::Smooth ? 0.5 * (3 * realSize + coefficients)
+                                                   : (y ? 2 : 1) * realSize + (b ? realSize : 0) + coefficients;
   if (pUpdate) {
     pUpdate->pNew->bind(8);
     pUpdate->scalars->bind(15);
@@ -200,7 +201,7 @@ void GpuLaplace::run(LaplaceMode mode, bool single, const GpuBuffer& x, const Gp
     glUniform2i(p.uniform("mean"), e.bSum, e.count);
     (e.scalars ? *e.scalars : x).bind(15);
     if (!cross) (e.z ? *e.z : x).bind(8);
-    countGpuTraffic(double(n_) * ((e.rz >= 0 ? 8.0 : 0.0) + (e.noRhs >= 0 ? 8.0 : 0.0)));
+    countGpuTraffic(double(n_) * realSize * ((e.rz >= 0 ? 1 : 0) + (e.noRhs >= 0 ? 1 : 0)));
   }
   if (dot) {
     setUniform(p, "slot", dot->slot);
@@ -234,7 +235,7 @@ void GpuLaplace::residual(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* r, 
 void GpuLaplace::applyUpdatingP(const GpuBuffer& p, const GpuBuffer& z, GpuBuffer* pNew, GpuBuffer* q, FusedDot pq,
                                 const GpuBuffer& scalars, std::array<int, 4> slots, bool first) const {
   const PUpdate u{pNew, &scalars, slots, first};
-  countGpuTraffic(double(n_) * 8.0);  // p' written (z is run's b)
+  countGpuTraffic(double(n_) * double(realBytes(real_)));  // p' written (z is run's b)
   run(LaplaceMode::Apply, false, p, q, &z, 0, 0.0f, &pq, &u);
 }
 

@@ -1,12 +1,14 @@
 // A LaplaceSystem (core/laplace_system.h) on the GPU: its face weights and
 // diagonal in storage buffers, and the kernels of shaders/laplace.comp on
-// double vectors (the PCG's) or float ones (the multigrid levels').
+// real vectors (the PCG's: float or double, precision()) or float ones (the
+// multigrid levels').
 #pragma once
 
 #include <array>
 #include <vector>
 
 #include "core/anisotropic_system.h"
+#include "core/backend.h"
 #include "core/laplace_system.h"
 #include "gpu/gpu_buffer.h"
 #include "gpu/gpu_reduction.h"
@@ -44,7 +46,7 @@ class GpuLaplace {
   template <int D>
   explicit GpuLaplace(const LaplaceSystem<D>& A);
   // A tensor operator: the axis part, and the mixed terms in apply() and
-  // residual() on double vectors (the float kernels, the multigrid's, take
+  // residual() on real vectors (the float kernels, the multigrid's, take
   // the axis part: the preconditioner is the axis part's, as on the CPU).
   template <int D>
   explicit GpuLaplace(const AnisotropicSystem<D>& A);
@@ -65,6 +67,16 @@ class GpuLaplace {
   void update(const AnisotropicSystem<D>& A);
 
   size_t size() const { return n_; }
+  // The real vectors' precision (apply, residual and the PCG's; Double unless
+  // set), and the solution's that residual() and a GpuPcg take (the vectors'
+  // unless given: a float pressure solve keeps its solution in double).
+  void setPrecision(GpuPrecision vectors) { setPrecision(vectors, vectors); }
+  void setPrecision(GpuPrecision vectors, GpuPrecision solution) {
+    real_ = vectors;
+    solution_ = solution;
+  }
+  GpuPrecision precision() const { return real_; }
+  GpuPrecision solutionPrecision() const { return solution_; }
   bool singular() const { return singular_; }
   int dimension() const { return dim_; }
   const std::array<int, 3>& dims() const { return dims_; }
@@ -87,8 +99,8 @@ class GpuLaplace {
   // red-black sweep would then race): such levels smooth by Jacobi.
   bool mixesColours() const;
 
-  void apply(const GpuBuffer& x, GpuBuffer* y) const;  // y = A x (double)
-  // y = A x or r = b - A x in double with the partial pass of x . y (apply)
+  void apply(const GpuBuffer& x, GpuBuffer* y) const;  // y = A x (real vectors)
+  // y = A x or r = b - A x on real vectors with the partial pass of x . y (apply)
   // or r . r (residual) into `dot`: bitwise a GpuReduction::dot after them,
   // one dispatch fewer.
   void apply(const GpuBuffer& x, GpuBuffer* y, FusedDot dot) const;
@@ -124,6 +136,7 @@ class GpuLaplace {
   std::array<bool, 3> periodic_{};
   int dim_ = 2;
   size_t n_ = 0;
+  GpuPrecision real_ = GpuPrecision::Double, solution_ = GpuPrecision::Double;
   double scale_ = 1.0;
   bool singular_ = false;
   std::array<GpuBuffer, 3> w_;

@@ -31,22 +31,29 @@ std::vector<std::vector<double>> perturbNearInitial(RDSolver<D>* rd, uint64_t se
   return start;
 }
 
-// The largest difference between the layers, and the largest change of the
-// CPU's from `start`, over every species and cell.
+// The largest difference between the layers, the largest change of the
+// CPU's from `start`, over every species and cell, and the cells where some
+// species differs by more than `relative` times that change.
 struct LayerDifference {
   double worst = 0.0, moved = 0.0;
+  size_t apart = 0;
 };
 template <int D>
 LayerDifference layerDifference(const GpuRDLayer<D>& gpu, const RDSolver<D>& cpu,
-                                const std::vector<std::vector<double>>& start) {
+                                const std::vector<std::vector<double>>& start, double relative = 0.0) {
   LayerDifference d;
+  std::vector<double> cellWorst(cpu.field(0).size(), 0.0);
   for (size_t k = 0; k < start.size(); ++k) {
     const std::vector<double> g = gpu.download(int(k));
     const Grid<double, D>& c = cpu.field(int(k));
     for (size_t i = 0; i < g.size(); ++i) {
-      d.worst = std::max(d.worst, std::abs(g[i] - c[i]));
+      cellWorst[i] = std::max(cellWorst[i], std::abs(g[i] - c[i]));
       d.moved = std::max(d.moved, std::abs(c[i] - start[k][i]));
     }
+  }
+  for (double w : cellWorst) {
+    d.worst = std::max(d.worst, w);
+    if (w > relative * d.moved) ++d.apart;
   }
   return d;
 }

@@ -1,16 +1,22 @@
 #include "gpu/gpu_layer_steppers.h"
 
+#include <fmt/format.h>
+
 #include "gpu/gl_context.h"
 
 namespace morphoflow {
 
-// Checkpoints: gpu.rd.time, gpu.rd.steps and the species (gpu.rd.layer.* in
-// double, gpu.rd.species.* in float), with the layer's warm starts.
+// Checkpoints: gpu.rd.time, gpu.rd.steps and the species (gpu.rd.layer.*,
+// the layer's values, exact in double; gpu.rd.species.* in float), with the
+// layer's warm starts.
 
 template <int D>
 void GpuLayerStepper<D>::advance(double dt, long count) {
   counts_.add([&] {
-    for (long k = 0; k < count; ++k) layer_.step(dt);
+    for (long k = 0; k < count; ++k) {
+      layer_.step(dt);
+      stats_.add(layer_.lastStats());
+    }
   });
   counts_.steps += count;
   for (long k = 0; k < count; ++k) {
@@ -35,6 +41,7 @@ void GpuLayerStepper<D>::save(StateWriter* out) const {
   out->put("gpu.rd.steps", steps_);
   for (int s = 0; s < layer_.species(); ++s) out->putVector("gpu.rd.layer." + species_[size_t(s)], layer_.download(s));
   layer_.save(out);
+  stats_.save(out);
 }
 
 template <int D>
@@ -47,17 +54,21 @@ void GpuLayerStepper<D>::load(const StateReader& in) {
     layer_.upload(s, v);
   }
   layer_.load(in);
+  stats_.load(in);
 }
 
 template <int D>
 void GpuLayerStepper<D>::resolved(nlohmann::json* j) const {
-  (*j)["explicit_step"] = "gpu, double species (gpu/gpu_rd_layer.h)";
+  (*j)["explicit_step"] = fmt::format("gpu, {} species (gpu/gpu_rd_layer.h)", precisionName(layer_.precision()));
 }
 
 template <int D>
 void GpuLayerStepper<D>::report(nlohmann::json* run) const {
   recordGlContext(run);
   (*run)["gpu"] = counts_.perStep();
+  (*run)["gpu"]["precision"] = precisionName(layer_.precision());
+  (*run)["gpu"]["device_bytes"] = {{"layer", layer_.deviceBytes()}, {"allocated_peak", GpuBuffer::peakBytes()}};
+  (*run)["gpu"]["tolerances"] = {{"rd", layer_.tolerance()}};
 }
 
 namespace {

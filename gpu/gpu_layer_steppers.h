@@ -1,5 +1,5 @@
-// The GPU's LayerSteppers (rd/layer_stepper.h): every integrator in double
-// precision (GpuRDLayer, gpu_rd_layer.h), and the plain explicit step of a
+// The GPU's LayerSteppers (rd/layer_stepper.h): every integrator in the
+// scene's precision (GpuRDLayer, gpu_rd_layer.h), and the plain explicit step of a
 // two-species layer in single precision (GpuExplicitRD, gpu_explicit_rd.h).
 // The species stay on the device; the host RDSolver gets a copy when asked.
 #pragma once
@@ -17,13 +17,14 @@ template <int D>
 class GpuLayerStepper final : public LayerStepper<D> {
  public:
   // The layer of `host` (whose operators it borrows: rd/layer_upload.h) from its current state.
-  explicit GpuLayerStepper(const RDSolver<D>& host)
-      : species_(host.model().info().species), layer_(layerUpload(host)) {}
+  GpuLayerStepper(const RDSolver<D>& host, GpuPrecision real)
+      : species_(host.model().info().species), layer_(layerUpload(host), real) {}
 
   void advance(double dt, long count) override;
   double time() const override { return time_; }
   long steps() const override { return steps_; }
-  const RDRunStats* runStats() const override { return nullptr; }
+  // The layer's statistics as it reads them back (GpuRDLayer::lastStats).
+  const RDRunStats* runStats() const override { return &stats_; }
   void toHost(RDSolver<D>* host) const override;
   void fromHost(const RDSolver<D>& host) override;
   void save(StateWriter* out) const override;
@@ -34,6 +35,7 @@ class GpuLayerStepper final : public LayerStepper<D> {
  private:
   std::vector<std::string> species_;
   GpuRDLayer<D> layer_;
+  RDRunStats stats_;
   double time_ = 0.0;
   long steps_ = 0;
   StepCounts counts_;

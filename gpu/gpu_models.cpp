@@ -32,9 +32,10 @@ int gpuSpecies(const std::string& name) {
   return m ? m->species() : 0;
 }
 
-std::string gpuReaction(const std::string& name, bool doublePrecision) {
+std::string gpuReaction(const std::string& name, GpuPrecision precision) {
   const ReactionModel* m = findModel(name);
-  if (!m || (!doublePrecision && m->species() != 2)) return "";
+  if (!m) return "";
+  const bool doublePrecision = precision == GpuPrecision::Double;
   const ModelKernel& k = m->kernel();
   std::string text = dialect(m->species(), doublePrecision) + k.defines;
   if (!k.base.empty())  // the kernels of the model it builds on; that model's own rates under other names

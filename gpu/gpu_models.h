@@ -5,15 +5,16 @@
 
 #include <string>
 
+#include "core/backend.h"
+
 namespace morphoflow {
 
 // GLSL defining NSPECIES, NPARAMETERS and
 //   void modelRates(T x[NSPECIES], T p[NPARAMETERS], out T r[NSPECIES])
 //   void modelJacobian(T x[NSPECIES], T p[NPARAMETERS], out T J[NSPECIES * NSPECIES])
 // (J row-major, dR_s / dx_t) for the model, in single or double precision
-// (T), or "" for an unknown model and, in single precision (the explicit
-// step), for a model of other than two species.
-std::string gpuReaction(const std::string& model, bool doublePrecision = false);
+// (T), or "" for an unknown model.
+std::string gpuReaction(const std::string& model, GpuPrecision precision);
 // The model's species, 0 for an unknown model.
 int gpuSpecies(const std::string& model);
 

@@ -195,7 +195,7 @@ void GpuMultigrid::runTail() {
   setUniform(p, "levels", count);
   glUniform3iv(p.uniform("dimsOf"), count, dims.data());
   glUniform1iv(p.uniform("offsetOf"), count, offsets_.data());
-  glUniform1dv(p.uniform("scaleOf"), count, scales.data());
+  setUniformDoubles(p, "scaleOf", scales.data(), count);
   setUniformBools(p, "periodic", A.periodic());
   setUniform(p, "preSmooth", options_.preSmooth);
   setUniform(p, "postSmooth", options_.postSmooth);
@@ -295,11 +295,12 @@ void GpuMultigrid::apply(const GpuBuffer& r, GpuBuffer* z, const GpuBuffer& scal
   const bool fused = sweepsFused();
   auto convert = [&](VectorOp op, const GpuBuffer& in, const GpuBuffer& out) {
     const bool back = op == VectorOp::FromFloat;
-    const ComputeProgram& p =
-        useProgram("vector_ops.comp", std::string("#define ") + define(op) + "\n#define DOT_PARTIAL" +
-                                          (!fused ? ""
-                                                  : fmt::format("\n#define DIM {}\n#define {}", L.A->dimension(),
-                                                                back ? "SWEEP_LAST" : "SWEEP_FIRST")));
+    const ComputeProgram& p = useProgram("vector_ops.comp",
+                                         std::string("#define ") + define(op) + "\n#define DOT_PARTIAL" +
+                                             (!fused ? ""
+                                                     : fmt::format("\n#define DIM {}\n#define {}", L.A->dimension(),
+                                                                   back ? "SWEEP_LAST" : "SWEEP_FIRST")),
+                                         L.A->precision());
     if (fused) {
       setUniform(p, "levelDims", L.A->dims());
       setUniform(p, "levelScale", L.A->scale());
@@ -323,7 +324,8 @@ void GpuMultigrid::apply(const GpuBuffer& r, GpuBuffer* z, const GpuBuffer& scal
     scalars.bind(6);
     rz.partials->bind(8);
     in.bind(9);
-    countGpuTraffic(double(n) * (back ? 20.0 : 12.0));
+    const double real = double(L.A->precision() == GpuPrecision::Float ? 4 : 8);  // r, z in; z out; f
+    countGpuTraffic(double(n) * (back ? 2 * real + 4 : real + 4));
     dispatchGroups(GpuReduction::groups(n), 1);
     storageBarrier();
   };

@@ -16,7 +16,7 @@ namespace morphoflow {
 
 namespace {
 
-std::string check(const ReactionModel& m) {
+std::string check(const ReactionModel& m, GpuPrecision real) {
   const ModelInfo& info = m.info();
   const int ns = m.species();
   RDSettings s;
@@ -38,28 +38,35 @@ std::string check(const ReactionModel& m) {
     rate = std::max(rate, row);
   }
   const std::vector<std::vector<double>> start = perturbNearInitial<2>(&cpu, 11);
-  GpuRDLayer<2> gpu(layerUpload(cpu));
+  GpuRDLayer<2> gpu(layerUpload(cpu), real);
   const double dt = 10.0 / rate;
   cpu.step(dt);
   gpu.step(dt);
-  const auto [worst, moved] = layerDifference<2>(gpu, cpu, start);
+  // double: the CPU's roots to rounding, in every cell. float: to 1e-4 of
+  // the step's change, but for at most 1 cell in 32, where a model with
+  // several roots near a fold (the three-layer Oregonator's) lets float's
+  // rounding pick the other branch; a driver whose arithmetic is wrong
+  // differs nearly everywhere (docs/gpu.md, "Drivers").
+  const bool single = real == GpuPrecision::Float;
+  const LayerDifference d = layerDifference<2>(gpu, cpu, start, single ? 1e-4 : 1e-9);
+  const size_t cells = cpu.field(0).size(), allowed = single ? cells / 32 : 0;
   const int gpuFailures = gpu.lastStats().newton.failures, cpuFailures = cpu.lastStats().newton.failures;
-  if (!(worst <= 1e-9 * moved) || gpuFailures > cpuFailures)
+  if (d.apart > allowed || gpuFailures > cpuFailures)
     return fmt::format(
-        "its Newton failed in {} of {} cells (the CPU's in {}) and its roots differ from the CPU's by {:.2g} of "
-        "the step's change",
-        gpuFailures, cpu.cells()[0] * cpu.cells()[1], cpuFailures, moved > 0 ? worst / moved : worst);
+        "its Newton failed in {} of {} cells (the CPU's in {}) and its roots differ from the CPU's in {} cells, by "
+        "up to {:.2g} of the step's change",
+        gpuFailures, cells, cpuFailures, d.apart, d.moved > 0 ? d.worst / d.moved : d.worst);
   return "";
 }
 
 }  // namespace
 
-std::string gpuNewtonDefect(const std::string& model) {
-  static std::map<std::string, std::string> checked;
-  auto it = checked.find(model);
+std::string gpuNewtonDefect(const std::string& model, GpuPrecision real) {
+  static std::map<std::pair<std::string, GpuPrecision>, std::string> checked;
+  auto it = checked.find({model, real});
   if (it == checked.end()) {
     const ReactionModel* m = findModel(model);
-    it = checked.emplace(model, m ? check(*m) : std::string()).first;
+    it = checked.emplace(std::pair{model, real}, m ? check(*m, real) : std::string()).first;
   }
   return it->second;
 }

@@ -4,8 +4,10 @@
 #include <cmath>
 
 #include "gpu/compute_program.h"
-#include "gpu/gpu_programs.h"
+#include "gpu/gl_context.h"
 #include "gpu/gpu_multigrid.h"
+#include "gpu/gpu_programs.h"
+#include "gpu/gpu_reals.h"
 
 namespace morphoflow {
 
@@ -16,9 +18,26 @@ constexpr GpuGate::Slots kGateSlots{kBB, kRR, kPQ};
 constexpr int kCalibrationLook = 8;  // iterations between looks while the schedule is calibrated
 }  // namespace
 
-GpuPcg::GpuPcg(const GpuLaplace& A)
-    : A_(A), r_(A.size() * sizeof(double)), p_(A.size() * sizeof(double)), q_(A.size() * sizeof(double)),
-      z_(A.size() * sizeof(double)), p2_(A.size() * sizeof(double)) {
+GpuPcgWork::GpuPcgWork(size_t size, GpuPrecision precision)
+    : n(size),
+      real(precision),
+      r(realBuffer(n, real)),
+      p(realBuffer(n, real)),
+      q(realBuffer(n, real)),
+      z(realBuffer(n, real)),
+      p2(realBuffer(n, real)) {}
+
+GpuPcg::GpuPcg(const GpuLaplace& A, std::shared_ptr<GpuPcgWork> work)
+    : A_(A),
+      work_(work ? std::move(work) : std::make_shared<GpuPcgWork>(A.size(), A.precision())),
+      r_(work_->r),
+      p_(work_->p),
+      q_(work_->q),
+      z_(work_->z),
+      p2_(work_->p2),
+      sums_(A.precision()) {
+  if (work_->n < A.size() || work_->real != A.precision())
+    throw GpuError("a solve's work vectors are smaller than its system, or of another precision");
   if (A_.singular()) sums_.activeCount(A_.diag(), A_.size(), kCount);
   last_.converged = true;
 }
@@ -28,7 +47,8 @@ void GpuPcg::op(VectorOp name, const GpuBuffer& x, const GpuBuffer& y, const Gpu
   // (every PCG op has its reductions fused in: DOT_PARTIAL)
   const ComputeProgram& p =
       useProgram("vector_ops.comp",
-                 std::string("#define ") + define(name) + "\n#define DOT_PARTIAL" + (check ? "\n#define GATE" : ""));
+                 std::string("#define ") + define(name) + "\n#define DOT_PARTIAL" + (check ? "\n#define GATE" : ""),
+                 A_.precision(), A_.solutionPrecision());
   if (check) gate_.checkInNext(kGateSlots, check->tolerance, check->maxIterations);
   setUniform(p, "n", int(A_.size()));
   setUniform(p, "slots", slots);
@@ -40,9 +60,11 @@ void GpuPcg::op(VectorOp name, const GpuBuffer& x, const GpuBuffer& y, const Gpu
   A_.diag().bind(4);  // (no float vector in these ops)
   A_.diag().bind(5);
   sums_.scalars().bind(6);
-  const double bytes = name == VectorOp::UpdateXR  ? (slots[3] >= 0 ? 68.0 : 48.0)
-                       : name == VectorOp::UpdateP ? 24.0
-                                                   : 20.0;
+  // (UpdateXR: x and r read and written, p, q; and w with the diagonal)
+  const double r = double(realBytes(A_.precision())), xr = double(realBytes(A_.solutionPrecision()));
+  const double bytes = name == VectorOp::UpdateXR  ? 2 * xr + 4 * r + (slots[3] >= 0 ? 2.5 * r : 0.0)
+                       : name == VectorOp::UpdateP ? 3 * r
+                                                   : 2 * r + 4;
   sums_.partials().bind(8);
   z_.bind(9);  // the fused diagonal preconditioner's z
   countGpuTraffic(double(A_.size()) * bytes);

@@ -10,6 +10,8 @@
 // solution, as on the CPU.
 #pragma once
 
+#include <memory>
+
 #include "core/pcg.h"
 #include "core/solver_result.h"
 #include "gpu/gpu_gate.h"
@@ -21,9 +23,20 @@ namespace morphoflow {
 
 class GpuMultigrid;
 
+// The vectors a solve works in (r, p, q, z and p's other buffer), for
+// systems of up to n unknowns: one set serves several GpuPcgs whose solves
+// never overlap (the pressure's and the viscosity's; a layer's species).
+struct GpuPcgWork {
+  GpuPcgWork(size_t n, GpuPrecision real);
+  size_t n;
+  GpuPrecision real;
+  GpuBuffer r, p, q, z, p2;
+};
+
 class GpuPcg {
  public:
-  explicit GpuPcg(const GpuLaplace& A);
+  // In `work` (null: a set of its own), whose size and precision must fit A's.
+  explicit GpuPcg(const GpuLaplace& A, std::shared_ptr<GpuPcgWork> work = nullptr);
   // Solves A x = b from x's current values to options.tolerance (relative
   // residual); b is made mean-free first when A is singular. M null: the
   // diagonal preconditioner. Returns the solve's own result, read back (one
@@ -46,7 +59,8 @@ class GpuPcg {
   void iterateFused(GpuBuffer* x, GpuMultigrid* M, const SolverOptions& options, int queue);
   SolverResult fromTally(const GpuGate::Tally& t, bool last);
   const GpuLaplace& A_;
-  GpuBuffer r_, p_, q_, z_, p2_;  // p2_: the p update's other buffer
+  std::shared_ptr<GpuPcgWork> work_;
+  GpuBuffer &r_, &p_, &q_, &z_, &p2_;  // work_'s; p2_: the p update's other buffer
   GpuReduction sums_;
   GpuGate gate_;
   int ahead_ = 0;  // iterations a solve queues; 0: not calibrated yet

@@ -3,19 +3,21 @@
 #include <map>
 #include <memory>
 #include <utility>
+#include <vector>
 
 #include <epoxy/gl.h>
 
 #include "gpu/compute_program.h"
 #include "gpu/gl_context.h"
 #include "gpu/gpu_counts.h"
+#include "gpu/gpu_reals.h"
 #include "gpu/shader_source.h"
 
 namespace morphoflow {
 
 namespace {
-// The shader's text with each line `#include "NAME"` replaced by shaders/NAME
-// (GLSL has no includes of its own without an extension).
+// The shader's text with each line `#include "NAME"` replaced by shaders/NAME,
+// itself expanded (GLSL has no includes of its own without an extension).
 std::string expandIncludes(const std::string& text) {
   std::string out;
   size_t at = 0;
@@ -25,7 +27,7 @@ std::string expandIncludes(const std::string& text) {
     const std::string line = text.substr(at, end - at);
     const size_t q = line.find('"');
     if (line.rfind("#include \"", 0) == 0 && q != std::string::npos)
-      out += shaderSource(line.substr(q + 1, line.find('"', q + 1) - q - 1)) + "\n";
+      out += expandIncludes(shaderSource(line.substr(q + 1, line.find('"', q + 1) - q - 1)));
     else
       out += line + "\n";
     at = end + 1;
@@ -47,6 +49,15 @@ const ComputeProgram& useProgram(const std::string& shader, const std::string& d
              .first;
   it->second->use();
   return *it->second;
+}
+
+const ComputeProgram& useProgram(const std::string& shader, const std::string& defines, GpuPrecision real) {
+  return useProgram(shader, defines, real, real);
+}
+
+const ComputeProgram& useProgram(const std::string& shader, const std::string& defines, GpuPrecision real,
+                                 GpuPrecision solution) {
+  return useProgram(shader, realDefines(real, solution) + defines);
 }
 
 namespace {
@@ -78,7 +89,21 @@ void storageBarrier() { glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT); }
 
 void setUniform(const ComputeProgram& p, const char* name, int v) { glUniform1i(p.uniform(name), v); }
 void setUniform(const ComputeProgram& p, const char* name, float v) { glUniform1f(p.uniform(name), v); }
-void setUniform(const ComputeProgram& p, const char* name, double v) { glUniform1d(p.uniform(name), v); }
+void setUniform(const ComputeProgram& p, const char* name, double v) { setUniformDoubles(p, name, &v, 1); }
+void setUniformDoubles(const ComputeProgram& p, const char* name, const double* v, int count, int components) {
+  const int at = p.uniform(name);
+  if (at < 0) return;
+  if (p.singlePrecision(name)) {
+    const std::vector<float> f(v, v + size_t(count) * size_t(components));
+    if (components == 1) glUniform1fv(at, count, f.data());
+    if (components == 2) glUniform2fv(at, count, f.data());
+    if (components == 3) glUniform3fv(at, count, f.data());
+    return;
+  }
+  if (components == 1) glUniform1dv(at, count, v);
+  if (components == 2) glUniform2dv(at, count, v);
+  if (components == 3) glUniform3dv(at, count, v);
+}
 void setUniform(const ComputeProgram& p, const char* name, const std::array<int, 3>& v) {
   glUniform3i(p.uniform(name), v[0], v[1], v[2]);
 }

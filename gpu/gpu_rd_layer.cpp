@@ -12,6 +12,7 @@
 #include "gpu/gpu_multigrid.h"
 #include "gpu/gpu_pcg.h"
 #include "gpu/gpu_programs.h"
+#include "gpu/gpu_reals.h"
 #include "rd/cosine_lobe.h"
 #include "rd/diffusion_tensor.h"
 #include "rd/rd_step.h"
@@ -33,22 +34,32 @@ struct GpuRDLayer<D>::Diffusion {
 };
 
 template <int D>
-GpuRDLayer<D>::GpuRDLayer(const LayerUpload<D>& upload)
-    : up_(upload), species_(upload.species), n_(upload.state[0]->size()) {
+GpuRDLayer<D>::GpuRDLayer(const LayerUpload<D>& upload, GpuPrecision real)
+    : up_(upload), real_(real), species_(upload.species), n_(upload.state[0]->size()) {
+  up_.settings.tolerance = std::max(up_.settings.tolerance, toleranceFloor(real));
   const LayerUpload<D>& rd = up_;
   for (size_t k = 0; k < rd.parameters.size() && k < params_.size(); ++k) params_[k] = rd.parameters[k];
   for (int s : rd.clamped) clamped_ |= 1u << s;
+  // Kim & Lin's implicit reaction writes no rates; the species' solves, one
+  // after another, share a work vector and the PCG's.
+  const bool rates = rd.settings.integrator != RDIntegrator::KimLin;
   for (int s = 0; s < species_; ++s) {
-    x_[size_t(s)] = GpuBuffer::of(*rd.state[size_t(s)]);
-    rates_[size_t(s)] = GpuBuffer(n_ * sizeof(double));
-    work_[size_t(s)] = GpuBuffer(n_ * sizeof(double));
+    x_[size_t(s)] = reals(*rd.state[size_t(s)]);
+    rates_[size_t(s)] = realBuffer(rates ? n_ : 1, real_);
     diffusion_[size_t(s)] = std::make_unique<Diffusion>();
-    diffusion_[size_t(s)]->increment = GpuBuffer(n_ * sizeof(double));
+    diffusion_[size_t(s)]->increment = realBuffer(n_, real_);
   }
+  work_ = realBuffer(n_, real_);
+  pcgWork_ = std::make_shared<GpuPcgWork>(n_, real_);
   stats_buffer_ = GpuBuffer(2 * sizeof(uint32_t));
   stats_buffer_.zero();
-  // each species' operator (a tensor's for the anisotropic ones), for the explicit part
-  for (int s = 0; s < species_; ++s) operator_[size_t(s)] = std::make_unique<GpuLaplace>(*rd.operators[size_t(s)]);
+  // each species' operator (a tensor's for the anisotropic ones), for the
+  // explicit part (theta < 1) and the operators rebuilt every step
+  for (int s = 0; s < species_; ++s) {
+    if (diffusionTheta(rd.settings.integrator) == 1.0 && !rebuilt(s)) continue;
+    operator_[size_t(s)] = std::make_unique<GpuLaplace>(*rd.operators[size_t(s)]);
+    operator_[size_t(s)]->setPrecision(real_);
+  }
   // parameter maps (and perturbations), concatenated
   std::vector<double> maps;
   mapAt_.fill(-1);
@@ -58,37 +69,37 @@ GpuRDLayer<D>::GpuRDLayer(const LayerUpload<D>& upload)
     mapAt_[k] = int(maps.size());
     maps.insert(maps.end(), f.begin(), f.end());
   }
-  maps_ = GpuBuffer::of(maps.empty() ? std::vector<double>{0.0} : maps);
+  maps_ = reals(maps.empty() ? std::vector<double>{0.0} : maps);
   for (int s = 0; s < species_; ++s) {
     const size_t si = size_t(s);
     if (rd.fixedMasks[si]) {
       isFixed_[si] = true;
       fixedMask_[si] = GpuBuffer::of(std::vector<uint32_t>(rd.fixedMasks[si]->begin(), rd.fixedMasks[si]->end()));
-      fixedValue_[si] = GpuBuffer::of(*rd.fixedValues[si]);
+      fixedValue_[si] = reals(*rd.fixedValues[si]);
     }
-    if (rd.dirichletFaces[si]) faces_[si] = GpuBuffer::of(*rd.dirichletFaces[si]);
+    if (rd.dirichletFaces[si]) faces_[si] = reals(*rd.dirichletFaces[si]);
   }
   for (int s : rd.settings.frozen) isFrozen_[size_t(s)] = true;
   if (const DiffusionTensorSpec<D>* t = rd.tensor; t && t->dynamic()) {
     std::vector<double> dir;
     for (int a = 0; a < D; ++a) dir.insert(dir.end(), t->direction[size_t(a)].begin(), t->direction[size_t(a)].end());
-    direction_ = GpuBuffer::of(dir);
-    lambda1_ = GpuBuffer::of(t->lambda1);
-    lambda2_ = GpuBuffer::of(t->lambda2);
-    sigma_ = GpuBuffer(n_ * AnisotropicSystem<D>::kComponents * sizeof(double));
+    direction_ = reals(dir);
+    lambda1_ = reals(t->lambda1);
+    lambda2_ = reals(t->lambda2);
+    sigma_ = realBuffer(n_ * AnisotropicSystem<D>::kComponents, real_);
     for (int s = 0; s < species_; ++s)
-      if (rd.anisotropic[size_t(s)] && !faces_[size_t(s)].id()) faces_[size_t(s)] = GpuBuffer(n_ * sizeof(double));
+      if (rd.anisotropic[size_t(s)] && !faces_[size_t(s)].id()) faces_[size_t(s)] = realBuffer(n_, real_);
   }
   if (const CosineLobeSpec* lobes = rd.lobes) {
-    lobeA_ = GpuBuffer(n_ * sizeof(double));
+    lobeA_ = realBuffer(n_, real_);
     std::vector<double> rot(lobes->theta0.empty() ? 2 : 2 * n_);
     for (size_t i = 0; i < lobes->theta0.size(); ++i) {
       rot[2 * i] = std::cos(lobes->theta0[i]);
       rot[2 * i + 1] = std::sin(lobes->theta0[i]);
     }
-    rot_ = GpuBuffer::of(rot);
+    rot_ = reals(rot);
     for (int s = 0; s < species_; ++s)
-      if (rd.lobed[size_t(s)] && !faces_[size_t(s)].id()) faces_[size_t(s)] = GpuBuffer(n_ * sizeof(double));
+      if (rd.lobed[size_t(s)] && !faces_[size_t(s)].id()) faces_[size_t(s)] = realBuffer(n_, real_);
   }
   allHeld_ = GpuBuffer::of(std::vector<uint32_t>(rd.settings.frozen.empty() ? 1 : n_, 1u));
 }
@@ -97,16 +108,26 @@ template <int D>
 GpuRDLayer<D>::~GpuRDLayer() = default;
 
 template <int D>
-size_t GpuRDLayer<D>::deviceBytes(size_t n, int species) {
-  // per species: the species, rates, work, a system (D weights, c, diagonal),
-  // PCG vectors, the increment and a multigrid's levels; the explicit Laplacian
-  return n * (size_t(species) * (3 * 8 + (D + 2) * 4 + 4 * 8 + 8 + 3 * 4 * 2) + (D + 2) * 4);
+size_t GpuRDLayer<D>::deviceBytes(size_t n, int species, GpuPrecision real) {
+  // per species: the species, its rates (an upper bound: Kim & Lin has none),
+  // the warm start, two systems (D weights, c, diagonal: the explicit
+  // operator and the implicit one) and a multigrid's levels; once: the work
+  // vector and the PCG's five
+  const size_t r = realBytes(real);
+  return n * (size_t(species) * (3 * r + 2 * (D + 2) * 4 + 3 * 4 * 2) + 6 * r);
+}
+
+template <int D>
+GpuBuffer GpuRDLayer<D>::reals(const std::vector<double>& values) const {
+  GpuBuffer b(values.size() * realBytes(real_));
+  uploadReals(&b, values, real_);
+  return b;
 }
 
 template <int D>
 void GpuRDLayer<D>::vectorOp(VectorOp op, const GpuBuffer& x, GpuBuffer* y, double a, double b,
                              const GpuBuffer* held) const {
-  const ComputeProgram& p = useProgram("vector_ops.comp", std::string("#define ") + define(op));
+  const ComputeProgram& p = useProgram("vector_ops.comp", std::string("#define ") + define(op), real_);
   setUniform(p, "n", int(n_));
   setUniform(p, "ca", a);
   setUniform(p, "cb", b);
@@ -121,7 +142,7 @@ void GpuRDLayer<D>::vectorOp(VectorOp op, const GpuBuffer& x, GpuBuffer* y, doub
 template <int D>
 void GpuRDLayer<D>::thetaStep(const GpuBuffer& rates, GpuBuffer* x, const GpuBuffer& ax, const GpuBuffer& faces,
                               double dt, double explicitD, double ghost) const {
-  const ComputeProgram& p = useProgram("vector_ops.comp", std::string("#define ") + define(VectorOp::ThetaStep));
+  const ComputeProgram& p = useProgram("vector_ops.comp", std::string("#define ") + define(VectorOp::ThetaStep), real_);
   setUniform(p, "n", int(n_));
   setUniform(p, "ca", dt);
   setUniform(p, "cb", explicitD);
@@ -141,11 +162,13 @@ void GpuRDLayer<D>::react(double dt, bool implicit) {
   std::string gather = "#define GATHER_PARAMETERS";
   for (size_t k = 0; k < up_.parameters.size(); ++k)
     gather += fmt::format(" p[{0}] = mapAt[{0}] < 0 ? uniformP[{0}] : maps[mapAt[{0}] + i];", k);
-  const ComputeProgram& p = useProgram("rd_react.comp", gpuReaction(up_.settings.model, true) + gather + "\n" +
-                                                           (implicit ? "#define MODE_IMPLICIT" : "#define MODE_RATES"));
+  const ComputeProgram& p = useProgram("rd_react.comp",
+                                       gpuReaction(up_.settings.model, real_) + gather + "\n" +
+                                           (implicit ? "#define MODE_IMPLICIT" : "#define MODE_RATES"),
+                                       real_);
   setUniform(p, "n", int(n_));
   setUniform(p, "dt", dt);
-  glUniform1dv(p.uniform("uniformP"), GLsizei(params_.size()), params_.data());
+  setUniformDoubles(p, "uniformP", params_.data(), int(params_.size()));
   glUniform1iv(p.uniform("mapAt"), GLsizei(mapAt_.size()), mapAt_.data());
   glUniform1ui(p.uniform("clamped"), clamped_);
   for (int s = 0; s < kMax; ++s) {  // (the unused bindings of a block array need a buffer too)
@@ -154,7 +177,7 @@ void GpuRDLayer<D>::react(double dt, bool implicit) {
   }
   stats_buffer_.bind(12);
   maps_.bind(13);
-  dispatchFlat(n_, 16.0 * species_);  // the species read and written (or rates written)
+  dispatchFlat(n_, 2.0 * double(realBytes(real_)) * species_);  // the species read and written (or rates written)
   storageBarrier();
 }
 
@@ -167,7 +190,8 @@ SolverResult GpuRDLayer<D>::diffuse(int s, double thetaDt) {
   if (rebuilt(s)) {  // rebuilt every step from this step's operator: I + theta dt d A
     if (!df.A) {
       df.A = std::make_unique<GpuLaplace>(up_.operators[size_t(s)]->shifted(thetaDt * d));
-      df.pcg = std::make_unique<GpuPcg>(*df.A);
+      df.A->setPrecision(real_);
+      df.pcg = std::make_unique<GpuPcg>(*df.A, pcgWork_);
     }
     const double k = thetaDt * d / (up_.h * up_.h);
     df.A->assignShifted(*operator_[size_t(s)], k);
@@ -178,7 +202,8 @@ SolverResult GpuRDLayer<D>::diffuse(int s, double thetaDt) {
       df.A->update(df.host);
     else
       df.A = std::make_unique<GpuLaplace>(df.host);
-    df.pcg = std::make_unique<GpuPcg>(*df.A);
+    df.A->setPrecision(real_);
+    df.pcg = std::make_unique<GpuPcg>(*df.A, pcgWork_);
     // multigrid once diffusion dominates the identity, the diagonal below
     const double scale = thetaDt * d / (up_.h * up_.h);
     df.M = scale > 1.0
@@ -187,20 +212,20 @@ SolverResult GpuRDLayer<D>::diffuse(int s, double thetaDt) {
     df.thetaDt = thetaDt;
   }
   GpuBuffer& b = x_[size_t(s)];
-  GpuBuffer& x = work_[size_t(s)];
+  GpuBuffer& x = work_;
   // the Dirichlet ghost adds theta dt d 2 g / h^2 per boundary face
   if (up_.settings.boundary == RDBoundary::Dirichlet)
     vectorOp(VectorOp::AddFaces, faces_[size_t(s)], &b,
              thetaDt * d / (up_.h * up_.h) * 2.0 * up_.settings.dirichletValues[size_t(s)], 1.0);
   // warm start: b plus the last change, rescaled to this theta dt
-  x.copyFrom(b, n_ * sizeof(double));
+  x.copyFrom(b, n_ * realBytes(real_));
   if (df.hasIncrement) vectorOp(VectorOp::ScaleAdd, df.increment, &x, thetaDt / df.incrementThetaDt, 1.0);
   const SolverResult r = df.pcg->solve(&b, &x, df.M.get(), {up_.settings.tolerance, 2000}, true);
-  df.increment.copyFrom(x, n_ * sizeof(double));
+  df.increment.copyFrom(x, n_ * realBytes(real_));
   vectorOp(VectorOp::ScaleAdd, b, &df.increment, -1.0, 1.0);
   df.incrementThetaDt = thetaDt;
   df.hasIncrement = true;
-  std::swap(x_[size_t(s)], work_[size_t(s)]);
+  std::swap(x_[size_t(s)], work_);
   return r;
 }
 
@@ -215,8 +240,8 @@ struct GpuRDLayer<D>::Stages {
     if (l.frozenTaken_) return;  // frozen species keep the values they start the run with
     for (int s = 0; s < l.species_; ++s)
       if (l.isFrozen_[size_t(s)]) {
-        l.frozen_[size_t(s)] = GpuBuffer(l.n_ * sizeof(double));
-        l.frozen_[size_t(s)].copyFrom(l.x_[size_t(s)], l.n_ * sizeof(double));
+        l.frozen_[size_t(s)] = realBuffer(l.n_, l.real_);
+        l.frozen_[size_t(s)].copyFrom(l.x_[size_t(s)], l.n_ * realBytes(l.real_));
       }
     l.frozenTaken_ = true;
   }
@@ -231,11 +256,11 @@ struct GpuRDLayer<D>::Stages {
   double diffusion(int s) const { return l.up_.diffusion[size_t(s)]; }
   void explicitPart(int s, double dt, double explicitD, bool implicit) {
     const size_t k = size_t(s);
-    if (explicitD > 0) l.operator_[k]->apply(l.x_[k], &l.work_[k]);  // A x = -lap x (less the ghosts)
+    if (explicitD > 0) l.operator_[k]->apply(l.x_[k], &l.work_);  // A x = -lap x (less the ghosts)
     if (implicit) return;
     const bool dirichlet = l.up_.settings.boundary == RDBoundary::Dirichlet;
     const double ghost = dirichlet ? 2.0 * l.up_.settings.dirichletValues[k] / (l.up_.h * l.up_.h) : 0.0;
-    l.thetaStep(l.rates_[k], &l.x_[k], l.work_[k], dirichlet ? l.faces_[k] : l.work_[k], dt, explicitD, ghost);
+    l.thetaStep(l.rates_[k], &l.x_[k], l.work_, dirichlet ? l.faces_[k] : l.work_, dt, explicitD, ghost);
   }
   SolverResult diffuse(int s, double thetaDt) { return l.diffuse(s, thetaDt); }
   void fold(const SolverResult& r) { foldWorst(&l.stats_.diffusion, r); }
@@ -274,7 +299,8 @@ void GpuRDLayer<D>::readStats() {
 template <int D>
 void GpuRDLayer<D>::lobeKernel(LobeMode mode, int species, GpuLaplace* target, GpuBuffer* faces) {
   const CosineLobeSpec& spec = *up_.lobes;
-  const ComputeProgram& p = useProgram("rd_lobes.comp", fmt::format("#define DIM {}\n#define {}", D, define(mode)));
+  const ComputeProgram& p =
+      useProgram("rd_lobes.comp", fmt::format("#define DIM {}\n#define {}", D, define(mode)), real_);
   std::array<int, 3> dims{1, 1, 1};
   for (int a = 0; a < D; ++a) dims[size_t(a)] = up_.cells[a];
   setUniform(p, "dims", dims);
@@ -291,8 +317,8 @@ void GpuRDLayer<D>::lobeKernel(LobeMode mode, int species, GpuLaplace* target, G
     centres[size_t(2 * m)] = std::cos(2.0 * M_PI * m / lobes);
     centres[size_t(2 * m + 1)] = std::sin(2.0 * M_PI * m / lobes);
   }
-  glUniform1dv(p.uniform("speeds"), 8, speeds.data());
-  glUniform1dv(p.uniform("centres"), 16, centres.data());
+  setUniformDoubles(p, "speeds", speeds.data(), 8);
+  setUniformDoubles(p, "centres", centres.data(), 16);
   setUniform(p, "meanA", meanLobeDiffusivity(spec));
   x_[size_t(species)].bind(0);
   lobeA_.bind(1);
@@ -313,7 +339,8 @@ bool GpuRDLayer<D>::rebuilt(int s) const {
 template <int D>
 void GpuRDLayer<D>::tensorKernel(TensorMode mode, GpuLaplace* target) {
   const DiffusionTensorSpec<D>& spec = *up_.tensor;
-  const ComputeProgram& p = useProgram("rd_tensor.comp", fmt::format("#define DIM {}\n#define {}", D, define(mode)));
+  const ComputeProgram& p =
+      useProgram("rd_tensor.comp", fmt::format("#define DIM {}\n#define {}", D, define(mode)), real_);
   std::array<int, 3> dims{1, 1, 1};
   for (int a = 0; a < D; ++a) dims[size_t(a)] = up_.cells[a];
   setUniform(p, "dims", dims);
@@ -370,12 +397,12 @@ void GpuRDLayer<D>::holdFixed() {
 
 template <int D>
 void GpuRDLayer<D>::upload(int s, const std::vector<double>& values) {
-  x_[size_t(s)].upload(values);
+  uploadReals(&x_[size_t(s)], values, real_);
 }
 
 template <int D>
 std::vector<double> GpuRDLayer<D>::download(int s) const {
-  return x_[size_t(s)].read<double>(n_);
+  return readReals(x_[size_t(s)], n_, real_);
 }
 
 template <int D>
@@ -385,9 +412,8 @@ void GpuRDLayer<D>::save(StateWriter* out) const {
     const std::string p = "gpu.rd." + std::to_string(s) + ".";
     out->put(p + "has_increment", df.hasIncrement ? 1 : 0);
     out->put(p + "increment_theta_dt", df.incrementThetaDt);
-    if (df.hasIncrement) out->putVector(p + "increment", df.increment.template read<double>(n_));
-    if (isFrozen_[size_t(s)] && frozenTaken_)
-      out->putVector(p + "frozen", frozen_[size_t(s)].template read<double>(n_));
+    if (df.hasIncrement) out->putVector(p + "increment", readReals(df.increment, n_, real_));
+    if (isFrozen_[size_t(s)] && frozenTaken_) out->putVector(p + "frozen", readReals(frozen_[size_t(s)], n_, real_));
   }
   out->put("gpu.rd.frozen_taken", frozenTaken_ ? 1 : 0);
 }
@@ -404,7 +430,7 @@ void GpuRDLayer<D>::load(const StateReader& in) {
     if (df.hasIncrement) {
       std::vector<double> v(n_);
       in.getVector(p + "increment", &v);
-      df.increment.upload(v);
+      uploadReals(&df.increment, v, real_);
     }
   }
   int taken = 0;
@@ -414,7 +440,7 @@ void GpuRDLayer<D>::load(const StateReader& in) {
     if (isFrozen_[size_t(s)]) {
       std::vector<double> v(n_);
       in.getVector("gpu.rd." + std::to_string(s) + ".frozen", &v);
-      frozen_[size_t(s)] = GpuBuffer::of(v);
+      frozen_[size_t(s)] = reals(v);
     }
 }
 

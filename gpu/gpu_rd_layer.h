@@ -1,5 +1,5 @@
-// A reaction-diffusion layer (rd/rd_solver.h) on the GPU, double precision:
-// the species in storage buffers, the reaction of any model
+// A reaction-diffusion layer (rd/rd_solver.h) on the GPU, in float or double
+// (gpu.precision; docs/gpu.md "Precision"): the species in storage buffers, the reaction of any model
 // (Kim & Lin's per-cell Newton, or the rates for the explicit and
 // semi-implicit integrators; shaders/rd_react.comp), then every integrator's
 // theta scheme on the isotropic diffusion, (I - theta dt d lap) x' = x + ...,
@@ -16,6 +16,7 @@
 #include <memory>
 #include <vector>
 
+#include "core/backend.h"
 #include "core/state_archive.h"
 #include "gpu/gpu_buffer.h"
 #include "gpu/kernel_modes.h"
@@ -27,13 +28,14 @@ namespace morphoflow {
 class GpuLaplace;
 class GpuMultigrid;
 class GpuPcg;
+struct GpuPcgWork;
 
 template <int D>
 class GpuRDLayer {
  public:
   // From the layer's description (rd/layer_upload.h: the settings, model,
   // parameters, operators and initial species of an assembled RDSolver).
-  explicit GpuRDLayer(const LayerUpload<D>& upload);
+  explicit GpuRDLayer(const LayerUpload<D>& upload, GpuPrecision real = GpuPrecision::Double);
   ~GpuRDLayer();
   GpuRDLayer(const GpuRDLayer&) = delete;
   GpuRDLayer& operator=(const GpuRDLayer&) = delete;
@@ -53,7 +55,10 @@ class GpuRDLayer {
   void save(StateWriter* out) const;
   void load(const StateReader& in);
   // Device bytes a layer of n cells and that many species allocates (its solvers included).
-  static size_t deviceBytes(size_t n, int species);
+  static size_t deviceBytes(size_t n, int species, GpuPrecision real);
+  size_t deviceBytes() const { return deviceBytes(n_, species_, real_); }
+  GpuPrecision precision() const { return real_; }
+  double tolerance() const { return up_.settings.tolerance; }  // its diffusion solves' (raised to the floor)
 
  private:
   struct Diffusion;
@@ -76,12 +81,16 @@ class GpuRDLayer {
   void lobeKernel(LobeMode mode, int species, GpuLaplace* target, GpuBuffer* faces);
 
   static constexpr int kMax = ReactionModel::kMaxSpecies;
+  GpuBuffer reals(const std::vector<double>& values) const;  // a buffer of values in the layer's precision
   LayerUpload<D> up_;
+  GpuPrecision real_;
   int species_ = 2;
   size_t n_ = 0;
   std::array<double, 12> params_{};
   unsigned clamped_ = 0;
-  std::array<GpuBuffer, kMax> x_, rates_, work_;
+  std::array<GpuBuffer, kMax> x_, rates_;
+  GpuBuffer work_;  // the species' solves' (one after another), swapped with the species solved
+  std::shared_ptr<GpuPcgWork> pcgWork_;
   GpuBuffer stats_buffer_;
   GpuBuffer maps_;                    // the parameter maps, one after another
   std::array<int, 12> mapAt_{};       // where parameter k's map starts (-1: uniform)
@@ -93,7 +102,8 @@ class GpuRDLayer {
   GpuBuffer allHeld_;                 // a mask of ones (frozen species)
   GpuBuffer lobeA_, rot_;             // a(theta) per cell; cos, sin of theta0 per cell
   GpuBuffer direction_, lambda1_, lambda2_, sigma_;  // a shaped tensor's spec and components
-  std::array<std::unique_ptr<GpuLaplace>, kMax> operator_;  // -lap or -div(sigma grad) (scale 1/h^2): the explicit part
+  // -lap or -div(sigma grad) (scale 1/h^2): the explicit part, and the operators rebuilt each step (else none)
+  std::array<std::unique_ptr<GpuLaplace>, kMax> operator_;
   std::array<std::unique_ptr<Diffusion>, kMax> diffusion_;
   RDStepStats stats_;
   long steps_ = 0;

@@ -9,6 +9,7 @@
 
 #include "gpu/compute_program.h"
 #include "gpu/gpu_programs.h"
+#include "gpu/gpu_reals.h"
 
 namespace morphoflow {
 
@@ -18,7 +19,8 @@ constexpr size_t kGroups = 256;  // partial sums: a fixed count, so the sum's or
 
 unsigned GpuReduction::groups(size_t n) { return unsigned(std::clamp<size_t>((n + 255) / 256, 1, kGroups)); }
 
-GpuReduction::GpuReduction() : partial_(kSlots * kGroups * sizeof(double)), scalars_(kSlots * sizeof(double)) {
+GpuReduction::GpuReduction(GpuPrecision real)
+    : real_(real), partial_(kSlots * kGroups * sizeof(double)), scalars_(kSlots * sizeof(double)) {
   partial_.zero();
   scalars_.zero();
 }
@@ -26,7 +28,7 @@ GpuReduction::GpuReduction() : partial_(kSlots * kGroups * sizeof(double)), scal
 void GpuReduction::run(const char* term, const GpuBuffer& x, const GpuBuffer& y, const GpuBuffer& diag, size_t n,
                        int slot, bool partialOnly) {
   const unsigned groups = GpuReduction::groups(n);
-  const ComputeProgram& p = useProgram("reduce.comp", fmt::format("#define MODE_PARTIAL\n#define {}", term));
+  const ComputeProgram& p = useProgram("reduce.comp", fmt::format("#define MODE_PARTIAL\n#define {}", term), real_);
   setUniform(p, "n", int(n));
   setUniform(p, "slot", slot);
   x.bind(0);
@@ -37,10 +39,11 @@ void GpuReduction::run(const char* term, const GpuBuffer& x, const GpuBuffer& y,
   x.bind(5);
   dispatchGroups(groups, 1);
   const std::string t = term;
-  countGpuTraffic(double(n) * (t == "TERM_DOT" ? 16.0 : t == "TERM_ACTIVE_SUM" ? 12.0 : 4.0));
+  const double r = double(realBytes(real_));
+  countGpuTraffic(double(n) * (t == "TERM_DOT" ? 2 * r : t == "TERM_ACTIVE_SUM" ? r + 4.0 : 4.0));
   storageBarrier();
   if (partialOnly) return;
-  const ComputeProgram& f = useProgram("reduce.comp", std::string("#define MODE_FINAL\n#define ") + term);
+  const ComputeProgram& f = useProgram("reduce.comp", std::string("#define MODE_FINAL\n#define ") + term, real_);
   setUniform(f, "n", int(groups));
   setUniform(f, "slot", slot);
   partial_.bind(3);

@@ -11,6 +11,7 @@
 
 #include <vector>
 
+#include "core/backend.h"
 #include "gpu/gpu_buffer.h"
 
 namespace morphoflow {
@@ -25,11 +26,12 @@ struct FusedDot {
 class GpuReduction {
  public:
   static constexpr int kSlots = 16;
-  GpuReduction();
+  // Over vectors of `real`s (dot, activeSum).
+  explicit GpuReduction(GpuPrecision real = GpuPrecision::Double);
   // The work groups a sum of n terms is split into (a fixed count for n, at most 256).
   static unsigned groups(size_t n);
 
-  void dot(const GpuBuffer& x, const GpuBuffer& y, size_t n, int slot);       // x . y (double vectors)
+  void dot(const GpuBuffer& x, const GpuBuffer& y, size_t n, int slot);  // x . y
   // The sum of x where diag > 0; partialOnly: its partials only (a kernel after makes the final pass).
   void activeSum(const GpuBuffer& x, const GpuBuffer& diag, size_t n, int slot, bool partialOnly = false);
   void activeCount(const GpuBuffer& diag, size_t n, int slot);
@@ -42,6 +44,7 @@ class GpuReduction {
  private:
   void run(const char* term, const GpuBuffer& x, const GpuBuffer& y, const GpuBuffer& diag, size_t n, int slot,
            bool partialOnly = false);
+  GpuPrecision real_;
   GpuBuffer partial_, scalars_;
 };
 

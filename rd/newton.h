@@ -27,6 +27,9 @@ struct NewtonResult {
 #define LIT(v) v
 #define CONSTEXPR static constexpr
 #define NS n
+#define NT double
+#define NEWTON_TOLERANCE 1e-12
+#define NEWTON_TINY 1e-300
 
 // One cell's solver: n species (at most N), the model's rates(y, r) and jacobian(y, J).
 template <int N, typename Rates, typename Jacobian>
@@ -54,6 +57,9 @@ struct NewtonKernel {
 #undef LIT
 #undef CONSTEXPR
 #undef NS
+#undef NT
+#undef NEWTON_TOLERANCE
+#undef NEWTON_TINY
 
 // Newton iterations per attempt (each start or continuation stage), kernels/newton.inc's.
 inline constexpr int kNewtonMaxIterations = NewtonKernel<1, int, int>::newtonMaxIterations();

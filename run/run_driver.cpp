@@ -11,6 +11,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "core/output_file.h"
+#include "core/parallel.h"
 #include "run/checkpoint.h"
 #include "run/folder_lock.h"
 #include "run/frame_schedule.h"
@@ -23,8 +25,7 @@
 #include "run/steady_state.h"
 #include "run/stop_signal.h"
 #include "run/version.h"
-#include "core/output_file.h"
-#include "core/parallel.h"
+#include "sim/steppers.h"
 
 namespace fs = std::filesystem;
 
@@ -56,6 +57,7 @@ class Driver {
     sinks_ = makeOutputSinks<D>(out_, scene_, [] { return StopSignals::received() != 0; });
     if (checkpoint_) restoreSinks();
     warnOfIdleSources();
+    warnOfRaisedTolerances();
     try {
       return loop();
     } catch (const NonFiniteError& e) {
@@ -69,6 +71,15 @@ class Driver {
   }
 
  private:
+  // A tolerance below what the GPU's float solves reach is raised to that floor (run.json's gpu.tolerances).
+  void warnOfRaisedTolerances() {
+    for (const RaisedTolerance& t : raisedTolerances(scene_, backendNamed(opt_.backend)))
+      log_.warn(
+          fmt::format("warning: {} = {:g} is below what the gpu's float solves reach: {:g} is used (gpu.precision "
+                      "= \"double\" keeps {:g})",
+                      t.key, t.asked, t.used, t.asked));
+  }
+
   // A source whose window opens when this run has ended (a short preview
   // of a longer shot) emits nothing here: said, not refused.
   void warnOfIdleSources() {

@@ -5,9 +5,11 @@
 #include <array>
 #include <cstdint>
 #include <map>
+#include <set>
 #include <string>
 #include <vector>
 
+#include "core/backend.h"
 #include "core/error.h"
 #include "core/spatial_field.h"
 #include "coupling/coupling_choices.h"
@@ -250,7 +252,10 @@ struct Scene {
   double reynolds = 0.0;           // resolved Re = U L / nu
   std::string resolvedJson;        // the scene as resolved (JSON text), for run.json
   SceneTimeline timeline;          // what changes during the run (keyframes, deposits, timed elements)
-  std::map<std::string, KeyRange> numericKeys;  // every numeric key read, with its range (the studio's controls)
+  GpuPrecision gpuPrecision = GpuPrecision::Float;  // gpu.precision
+  std::map<std::string, KeyRange> numericKeys;
+  std::set<std::string> givenKeys;  // the keys the file or an override gave (not defaulted)  // every numeric key read,
+                                    // with its range (the studio's controls)
   long totalSteps() const;         // resolved from steps or duration/dt
 };
 

@@ -101,10 +101,14 @@ Scene parseTree(toml::table& root, const std::string& path, const std::map<std::
   parseCoupling(c, &s);
   parseOutput(c, &s);
   parseDeposits(c, &s);
+  const bool singleOnGpu =
+      r.string(r.table(root, "", "gpu"), "gpu.", "precision", "float", {"float", "double"}) == "float";
+  s.gpuPrecision = singleOnGpu ? GpuPrecision::Float : GpuPrecision::Double;
   checkBackTraces(c, s);
   checkUntilSteady(c, s);
   s.inputs = r.inputs();
   s.numericKeys = r.numericKeys();
+  s.givenKeys = r.givenKeys();
   for (const RDStroke& st : s.rd.strokes) s.timeline.strokeStarts.push_back(st.start);
 
   r.checkUnknown(root, "");

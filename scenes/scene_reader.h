@@ -66,7 +66,9 @@ class Reader {
   const toml::node* node(const toml::table* t, const std::string& prefix, const std::string& key) {
     if (!t) return nullptr;
     known_[t].insert(key);
-    return t->get(key);
+    const toml::node* n = t->get(key);
+    if (n) given_.insert(prefix + key);
+    return n;
   }
 
   double number(const toml::table* t, const std::string& prefix, const std::string& key, double def,
@@ -206,6 +208,7 @@ class Reader {
   const std::vector<SceneInput>& inputs() const { return inputs_; }
   // Every number and array of numbers asked for, with its range and value.
   const std::map<std::string, KeyRange>& numericKeys() const { return numeric_; }
+  const std::set<std::string>& givenKeys() const { return given_; }  // the keys the scene (or --set) gave
 
  private:
   std::string file_;
@@ -214,6 +217,7 @@ class Reader {
   std::map<const toml::table*, std::set<std::string>> known_;
   std::vector<SceneInput> inputs_;
   std::map<std::string, KeyRange> numeric_;
+  std::set<std::string> given_;
 };
 
 // An array of species names of `model` (one of `species`), as indices.

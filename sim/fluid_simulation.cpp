@@ -68,7 +68,7 @@ FluidSimulation<D>::FluidSimulation(const Scene& scene, Backend backend, Warn wa
   checkFluidLeft<D>(scene, fluid_);
   warnOfEmptySources<D>(scene, fluid_, warn_);
   initialiseDye<D>(scene, &fluid_);
-  stepper_ = makeFluidStepper<D>(backend, &fluid_);  // from the state set up here
+  stepper_ = makeFluidStepper<D>(scene, backend, &fluid_);  // from the state set up here
   for (int a = 0; a < D; ++a)
     for (bool hi : {false, true})
       if (scene.fluid.boundaries.side(a, hi).kind == BoundaryKind::Inflow) flowAxis_ = a;

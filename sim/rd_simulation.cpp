@@ -46,7 +46,8 @@ RDSimulation<D>::RDSimulation(const Scene& scene, Backend backend, const Log& lo
       backend_(backend),
       rd_(scene.rd.settings, *findModel(scene.rd.settings.model)),
       host_([this] { stepper_->toHost(&rd_); }) {
-  if (!growCoarseToFine<D>(scene, &rd_, log, &coarseReport_, coarseAdvance<D>(backend))) initialState<D>(scene, &rd_);
+  if (!growCoarseToFine<D>(scene, &rd_, log, &coarseReport_, coarseAdvance<D>(scene, backend)))
+    initialState<D>(scene, &rd_);
   applyScene<D>(scene, &rd_);
   stepper_ = makeLayerStepper<D>(scene, backend, &rd_);  // from the state set up here
 }

@@ -5,6 +5,8 @@
 #pragma once
 
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "coupling/ard_solver.h"
 #include "coupling/coupled_stepper.h"
@@ -21,13 +23,23 @@ namespace morphoflow {
 // device memory). Nothing is allocated before this says yes.
 void checkBackend(const Scene& scene, Backend backend);
 
+// A solver tolerance the scene gives below what the backend's precision
+// reaches (gpu.precision float: gpu/gpu_reals.h toleranceFloor), and the one
+// used (a defaulted one is raised too, unsaid; run.json's gpu.tolerances).
+struct RaisedTolerance {
+  std::string key;
+  double asked, used;
+};
+std::vector<RaisedTolerance> raisedTolerances(const Scene& scene, Backend backend);
+
 // The stepper of `host`, from its current state (which it must outlive).
 template <int D>
-std::unique_ptr<FluidStepper<D>> makeFluidStepper(Backend backend, FluidSolver<D>* host);
+std::unique_ptr<FluidStepper<D>> makeFluidStepper(const Scene& scene, Backend backend, FluidSolver<D>* host);
 
 // The stepper of an RD-only scene's layer `host`, from its current state:
 // the plain explicit step fused (float species), every other step the
-// RDSolver's own; on the GPU, in float or double likewise.
+// RDSolver's own; on the GPU, the explicit step in float, the others in the
+// scene's gpu.precision.
 template <int D>
 std::unique_ptr<LayerStepper<D>> makeLayerStepper(const Scene& scene, Backend backend, RDSolver<D>* host);
 
@@ -38,6 +50,6 @@ std::unique_ptr<CoupledStepper<D>> makeCoupledStepper(const Scene& scene, Backen
 
 // How a coarse-to-fine start steps its coarse levels on the backend.
 template <int D>
-CoarseAdvance<D> coarseAdvance(Backend backend);
+CoarseAdvance<D> coarseAdvance(const Scene& scene, Backend backend);
 
 }  // namespace morphoflow

@@ -1,5 +1,5 @@
 // The chemicals carried by the fluid (coupling/chemical_advection.cpp; seed
-// 001 eq. 18-20), two species in double precision, one invocation a
+// 001 eq. 18-20), two species in REAL (float or REAL), one invocation a
 // reaction-diffusion cell. MODE_ADVECT: the cell centre is traced back
 // through the fluid's MAC velocity (midpoint rule, single precision, in
 // fluid cell units), and both species take their value at the foot, linear
@@ -11,16 +11,16 @@
 // the error-compensated 1.5 S - 0.5 C, C the backward step's values, clamped
 // the same way (chemical_advection.cpp's bfecc). MODE_SOLIDS: solid cells take the
 // solid values. MODE_PREFILTER: one invocation a line along `axis` of the
-// coefficients T0, in place (bspline.cpp's prefilterLine, with the powers
+// coefficients T0, in place (kernels/bspline_prefilter.inc, with the powers
 // of the pole the host computed).
 layout(std430, binding = 0) readonly buffer Vel { float vel[]; };
-layout(std430, binding = 1) readonly buffer S0 { double s0[]; };
-layout(std430, binding = 2) readonly buffer S1 { double s1[]; };
-layout(std430, binding = 3) buffer T0 { double t0[]; };
-layout(std430, binding = 4) buffer T1 { double t1[]; };
+layout(std430, binding = 1) readonly buffer S0 { REAL s0[]; };
+layout(std430, binding = 2) readonly buffer S1 { REAL s1[]; };
+layout(std430, binding = 3) buffer T0 { REAL t0[]; };
+layout(std430, binding = 4) buffer T1 { REAL t1[]; };
 layout(std430, binding = 5) readonly buffer Solid { uint solid[]; };
-layout(std430, binding = 6) readonly buffer C0 { double c0[]; };
-layout(std430, binding = 7) readonly buffer C1 { double c1[]; };
+layout(std430, binding = 6) readonly buffer C0 { REAL c0[]; };
+layout(std430, binding = 7) readonly buffer C1 { REAL c1[]; };
 
 uniform ivec3 cells, periodic, velOff;  // the fluid's
 uniform ivec3 rdCells;
@@ -28,15 +28,18 @@ uniform float c;          // dt / h_fluid
 uniform float r;          // h_rd / h_fluid
 uniform ivec3 inflowLo, inflowHi;
 uniform bool inflow;
-uniform dvec2 inValue, solidValue;
+uniform REAL2 inValue, solidValue;
 uniform bool cubic, spline;
 uniform bool bfecc;       // BFECC's last pass: samples of 1.5 S - 0.5 C (C: the backward step), limited to S's range
 uniform int axis, lines;
-uniform double z, zn, z2n;  // the pole, z^n and z^(2n - 2) along the axis
+uniform REAL z, zn, z2n;  // the pole, z^n and z^(2n - 2) along the axis
 
 #include "mac_sampling.glsl"
-#define WEIGHTS4(name, t, w) void name(double t, precise out double w[4])
+#define WEIGHTS4(name, t, w) void name(REAL t, precise out REAL w[4])
+#define W_REAL REAL
+#ifndef PRECISE
 #define PRECISE precise
+#endif
 #include "interpolation.inc"
 
 // j wrapped into [0, n) (GLSL's % is undefined for negative operands)
@@ -44,17 +47,17 @@ int wrapIndex(int j, int n) { return j >= 0 ? j % n : (n - 1) - ((-j - 1) % n); 
 
 // The sample indices and weights of one axis (axisWeights): linear takes
 // k = 1, 2; cubic k = 0..3 at i - 1 .. i + 2.
-void axisWeights(double x, int n, bool wrap, out int index[4], out double w[4]) {
-  if (!wrap) x = clamp(x, 0.0lf, double(n - 1));
-  const double f = floor(x);
-  precise double t = x - f;
+void axisWeights(REAL x, int n, bool wrap, out int index[4], out REAL w[4]) {
+  if (!wrap) x = clamp(x, REAL(0.0), REAL(n - 1));
+  const REAL f = floor(x);
+  precise REAL t = x - f;
   const int i = int(f);
   for (int k = 0; k < 4; ++k) {
     const int j = i - 1 + k;
     index[k] = wrap ? wrapIndex(j, n) : clamp(j, 0, n - 1);
   }
   if (!cubic) {
-    w[0] = 0.0lf; w[1] = 1.0lf - t; w[2] = t; w[3] = 0.0lf;
+    w[0] = REAL(0.0); w[1] = REAL(1.0) - t; w[2] = t; w[3] = REAL(0.0);
     return;
   }
   catmullRomWeights(t, w);
@@ -62,9 +65,9 @@ void axisWeights(double x, int n, bool wrap, out int index[4], out double w[4]) 
 
 // The spline's indices along an axis (splineAxis): i - 1 .. i + 2 mirrored
 // at walls or wrapped, the linear neighbours i0, i1 and the fraction t.
-void splineAxis(double x, int n, bool wrap, out int index[4], out int i0, out int i1, out double t) {
-  if (!wrap) x = clamp(x, 0.0lf, double(n - 1));
-  const double f = floor(x);
+void splineAxis(REAL x, int n, bool wrap, out int index[4], out int i0, out int i1, out REAL t) {
+  if (!wrap) x = clamp(x, REAL(0.0), REAL(n - 1));
+  const REAL f = floor(x);
   t = x - f;
   const int i = int(f);
   for (int k = 0; k < 4; ++k) {
@@ -85,6 +88,11 @@ void splineAxis(double x, int n, bool wrap, out int index[4], out int i0, out in
 }
 
 #if defined(MODE_PREFILTER)
+#define BS_REAL REAL
+#define BS_LINE int base, int stride
+#define BS_AT(k) t0[base + stride * (k)]
+#include "bspline_prefilter.inc"
+
 void main() {
   const int line = flatIndex();
   if (line >= lines) return;
@@ -100,38 +108,7 @@ void main() {
   }
   const int base = indexOf(start, rdCells);
   const int stride = axis == 0 ? 1 : axis == 1 ? rdCells.x : rdCells.x * rdCells.y;
-  const bool wrap = periodic[axis] != 0;
-  precise double zk = 1.0lf, sum = 0.0lf;
-  if (wrap) {
-    for (int k = 0; k < n; ++k) { sum += zk * t0[base + stride * ((n - k) % n)]; zk *= z; }
-    t0[base] = sum / (1.0lf - zn);
-  } else {
-    for (int k = 0; k < n; ++k) { sum += zk * t0[base + stride * k]; zk *= z; }
-    precise double back = 0.0lf, zb = zn;
-    for (int k = n - 2; k >= 1; --k) { back += zb * t0[base + stride * k]; zb *= z; }
-    t0[base] = (sum + back) / (1.0lf - z2n);
-  }
-  for (int k = 1; k < n; ++k) {
-    precise double v = t0[base + stride * k] + z * t0[base + stride * (k - 1)];
-    t0[base + stride * k] = v;
-  }
-  if (wrap) {
-    precise double s = 0.0lf;
-    zk = 1.0lf;
-    for (int k = 0; k < n; ++k) { s += zk * t0[base + stride * ((n - 1 + k) % n)]; zk *= z; }
-    t0[base + stride * (n - 1)] = -z * s / (1.0lf - zn);
-  } else {
-    precise double e = z / (z * z - 1.0lf) * (t0[base + stride * (n - 1)] + z * t0[base + stride * (n - 2)]);
-    t0[base + stride * (n - 1)] = e;
-  }
-  for (int k = n - 2; k >= 0; --k) {
-    precise double v = z * (t0[base + stride * (k + 1)] - t0[base + stride * k]);
-    t0[base + stride * k] = v;
-  }
-  for (int k = 0; k < n; ++k) {
-    precise double v = t0[base + stride * k] * 6.0lf;
-    t0[base + stride * k] = v;
-  }
+  bsplinePrefilterLine(base, stride, n, periodic[axis] != 0, z, zn, z2n);
 }
 #else
 void main() {
@@ -150,78 +127,78 @@ void main() {
   for (int a = 0; a < DIM; ++a) m[a] = p[a] - (0.5 * c) * velocityAt(a, p);
   const float invR = 1.0 / r;
   for (int a = 0; a < DIM; ++a) foot[a] = (p[a] - c * velocityAt(a, m)) * invR - 0.5;
-  double w = 0.0lf;
+  REAL w = REAL(0.0);
   if (inflow)
     for (int a = 0; a < DIM; ++a) {
-      const double x = double(foot[a]);
-      if (inflowLo[a] != 0) w = max(w, clamp(-2.0lf * x, 0.0lf, 1.0lf));
-      if (inflowHi[a] != 0) w = max(w, clamp(2.0lf * (x - double(rdCells[a] - 1)), 0.0lf, 1.0lf));
+      const REAL x = REAL(foot[a]);
+      if (inflowLo[a] != 0) w = max(w, clamp(-REAL(2.0) * x, REAL(0.0), REAL(1.0)));
+      if (inflowHi[a] != 0) w = max(w, clamp(REAL(2.0) * (x - REAL(rdCells[a] - 1)), REAL(0.0), REAL(1.0)));
     }
-  if (w >= 1.0lf) {
+  if (w >= REAL(1.0)) {
     t0[i] = inValue.x;
     t1[i] = inValue.y;
     return;
   }
   if (spline) {
     int sidx[3][4], i0[3], i1[3];
-    double sw[3][4];
+    REAL sw[3][4];
     for (int a = 0; a < 3; ++a) {
       if (a < DIM) {
-        double t;
-        splineAxis(double(foot[a]), rdCells[a], periodic[a] != 0, sidx[a], i0[a], i1[a], t);
+        REAL t;
+        splineAxis(REAL(foot[a]), rdCells[a], periodic[a] != 0, sidx[a], i0[a], i1[a], t);
         bsplineWeights(t, sw[a]);
       } else {
-        for (int q = 0; q < 4; ++q) { sidx[a][q] = 0; sw[a][q] = 1.0lf; }
+        for (int q = 0; q < 4; ++q) { sidx[a][q] = 0; sw[a][q] = REAL(1.0); }
         i0[a] = 0;
         i1[a] = 0;
       }
     }
-    precise dvec2 ssum = dvec2(0.0lf);
+    precise REAL2 ssum = REAL2(REAL(0.0));
     for (int kz = 0; kz < (DIM == 3 ? 4 : 1); ++kz)
       for (int ky = 0; ky < 4; ++ky)
         for (int kx = 0; kx < 4; ++kx) {
           const int at = sidx[0][kx] + rdCells.x * (sidx[1][ky] + rdCells.y * sidx[2][kz]);
-          precise double wk = sw[0][kx] * sw[1][ky];
+          precise REAL wk = sw[0][kx] * sw[1][ky];
           if (DIM == 3) wk = wk * sw[2][kz];
-          ssum += wk * dvec2(c0[at], c1[at]);
+          ssum += wk * REAL2(c0[at], c1[at]);
         }
-    dvec2 slo = dvec2(1e300lf), shi = dvec2(-1e300lf);
+    REAL2 slo = REAL2(REAL_HUGE), shi = REAL2(-REAL_HUGE);
     for (int q = 0; q < (1 << DIM); ++q) {
       const int at = ((q & 1) != 0 ? i1[0] : i0[0]) + rdCells.x * (((q & 2) != 0 ? i1[1] : i0[1]) +
                                                                   rdCells.y * ((q & 4) != 0 ? i1[2] : i0[2]));
-      const dvec2 v = dvec2(s0[at], s1[at]);
+      const REAL2 v = REAL2(s0[at], s1[at]);
       slo = min(slo, v);
       shi = max(shi, v);
     }
     ssum = clamp(ssum, slo, shi);
-    precise dvec2 sout = w * inValue + (1.0lf - w) * ssum;
+    precise REAL2 sout = w * inValue + (REAL(1.0) - w) * ssum;
     t0[i] = sout.x;
     t1[i] = sout.y;
     return;
   }
   int idx[3][4];
-  double wt[3][4];
+  REAL wt[3][4];
   for (int a = 0; a < 3; ++a) {
     if (a < DIM) {
-      axisWeights(double(foot[a]), rdCells[a], periodic[a] != 0, idx[a], wt[a]);
+      axisWeights(REAL(foot[a]), rdCells[a], periodic[a] != 0, idx[a], wt[a]);
     } else {
-      for (int q = 0; q < 4; ++q) { idx[a][q] = 0; wt[a][q] = q == 1 ? 1.0lf : 0.0lf; }
+      for (int q = 0; q < 4; ++q) { idx[a][q] = 0; wt[a][q] = q == 1 ? REAL(1.0) : REAL(0.0); }
     }
   }
   const int first = cubic ? 0 : 1, count = cubic ? 4 : 2;
   const int nx = rdCells.x, ny = rdCells.y;
-  precise dvec2 sum = dvec2(0.0lf);
-  dvec2 lo = dvec2(1e300lf), hi = dvec2(-1e300lf);
+  precise REAL2 sum = REAL2(REAL(0.0));
+  REAL2 lo = REAL2(REAL_HUGE), hi = REAL2(-REAL_HUGE);
   const int kz0 = DIM == 3 ? first : 1, kz1 = DIM == 3 ? first + count : 2;
   for (int kz = kz0; kz < kz1; ++kz)
     for (int ky = first; ky < first + count; ++ky)
       for (int kx = first; kx < first + count; ++kx) {
         const int at = idx[0][kx] + nx * (idx[1][ky] + ny * idx[2][kz]);
-        precise double wk = wt[0][kx] * wt[1][ky];
+        precise REAL wk = wt[0][kx] * wt[1][ky];
         if (DIM == 3) wk = wk * wt[2][kz];
-        const dvec2 v = dvec2(s0[at], s1[at]);
+        const REAL2 v = REAL2(s0[at], s1[at]);
         if (bfecc) {
-          precise dvec2 corrected = 1.5lf * v - 0.5lf * dvec2(c0[at], c1[at]);
+          precise REAL2 corrected = REAL(1.5) * v - REAL(0.5) * REAL2(c0[at], c1[at]);
           sum += wk * corrected;
         } else {
           sum += wk * v;
@@ -232,7 +209,7 @@ void main() {
         }
       }
   if (cubic || bfecc) sum = clamp(sum, lo, hi);  // no new extrema
-  precise dvec2 out_ = w * inValue + (1.0lf - w) * sum;
+  precise REAL2 out_ = w * inValue + (REAL(1.0) - w) * sum;
   t0[i] = out_.x;
   t1[i] = out_.y;
 #endif

@@ -9,9 +9,15 @@ layout(std430, binding = 3) buffer F0 { float f0[]; };   // dye; src; ...
 layout(std430, binding = 4) buffer F1 { float f1[]; };   // back
 layout(std430, binding = 5) buffer F2 { float f2[]; };   // lo
 layout(std430, binding = 6) buffer F3 { float f3[]; };   // hi
-layout(std430, binding = 7) buffer D0 { double d0[]; };  // rhs / phi / b
-layout(std430, binding = 8) buffer D1 { double d1[]; };  // rate_prev / x / boundary rhs
-layout(std430, binding = 9) buffer D2 { double d2[]; };  // boundary rhs
+#if !defined(D0_REAL)
+#define D0_REAL REAL
+#endif
+layout(std430, binding = 7) buffer D0 { D0_REAL d0[]; };  // rhs / phi (XREAL) / b (REAL: the solver vectors')
+#if !defined(D1_REAL)
+#define D1_REAL REAL
+#endif
+layout(std430, binding = 8) buffer D1 { D1_REAL d1[]; };  // rate_prev (float) / x / boundary rhs
+layout(std430, binding = 9) buffer D2 { REAL d2[]; };  // boundary rhs
 layout(std430, binding = 10) readonly buffer Solid { uint solid[]; };
 layout(std430, binding = 11) buffer F4 { float f4[]; };  // hi
 layout(std430, binding = 12) readonly buffer Open { float open[]; };  // the faces' open fractions
@@ -23,7 +29,8 @@ uniform ivec3 udims;        // MODE_VISCOUS_*: the unknowns (faces less a period
 uniform int blockOff;       // MODE_VISCOUS_*: the component's first unknown in b and x (one block system)
 uniform float fa, fb;       // MODE_FORCES: dt f_a, dt b dir_a
 uniform int f1Off, dstOff;  // offsets into f1 / f0 (MODE_MACCORMACK / BFECC)
-uniform double invH, dt, lastDt, s;
+uniform XREAL invH, dt, invLastDt;  // the projection's (in its solution's type)
+uniform REAL s;
 uniform bool extrapolate;
 uniform ivec4 inflow;       // MODE_INFLOW_DYE: axis, high side, across axis, stripes
 

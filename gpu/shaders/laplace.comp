@@ -7,16 +7,21 @@
 // MODE_SMOOTH: one colour of a red-black Gauss-Seidel sweep,
 // x_i = (b_i / scale + sum_f w_f x_j) / diag_i; MODE_JACOBI: y = x + omega
 // (that update - x) (levels whose odd periodic axis mixes the colours).
-// REAL is double for the PCG vectors, float for the multigrid levels.
+// REAL (the host's) is the PCG vectors' precision, float for the multigrid
+// levels; sums are accumulated in double from exact products.
 // CROSS (apply and residual): the mixed terms of a tensor diffusion operator
 // (core/anisotropic_system.h), pair couplings K (x_i - x_q) with the four
 // diagonal neighbours in each plane; the preconditioners take the axis part.
-// DOT_PARTIAL (apply and residual, double): with the partial pass of the
+// DOT_PARTIAL (apply and residual): with the partial pass of the
 // dot product the PCG takes next (see main).
 // BLOCK (apply and residual): a block-diagonal system of up to 4 systems in
 // one vector (gpu_laplace.h), block k's cells from blockStart[k], each with
 // its own dims and scale: several systems solved as one.
+#if defined(MODE_RESIDUAL)
+layout(std430, binding = 0) buffer X { XREAL x[]; };  // the solution (XREAL)
+#else
 layout(std430, binding = 0) buffer X { REAL x[]; };
+#endif
 layout(std430, binding = 1) buffer Y { REAL y[]; };
 #if defined(MODE_RESIDUAL) && defined(DOT_PARTIAL)
 layout(std430, binding = 2) buffer B { REAL b[]; };  // (made mean-free in place)
@@ -90,8 +95,8 @@ float weight(int a, int i) { return a == 0 ? w0[base_ + i] : a == 1 ? w1[base_ +
 // with CROSS): A is applied to p' = z + beta p (b holds z, x holds p),
 // computed where it is read as OP_UPDATE_P computes it, and p' is written.
 // P_FIRST: the first iteration's, p' = z.
-layout(std430, binding = 8) buffer PNew { double pNew[]; };
-double beta_ = 0.0lf;
+layout(std430, binding = 8) buffer PNew { REAL pNew[]; };
+REAL beta_ = REAL(0);
 #if defined(P_FIRST)
 #define LX(i) b[base_ + (i)]
 #else
@@ -101,23 +106,32 @@ double beta_ = 0.0lf;
 #define LX(i) x[base_ + (i)]
 #endif
 #define LW(a, i) weight(a, i)
+// The residual is evaluated in double from the REAL vectors (exact for the
+// x a float solve holds, so its stopping test and reported residual are
+// those of the stored solution); the rest in REAL.
+#if defined(MODE_RESIDUAL)
+#define OP_REAL double
+#else
+#define OP_REAL REAL
+#endif
+#define STENCIL_REAL OP_REAL
 #include "laplace_stencil.glsl"
 
 #if defined(MODE_APPLY) || defined(MODE_RESIDUAL)
 // A x at active cell i of the current block (enterBlock).
-REAL axAt(int i) {
+OP_REAL axAt(int i) {
   const ivec3 c = coordsOf(i, dims);
-  precise REAL ax = operatorTerm(c, i, dims, scale, cTerm[base_ + i]);
+  precise OP_REAL ax = operatorTerm(c, i, dims, scale, cTerm[base_ + i]);
 #if defined(CROSS)
-  ax += REAL(scale) * crossSum(c, i);
+  ax += OP_REAL(scale) * OP_REAL(crossSum(c, i));
 #endif
   return ax;
 }
 
 // A x (MODE_APPLY) or b - A x (MODE_RESIDUAL, b = bi) at cell i of the
 // current block; 0 on inactive cells.
-REAL operatorAt(int i, REAL bi) {
-  if (diag[base_ + i] <= 0.0) return REAL(0);
+OP_REAL operatorAt(int i, OP_REAL bi) {
+  if (diag[base_ + i] <= 0.0) return OP_REAL(0);
 #if defined(MODE_APPLY)
   return axAt(i);
 #else
@@ -161,7 +175,7 @@ uniform ivec4 pSlots;
 uniform ivec4 extra;  // (CROSS: the mixed terms take zOut's binding; extra.y < 0)
 uniform ivec2 mean;
 #if !defined(CROSS)
-layout(std430, binding = 8) buffer ZOut { double zOut[]; };
+layout(std430, binding = 8) buffer ZOut { REAL zOut[]; };
 #endif
 #endif
 
@@ -170,7 +184,7 @@ void main() {
   const int groups = int(gl_NumWorkGroups.x);
   const double rzNew = finalSum(pSlots.x, groups);
 #if !defined(P_FIRST)
-  beta_ = rzNew / S[pSlots.y];
+  beta_ = REAL(rzNew / S[pSlots.y]);
 #endif
 #endif
   double s = 0.0lf;
@@ -187,35 +201,35 @@ void main() {
 #if defined(MODE_RESIDUAL)
     REAL bi = b[i];
 #if defined(MEAN_FREE)  // (b is read at i only)
-    bi = diag[i] > 0.0 ? bi - bSum / S[mean.y] : REAL(0);
+    bi = diag[i] > 0.0 ? bi - REAL(bSum / S[mean.y]) : REAL(0);
     b[i] = bi;
 #endif
-    REAL v;
+    OP_REAL v;
     if (noRhs) {
-      x[i] = REAL(0);
-      v = diag[i] <= 0.0 ? REAL(0) : bi;
+      x[i] = XREAL(0);
+      v = diag[i] <= 0.0 ? OP_REAL(0) : bi;
     } else {
       v = operatorAt(li, bi);
     }
 #else
     const REAL v = operatorAt(li, REAL(0));
 #endif
-    y[i] = v;
+    y[i] = REAL(v);
 #if defined(P_UPDATE)
-    const double pi = LX(li);
+    const REAL pi = LX(li);
     pNew[i] = pi;
-    s = s + pi * v;
+    s = s + double(pi) * double(v);
 #elif defined(MODE_APPLY)
-    s = s + x[i] * v;
+    s = s + double(x[i]) * double(v);
 #else
-    s = s + v * v;
-    if (extra.x >= 0) bb = bb + bi * bi;
-    if (extra.w >= 0) xs = xs + (diag[i] > 0.0 ? (noRhs ? 0.0lf : x[i]) : 0.0lf);
+    s = s + double(v) * double(v);  // (the residual's own terms, before it is rounded to REAL)
+    if (extra.x >= 0) bb = bb + double(bi) * double(bi);
+    if (extra.w >= 0) xs = xs + (diag[i] > 0.0 ? (noRhs ? 0.0lf : double(x[i])) : 0.0lf);
 #if !defined(CROSS)
     if (extra.y >= 0) {
-      const double zi = diag[i] > 0.0 ? v / double(diag[i]) : 0.0lf;
+      const REAL zi = diag[i] > 0.0 ? REAL(v) / REAL(diag[i]) : REAL(0);
       zOut[i] = zi;
-      rz = rz + v * zi;
+      rz = rz + double(REAL(v)) * double(zi);
     }
 #endif
 #endif

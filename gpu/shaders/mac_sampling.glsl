@@ -34,15 +34,17 @@ void corners(Tap t[3], ivec3 d, out int idx[8]) {
     idx[k] = indexOf(ivec3((k & 1) != 0 ? t[0].hi : t[0].lo, (k & 2) != 0 ? t[1].hi : t[1].lo,
                            (k & 4) != 0 ? t[2].hi : t[2].lo), d);
 }
-// `precise`: no fused multiply-adds, so each operation rounds as the CPU's does.
+// kernels/multilinear.inc in float; `precise`: no fused multiply-adds, so
+// each operation rounds as the CPU's does.
+#define ML_FN float
+#define ML_T float
+#ifndef PRECISE
+#define PRECISE precise
+#endif
+#include "multilinear.inc"
 float blend(float v[8], Tap t[3]) {
-  precise float a0 = v[0] + t[0].t * (v[1] - v[0]), a1 = v[2] + t[0].t * (v[3] - v[2]);
-  precise float y0 = a0 + t[1].t * (a1 - a0);
-  if (DIM == 2) return y0;
-  precise float b0 = v[4] + t[0].t * (v[5] - v[4]), b1 = v[6] + t[0].t * (v[7] - v[6]);
-  precise float y1 = b0 + t[1].t * (b1 - b0);
-  precise float r = y0 + t[2].t * (y1 - y0);
-  return r;
+  if (DIM == 2) return bilinear(v[0], v[1], v[2], v[3], t[0].t, t[1].t);
+  return trilinear(v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], t[0].t, t[1].t, t[2].t);
 }
 
 // Velocity component a at p: on its faces along a, at centres along the others.

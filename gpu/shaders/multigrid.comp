@@ -23,7 +23,7 @@ layout(std430, binding = 8) readonly buffer W2 { float w2[]; };
 layout(std430, binding = 9) readonly buffer FineDiag { float fineDiag[]; };
 layout(std430, binding = 10) readonly buffer FineC { float fineC[]; };
 uniform double fineScale;
-#define REAL float
+#define STENCIL_REAL float
 #define LX(i) fineX[i]
 #define LW(a, i) ((a) == 0 ? w0[i] : (a) == 1 ? w1[i] : w2[i])
 #include "laplace_stencil.glsl"

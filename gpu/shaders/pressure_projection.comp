@@ -1,32 +1,41 @@
-// The projection's stages besides its solve (fluid/pressure_projection.cpp), one MODE each.
+// The projection's stages besides its solve (fluid/pressure_projection.cpp), one MODE each,
+// the formulas kernels/pressure_projection.inc's, in XREAL (the solve's solution type):
 // MODE_DIVERGENCE       rhs = -(div u) / h through the faces' open fractions, 0 in cells
-//                       without a pressure (double)
+//                       without a pressure
 // MODE_WARM_START       phi = dt (2 rate - rate_prev) (or dt rate), rate = phi / last dt
+//                       (rate_prev in float, as the CPU keeps it)
 // MODE_GRADIENT         u_a -= d phi / d x_a on free faces (outflow: ghost phi = -phi)
+#if !defined(MODE_DIVERGENCE)
+#define D0_REAL XREAL  // phi, the pressure solve's solution
+#endif
+#define D1_REAL float  // rate_prev
 #include "fluid_faces.glsl"
+#define PP_FN XREAL
+#define PP_REAL XREAL
+#include "pressure_projection.inc"
 
 void main() {
   const int i = flatIndex();
   if (i >= n) return;
 #if defined(MODE_DIVERGENCE)
   const ivec3 k = coordsOf(i, cells);
-  double d = 0.0lf;
+  XREAL d = XREAL(0);
   for (int a = 0; a < DIM; ++a) {
     ivec3 fd = cells, up = k;
     fd[a] += 1;
     up[a] += 1;
     const int hi = velOff[a] + indexOf(up, fd), lo = velOff[a] + indexOf(k, fd);
 #if defined(CUT_FACES)  // a cut obstacle's faces: the flux through their open part
-    d += double(open[hi]) * double(vel[hi]) - double(open[lo]) * double(vel[lo]);
+    d += ppAxisFlux(XREAL(open[hi]), XREAL(vel[hi]), XREAL(open[lo]), XREAL(vel[lo]));
 #else
-    d += double(vel[hi]) - double(vel[lo]);
+    d += ppAxisFlux(XREAL(1), XREAL(vel[hi]), XREAL(1), XREAL(vel[lo]));
 #endif
   }
-  d0[i] = solid[i] != 0u ? 0.0lf : d * -invH;  // (solid: the cells without a pressure)
+  d0[i] = solid[i] != 0u ? REAL(0) : REAL(d * -invH);  // (solid: the cells without a pressure)
 #elif defined(MODE_WARM_START)  // d0 = phi, d1 = rate_prev
-  const double rate = d0[i] / lastDt;
-  d0[i] = dt * (extrapolate ? 2.0lf * rate - d1[i] : rate);
-  d1[i] = rate;
+  const XREAL rate = d0[i] * invLastDt;
+  d0[i] = ppWarmStart(rate, XREAL(d1[i]), dt, extrapolate);
+  d1[i] = float(rate);
 #elif defined(MODE_GRADIENT)  // d0 = phi
   if (fixedFace[velOff[axis] + i] != 0u) return;
   const ivec3 k = coordsOf(i, faceDims());
@@ -36,7 +45,7 @@ void main() {
     if (lo[axis] < 0) lo[axis] += cells[axis];
     if (hi[axis] >= cells[axis]) hi[axis] -= cells[axis];
   }
-  double pl, ph;
+  XREAL pl, ph;
   if (lo[axis] < 0) {  // outflow on the low side: ghost phi = -phi
     ph = d0[indexOf(hi, cells)];
     pl = -ph;
@@ -47,6 +56,6 @@ void main() {
     pl = d0[indexOf(lo, cells)];
     ph = d0[indexOf(hi, cells)];
   }
-  vel[velOff[axis] + i] = float(double(vel[velOff[axis] + i]) - (ph - pl) * invH);
+  vel[velOff[axis] + i] = float(ppProjectedFace(XREAL(vel[velOff[axis] + i]), pl, ph, invH));
 #endif
 }

@@ -1,12 +1,12 @@
-// Deterministic sums in double: MODE_PARTIAL has each of the dispatch's
+// Deterministic sums in double (of REAL vectors, products exact): MODE_PARTIAL has each of the dispatch's
 // (fixed number of) work groups sum a fixed, strided share of the terms in
 // a fixed tree order into partial[slot * 256 + group]; MODE_FINAL sums those
 // partials the same way in one work group into scalars[slot] (kernels that
 // make the terms can do the partial pass themselves: fused_sum.glsl). Terms (MODE_PARTIAL):
 // TERM_DOT x_i y_i, TERM_ACTIVE_SUM x_i where diag_i > 0, TERM_ACTIVE_COUNT
 // 1 where diag_i > 0, TERM_MAX_ABS |f_i| (a float vector, combined by max).
-layout(std430, binding = 0) readonly buffer X { double x[]; };
-layout(std430, binding = 1) readonly buffer Y { double y[]; };
+layout(std430, binding = 0) readonly buffer X { REAL x[]; };
+layout(std430, binding = 1) readonly buffer Y { REAL y[]; };
 layout(std430, binding = 2) readonly buffer Diag { float diag[]; };
 layout(std430, binding = 3) buffer Partial { double partial[]; };
 layout(std430, binding = 4) buffer Scalars { double scalars[]; };
@@ -25,11 +25,11 @@ shared double sums[256];
 
 double term(int i) {
 #if defined(TERM_DOT)
-  return x[i] * y[i];
+  return double(x[i]) * double(y[i]);
 #elif defined(TERM_MAX_ABS)
   return double(abs(fl[i]));
 #elif defined(TERM_ACTIVE_SUM)
-  return diag[i] > 0.0 ? x[i] : 0.0lf;
+  return diag[i] > 0.0 ? double(x[i]) : 0.0lf;
 #else
   return diag[i] > 0.0 ? 1.0lf : 0.0lf;
 #endif

@@ -20,10 +20,13 @@ layout(std430, binding = 6) buffer Omega { float omega[]; };  // W components, t
 
 uniform ivec3 cells, periodic, velOff;
 uniform int axis, n;  // the component a (MODE_INJECT, MODE_ADD_FACES); samples the mode runs over
-uniform double dRho, dT, value, alpha, beta, ambient, s, h, dt, keepRho, keepT;
-uniform dvec3 up;
+uniform REAL dRho, dT, value, alpha, beta, ambient, s, h, dt, keepRho, keepT;
+uniform REAL3 up;
 
-#define SMOKE_FN(name) double name
+#define SMOKE_FN(name) REAL name
+#define SMOKE_F(name) float name
+#define SMOKE_REAL REAL
+#define SMOKE_SQRT sqrt
 #include "smoke_physics.inc"
 
 ivec3 faceDims() { ivec3 d = cells; d[axis] += 1; return d; }
@@ -46,13 +49,13 @@ void neighbours(ivec3 k, int a, out int lo, out int hi, out int span) {
 }
 
 // d (field at offset off) / d x_a at cell k.
-double derivative(ivec3 k, int a, int which, int off) {
+REAL derivative(ivec3 k, int a, int which, int off) {
   int lo, hi, span;
   neighbours(k, a, lo, hi, span);
-  if (span == 0) return 0.0lf;
-  const double flo = which == 0 ? double(centre[off + lo]) : double(omega[off + lo]);
-  const double fhi = which == 0 ? double(centre[off + hi]) : double(omega[off + hi]);
-  return (fhi - flo) / (double(span) * h);
+  if (span == 0) return REAL(0.0);
+  const REAL flo = which == 0 ? REAL(centre[off + lo]) : REAL(omega[off + lo]);
+  const REAL fhi = which == 0 ? REAL(centre[off + hi]) : REAL(omega[off + hi]);
+  return smokeDifference(flo, fhi, REAL(span) * h);
 }
 
 void main() {
@@ -61,18 +64,18 @@ void main() {
 #if defined(MODE_EMIT)
   const float c = cover[i];
   if (c == 0.0) return;
-  if (dRho != 0.0lf) smoke[i] = float(double(smoke[i]) + dRho * double(c));
-  if (dT != 0.0lf) temp[i] = float(double(temp[i]) + dT * double(c));
+  if (dRho != REAL(0.0)) smoke[i] = float(REAL(smoke[i]) + dRho * REAL(c));
+  if (dT != REAL(0.0)) temp[i] = float(REAL(temp[i]) + dT * REAL(c));
 #elif defined(MODE_INJECT)
   const ivec3 k = coordsOf(i, faceDims());
   ivec3 lo = k;
   lo[axis] -= 1;
-  const double cl = lo[axis] >= 0 ? double(cover[indexOf(lo, cells)]) : 0.0lf;
-  const double ch = k[axis] < cells[axis] ? double(cover[indexOf(k, cells)]) : 0.0lf;
-  const double w = 0.5lf * (cl + ch);
-  if (w > 0.0lf) vel[velOff[axis] + i] = float(coverBlend(double(vel[velOff[axis] + i]), w, value));
+  const REAL cl = lo[axis] >= 0 ? REAL(cover[indexOf(lo, cells)]) : REAL(0.0);
+  const REAL ch = k[axis] < cells[axis] ? REAL(cover[indexOf(k, cells)]) : REAL(0.0);
+  const REAL w = REAL(0.5) * (cl + ch);
+  if (w > REAL(0.0)) vel[velOff[axis] + i] = float(coverBlend(REAL(vel[velOff[axis] + i]), w, value));
 #elif defined(MODE_BUOYANCY)
-  const double b = smokeBuoyancy(double(smoke[i]), double(temp[i]), alpha, beta, ambient);
+  const REAL b = smokeBuoyancy(REAL(smoke[i]), REAL(temp[i]), alpha, beta, ambient);
   for (int a = 0; a < DIM; ++a) force[a * n + i] = float(b * up[a]);
 #elif defined(MODE_CENTRE)
   const ivec3 k = coordsOf(i, cells);
@@ -81,44 +84,44 @@ void main() {
     d[a] += 1;
     ivec3 k1 = k;
     k1[a] += 1;
-    centre[a * n + i] = 0.5 * (vel[velOff[a] + indexOf(k, d)] + vel[velOff[a] + indexOf(k1, d)]);
+    centre[a * n + i] = faceMean(vel[velOff[a] + indexOf(k, d)], vel[velOff[a] + indexOf(k1, d)]);
   }
 #elif defined(MODE_VORTICITY)
   const ivec3 k = coordsOf(i, cells);
 #if DIM == 2
-  const double o = derivative(k, 0, 0, n) - derivative(k, 1, 0, 0);
+  const REAL o = derivative(k, 0, 0, n) - derivative(k, 1, 0, 0);
   omega[i] = float(o);
   omega[n + i] = float(abs(o));
 #else
-  const double o0 = derivative(k, 1, 0, 2 * n) - derivative(k, 2, 0, n);
-  const double o1 = derivative(k, 2, 0, 0) - derivative(k, 0, 0, 2 * n);
-  const double o2 = derivative(k, 0, 0, n) - derivative(k, 1, 0, 0);
+  const REAL o0 = derivative(k, 1, 0, 2 * n) - derivative(k, 2, 0, n);
+  const REAL o1 = derivative(k, 2, 0, 0) - derivative(k, 0, 0, 2 * n);
+  const REAL o2 = derivative(k, 0, 0, n) - derivative(k, 1, 0, 0);
   omega[i] = float(o0);
   omega[n + i] = float(o1);
   omega[2 * n + i] = float(o2);
-  omega[3 * n + i] = float(sqrt(o0 * o0 + o1 * o1 + o2 * o2));
+  omega[3 * n + i] = float(vectorLength(o0, o1, o2));
 #endif
 #elif defined(MODE_CONFINE)
   const ivec3 k = coordsOf(i, cells);
   const int W = DIM == 2 ? 1 : 3;
-  double eta[3] = double[3](0.0lf, 0.0lf, 0.0lf);
-  double len2 = 0.0lf;
+  REAL eta[3] = REAL[3](REAL(0.0), REAL(0.0), REAL(0.0));
+  REAL len2 = REAL(0.0);
   for (int a = 0; a < DIM; ++a) {
     eta[a] = derivative(k, a, 1, W * n);
     len2 += eta[a] * eta[a];
   }
-  if (!(len2 > 1e-300lf)) return;
-  const double inv = 1.0lf / sqrt(len2);
-  const double N0 = eta[0] * inv, N1 = eta[1] * inv, N2 = eta[2] * inv;
+  if (!(len2 > REAL_TINY)) return;
+  const REAL inv = inverseLength(len2);
+  const REAL N0 = eta[0] * inv, N1 = eta[1] * inv, N2 = eta[2] * inv;
 #if DIM == 2
-  const double w0 = double(omega[i]);
-  force[i] = float(double(force[i]) + double(float(confinementTerm(s, N1, w0, 0.0lf, 0.0lf))));
-  force[n + i] = float(double(force[n + i]) + double(float(confinementTerm(s, 0.0lf, 0.0lf, N0, w0))));
+  const REAL w0 = REAL(omega[i]);
+  force[i] = float(REAL(force[i]) + REAL(float(confinementTerm(s, N1, w0, REAL(0.0), REAL(0.0)))));
+  force[n + i] = float(REAL(force[n + i]) + REAL(float(confinementTerm(s, REAL(0.0), REAL(0.0), N0, w0))));
 #else
-  const double w0 = double(omega[i]), w1 = double(omega[n + i]), w2 = double(omega[2 * n + i]);
-  force[i] = float(double(force[i]) + double(float(confinementTerm(s, N1, w2, N2, w1))));
-  force[n + i] = float(double(force[n + i]) + double(float(confinementTerm(s, N2, w0, N0, w2))));
-  force[2 * n + i] = float(double(force[2 * n + i]) + double(float(confinementTerm(s, N0, w1, N1, w0))));
+  const REAL w0 = REAL(omega[i]), w1 = REAL(omega[n + i]), w2 = REAL(omega[2 * n + i]);
+  force[i] = float(REAL(force[i]) + REAL(float(confinementTerm(s, N1, w2, N2, w1))));
+  force[n + i] = float(REAL(force[n + i]) + REAL(float(confinementTerm(s, N2, w0, N0, w2))));
+  force[2 * n + i] = float(REAL(force[2 * n + i]) + REAL(float(confinementTerm(s, N0, w1, N1, w0))));
 #endif
 #elif defined(MODE_ADD_FACES)
   const ivec3 k = coordsOf(i, faceDims());
@@ -127,10 +130,11 @@ void main() {
   lo[axis] -= 1;
   if (lo[axis] < 0) lo[axis] = periodic[axis] != 0 ? cells[axis] - 1 : 0;
   if (hi[axis] >= cells[axis]) hi[axis] = periodic[axis] != 0 ? 0 : cells[axis] - 1;
-  const float halfDt = float(0.5lf * dt);
-  vel[velOff[axis] + i] += halfDt * (force[axis * nc + indexOf(lo, cells)] + force[axis * nc + indexOf(hi, cells)]);
+  const float halfDt = float(REAL(0.5) * dt);
+  const float fl = force[axis * nc + indexOf(lo, cells)], fh = force[axis * nc + indexOf(hi, cells)];
+  vel[velOff[axis] + i] += faceForce(halfDt, fl, fh);
 #elif defined(MODE_DECAY)
-  if (keepRho != 1.0lf) smoke[i] = float(decayed(double(smoke[i]), keepRho, 0.0lf));
-  if (keepT != 1.0lf) temp[i] = float(decayed(double(temp[i]), keepT, ambient));
+  if (keepRho != REAL(1.0)) smoke[i] = float(decayed(REAL(smoke[i]), keepRho, REAL(0.0)));
+  if (keepT != REAL(1.0)) temp[i] = float(decayed(REAL(temp[i]), keepT, ambient));
 #endif
 }

@@ -4,26 +4,34 @@
 // MODE_MASK   x_s = rest_s where the smoke, interpolated at the cell's centre
 //             through the host's taps (interpolateStencil's order), is at most threshold
 #define N NSPECIES
-layout(std430, binding = 0) buffer Species { double v[]; } xs[N];
+layout(std430, binding = 0) buffer Species { REAL v[]; } xs[N];
 layout(std430, binding = 8) readonly buffer Cover { float cover[]; };
 layout(std430, binding = 9) readonly buffer Smoke { float smoke[]; };
 layout(std430, binding = 10) readonly buffer Taps { int taps[]; };  // axis a at tapOff[a]: i0, i1, bits of t per cell
 
 uniform int n;
 uniform ivec3 rdCells, cells, tapOff;
-uniform double values[N];
-uniform double threshold;
+uniform REAL values[N];
+uniform REAL threshold;
 
-#define SMOKE_FN(name) double name
+// kernels/multilinear.inc in float, `precise`: each operation rounded as the CPU's
+#define ML_FN float
+#define ML_T float
+#define PRECISE precise
+#include "multilinear.inc"
+#define SMOKE_FN(name) REAL name
+#define SMOKE_F(name) float name
+#define SMOKE_REAL REAL
+#define SMOKE_SQRT sqrt
 #include "smoke_physics.inc"
 
 void main() {
   const int i = flatIndex();
   if (i >= n) return;
 #if defined(MODE_BLEND)
-  const double c = double(cover[i]);
+  const REAL c = REAL(cover[i]);
   for (int s = 0; s < N; ++s) {
-    precise double x = coverBlend(xs[s].v[i], c, values[s]);
+    precise REAL x = coverBlend(xs[s].v[i], c, values[s]);
     xs[s].v[i] = x;
   }
 #elif defined(MODE_MASK)
@@ -40,16 +48,9 @@ void main() {
   for (int c = 0; c < (1 << DIM); ++c)
     v[c] = smoke[indexOf(ivec3((c & 1) != 0 ? hi[0] : lo[0], (c & 2) != 0 ? hi[1] : lo[1],
                                (c & 4) != 0 ? hi[2] : lo[2]), cells)];
-  // `precise`: no fused multiply-adds, each operation rounded as the CPU's
-  precise float x00 = v[0] + t[0] * (v[1] - v[0]), x10 = v[2] + t[0] * (v[3] - v[2]);
-  precise float y0 = x00 + t[1] * (x10 - x00);
-  precise float r = y0;
-  if (DIM == 3) {
-    precise float x01 = v[4] + t[0] * (v[5] - v[4]), x11 = v[6] + t[0] * (v[7] - v[6]);
-    precise float y1 = x01 + t[1] * (x11 - x01);
-    r = y0 + t[2] * (y1 - y0);
-  }
-  if (double(r) > threshold) return;
+  const float r = DIM == 2 ? bilinear(v[0], v[1], v[2], v[3], t[0], t[1])
+                           : trilinear(v[0], v[1], v[2], v[3], v[4], v[5], v[6], v[7], t[0], t[1], t[2]);
+  if (REAL(r) > threshold) return;
   for (int s = 0; s < N; ++s) xs[s].v[i] = values[s];
 #endif
 }

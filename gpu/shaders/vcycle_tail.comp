@@ -24,7 +24,7 @@ uniform double scaleOf[kMaxLevels];
 uniform bvec3 periodic;
 uniform int preSmooth, postSmooth;
 
-#define REAL float
+#define STENCIL_REAL float
 int lo = 0;  // the offset of the level the accessors read
 int co = 0;  // the transfers' coarse level's offset
 #define LX(i) xs[lo + (i)]

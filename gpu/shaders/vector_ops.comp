@@ -1,4 +1,5 @@
-// Element-wise steps on double vectors. The reaction-diffusion layer's, one
+// Element-wise steps on real vectors (REAL: float or double; every sum
+// accumulated in double from exact products). The reaction-diffusion layer's, one
 // invocation a cell:
 // OP_SCALE_ADD  y = a x + b y (a, b uniforms)
 // OP_CLAMP_ZERO y = max(y, 0)
@@ -30,10 +31,14 @@
 // (colour 0 from x = 0, written into levelX) or its last post-smoothing
 // colour (colour 0, into f) made first, as laplace.comp's MODE_SMOOTH
 // does (gpu_multigrid.cpp)
-layout(std430, binding = 0) buffer X { double x[]; };
-layout(std430, binding = 1) buffer Y { double y[]; };
-layout(std430, binding = 2) buffer Z { double z[]; };
-layout(std430, binding = 3) buffer Q { double q[]; };
+#if defined(OP_UPDATE_XR) || defined(OP_SUB_MEAN)
+layout(std430, binding = 0) buffer X { XREAL x[]; };  // a solve's solution
+#else
+layout(std430, binding = 0) buffer X { REAL x[]; };
+#endif
+layout(std430, binding = 1) buffer Y { REAL y[]; };
+layout(std430, binding = 2) buffer Z { REAL z[]; };
+layout(std430, binding = 3) buffer Q { REAL q[]; };
 layout(std430, binding = 4) buffer F { float f[]; };
 layout(std430, binding = 5) readonly buffer Diag { float diag[]; };
 layout(std430, binding = 6) buffer Scalars { double S[]; };
@@ -42,11 +47,11 @@ layout(std430, binding = 7) readonly buffer Held { uint held[]; };
 uniform int n;
 uniform ivec4 slots;   // the scalar slots each op reads
 uniform bool first;
-uniform double ca, cb, cc;
+uniform REAL ca, cb, cc;
 
 #if defined(DOT_PARTIAL)
 layout(std430, binding = 8) buffer Partials { double partial[]; };
-layout(std430, binding = 9) buffer W { double w[]; };
+layout(std430, binding = 9) buffer W { REAL w[]; };
 #include "fused_sum.glsl"
 #if defined(GATE)
 #define GATE_BASE 10
@@ -77,7 +82,7 @@ layout(std430, binding = 11) readonly buffer W0 { float w0[]; };
 layout(std430, binding = 12) readonly buffer W1 { float w1[]; };
 layout(std430, binding = 13) readonly buffer W2 { float w2[]; };
 layout(std430, binding = 14) readonly buffer LevelB { float levelB[]; };
-#define REAL float
+#define STENCIL_REAL float
 #define LX(i) f[i]
 #define LW(a, i) ((a) == 0 ? w0[i] : (a) == 1 ? w1[i] : w2[i])
 #include "laplace_stencil.glsl"
@@ -91,23 +96,24 @@ float lastSweepAt(int i) {
 }
 #endif
 
-double jacobi(double r, int i) { return diag[i] > 0.0 ? r / double(diag[i]) : 0.0lf; }
+REAL jacobi(REAL r, int i) { return diag[i] > 0.0 ? r / REAL(diag[i]) : REAL(0); }
 
 void main() {
   const int groups = int(gl_NumWorkGroups.x);
 #if defined(OP_UPDATE_XR)  // x, y = r, z = p, q
   const double pq = finalSum(slots.y, groups);
-  const double alpha = pq > 0.0lf ? S[slots.x] / pq : 0.0lf;  // 0 on breakdown
+  const double alphaD = pq > 0.0lf ? S[slots.x] / pq : 0.0lf;  // 0 on breakdown
+  const REAL alpha = REAL(alphaD);
   double rr = 0.0lf, rw = 0.0lf;
   FOR_REDUCTION(i, n) {
-    x[i] += alpha * z[i];
-    const double r = y[i] - alpha * q[i];
+    x[i] += XREAL(alphaD) * XREAL(z[i]);
+    const REAL r = y[i] - alpha * q[i];
     y[i] = r;
-    rr = rr + r * r;
+    rr = rr + double(r) * double(r);
     if (slots.w >= 0) {
-      const double wi = jacobi(r, i);
+      const REAL wi = jacobi(r, i);
       w[i] = wi;
-      rw = rw + r * wi;
+      rw = rw + double(r) * double(wi);
     }
   }
   if (slots.w >= 0)
@@ -116,7 +122,7 @@ void main() {
     writePartial(rr, slots.z);
 #elif defined(OP_UPDATE_P)  // x = z, y = p
   const double rzNew = finalSum(slots.x, groups);
-  const double beta = first ? 0.0lf : rzNew / S[slots.y];
+  const REAL beta = REAL(first ? 0.0lf : rzNew / S[slots.y]);
   FOR_REDUCTION(i, n) y[i] = first ? x[i] : x[i] + beta * y[i];
   if (gl_WorkGroupID.x == 0u && gl_LocalInvocationID.x == 0u) S[slots.x] = rzNew;
 #if defined(GATE)
@@ -125,7 +131,7 @@ void main() {
 #elif defined(OP_TO_FLOAT)
   const double rr = finalSum(slots.x, groups);
   FOR_REDUCTION(i, n) {
-    const float bi = float(x[i] / sqrt(rr));
+    const float bi = float(double(x[i]) / sqrt(rr));
     f[i] = bi;
 #if defined(SWEEP_FIRST)
     levelX[i] = firstSweepAt(i, bi);
@@ -135,25 +141,25 @@ void main() {
 #elif defined(OP_JACOBI)  // x = r, y = z
   double s = 0.0lf;
   FOR_REDUCTION(i, n) {
-    const double zi = jacobi(x[i], i);
+    const REAL zi = jacobi(x[i], i);
     y[i] = zi;
-    s = s + x[i] * zi;
+    s = s + double(x[i]) * double(zi);
   }
   writePartial(s, slots.x);
 #elif defined(OP_SUB_MEAN)
   const double sum = finalSum(slots.x, groups);
-  FOR_REDUCTION(i, n) x[i] = diag[i] > 0.0 ? x[i] - sum / S[slots.y] : 0.0lf;
+  FOR_REDUCTION(i, n) x[i] = diag[i] > 0.0 ? x[i] - XREAL(sum / S[slots.y]) : XREAL(0);
   if (gl_WorkGroupID.x == 0u && gl_LocalInvocationID.x == 0u) S[slots.x] = sum;
 #elif defined(OP_FROM_FLOAT)  // y = z, z = r
   double s = 0.0lf;
   FOR_REDUCTION(i, n) {
 #if defined(SWEEP_LAST)
-    const double zi = double(lastSweepAt(i)) * sqrt(S[slots.x]);
+    const REAL zi = REAL(double(lastSweepAt(i)) * sqrt(S[slots.x]));
 #else
-    const double zi = double(f[i]) * sqrt(S[slots.x]);
+    const REAL zi = REAL(double(f[i]) * sqrt(S[slots.x]));
 #endif
     y[i] = zi;
-    s = s + z[i] * zi;
+    s = s + double(z[i]) * double(zi);
   }
   writePartial(s, slots.y);
 #endif
@@ -165,11 +171,11 @@ void main() {
 #if defined(OP_SCALE_ADD)
   y[i] = ca * x[i] + cb * y[i];
 #elif defined(OP_THETA_STEP)
-  precise double L = -z[i] + cc * q[i];
-  precise double v = y[i] + (cb != 0.0lf ? ca * x[i] + cb * L : ca * x[i]);
+  precise REAL L = -z[i] + cc * q[i];
+  precise REAL v = y[i] + (cb != REAL(0) ? ca * x[i] + cb * L : ca * x[i]);
   y[i] = v;
 #elif defined(OP_CLAMP_ZERO)
-  y[i] = max(y[i], 0.0lf);
+  y[i] = max(y[i], REAL(0));
 #elif defined(OP_HOLD)
   if (held[i] != 0u) y[i] = x[i];
 #elif defined(OP_ADD_FACES)

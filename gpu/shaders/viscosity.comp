@@ -9,9 +9,9 @@ void main() {
 #if defined(MODE_VISCOUS_SETUP)  // d0 = b, d1 = x, d2 = boundary rhs
   const int gi = indexOf(coordsOf(i, udims), faceDims());
   const bool held = fixedFace[velOff[axis] + gi] != 0u;
-  const double u = double(vel[velOff[axis] + gi]);
-  d0[blockOff + i] = held ? 0.0lf : u + s * d2[i];
-  d1[blockOff + i] = held ? 0.0lf : u;
+  const REAL u = REAL(vel[velOff[axis] + gi]);
+  d0[blockOff + i] = held ? REAL(0) : u + s * d2[i];
+  d1[blockOff + i] = held ? REAL(0) : u;
 #elif defined(MODE_VISCOUS_STORE)  // d1 = x
   const int gi = indexOf(coordsOf(i, udims), faceDims());
   // (or the viscosity's held flags)

@@ -8,7 +8,9 @@
 #include <csignal>
 #include <fstream>
 #include <functional>
+#include <iostream>
 #include <map>
+#include <optional>
 
 #include <nlohmann/json.hpp>
 
@@ -161,28 +163,54 @@ struct Parity {
   bool moved = false;
 };
 
+// The GPU's runs in each precision (gpu.precision): the parity tests run
+// the GPU in double, as the CPU computes, and in float, the default.
+const std::string kInDouble = " --set 'gpu.precision=\"double\"'";
+const std::string kInFloat = " --set 'gpu.precision=\"float\"'";
+
+// The worst difference of every channel of dump `g` from `c`, relative to the channel's largest magnitude.
+double worstRelative(const morphoflow::FieldDump& g, const morphoflow::FieldDump& c) {
+  double worst = 0;
+  for (const std::string& channel : c.names) {
+    const auto [w, size] = channelDifference(g, c, channel);
+    worst = std::max(worst, size > 0 ? w / size : w);
+  }
+  return worst;
+}
+
 // Runs each scene (a scene file and its --set options, output.fields added)
-// on the gpu and tbb backends and compares their dumps `frame`.
+// on the gpu backend in double and on tbb, and compares their dumps `frame`
+// with `parity`; with `inFloat`, the gpu in float too, compared with it
+// (the measured worst relative difference printed for docs/gpu.md).
 void expectScenesAgree(const std::string& folder, const std::vector<std::string>& scenes, const std::string& frame,
-                       Parity parity, const std::function<void(const fs::path&)>& checkRun = {}) {
+                       Parity parity, const std::function<void(const fs::path&)>& checkRun = {},
+                       std::optional<Parity> inFloat = std::nullopt) {
   const fs::path dir = tempDir(folder);
   for (const std::string& scene : scenes) {
-    for (const char* backend : {"gpu", "tbb"}) {
+    std::vector<std::pair<std::string, std::string>> runs = {{"gpu", "gpu" + kInDouble}, {"tbb", "tbb"}};
+    if (inFloat) runs.push_back({"gpu_float", "gpu" + kInFloat});
+    for (const auto& [name, backend] : runs) {
       CommandResult r = runMorphoflow("run " + scene + " --set output.fields=true --quiet --backend " + backend +
-                                      " --out " + (dir / backend).string());
+                                      " --out " + (dir / name).string());
       ASSERT_EQ(r.status, 0) << scene << " " << backend << "\n" << r.output;
-      if (checkRun) checkRun(dir / backend);
+      if (checkRun) checkRun(dir / name);
     }
-    const morphoflow::FieldDump g = dump(dir / "gpu" / "fields" / frame), c = dump(dir / "tbb" / "fields" / frame);
+    const morphoflow::FieldDump c = dump(dir / "tbb" / "fields" / frame);
     const morphoflow::FieldDump start = dump(dir / "tbb" / "fields" / "000000.exr");
-    ASSERT_EQ(g.names, c.names) << scene;
-    ASSERT_EQ(g.step, c.step) << scene;
-    for (const std::string& channel : c.names) {
-      const auto [worst, size] = channelDifference(g, c, channel);
-      EXPECT_LE(worst, parity.relative * size + parity.absolute) << scene << " " << channel;
-      if (parity.moved) {
-        EXPECT_GT(channelDifference(c, start, channel).first, 1e-3 * size) << scene << " " << channel;
+    for (const auto& [name, backend] : runs) {
+      if (name == "tbb") continue;
+      const Parity& p = name == "gpu" ? parity : *inFloat;
+      const morphoflow::FieldDump g = dump(dir / name / "fields" / frame);
+      ASSERT_EQ(g.names, c.names) << scene;
+      ASSERT_EQ(g.step, c.step) << scene;
+      for (const std::string& channel : c.names) {
+        const auto [worst, size] = channelDifference(g, c, channel);
+        EXPECT_LE(worst, p.relative * size + p.absolute) << scene << " " << channel << " " << name;
+        if (p.moved) {
+          EXPECT_GT(channelDifference(c, start, channel).first, 1e-3 * size) << scene << " " << channel;
+        }
       }
+      if (name == "gpu_float") std::cout << "float parity: " << worstRelative(g, c) << " " << scene << "\n";
     }
     fs::remove_all(dir);
   }
@@ -193,51 +221,63 @@ void expectScenesAgree(const std::string& folder, const std::vector<std::string>
 // The shipped fluid scenes, smaller and shorter, on both backends: speed,
 // pressure and vorticity agree to the tolerances docs/gpu.md states (the
 // solvers stop at 1e-6 each, and the MacCormack limiter amplifies the
-// difference where it switches on one backend only); the striped dye, a
-// field of jumps, agrees less closely for the same reason. The centreline
-// profiles agree to their printed digits.
+// difference where it switches on one backend only), the gpu in double and
+// in float (its solves at the float floor, 4e-6: measured 1.5e-5 to 4.2e-4,
+// 3e-3 past the sub-cell obstacle, whose cut faces the float rounding of
+// the velocity moves most). The centreline profiles agree to their printed digits.
 TEST(Gpu, ShippedFluidScenesMatchTheCpu) {
   if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
   const fs::path dir = tempDir("gpu_fluid_scenes");
   struct Case {
     std::string scene, sets;
-    double tolerance;  // relative to the field's largest magnitude
+    double tolerance, inFloat;  // relative to the field's largest magnitude, the gpu in double and in float
   };
   for (const Case& c :
-       {Case{"lid_driven_cavity.toml", "--set grid.resolution=[48,48] --set time.duration=1.0", 2e-4},
-        Case{"flow_past_obstacle.toml", "--set grid.resolution=[220,41] --set time.duration=0.2", 2e-4},
+       {Case{"lid_driven_cavity.toml", "--set grid.resolution=[48,48] --set time.duration=1.0", 2e-4, 1e-3},
+        Case{"flow_past_obstacle.toml", "--set grid.resolution=[220,41] --set time.duration=0.2", 2e-4, 5e-4},
         // an obstacle smaller than a cell, cut and voxel (measured 2.3e-4 and 1.7e-4 in pressure)
         Case{"flow_past_obstacle.toml",
              "--set grid.resolution=[220,41] --set time.duration=0.2"
              " --set 'obstacles=[{center=[0.2,0.205],radius=0.004}]'",
-             5e-4},
+             5e-4, 1e-2},
         Case{"flow_past_obstacle.toml",
              "--set grid.resolution=[220,41] --set time.duration=0.2"
              " --set 'obstacles=[{center=[0.2,0.2],radius=0.004,boundary=\"voxel\"}]'",
-             5e-4},
-        Case{"lid_driven_cavity_3d.toml", "--set grid.resolution=[16,16,16] --set time.duration=0.4", 5e-4},
-        Case{"flow_past_obstacle_3d.toml", "--set grid.resolution=[24,8,8] --set time.duration=0.6", 5e-4}}) {
-    for (const char* backend : {"gpu", "tbb"}) {
+             5e-4, 1e-2},
+        Case{"lid_driven_cavity_3d.toml", "--set grid.resolution=[16,16,16] --set time.duration=0.4", 5e-4, 1e-4},
+        Case{"flow_past_obstacle_3d.toml", "--set grid.resolution=[24,8,8] --set time.duration=0.6", 5e-4, 1e-4}}) {
+    for (const auto& [name, backend] : std::vector<std::pair<std::string, std::string>>{
+             {"gpu", "gpu" + kInDouble}, {"gpu_float", "gpu" + kInFloat}, {"tbb", "tbb"}}) {
       CommandResult r = runMorphoflow("run " + sceneFile(c.scene) + " " + c.sets +
                                       " --set output.fields=true --set output.every=10"
                                       " --quiet --backend " +
-                                      backend + " --out " + (dir / backend).string());
+                                      backend + " --out " + (dir / name).string());
       ASSERT_EQ(r.status, 0) << c.scene << " " << backend << "\n" << r.output;
     }
     fs::path last;
     for (const auto& e : fs::directory_iterator(dir / "tbb" / "fields")) last = std::max(last, e.path().filename());
-    const morphoflow::FieldDump g = dump(dir / "gpu" / "fields" / last), cpu = dump(dir / "tbb" / "fields" / last);
-    EXPECT_EQ(g.step, cpu.step) << c.scene;
+    const morphoflow::FieldDump cpu = dump(dir / "tbb" / "fields" / last);
     EXPECT_GE(cpu.step, 20) << c.scene;
-    for (const char* field : {"speed", "pressure", "vorticity"}) {
-      const auto [worst, size] = channelDifference(g, cpu, field);
-      EXPECT_GT(size, 0.0) << c.scene << " " << field;
-      EXPECT_LE(worst, c.tolerance * size) << c.scene << " " << field;
+    for (const char* name : {"gpu", "gpu_float"}) {
+      const bool single = std::string(name) == "gpu_float";
+      const morphoflow::FieldDump g = dump(dir / name / "fields" / last);
+      EXPECT_EQ(g.step, cpu.step) << c.scene;
+      double measured = 0;
+      for (const char* field : {"speed", "pressure", "vorticity"}) {
+        const auto [worst, size] = channelDifference(g, cpu, field);
+        EXPECT_GT(size, 0.0) << c.scene << " " << field;
+        EXPECT_LE(worst, (single ? c.inFloat : c.tolerance) * size) << c.scene << " " << field << " " << name;
+        measured = std::max(measured, worst / size);
+      }
+      if (single) std::cout << "float parity: " << measured << " " << c.scene << " " << c.sets << "\n";
+      // the solves meet the tolerance they were given (float: raised to its floor, in run.json)
+      std::ifstream in(dir / name / "run.json");
+      const nlohmann::json j = nlohmann::json::parse(in);
+      const double tolerance = j["gpu"]["tolerances"]["pressure"];
+      EXPECT_EQ(tolerance, single ? 4e-6 : 1e-6) << c.scene;
+      EXPECT_EQ(j["solvers"]["pressure_unconverged_steps"], 0) << c.scene << " " << name;
+      EXPECT_LE(j["solvers"]["pressure_residual_max"].get<double>(), 1.0001 * tolerance) << c.scene << " " << name;
     }
-    std::ifstream in(dir / "gpu" / "run.json");
-    const nlohmann::json j = nlohmann::json::parse(in);
-    EXPECT_EQ(j["solvers"]["pressure_unconverged_steps"], 0) << c.scene;
-    EXPECT_LE(j["solvers"]["pressure_residual_max"].get<double>(), 1.0001e-6) << c.scene;
     fs::remove_all(dir);
   }
 }
@@ -325,7 +365,8 @@ TEST(Gpu, CoupledCavityGrayScottMatchesTheCpuAfter100Steps) {
 
 // Every other shipped coupled scene, smaller and shorter (the same ratio of
 // the chemicals' grid to the fluid's): every species within 1e-4 of the
-// CPU's (measured at most 2.1e-5), through each coupling mode (ard,
+// CPU's (measured at most 2.1e-5), in float within 1e-2 (measured at most
+// 3.2e-3, the BFECC channel), through each coupling mode (ard,
 // passive, rd-only), linear, cubic, B-spline and BFECC transport, inflow
 // and solid values, 2D and 3D.
 TEST(Gpu, ShippedCoupledScenesMatchTheCpu) {
@@ -361,15 +402,15 @@ TEST(Gpu, ShippedCoupledScenesMatchTheCpu) {
                      scene("obstacle_gray_scott_3d.toml",
                            " --set grid.resolution=[16,32,16] --set rd.resolution=[16,32,16]"
                            " --set time.steps=10 --set output.every=5")},
-                    "000002.exr", {0.0, 1e-4, false});
+                    "000002.exr", {0.0, 1e-4, false}, {}, Parity{0.0, 1e-2, false});
 }
 
 // A scene with a timeline (scenes/coupled/cavity_timeline.toml: a stroke at
 // t = 2, a deposit at 3, an obstacle from 4 to 10, F stepping at 5, the lid
 // at 12), smaller, at a longer step, its lid keyed by steps: the GPU is built
 // again at the same steps as the CPU (5 times) and its species agree within
-// 1e-2 at t = 13 (measured 3.6e-3; a missed event is 0.25 off), the run
-// having moved them.
+// 1e-2 at t = 13 (measured 3.6e-3; a missed event is 0.25 off), in float
+// within 3e-2 (measured 1.4e-2), the run having moved them.
 TEST(Gpu, ATimelineSceneChangesAtTheCpusSteps) {
   if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
   expectScenesAgree(
@@ -378,17 +419,19 @@ TEST(Gpu, ATimelineSceneChangesAtTheCpusSteps) {
        " --set grid.resolution=[32,32] --set rd.resolution=[64,64] --set time.dt=0.04 --set time.steps=325"
        " --set output.every=100 --set output.video=false"
        " --set 'fluid.lid_velocity={keys=[[8.0,1.0],[12.0,0.4]],interpolation=\"step\"}'"},
-      "000003.exr", {0.0, 1e-2, true}, [](const fs::path& run) {
+      "000003.exr", {0.0, 1e-2, true},
+      [](const fs::path& run) {
         std::ifstream in(run / "run.json");
         EXPECT_EQ(nlohmann::json::parse(in)["timeline"]["rebuilds"], 5) << run;
-      });
+      },
+      Parity{0.0, 3e-2, false});
 }
 
 // The pattern on the smoke (coupling.smoke_mask, sources' chemicals) on both
 // backends: the patterned plumes, smaller and shorter, 2D and 3D, every
 // species within 1e-5 of the CPU's (measured 1.5e-6 in 2D, 1.2e-7 in 3D: the
 // mask reads the same taps and no cell's smoke sits within rounding of the
-// threshold).
+// threshold); in float within 2e-3 (measured at most 7.7e-4).
 TEST(Gpu, PatternedPlumesMatchTheCpu) {
   if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
   auto scene = [](const char* name, const std::string& sets) {
@@ -405,21 +448,21 @@ TEST(Gpu, PatternedPlumesMatchTheCpu) {
                      scene("plume_gray_scott_3d.toml",
                            " --set grid.resolution=[12,20,12] --set rd.resolution=[24,40,24]"
                            " --set time.duration=0.4 --set output.every=20")},
-                    "000002.exr", {0.0, 1e-5, true});
+                    "000002.exr", {0.0, 1e-5, true}, {}, Parity{0.0, 2e-3, false});
 }
 
-// time.until_steady on the GPU: the run stops at the CPU's step, its last
-// measured change within 1e-4 of the CPU's (measured 4e-5 relative).
+// time.until_steady on the GPU in double: the run stops at the CPU's step,
+// its last measured change within 1e-4 of the CPU's (measured 4e-5 relative).
 TEST(Gpu, UntilSteadyStopsAtTheCpusStep) {
   if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
   const fs::path dir = tempDir("gpu_until_steady");
   std::map<std::string, nlohmann::json> got;
-  for (const char* backend : {"gpu", "tbb"}) {
+  for (const char* backend : {"gpu", "tbb"}) {  // (the gpu in double: the step it stops at is exact)
     const CommandResult r =
         runMorphoflow("run " + sceneFile("lid_driven_cavity.toml") +
                       " --set grid.resolution=[24,24] --set output.images=false --set time.until_steady=5e-3"
-                      " --quiet --backend " +
-                      backend + " --out " + (dir / backend).string());
+                      " --quiet" +
+                      kInDouble + " --backend " + backend + " --out " + (dir / backend).string());
     ASSERT_EQ(r.status, 0) << backend << "\n" << r.output;
     got[backend] = nlohmann::json::parse(std::ifstream(dir / backend / "run.json"))["until_steady"];
   }
@@ -464,6 +507,10 @@ TEST(Gpu, TheCoupledCavityStepsDispatchesAndHostWaitsAddUpOverItsStages) {
 // error, which a forming pattern amplifies as it would a change of
 // tolerance on the CPU alone): every species within 2e-4 of its largest value
 // (measured at most 7e-5, Barkley's B beside a front; most agree to 1e-8).
+// In float (the solves at its floor, 4e-6, and Newton at float's tolerance)
+// within 1e-1 (measured 3.2e-4 for Gray-Scott and FitzHugh-Nagumo; 1.5e-2
+// and 3.7e-2 for Turing's and Barkley's moving fronts, which a difference
+// of a cell's fraction in a front's place makes).
 TEST(Gpu, ShippedImplicitRDScenesMatchTheCpu) {
   if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
   std::vector<std::string> scenes;
@@ -472,7 +519,7 @@ TEST(Gpu, ShippedImplicitRDScenesMatchTheCpu) {
     scenes.push_back(
         sceneFile(s) +
         " --set grid.resolution=[96,96] --set rd.tolerance=1e-12 --set time.steps=100 --set output.every=50");
-  expectScenesAgree("gpu_rd_scenes", scenes, "000002.exr", {2e-4, 0.0, true});
+  expectScenesAgree("gpu_rd_scenes", scenes, "000002.exr", {2e-4, 0.0, true}, {}, Parity{1e-1, 0.0, false});
 }
 
 // The GPU suites print the CPU suites' tables for the same problems (here at
@@ -525,7 +572,8 @@ TEST(Gpu, BenchSuitesTimeTheFluidTheLayerAndTheCoupling) {
 // saddle, circles, a four-species layer) and Kim & Lin's cosine lobes (three
 // lobes, Witkin-Kass, a painted spiral steering one lobe), at 64^2 for 40 steps with
 // the solves at 1e-12: every species within 1e-6 of its largest value
-// (measured: float rounding of the dumps, or exactly equal).
+// (measured: float rounding of the dumps, or exactly equal); in float within
+// 1e-3 (measured at most 4.6e-4, the Witkin-Kass lobes).
 TEST(Gpu, ShippedMapFixedAndMultiSpeciesScenesMatchTheCpu) {
   if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
   std::vector<std::string> scenes;
@@ -535,7 +583,7 @@ TEST(Gpu, ShippedMapFixedAndMultiSpeciesScenesMatchTheCpu) {
     scenes.push_back(
         sceneFile(std::string("rd/seeds/") + s + ".toml") +
         " --set grid.resolution=[64,64] --set rd.tolerance=1e-12 --set time.steps=40 --set output.every=20");
-  expectScenesAgree("gpu_map_scenes", scenes, "000002.exr", {1e-6, 0.0, false});
+  expectScenesAgree("gpu_map_scenes", scenes, "000002.exr", {1e-6, 0.0, false}, {}, Parity{1e-3, 0.0, false});
 }
 
 // An explicit scene whose stroke deposits chemical: the cells under the
@@ -571,8 +619,8 @@ TEST(Gpu, ExplicitSceneWithDepositingStrokeHoldsItsCells) {
   fs::remove_all(dir);
 }
 
-// The coarse-to-fine start on the GPU (its 64^2 and 128^2 levels stepped by
-// the double-precision layer: bitwise the CPU's start), then Turing's
+// The coarse-to-fine start on the GPU in double (its 64^2 and 128^2 levels
+// stepped by the double-precision layer: bitwise the CPU's start), then Turing's
 // explicit step in single precision with b clamped at 0 after every step, as
 // the CPU clamps it: within 1e-6 of the largest value after 20 steps
 // (measured 1.4e-7).
@@ -582,8 +630,8 @@ TEST(Gpu, CoarseToFineStartAndClampedExplicitSpeciesMatchTheCpu) {
   for (const char* backend : {"gpu", "tbb"}) {
     CommandResult r = runMorphoflow("run " + sceneFile("rd/turing_coarse_to_fine.toml") +
                                     " --set rd.coarse_to_fine.steps=100 --set time.steps=20 --set output.every=20"
-                                    " --set output.fields=true --quiet --backend " +
-                                    backend + " --out " + (dir / backend).string());
+                                    " --set output.fields=true --quiet" +
+                                    kInDouble + " --backend " + backend + " --out " + (dir / backend).string());
     ASSERT_EQ(r.status, 0) << backend << "\n" << r.output;
   }
   for (const char* frame : {"000000.exr", "000001.exr"}) {
@@ -605,7 +653,8 @@ TEST(Gpu, CoarseToFineStartAndClampedExplicitSpeciesMatchTheCpu) {
 // The rest of the shipped seed scenes (Sanderson's figures 3, 4, 5a, 5b, 12
 // and 15, the Turing spots, Lawlor's parameter map, Pearson's explicit
 // theta), at 64^2 for 40 steps with the solves at 1e-12: every species
-// within 1e-6 of its largest value (measured: equal, or float rounding).
+// within 1e-6 of its largest value (measured: equal, or float rounding); in
+// float within 1e-3 (measured at most 3.6e-4).
 TEST(Gpu, ShippedSeedScenesMatchTheCpu) {
   if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
   std::vector<std::string> scenes = {
@@ -616,7 +665,7 @@ TEST(Gpu, ShippedSeedScenesMatchTheCpu) {
     scenes.push_back(
         sceneFile(std::string("rd/seeds/") + s + ".toml") +
         " --set grid.resolution=[64,64] --set rd.tolerance=1e-12 --set time.steps=40 --set output.every=20");
-  expectScenesAgree("gpu_seed_scenes", scenes, "000002.exr", {1e-6, 0.0, false});
+  expectScenesAgree("gpu_seed_scenes", scenes, "000002.exr", {1e-6, 0.0, false}, {}, Parity{1e-3, 0.0, false});
 }
 
 // A GPU reaction-diffusion run killed midway (SIGKILL) and resumed from its

@@ -166,7 +166,7 @@ def test_batch_and_sweep_return_their_summaries(tmp_path):
 
 
 def test_the_gpu_backend_takes_and_gives_fields_as_the_cpu():
-    scene = morphoflow.load_scene(PEARSON, set=SMALL)
+    scene = morphoflow.load_scene(PEARSON, set={**SMALL, "gpu.precision": "double"})  # (compared to 1e-5)
     try:
         gpu = morphoflow.Simulation(scene, backend="gpu")
     except ValueError as e:

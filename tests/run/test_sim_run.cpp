@@ -228,12 +228,15 @@ TEST(Steppers, EveryKindOfSceneResumesBitwiseOnTheGpu) {
 }
 
 // The one choice of a layer's stepper: the plain explicit step fused on the
-// CPU (float species) and in float on the GPU, every other step in double;
+// CPU (float species) and in float on the GPU, every other step in double on
+// the CPU and in the scene's gpu.precision on the GPU (float unless double);
 // the same simulation class on both backends says which it took.
 TEST(Steppers, TheLayerStepperFollowsTheSceneAndTheBackend) {
   const Scene plain =
       loadScene(sceneFile("rd/turing_coarse_to_fine.toml"), {"grid.resolution=[32,32]", "rd.coarse_to_fine.steps=3"});
   const Scene implicit = loadScene(sceneFile("rd/gray_scott_pearson.toml"), {"grid.resolution=[32,32]"});
+  const Scene inDouble =
+      loadScene(sceneFile("rd/gray_scott_pearson.toml"), {"grid.resolution=[32,32]", "gpu.precision=\"double\""});
   ASSERT_TRUE(plain.rd.plainExplicit());
   ASSERT_FALSE(implicit.rd.plainExplicit());
   auto step = [](const Scene& s, Backend b) {
@@ -243,7 +246,8 @@ TEST(Steppers, TheLayerStepperFollowsTheSceneAndTheBackend) {
   EXPECT_EQ(step(implicit, Backend::TBB).rfind("RDSolver", 0), 0u);
   if (const GpuInfo g = gpuInfo(); !g.available) GTEST_SKIP() << g.reason;
   EXPECT_NE(step(plain, Backend::Gpu).find("float"), std::string::npos);
-  EXPECT_NE(step(implicit, Backend::Gpu).find("double"), std::string::npos);
+  EXPECT_NE(step(implicit, Backend::Gpu).find("float"), std::string::npos);
+  EXPECT_NE(step(inDouble, Backend::Gpu).find("double"), std::string::npos);
 }
 
 // The pattern on the smoke (coupling.smoke_mask): after every step, an RD
