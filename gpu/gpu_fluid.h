@@ -1,5 +1,7 @@
 // The stable fluid (fluid/fluid_solver.h) on the GPU: the same stages in the
-// same order (forces, advect, diffuse, project) on the same MAC grid, with
+// same order (fluid/fluid_step.h), each a class of gpu/fluid/ named after
+// its CPU file (advection, viscosity, projection, smoke), on the same MAC
+// grid (gpu/fluid/gpu_mac_grid.h), with
 // the CPU's boundary handling (walls, moving lids, inflow, outflow, periodic
 // axes, obstacles) taken from the same VelocityConstraints. Advection is
 // semi-Lagrangian, MacCormack or BFECC; viscosity is implicit (diagonally
@@ -26,6 +28,11 @@
 #include "fluid/fluid_stepper.h"
 #include "fluid/velocity_constraints.h"
 #include "fluid/viscosity.h"
+#include "gpu/fluid/gpu_advection.h"
+#include "gpu/fluid/gpu_mac_grid.h"
+#include "gpu/fluid/gpu_projection.h"
+#include "gpu/fluid/gpu_smoke.h"
+#include "gpu/fluid/gpu_viscosity.h"
 #include "gpu/gpu_buffer.h"
 #include "gpu/gpu_counts.h"
 #include "gpu/gpu_stage_timer.h"
@@ -34,9 +41,6 @@
 namespace morphoflow {
 
 class ComputeProgram;
-class GpuLaplace;
-class GpuMultigrid;
-class GpuPcg;
 
 template <int D>
 class GpuFluid final : public FluidStepper<D> {
@@ -80,18 +84,18 @@ class GpuFluid final : public FluidStepper<D> {
   void download(MacVelocity<D>* u, Grid<float, D>* dye, Grid<float, D>* temperature = nullptr) const;
   // phi of the last projection (p = rho phi / dt), and that dt.
   std::vector<double> phi() const;
-  double lastDt() const { return lastDt_; }
+  double lastDt() const { return projection_.lastDt(); }
   // The velocity buffer (component a at offset(a) floats) for the chemicals' advection.
-  const GpuBuffer& velocity() const { return vel_; }
+  const GpuBuffer& velocity() const { return grid_.vel; }
   // The velocity the last step's advection traced through (its start
   // velocity with its forces applied: FluidSolver::advectedVelocity), kept
   // until the next step's advection.
-  const GpuBuffer& advectedVelocity() const { return velScratch_; }
+  const GpuBuffer& advectedVelocity() const { return grid_.velScratch; }
   // The dye (the smoke, with [smoke]), cell-centred.
   const GpuBuffer& dye() const { return dye_; }
   // The stages' dispatches and host waits (gpu_counts.h).
   const GpuStageTimer& stageTimer() const { return *timer_; }
-  size_t offset(int a) const { return off_[size_t(a)]; }
+  size_t offset(int a) const { return grid_.off[size_t(a)]; }
   // The velocity, dye, clock and last projection into `host`; the velocity, dye and clock from it.
   void toHost(FluidSolver<D>* host) const override;
   void fromHost(const FluidSolver<D>& host) override;
@@ -102,61 +106,29 @@ class GpuFluid final : public FluidStepper<D> {
   void report(nlohmann::json* run) const override;
 
  private:
-  struct Viscous;
-  void applyConstraints(const GpuBuffer& vel);
+  struct Stages;  // the step's stages (fluid/fluid_step.h)
   void forces(double dt);
-  // [smoke] (fluid/smoke.h, shaders/smoke.comp): emission, its forces, decay.
-  void emitSmoke(double dt);
-  void smokeForces(double dt);
-  void decaySmoke(double dt);
-  void runSmoke(SmokeOp mode, size_t n, int axis, const std::function<void(const ComputeProgram&)>& uniforms);
   void advect(double dt);
-  void advectField(const GpuBuffer& src, size_t srcOff, const std::array<int, 3>& dims,
-                   const std::array<float, 3>& offset, double dt, GpuBuffer* dst, size_t dstOff);
-  void diffuse(double dt);
-  void project(double dt);
-  size_t faces(int a) const;
-  std::array<int, 3> velocityOffsets() const;  // the components' offsets in the velocity buffer (uniform velOff)
+  void injectInflowDye();
+  void readSolverStats() const;  // the solves' tallies into stats_
 
   FluidSettings settings_;
   GpuPrecision real_;
   double time_ = 0.0;
   long steps_ = 0;
-  std::array<int, 3> cells_{1, 1, 1}, periodic_{};
-  std::array<size_t, 3> off_{};
-  size_t cellCount_ = 0, faceCount_ = 0, maxGrid_ = 0;
-  double h_ = 1.0;
+  // the stages, one a CPU file (gpu/fluid/)
+  GpuMacGrid<D> grid_;
+  GpuAdvection<D> advection_;
+  mutable GpuViscosity<D> viscosity_;
+  mutable GpuProjection<D> projection_;
+  std::unique_ptr<GpuSmoke<D>> smoke_;  // with [smoke]
+  GpuBuffer dye_, dyeScratch_;
   bool dyeActive_ = false;
-  GpuBuffer vel_, velScratch_, fixed_, value_, dye_, dyeScratch_, solid_;
-  // The faces' open fractions and the cells without a pressure (the
-  // projection's weights: fluid/cut_cells.h); with cut obstacles, the
-  // viscosity's held faces (prescribed, or inside a cut obstacle).
-  GpuBuffer open_, inactive_, viscousHeld_;
-  GpuBuffer lo_, hi_, back_, fwd_;  // the second-order schemes' scratch
-  // [smoke]: the temperature, each source's cover, the forces' work vectors
-  GpuBuffer temp_, tempScratch_, force_, centre_, omega_;
-  std::vector<GpuBuffer> cover_;
-  Grid<uint8_t, D> solidHost_;  // for a moving source's cover
-  // pressure
-  std::unique_ptr<GpuLaplace> pressure_;
-  std::unique_ptr<GpuMultigrid> multigrid_;
-  std::unique_ptr<GpuPcg> pressurePcg_;
-  GpuBuffer phi_, rhs_, ratePrev_;
-  double lastDt_ = 0.0;
-  int solves_ = 0;
-  std::array<std::unique_ptr<Viscous>, D> viscous_;
-  std::unique_ptr<GpuLaplace> viscousA_;  // the components' systems, one block system
-  std::unique_ptr<GpuPcg> viscousPcg_;
-  GpuBuffer viscousB_, viscousX_;  // the components' right-hand sides and solutions, as its blocks
-  double s_ = -1.0;
   mutable FluidStepStats stats_;
-  void readSolverStats() const;  // the solves' tallies into stats_
   mutable double speed_cached_ = -1.0;  // maxSpeed() of the current velocity (-1: not yet read)
   std::unique_ptr<class GpuReduction> speed_;
   std::unique_ptr<class GpuStageTimer> timer_;
   StepCounts counts_;
-  struct Stages;  // the step's stages (fluid/fluid_step.h)
-  void injectInflowDye();
 };
 
 }  // namespace morphoflow

@@ -1,0 +1,106 @@
+#include "gpu/fluid/gpu_projection.h"
+
+#include <algorithm>
+
+#include "core/multigrid.h"
+#include "fluid/pressure_projection.h"
+#include "gpu/compute_program.h"
+#include "gpu/gpu_laplace.h"
+#include "gpu/gpu_multigrid.h"
+#include "gpu/gpu_pcg.h"
+#include "gpu/gpu_programs.h"
+#include "gpu/gpu_reals.h"
+
+namespace morphoflow {
+
+template <int D>
+GpuProjection<D>::GpuProjection(const VelocityConstraints<D>& vc, GpuMacGrid<D>* grid, GpuPrecision real,
+                                std::shared_ptr<GpuPcgWork> work)
+    : grid_(*grid), real_(real) {
+  // The CPU's system and multigrid levels, uploaded once.
+  const LaplaceSystem<D> P = pressureSystem<D>(vc);
+  const std::vector<float> diag = P.diag.expanded();
+  std::vector<uint32_t> inactive(diag.size());
+  for (size_t i = 0; i < diag.size(); ++i) inactive[i] = diag[i] == 0.0f ? 1u : 0u;
+  inactive_ = GpuBuffer::of(inactive);
+  A_ = std::make_unique<GpuLaplace>(P);
+  A_->setPrecision(real_, kPhiPrecision);
+  multigrid_ = std::make_unique<GpuMultigrid>(Multigrid<D>(P), *A_, MultigridOptions{});
+  pcg_ = std::make_unique<GpuPcg>(*A_, std::move(work));
+  rhs_ = realBuffer(grid_.cellCount, real_);
+  ratePrev_ = realBuffer(grid_.cellCount, GpuPrecision::Float);
+  phi_ = realBuffer(grid_.cellCount, kPhiPrecision);
+}
+
+template <int D>
+GpuProjection<D>::~GpuProjection() = default;
+
+template <int D>
+void GpuProjection<D>::run(FluidOp mode, int axis, size_t n, double dt) {
+  const bool cut = mode == FluidOp::Divergence && grid_.cut;  // (made for cut obstacles only)
+  const ComputeProgram& p = grid_.stage(mode, real_, cut ? "\n#define CUT_FACES" : "");
+  setUniform(p, "cells", grid_.cells);
+  setUniform(p, "periodic", grid_.periodic);
+  setUniform(p, "axis", axis);
+  setUniform(p, "n", int(n));
+  setUniform(p, "velOff", grid_.velocityOffsets());
+  setUniform(p, "invH", 1.0 / grid_.h);
+  setUniform(p, "dt", dt);
+  setUniform(p, "invLastDt", lastDt_ > 0 ? 1.0 / lastDt_ : 0.0);
+  setUniform(p, "extrapolate", solves_ >= 2 ? 1 : 0);
+  grid_.vel.bind(0);
+  grid_.fixed.bind(1);
+  (mode == FluidOp::Divergence ? rhs_ : phi_).bind(7);
+  ratePrev_.bind(8);
+  inactive_.bind(10);  // (the divergence's "solid": the cells without a pressure)
+  grid_.open.bind(12);
+  dispatchFlat(n, mode == FluidOp::Divergence ? 12.0 * D + 12.0 : 32.0);
+  storageBarrier();
+}
+
+template <int D>
+SolverResult GpuProjection<D>::project(double dt, const SolverOptions& options) {
+  run(FluidOp::Divergence, 0, grid_.cellCount, dt);
+  // Warm start: phi / dt extrapolated from the last two projections.
+  if (solves_ >= 1 && lastDt_ > 0) run(FluidOp::WarmStart, 0, grid_.cellCount, dt);
+  const SolverResult r = pcg_->solve(&rhs_, &phi_, multigrid_.get(), options, true);
+  lastDt_ = dt;
+  solves_ = dt > 0 ? std::min(solves_ + 1, 2) : 0;
+  for (int a = 0; a < D; ++a) run(FluidOp::Gradient, a, grid_.faces(a), dt);
+  grid_.constrain(grid_.vel, real_);
+  return r;
+}
+
+template <int D>
+SolverResult GpuProjection<D>::tally() {
+  return pcg_->tally();
+}
+
+template <int D>
+std::vector<double> GpuProjection<D>::phi() const {
+  return readReals(phi_, grid_.cellCount, kPhiPrecision);
+}
+
+template <int D>
+void GpuProjection<D>::save(StateWriter* out) const {
+  out->putVector("gpu.fluid.phi", phi());
+  out->putVector("gpu.fluid.rate_prev", readReals(ratePrev_, grid_.cellCount, GpuPrecision::Float));
+  out->put("gpu.fluid.last_dt", lastDt_);
+  out->put("gpu.fluid.solves", solves_);
+}
+
+template <int D>
+void GpuProjection<D>::load(const StateReader& in) {
+  std::vector<double> v(grid_.cellCount);
+  in.getVector("gpu.fluid.phi", &v);
+  uploadReals(&phi_, v, kPhiPrecision);
+  in.getVector("gpu.fluid.rate_prev", &v);
+  uploadReals(&ratePrev_, v, GpuPrecision::Float);
+  in.get("gpu.fluid.last_dt", &lastDt_);
+  in.get("gpu.fluid.solves", &solves_);
+}
+
+template class GpuProjection<2>;
+template class GpuProjection<3>;
+
+}  // namespace morphoflow
