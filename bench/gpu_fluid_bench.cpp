@@ -5,7 +5,8 @@
 // Gray-Scott ARD layer on its grid (Kim & Lin at ten times the explicit
 // diffusion limit, linear advection), and the overhead (fluid + ARD) / fluid
 // (seed 001 Table 1). Both print GB/s, the traffic model of
-// gpu/gpu_programs.h over the time, and its fraction of the device's peak.
+// gpu/gpu_programs.h over the time, and its fractions of the device's peak and
+// of its measured copy bandwidth.
 #include <fstream>
 #include <iostream>
 #include <vector>
@@ -53,7 +54,7 @@ Timed timeGpu(double minSeconds, Step&& step, After&& after) {
 }
 
 template <int D>
-nlohmann::json benchGpuFluid(int n, double minSeconds, double peak, GpuPrecision real) {
+nlohmann::json benchGpuFluid(int n, double minSeconds, GpuPrecision real) {
   FluidSolver<D> host(benchCavity<D>(n));  // the constraints; never stepped
   GpuFluid<D> gpu(host.settings(), host.constraints(), real);
   const double dt = host.h();
@@ -85,14 +86,12 @@ nlohmann::json benchGpuFluid(int n, double minSeconds, double peak, GpuPrecision
                       {"host_waits_per_step", t.hostWaits}};
   for (int k = 0; k < FluidStepStats::kStages; ++k)
     j["ms_" + std::string(FluidStepStats::kStageNames[k])] = 1e3 * stage[size_t(k)] / steps;
-  if (peak > 0) j["fraction_of_peak_bandwidth"] = j["gb_per_second"].get<double>() / peak;
   return j;
 }
 
 template <int D>
-nlohmann::json benchGpuCoupling(int n, ChemicalInterpolation interpolation, double minSeconds, double peak,
-                                GpuPrecision real) {
-  const nlohmann::json fluid = benchGpuFluid<D>(n, minSeconds, peak, real);
+nlohmann::json benchGpuCoupling(int n, ChemicalInterpolation interpolation, double minSeconds, GpuPrecision real) {
+  const nlohmann::json fluid = benchGpuFluid<D>(n, minSeconds, real);
   FluidSolver<D> host(benchCavity<D>(n));
   RDSolver<D> rd(benchGrayScott<D>(n, 1.0 / n, RDIntegrator::KimLin), *findModel("gray-scott"));
   pearsonStart(&rd);
@@ -127,7 +126,6 @@ nlohmann::json benchGpuCoupling(int n, ChemicalInterpolation interpolation, doub
                       {"gb_per_second", t.bytes / t.seconds * 1e-9},
                       {"dispatches_per_step", t.dispatches},
                       {"host_waits_per_step", t.hostWaits}};
-  if (peak > 0) j["fraction_of_peak_bandwidth"] = j["gb_per_second"].get<double>() / peak;
   return j;
 }
 
@@ -135,22 +133,25 @@ nlohmann::json benchGpuCoupling(int n, ChemicalInterpolation interpolation, doub
 
 bool runGpuFluidBench(const BenchOptions& o) {
   const GpuPrecision real = benchPrecision(o);
-  const double peak = announceGpu(real);
-  std::cout << fmt::format("{:>4} {:>6} {:>7} {:>12} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>8} {:>7} {:>10} {:>7}\n",
-                           "dim", "n", "backend", "ms/step(med)", "p-iters", "v-iters", "forces", "advect", "diffuse",
-                           "project", "GB/s", "of peak", "dispatches", "waits");
+  const GpuBandwidth bw = announceGpu(real);
+  std::cout << fmt::format(
+      "{:>4} {:>6} {:>7} {:>12} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>8} {:>7} {:>7} {:>10} {:>7}\n", "dim", "n",
+      "backend", "ms/step(med)", "p-iters", "v-iters", "forces", "advect", "diffuse", "project", "GB/s", "of peak",
+      "of copy", "dispatches", "waits");
   nlohmann::json all = nlohmann::json::array();
   for (BenchCase c : selectBenchCases(kCases, o.size)) {
-    const nlohmann::json j =
-        c.dim == 2 ? benchGpuFluid<2>(c.n, o.minSeconds, peak, real) : benchGpuFluid<3>(c.n, o.minSeconds, peak, real);
+    nlohmann::json j =
+        c.dim == 2 ? benchGpuFluid<2>(c.n, o.minSeconds, real) : benchGpuFluid<3>(c.n, o.minSeconds, real);
+    addBandwidthFractions(&j, bw);
     std::cout << fmt::format(
                      "{:>4} {:>6} {:>7} {:>12.3f} {:>8.1f} {:>8.1f} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.3f} {:>8.1f} {:>7} "
-                     "{:>10.1f} {:>7.1f}{}\n",
+                     "{:>7} {:>10.1f} {:>7.1f}{}\n",
                      c.dim, c.n, "gpu", j["ms_per_step_median"].get<double>(),
                      j["pressure_iterations_mean"].get<double>(), j["viscosity_iterations_mean"].get<double>(),
                      j["ms_forces"].get<double>(), j["ms_advect"].get<double>(), j["ms_diffuse"].get<double>(),
                      j["ms_project"].get<double>(), j["gb_per_second"].get<double>(),
-                     ofPeak(j["gb_per_second"].get<double>(), peak), j["dispatches_per_step"].get<double>(),
+                     ofPeak(j["gb_per_second"].get<double>(), bw.peak),
+                     ofPeak(j["gb_per_second"].get<double>(), bw.copy), j["dispatches_per_step"].get<double>(),
                      j["host_waits_per_step"].get<double>(),
                      j["pressure_converged"].get<bool>() ? "" : "  (unconverged)")
               << std::flush;
@@ -162,25 +163,28 @@ bool runGpuFluidBench(const BenchOptions& o) {
 
 bool runGpuCouplingBench(const BenchOptions& o) {
   const GpuPrecision real = benchPrecision(o);
-  const double peak = announceGpu(real);
+  const GpuBandwidth bw = announceGpu(real);
   const ChemicalInterpolation interpolation = interpolationNamed(o.interpolation);
   std::cout
       << "overhead = (fluid + ARD) / fluid only; targets: >= 1000 steps/s at 1024^2, >= 30 at 256^3, overhead <= 1.10; "
          "chemicals: "
       << o.interpolation << " interpolation\n";
-  std::cout << fmt::format("{:>4} {:>6} {:>10} {:>10} {:>10} {:>10} {:>9} {:>8} {:>7} {:>10} {:>7}\n", "dim", "n",
-                           "fluid/s", "gpu/s", "ms gpu", "ms ARD", "overhead", "GB/s", "of peak", "dispatches",
-                           "waits");
+  std::cout << fmt::format("{:>4} {:>6} {:>10} {:>10} {:>10} {:>10} {:>9} {:>8} {:>7} {:>7} {:>10} {:>7}\n", "dim", "n",
+                           "fluid/s", "gpu/s", "ms gpu", "ms ARD", "overhead", "GB/s", "of peak", "of copy",
+                           "dispatches", "waits");
   nlohmann::json all = nlohmann::json::array();
   for (BenchCase c : selectBenchCases(kCases, o.size)) {
-    const nlohmann::json j = c.dim == 2 ? benchGpuCoupling<2>(c.n, interpolation, o.minSeconds, peak, real)
-                                        : benchGpuCoupling<3>(c.n, interpolation, o.minSeconds, peak, real);
+    nlohmann::json j = c.dim == 2 ? benchGpuCoupling<2>(c.n, interpolation, o.minSeconds, real)
+                                  : benchGpuCoupling<3>(c.n, interpolation, o.minSeconds, real);
+    addBandwidthFractions(&j, bw);
     std::cout << fmt::format(
-                     "{:>4} {:>6} {:>10.1f} {:>10.1f} {:>10.3f} {:>10.3f} {:>9.2f} {:>8.1f} {:>7} {:>10.1f} {:>7.1f}\n",
+                     "{:>4} {:>6} {:>10.1f} {:>10.1f} {:>10.3f} {:>10.3f} {:>9.2f} {:>8.1f} {:>7} {:>7} {:>10.1f} "
+                     "{:>7.1f}\n",
                      c.dim, c.n, j["fluid_only_steps_per_second"].get<double>(), j["steps_per_second"].get<double>(),
                      j["ms"].get<double>(), j["ard_part_ms"].get<double>(), j["overhead"].get<double>(),
-                     j["gb_per_second"].get<double>(), ofPeak(j["gb_per_second"].get<double>(), peak),
-                     j["dispatches_per_step"].get<double>(), j["host_waits_per_step"].get<double>())
+                     j["gb_per_second"].get<double>(), ofPeak(j["gb_per_second"].get<double>(), bw.peak),
+                     ofPeak(j["gb_per_second"].get<double>(), bw.copy), j["dispatches_per_step"].get<double>(),
+                     j["host_waits_per_step"].get<double>())
               << std::flush;
     all.push_back(j);
   }

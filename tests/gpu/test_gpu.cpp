@@ -524,8 +524,10 @@ TEST(Gpu, ShippedImplicitRDScenesMatchTheCpu) {
 
 // The GPU suites print the CPU suites' tables for the same problems (here at
 // 32^2, on llvmpipe) and their JSON: every case converged, a positive rate,
-// the modelled traffic over the time as GB/s, the ARD part of a coupled step
-// timed (no figure is asserted: timings on a shared machine are not tests).
+// the modelled traffic over the time as GB/s and as a fraction of the
+// device's measured copy bandwidth, the ARD part of a coupled step timed,
+// the precision the suite ran in (float by default; no figure is asserted:
+// timings on a shared machine are not tests).
 TEST(Gpu, BenchSuitesTimeTheFluidTheLayerAndTheCoupling) {
   if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
   const fs::path dir = tempDir("gpu_bench");
@@ -535,6 +537,7 @@ TEST(Gpu, BenchSuitesTimeTheFluidTheLayerAndTheCoupling) {
         runMorphoflow(std::string("bench ") + suite + " --backend gpu --size 32 --seconds 0 --json " + json.string());
     ASSERT_EQ(r.status, 0) << suite << "\n" << r.output;
     EXPECT_NE(r.output.find("gpu: "), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("copy bandwidth: "), std::string::npos) << r.output;
     std::ifstream in(json);
     const nlohmann::json j = nlohmann::json::parse(in);
     ASSERT_FALSE(j.empty()) << suite;
@@ -549,6 +552,10 @@ TEST(Gpu, BenchSuitesTimeTheFluidTheLayerAndTheCoupling) {
       }
       EXPECT_GT(c.contains("ms") ? c["ms"].get<double>() : c["ms_per_step_median"].get<double>(), 0.0) << c;
       EXPECT_GT(c["gb_per_second"].get<double>(), 0.0) << c;
+      EXPECT_GT(c["fraction_of_copy_bandwidth"].get<double>(), 0.0) << c;
+      if (c.contains("precision")) {
+        EXPECT_EQ(c["precision"], "float") << c;
+      }
       if (c.contains("pressure_converged")) {
         EXPECT_TRUE(c["pressure_converged"].get<bool>()) << c;
       }
