@@ -8,10 +8,10 @@
 namespace morphoflow {
 
 namespace {
-// kernels/pressure_projection.inc, shared with the GPU (kernels/README.md)
+// kernels/projection.inc, shared with the GPU (kernels/README.md)
 #define PP_FN inline double
 #define PP_REAL double
-#include "kernels/pressure_projection.inc"
+#include "kernels/projection.inc"
 #undef PP_FN
 #undef PP_REAL
 }  // namespace

@@ -3,7 +3,7 @@
 // last two projections, MGPCG to the scene's tolerance on the CPU's own
 // system and multigrid levels (phi in double: kPhiPrecision), then the
 // gradient on every free face (shaders/pressure_projection.comp, the
-// formulas kernels/pressure_projection.inc's).
+// formulas kernels/projection.inc's).
 #pragma once
 
 #include <memory>

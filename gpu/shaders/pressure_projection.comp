@@ -1,5 +1,5 @@
 // The projection's stages besides its solve (fluid/pressure_projection.cpp), one MODE each,
-// the formulas kernels/pressure_projection.inc's, in XREAL (the solve's solution type):
+// the formulas kernels/projection.inc's, in XREAL (the solve's solution type):
 // MODE_DIVERGENCE       rhs = -(div u) / h through the faces' open fractions, 0 in cells
 //                       without a pressure
 // MODE_WARM_START       phi = dt (2 rate - rate_prev) (or dt rate), rate = phi / last dt
@@ -12,7 +12,7 @@
 #include "fluid_faces.glsl"
 #define PP_FN XREAL
 #define PP_REAL XREAL
-#include "pressure_projection.inc"
+#include "projection.inc"
 
 void main() {
   const int i = flatIndex();
