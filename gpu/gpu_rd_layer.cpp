@@ -119,9 +119,7 @@ size_t GpuRDLayer<D>::deviceBytes(size_t n, int species, GpuPrecision real) {
 
 template <int D>
 GpuBuffer GpuRDLayer<D>::reals(const std::vector<double>& values) const {
-  GpuBuffer b(values.size() * realBytes(real_));
-  uploadReals(&b, values, real_);
-  return b;
+  return realBuffer(values, real_);
 }
 
 template <int D>

@@ -17,6 +17,12 @@ GpuBuffer realBuffer(size_t n, GpuPrecision p) {
   return b;
 }
 
+GpuBuffer realBuffer(const std::vector<double>& values, GpuPrecision p) {
+  GpuBuffer b(values.size() * realBytes(p));
+  uploadReals(&b, values, p);
+  return b;
+}
+
 void uploadReals(GpuBuffer* b, const std::vector<double>& values, GpuPrecision p, size_t firstElement) {
   if (p == GpuPrecision::Double) return b->upload(values, firstElement * sizeof(double));
   b->upload(std::vector<float>(values.begin(), values.end()), firstElement * sizeof(float));

@@ -25,6 +25,8 @@ std::string realDefines(GpuPrecision p, GpuPrecision solution);
 constexpr double toleranceFloor(GpuPrecision p) { return p == GpuPrecision::Float ? 4e-6 : 0.0; }
 // A buffer of n reals (zeroed).
 GpuBuffer realBuffer(size_t n, GpuPrecision p);
+// A buffer holding `values` in p.
+GpuBuffer realBuffer(const std::vector<double>& values, GpuPrecision p);
 void uploadReals(GpuBuffer* b, const std::vector<double>& values, GpuPrecision p, size_t firstElement = 0);
 std::vector<double> readReals(const GpuBuffer& b, size_t n, GpuPrecision p, size_t firstElement = 0);
 

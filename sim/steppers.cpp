@@ -2,8 +2,6 @@
 
 #include <fmt/format.h>
 
-#include "gpu/gpu_reals.h"
-
 #include "core/error.h"
 #include "coupling/cpu_coupled_stepper.h"
 #include "gpu/gl_context.h"
@@ -12,6 +10,7 @@
 #include "gpu/gpu_layer_steppers.h"
 #include "gpu/gpu_models.h"
 #include "gpu/gpu_newton_check.h"
+#include "gpu/gpu_reals.h"
 
 namespace morphoflow {
 

@@ -27,8 +27,7 @@ GpuViscosity<D>::GpuViscosity(const VelocityConstraints<D>& vc, GpuMacGrid<D>* g
     c->host = viscousSystem<D>(vc, a);
     c->host.setRate(1.0);
     const std::vector<float> rhs = c->host.boundaryRhs.expanded();  // (the shader reads reals)
-    c->boundaryRhs = realBuffer(rhs.size(), real_);
-    uploadReals(&c->boundaryRhs, std::vector<double>(rhs.begin(), rhs.end()), real_);
+    c->boundaryRhs = realBuffer(std::vector<double>(rhs.begin(), rhs.end()), real_);
     blocks.push_back(&c->host.A);
     components_[size_t(a)] = std::move(c);
   }

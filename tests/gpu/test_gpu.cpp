@@ -657,6 +657,40 @@ TEST(Gpu, CoarseToFineStartAndClampedExplicitSpeciesMatchTheCpu) {
   fs::remove_all(dir);
 }
 
+// gpu.precision: float by default; a Krylov tolerance the scene gives below
+// float's floor is raised to it and said at the start, run.json holding the
+// one used and the precision; "double" keeps it; any other precision is a
+// located error, exit 2.
+TEST(Gpu, AToleranceBelowFloatsFloorIsRaisedAndSaid) {
+  if (const std::string why = gpuUnavailable(); !why.empty()) GTEST_SKIP() << why;
+  const fs::path dir = tempDir("gpu_floor");
+  const std::string scene = sceneFile("rd/gray_scott_pearson.toml") +
+                            " --set grid.resolution=[32,32] --set time.steps=4 --set output.every=4";
+  for (const std::string& precision : {std::string(), kInDouble}) {
+    CommandResult r = runMorphoflow("run " + scene + " --set rd.tolerance=1e-12" + precision + " --backend gpu --out " +
+                                    (dir / "o").string());
+    ASSERT_EQ(r.status, 0) << r.output;
+    const bool single = precision.empty();
+    EXPECT_EQ(
+        r.output.find("warning: rd.tolerance = 1e-12 is below what the gpu's float solves reach: 4e-06 is used") !=
+            std::string::npos,
+        single)
+        << r.output;
+    std::ifstream in(dir / "o" / "run.json");
+    const nlohmann::json j = nlohmann::json::parse(in);
+    EXPECT_EQ(j["gpu"]["precision"], single ? "float" : "double");
+    EXPECT_EQ(j["gpu"]["tolerances"]["rd"].get<double>(), single ? 4e-6 : 1e-12);
+  }
+  // the default tolerance (1e-8) is raised too, unsaid
+  CommandResult r = runMorphoflow("run " + scene + " --backend gpu --out " + (dir / "o").string());
+  EXPECT_EQ(r.output.find("below what the gpu's float solves reach"), std::string::npos) << r.output;
+  r = runMorphoflow("run " + scene + " --set 'gpu.precision=\"half\"' --out " + (dir / "half").string());
+  EXPECT_EQ(r.status, 2) << r.output;
+  EXPECT_NE(r.output.find("'gpu.precision': 'half' is not one of: float, double"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(dir / "half" / "frames"));
+  fs::remove_all(dir);
+}
+
 // The rest of the shipped seed scenes (Sanderson's figures 3, 4, 5a, 5b, 12
 // and 15, the Turing spots, Lawlor's parameter map, Pearson's explicit
 // theta), at 64^2 for 40 steps with the solves at 1e-12: every species
