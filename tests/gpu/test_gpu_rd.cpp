@@ -1,5 +1,5 @@
-// The GPU's reaction-diffusion layer (double precision) against the CPU's
-// RDSolver: Kim & Lin's implicit reaction for every two-species model at
+// The GPU's reaction-diffusion layer (in double, and in float where named)
+// against the CPU's RDSolver: Kim & Lin's implicit reaction for every two-species model at
 // time steps far beyond the explicit limit (where Newton needs its line
 // search, continuation and restarts), each integrator's theta scheme, 2D and
 // 3D, periodic and zero-flux walls.
@@ -26,16 +26,21 @@ namespace {
 // Steps both layers from the same random state near the model's default and
 // returns the largest difference over the largest change (both species).
 template <int D>
-double relativeDifference(RDSettings s, const ReactionModel& m, double dt, int steps) {
+double relativeDifference(RDSettings s, const ReactionModel& m, double dt, int steps,
+                          GpuPrecision real = GpuPrecision::Double) {
   RDSolver<D> cpu(s, m);
   const ModelInfo& info = m.info();
   const std::vector<std::vector<double>> start = perturbNearInitial<D>(&cpu, 3);
-  GpuRDLayer<D> gpu(layerUpload(cpu));
+  GpuRDLayer<D> gpu(layerUpload(cpu), real);
   for (int n = 0; n < steps; ++n) {
     cpu.step(dt);
     gpu.step(dt);
-    EXPECT_TRUE(gpu.lastStats().diffusion.converged) << info.name;
-    EXPECT_EQ(gpu.lastStats().newton.failures, cpu.lastStats().newton.failures) << info.name;
+    EXPECT_TRUE(gpu.lastStats().diffusion.converged) << info.name << " " << gpu.lastStats().diffusion.residual;
+    if (real == GpuPrecision::Double) {
+      EXPECT_EQ(gpu.lastStats().newton.failures, cpu.lastStats().newton.failures) << info.name;
+    } else {
+      EXPECT_LE(gpu.lastStats().newton.failures, cpu.lastStats().newton.failures) << info.name;
+    }
   }
   const auto [worst, moved, apart] = layerDifference<D>(gpu, cpu, start);
   EXPECT_GT(moved, 1e-4) << info.name << ": the steps must change the state";
@@ -99,6 +104,31 @@ TEST(GpuRD, EveryIntegratorMatchesTheCpuIn2DAnd3D) {
     s.size = {0.12, 0.10, 0.08};
     s.boundary = RDBoundary::Neumann;
     EXPECT_LT(relativeDifference<3>(s, gs, dt, 10), 1e-6) << int(integ) << " 3D";
+  }
+}
+
+// In float (the default): every integrator within 5e-4 of the change over
+// the run (measured 1.4e-6 explicit, at most 1.1e-4 implicit: the CPU's
+// solves stop at 1e-8, the float ones at float's floor, 4e-6, and meet it),
+// Kim & Lin's Newton at float's tolerance failing in no more cells than the CPU's.
+TEST(GpuRD, EveryIntegratorMatchesTheCpuInFloat) {
+  if (const std::string why = gpuContextMissing(); !why.empty()) GTEST_SKIP() << why;
+  const ReactionModel& gs = *findModel("gray-scott");
+  for (RDIntegrator integ :
+       {RDIntegrator::ExplicitEuler, RDIntegrator::SemiImplicit, RDIntegrator::KimLin, RDIntegrator::CrankNicolson}) {
+    RDSettings s;
+    s.model = "gray-scott";
+    s.integrator = integ;
+    s.resolution = {32, 32};
+    s.size = {0.32, 0.32};
+    s.diffusion = {2e-5, 1e-5};
+    s.boundary = RDBoundary::Periodic;
+    const double dt = integ == RDIntegrator::ExplicitEuler ? 0.5 : 5.0;
+    EXPECT_LT(relativeDifference<2>(s, gs, dt, 20, GpuPrecision::Float), 5e-4) << int(integ);
+    s.resolution = {12, 10, 8};
+    s.size = {0.12, 0.10, 0.08};
+    s.boundary = RDBoundary::Neumann;
+    EXPECT_LT(relativeDifference<3>(s, gs, dt, 10, GpuPrecision::Float), 5e-4) << int(integ) << " 3D";
   }
 }
 
