@@ -325,10 +325,12 @@ FluidSettings smoky(std::vector<int> res) {
   return s;
 }
 
+// The GPU's velocity, smoke and temperature within `tolerance` of their largest values.
 template <int D>
-void expectSmokeMatches(const FluidSettings& s, int steps, double dt) {
+void expectSmokeMatches(const FluidSettings& s, int steps, double dt, GpuPrecision real = GpuPrecision::Double,
+                        double tolerance = 1e-5) {
   FluidSolver<D> cpu(s);
-  GpuFluid<D> gpu(s, cpu.constraints());
+  GpuFluid<D> gpu(s, cpu.constraints(), real);
   gpu.upload(cpu.velocity(), cpu.dye(), &cpu.temperature());
   for (int n = 0; n < steps; ++n) cpu.step(dt), gpu.step(dt);
   MacVelocity<D> u = cpu.velocity();
@@ -348,18 +350,22 @@ void expectSmokeMatches(const FluidSettings& s, int steps, double dt) {
   }
   EXPECT_GT(umax, 0.05);
   EXPECT_GT(dmax, 0.05);
-  EXPECT_LT(du / umax, 1e-5) << D << "D velocity";
-  EXPECT_LT(dd / dmax, 1e-5) << D << "D smoke";
-  EXPECT_LT(dt2 / tmax, 1e-5) << D << "D temperature";
+  EXPECT_LT(du / umax, tolerance) << D << "D velocity";
+  EXPECT_LT(dd / dmax, tolerance) << D << "D smoke";
+  EXPECT_LT(dt2 / tmax, tolerance) << D << "D temperature";
 }
 
 }  // namespace
 
 // Smoke on the GPU: sources (fixed, moving, injecting), buoyancy, vorticity
 // confinement, dissipation and cooling take the CPU's steps, 2D and 3D, to
-// float rounding of the largest value (measured: 2e-7 in 2D, 4e-7 in 3D).
+// float rounding of the largest value in double (measured: 2e-7 in 2D, 4e-7
+// in 3D), and within 1e-4 in float, its solves at float's floor (measured
+// 1.4e-5 in 2D, 1.2e-6 in 3D).
 TEST(GpuFluid, SmokeMatchesTheCpu) {
   if (const std::string why = gpuContextMissing(); !why.empty()) GTEST_SKIP() << why;
   expectSmokeMatches<2>(smoky({48, 48}), 40, 0.01);
   expectSmokeMatches<3>(smoky({20, 20, 20}), 20, 0.02);
+  expectSmokeMatches<2>(smoky({48, 48}), 40, 0.01, GpuPrecision::Float, 1e-4);
+  expectSmokeMatches<3>(smoky({20, 20, 20}), 20, 0.02, GpuPrecision::Float, 1e-4);
 }
