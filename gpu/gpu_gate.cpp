@@ -112,17 +112,33 @@ void GpuGate::dispatch(unsigned gx, unsigned gy) {
 
 bool GpuGate::going() const { return state_.read<uint32_t>(1)[0] != 0u; }
 
+namespace {
+GpuGate::Tally tallyOf(const uint8_t* raw) {
+  uint32_t u[8];
+  std::memcpy(u, raw, sizeof u);
+  GpuGate::Tally t;
+  t.solves = u[2], t.iterations = u[3], t.maxIterations = u[4], t.unconverged = u[5];
+  t.lastIterations = u[6], t.lastConverged = u[7] != 0u;
+  std::memcpy(&t.maxResidual, raw + 32, sizeof(double));
+  std::memcpy(&t.lastResidual, raw + 40, sizeof(double));
+  return t;
+}
+}  // namespace
+
 GpuGate::Tally GpuGate::read() const {
   std::vector<uint8_t> raw(kStateBytes);
   state_.download(raw.data(), kStateBytes);
-  uint32_t u[8];
-  std::memcpy(u, raw.data(), sizeof u);
-  Tally t;
-  t.solves = u[2], t.iterations = u[3], t.maxIterations = u[4], t.unconverged = u[5];
-  t.lastIterations = u[6], t.lastConverged = u[7] != 0u;
-  std::memcpy(&t.maxResidual, raw.data() + 32, sizeof(double));
-  std::memcpy(&t.lastResidual, raw.data() + 40, sizeof(double));
-  return t;
+  return tallyOf(raw.data());
+}
+
+std::vector<GpuGate::Tally> GpuGate::read(const std::vector<const GpuGate*>& gates) {
+  GpuBuffer all(gates.size() * kStateBytes);
+  for (size_t k = 0; k < gates.size(); ++k) all.copyFrom(gates[k]->state_, kStateBytes, 0, k * kStateBytes);
+  std::vector<uint8_t> raw(gates.size() * kStateBytes);
+  all.download(raw.data(), raw.size());
+  std::vector<Tally> tallies;
+  for (size_t k = 0; k < gates.size(); ++k) tallies.push_back(tallyOf(raw.data() + k * kStateBytes));
+  return tallies;
 }
 
 void GpuGate::resetTally() {

@@ -74,6 +74,8 @@ class GpuGate final : public DispatchRoute {
   // Whether the solve is still going (one host wait).
   bool going() const;
   Tally read() const;  // one host wait
+  // The tallies of several gates, in one host wait (their states copied side by side on the device first).
+  static std::vector<Tally> read(const std::vector<const GpuGate*>& gates);
   void resetTally();
 
  private:

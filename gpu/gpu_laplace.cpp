@@ -24,48 +24,6 @@ GpuLaplace::GpuLaplace(const LaplaceSystem<D>& A) : dim_(D), n_(A.size()) {
 }
 
 template <int D>
-GpuLaplace::GpuLaplace(const std::vector<const LaplaceSystem<D>*>& blocks) : dim_(D) {
-  if (blocks.empty() || blocks.size() > 4) throw GpuError("a block system holds 1 to 4 systems");
-  for (const LaplaceSystem<D>* A : blocks) {
-    Block k{n_, {1, 1, 1}, A->scale};
-    for (int a = 0; a < D; ++a) k.dims[size_t(a)] = A->dims[a];
-    blocks_.push_back(k);
-    n_ += A->size();
-  }
-  for (int a = 0; a < 3; ++a) w_[size_t(a)] = GpuBuffer((a < D ? n_ : 1) * sizeof(float));
-  diag_ = GpuBuffer(n_ * sizeof(float));
-  c_ = GpuBuffer(n_ * sizeof(float));
-  for (size_t k = 0; k < blocks.size(); ++k) updateBlock(int(k), *blocks[k]);
-}
-
-template <int D>
-void GpuLaplace::updateBlock(int k, const LaplaceSystem<D>& A) {
-  if (A.singular()) throw GpuError("a block system's blocks must not be singular");
-  Block& B = blocks_.at(size_t(k));
-  const size_t at = B.start * sizeof(float);
-  for (int a = 0; a < D; ++a) w_[size_t(a)].upload(A.w[a].expanded(), at);
-  diag_.upload(A.diag.expanded(), at);
-  c_.upload(A.c.expanded(), at);
-  B.scale = A.scale;
-}
-
-void GpuLaplace::setBlockUniforms(const ComputeProgram& p) const {
-  std::array<int, 4> start{};
-  std::array<int, 12> dims{};
-  std::array<double, 4> scale{};
-  for (size_t k = 0; k < 4; ++k) {
-    const bool used = k < blocks_.size();
-    start[k] = used ? int(blocks_[k].start) : int(n_);
-    for (size_t a = 0; a < 3; ++a) dims[3 * k + a] = used ? blocks_[k].dims[a] : 1;
-    scale[k] = used ? blocks_[k].scale : 1.0;
-  }
-  setUniform(p, "blockStart", start);
-  glUniform3iv(p.uniform("blockDims"), 4, dims.data());
-  setUniformDoubles(p, "blockScale", scale.data(), 4);
-  setUniform(p, "cells", int(n_));
-}
-
-template <int D>
 GpuLaplace::GpuLaplace(const AnisotropicSystem<D>& A) : GpuLaplace(A.axis) {
   update(A);
 }
@@ -153,27 +111,19 @@ void GpuLaplace::run(LaplaceMode mode, bool single, const GpuBuffer& x, const Gp
                      int colour, float omega, const FusedDot* dot, const PUpdate* pUpdate,
                      const ResidualExtras* extras) const {
   const bool cross = hasCross_ && !single && (mode == LaplaceMode::Apply || mode == LaplaceMode::Residual);
-  const bool block = !blocks_.empty();
-  if (block && (mode == LaplaceMode::Smooth || mode == LaplaceMode::Jacobi))
-    throw GpuError("a block system is not smoothed (no multigrid)");
   const GpuPrecision real = single ? GpuPrecision::Float : real_, solution = single ? real : solution_;
   std::string defines = fmt::format("#define DIM {}\n#define {}", dim_, define(mode));
   const auto add = [&](bool on, const char* name) {
     if (on) defines += std::string("\n#define ") + name;
   };
   add(cross, "CROSS");
-  add(block, "BLOCK");
   add(extras && extras->bSum >= 0, "MEAN_FREE");
   add(dot, "DOT_PARTIAL");
   add(pUpdate, "P_UPDATE");
   add(pUpdate && pUpdate->first, "P_FIRST");
   const ComputeProgram& p = useProgram("laplace.comp", defines, real, solution);
-  if (block) {
-    setBlockUniforms(p);
-  } else {
-    setUniform(p, "dims", dims_);
-    setUniform(p, "scale", scale_);
-  }
+  setUniform(p, "dims", dims_);
+  setUniform(p, "scale", scale_);
   setUniform(p, "colour", colour);
   setUniform(p, "omega", omega);
   x.bind(0);
@@ -251,10 +201,6 @@ template GpuLaplace::GpuLaplace(const LaplaceSystem<2>&);
 template GpuLaplace::GpuLaplace(const LaplaceSystem<3>&);
 template void GpuLaplace::update(const LaplaceSystem<2>&);
 template void GpuLaplace::update(const LaplaceSystem<3>&);
-template GpuLaplace::GpuLaplace(const std::vector<const LaplaceSystem<2>*>&);
-template GpuLaplace::GpuLaplace(const std::vector<const LaplaceSystem<3>*>&);
-template void GpuLaplace::updateBlock(int, const LaplaceSystem<2>&);
-template void GpuLaplace::updateBlock(int, const LaplaceSystem<3>&);
 template GpuLaplace::GpuLaplace(const AnisotropicSystem<2>&);
 template GpuLaplace::GpuLaplace(const AnisotropicSystem<3>&);
 template void GpuLaplace::update(const AnisotropicSystem<2>&);

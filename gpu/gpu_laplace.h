@@ -50,16 +50,6 @@ class GpuLaplace {
   // the axis part: the preconditioner is the axis part's, as on the CPU).
   template <int D>
   explicit GpuLaplace(const AnisotropicSystem<D>& A);
-  // The block-diagonal system of up to 4 systems (no mixed terms), one
-  // vector for all: block k's cells follow block k - 1's, from
-  // blockStart(k). apply() and residual() (with or without the fused dot
-  // and p update) act on each block as its own system, so a GpuPcg solves
-  // them as one system (the viscosity's components); not for smoothing.
-  template <int D>
-  explicit GpuLaplace(const std::vector<const LaplaceSystem<D>*>& blocks);
-  template <int D>
-  void updateBlock(int k, const LaplaceSystem<D>& A);  // block k's coefficients changed
-  size_t blockStart(int k) const { return blocks_.empty() ? 0 : blocks_[size_t(k)].start; }
   // The system's coefficients changed, not its shape.
   template <int D>
   void update(const LaplaceSystem<D>& A);
@@ -125,13 +115,6 @@ class GpuLaplace {
   void run(LaplaceMode mode, bool single, const GpuBuffer& x, const GpuBuffer* y, const GpuBuffer* b, int colour,
            float omega, const FusedDot* dot = nullptr, const PUpdate* pUpdate = nullptr,
            const ResidualExtras* extras = nullptr) const;
-  void setBlockUniforms(const ComputeProgram& p) const;
-  struct Block {
-    size_t start;
-    std::array<int, 3> dims;
-    double scale;
-  };
-  std::vector<Block> blocks_;  // empty: one system
   std::array<int, 3> dims_{1, 1, 1};
   std::array<bool, 3> periodic_{};
   int dim_ = 2;

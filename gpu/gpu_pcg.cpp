@@ -182,4 +182,14 @@ SolverResult GpuPcg::tally() {
   return fromTally(t, false);
 }
 
+std::vector<SolverResult> GpuPcg::tally(const std::vector<GpuPcg*>& solves) {
+  std::vector<const GpuGate*> gates;
+  for (const GpuPcg* s : solves) gates.push_back(&s->gate_);
+  const std::vector<GpuGate::Tally> tallies = GpuGate::read(gates);
+  std::vector<SolverResult> results;
+  for (size_t k = 0; k < solves.size(); ++k)
+    results.push_back(tallies[k].solves == 0 ? solves[k]->last_ : solves[k]->fromTally(tallies[k], false));
+  return results;
+}
+
 }  // namespace morphoflow

@@ -11,6 +11,7 @@
 #pragma once
 
 #include <memory>
+#include <vector>
 
 #include "core/pcg.h"
 #include "core/solver_result.h"
@@ -46,6 +47,15 @@ class GpuPcg {
   // when all were, a solve's mean iterations, the largest residual; and the
   // schedule adapted to them.
   SolverResult tally();
+  // The tallies of several solves, in one host wait.
+  static std::vector<SolverResult> tally(const std::vector<GpuPcg*>& solves);
+  // The iterations a solve queues (0: not calibrated yet), and a schedule
+  // taken from a like system's where this one has none (a right-hand side
+  // that has stayed 0), so that it does not calibrate, reading back.
+  int schedule() const { return ahead_; }
+  void adoptSchedule(int ahead) {
+    if (ahead_ == 0) ahead_ = ahead;
+  }
   GpuReduction& reduction() { return sums_; }
 
  private:

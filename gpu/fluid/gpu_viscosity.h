@@ -1,9 +1,11 @@
 // The implicit viscosity on the GPU (fluid/viscosity.h): (I - nu dt lap) u =
 // u* on each component's free faces, with the CPU's own systems (the faces
 // inside a cut obstacle held, the cut surface's couplings in their boundary
-// terms), the components one block system solved by CG with the diagonal as
-// preconditioner to the relative residual of the whole velocity system
-// (shaders/viscosity.comp sets the blocks up and stores them).
+// terms), one component after another, each solved by CG with the diagonal
+// as preconditioner to the relative residual (shaders/viscosity.comp sets a
+// component's system up and stores its solution). The components' solves
+// share one set of work vectors, one right-hand side and solution, one read
+// of their tallies, and their schedule where one has none of its own.
 #pragma once
 
 #include <array>
@@ -37,10 +39,8 @@ class GpuViscosity {
   GpuMacGrid<D>& grid_;
   GpuPrecision real_;
   std::array<std::unique_ptr<Component>, D> components_;
-  std::unique_ptr<GpuLaplace> A_;  // the components' systems, one block system
   std::shared_ptr<GpuPcgWork> work_;
-  std::unique_ptr<GpuPcg> pcg_;
-  GpuBuffer b_, x_;  // the components' right-hand sides and solutions, as its blocks
+  GpuBuffer b_, x_;  // the component being solved: its right-hand side and solution
   GpuBuffer held_;   // with cut obstacles: the held faces (prescribed, or inside an obstacle)
   double s_ = -1.0;  // nu dt / h^2 of the systems
 };

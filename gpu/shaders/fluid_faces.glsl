@@ -26,7 +26,6 @@ uniform ivec3 cells, periodic, velOff;
 uniform int axis;           // the velocity component a
 uniform int n;              // samples of the grid the mode runs over
 uniform ivec3 udims;        // MODE_VISCOUS_*: the unknowns (faces less a periodic duplicate layer)
-uniform int blockOff;       // MODE_VISCOUS_*: the component's first unknown in b and x (one block system)
 uniform float fa, fb;       // MODE_FORCES: dt f_a, dt b dir_a
 uniform int f1Off, dstOff;  // offsets into f1 / f0 (MODE_MACCORMACK / BFECC)
 uniform XREAL invH, dt, invLastDt;  // the projection's (in its solution's type)

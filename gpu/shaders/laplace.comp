@@ -14,9 +14,6 @@
 // diagonal neighbours in each plane; the preconditioners take the axis part.
 // DOT_PARTIAL (apply and residual): with the partial pass of the
 // dot product the PCG takes next (see main).
-// BLOCK (apply and residual): a block-diagonal system of up to 4 systems in
-// one vector (gpu_laplace.h), block k's cells from blockStart[k], each with
-// its own dims and scale: several systems solved as one.
 #if defined(MODE_RESIDUAL)
 layout(std430, binding = 0) buffer X { XREAL x[]; };  // the solution (XREAL)
 #else
@@ -34,30 +31,9 @@ layout(std430, binding = 5) readonly buffer W2 { float w2[]; };
 layout(std430, binding = 6) readonly buffer Diag { float diag[]; };
 layout(std430, binding = 7) readonly buffer C { float cTerm[]; };
 
-#if defined(BLOCK)
-uniform ivec4 blockStart;  // unused blocks start past the last cell
-uniform ivec3 blockDims[4];
-uniform double blockScale[4];
-uniform int cells;  // all blocks'
-ivec3 dims;
-double scale;
-int base_ = 0;
-// Makes cell i's block current; i's index in its block.
-int enterBlock(int i) {
-  const int k = int(i >= blockStart.y) + int(i >= blockStart.z) + int(i >= blockStart.w);
-  base_ = blockStart[k];
-  dims = blockDims[k];
-  scale = blockScale[k];
-  return i - base_;
-}
-#define CELLS cells
-#else
 uniform ivec3 dims;
 uniform double scale;
-#define base_ 0
-int enterBlock(int i) { return i; }
 #define CELLS (dims.x * dims.y * dims.z)
-#endif
 uniform int colour;    // MODE_SMOOTH: the cells with (x + y + z) % 2 == colour
 uniform float omega;   // MODE_JACOBI
 
@@ -89,7 +65,7 @@ REAL crossSum(ivec3 c, int i) {
 }
 #endif
 
-float weight(int a, int i) { return a == 0 ? w0[base_ + i] : a == 1 ? w1[base_ + i] : w2[base_ + i]; }
+float weight(int a, int i) { return a == 0 ? w0[i] : a == 1 ? w1[i] : w2[i]; }
 #if defined(P_UPDATE)
 // The PCG's p update fused into its operator (MODE_APPLY, DOT_PARTIAL; not
 // with CROSS): A is applied to p' = z + beta p (b holds z, x holds p),
@@ -98,12 +74,12 @@ float weight(int a, int i) { return a == 0 ? w0[base_ + i] : a == 1 ? w1[base_ +
 layout(std430, binding = 8) buffer PNew { REAL pNew[]; };
 REAL beta_ = REAL(0);
 #if defined(P_FIRST)
-#define LX(i) b[base_ + (i)]
+#define LX(i) b[(i)]
 #else
-#define LX(i) (b[base_ + (i)] + beta_ * x[base_ + (i)])
+#define LX(i) (b[(i)] + beta_ * x[(i)])
 #endif
 #else
-#define LX(i) x[base_ + (i)]
+#define LX(i) x[(i)]
 #endif
 #define LW(a, i) weight(a, i)
 // The residual is evaluated in double from the REAL vectors (exact for the
@@ -118,20 +94,20 @@ REAL beta_ = REAL(0);
 #include "laplace_stencil.glsl"
 
 #if defined(MODE_APPLY) || defined(MODE_RESIDUAL)
-// A x at active cell i of the current block (enterBlock).
+// A x at active cell i.
 OP_REAL axAt(int i) {
   const ivec3 c = coordsOf(i, dims);
-  precise OP_REAL ax = operatorTerm(c, i, dims, scale, cTerm[base_ + i]);
+  precise OP_REAL ax = operatorTerm(c, i, dims, scale, cTerm[i]);
 #if defined(CROSS)
   ax += OP_REAL(scale) * OP_REAL(crossSum(c, i));
 #endif
   return ax;
 }
 
-// A x (MODE_APPLY) or b - A x (MODE_RESIDUAL, b = bi) at cell i of the
-// current block; 0 on inactive cells.
+// A x (MODE_APPLY) or b - A x (MODE_RESIDUAL, b = bi) at cell i; 0 on
+// inactive cells.
 OP_REAL operatorAt(int i, OP_REAL bi) {
-  if (diag[base_ + i] <= 0.0) return OP_REAL(0);
+  if (diag[i] <= 0.0) return OP_REAL(0);
 #if defined(MODE_APPLY)
   return axAt(i);
 #else
@@ -197,7 +173,6 @@ void main() {
 #endif
 #endif
   FOR_REDUCTION(i, CELLS) {
-    const int li = enterBlock(i);
 #if defined(MODE_RESIDUAL)
     REAL bi = b[i];
 #if defined(MEAN_FREE)  // (b is read at i only)
@@ -209,14 +184,14 @@ void main() {
       x[i] = XREAL(0);
       v = diag[i] <= 0.0 ? OP_REAL(0) : bi;
     } else {
-      v = operatorAt(li, bi);
+      v = operatorAt(i, bi);
     }
 #else
-    const REAL v = operatorAt(li, REAL(0));
+    const REAL v = operatorAt(i, REAL(0));
 #endif
     y[i] = REAL(v);
 #if defined(P_UPDATE)
-    const REAL pi = LX(li);
+    const REAL pi = LX(i);
     pNew[i] = pi;
     s = s + double(pi) * double(v);
 #elif defined(MODE_APPLY)
@@ -254,7 +229,7 @@ void main() {
   const int i = flatIndex();
   if (i >= CELLS) return;
 #if defined(MODE_APPLY)
-  y[i] = operatorAt(enterBlock(i), REAL(0));
+  y[i] = operatorAt(i, REAL(0));
 #else
   const ivec3 c = coordsOf(i, dims);
 #if defined(MODE_SMOOTH)

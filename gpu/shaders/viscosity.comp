@@ -10,11 +10,11 @@ void main() {
   const int gi = indexOf(coordsOf(i, udims), faceDims());
   const bool held = fixedFace[velOff[axis] + gi] != 0u;
   const REAL u = REAL(vel[velOff[axis] + gi]);
-  d0[blockOff + i] = held ? REAL(0) : u + s * d2[i];
-  d1[blockOff + i] = held ? REAL(0) : u;
+  d0[i] = held ? REAL(0) : u + s * d2[i];
+  d1[i] = held ? REAL(0) : u;
 #elif defined(MODE_VISCOUS_STORE)  // d1 = x
   const int gi = indexOf(coordsOf(i, udims), faceDims());
   // (or the viscosity's held flags)
-  if (fixedFace[velOff[axis] + gi] == 0u) vel[velOff[axis] + gi] = float(d1[blockOff + i]);
+  if (fixedFace[velOff[axis] + gi] == 0u) vel[velOff[axis] + gi] = float(d1[i]);
 #endif
 }
