@@ -44,7 +44,7 @@ GpuRDLayer<D>::GpuRDLayer(const LayerUpload<D>& upload, GpuPrecision real)
   // after another, share a work vector and the PCG's.
   const bool rates = rd.settings.integrator != RDIntegrator::KimLin;
   for (int s = 0; s < species_; ++s) {
-    x_[size_t(s)] = reals(*rd.state[size_t(s)]);
+    x_[size_t(s)] = realBuffer(*rd.state[size_t(s)], real_);
     rates_[size_t(s)] = realBuffer(rates ? n_ : 1, real_);
     diffusion_[size_t(s)] = std::make_unique<Diffusion>();
     diffusion_[size_t(s)]->increment = realBuffer(n_, real_);
@@ -69,23 +69,23 @@ GpuRDLayer<D>::GpuRDLayer(const LayerUpload<D>& upload, GpuPrecision real)
     mapAt_[k] = int(maps.size());
     maps.insert(maps.end(), f.begin(), f.end());
   }
-  maps_ = reals(maps.empty() ? std::vector<double>{0.0} : maps);
+  maps_ = realBuffer(maps.empty() ? std::vector<double>{0.0} : maps, real_);
   for (int s = 0; s < species_; ++s) {
     const size_t si = size_t(s);
     if (rd.fixedMasks[si]) {
       isFixed_[si] = true;
       fixedMask_[si] = GpuBuffer::of(std::vector<uint32_t>(rd.fixedMasks[si]->begin(), rd.fixedMasks[si]->end()));
-      fixedValue_[si] = reals(*rd.fixedValues[si]);
+      fixedValue_[si] = realBuffer(*rd.fixedValues[si], real_);
     }
-    if (rd.dirichletFaces[si]) faces_[si] = reals(*rd.dirichletFaces[si]);
+    if (rd.dirichletFaces[si]) faces_[si] = realBuffer(*rd.dirichletFaces[si], real_);
   }
   for (int s : rd.settings.frozen) isFrozen_[size_t(s)] = true;
   if (const DiffusionTensorSpec<D>* t = rd.tensor; t && t->dynamic()) {
     std::vector<double> dir;
     for (int a = 0; a < D; ++a) dir.insert(dir.end(), t->direction[size_t(a)].begin(), t->direction[size_t(a)].end());
-    direction_ = reals(dir);
-    lambda1_ = reals(t->lambda1);
-    lambda2_ = reals(t->lambda2);
+    direction_ = realBuffer(dir, real_);
+    lambda1_ = realBuffer(t->lambda1, real_);
+    lambda2_ = realBuffer(t->lambda2, real_);
     sigma_ = realBuffer(n_ * AnisotropicSystem<D>::kComponents, real_);
     for (int s = 0; s < species_; ++s)
       if (rd.anisotropic[size_t(s)] && !faces_[size_t(s)].id()) faces_[size_t(s)] = realBuffer(n_, real_);
@@ -97,7 +97,7 @@ GpuRDLayer<D>::GpuRDLayer(const LayerUpload<D>& upload, GpuPrecision real)
       rot[2 * i] = std::cos(lobes->theta0[i]);
       rot[2 * i + 1] = std::sin(lobes->theta0[i]);
     }
-    rot_ = reals(rot);
+    rot_ = realBuffer(rot, real_);
     for (int s = 0; s < species_; ++s)
       if (rd.lobed[size_t(s)] && !faces_[size_t(s)].id()) faces_[size_t(s)] = realBuffer(n_, real_);
   }
@@ -115,11 +115,6 @@ size_t GpuRDLayer<D>::deviceBytes(size_t n, int species, GpuPrecision real) {
   // vector and the PCG's five
   const size_t r = realBytes(real);
   return n * (size_t(species) * (3 * r + 2 * (D + 2) * 4 + 3 * 4 * 2) + 6 * r);
-}
-
-template <int D>
-GpuBuffer GpuRDLayer<D>::reals(const std::vector<double>& values) const {
-  return realBuffer(values, real_);
 }
 
 template <int D>
@@ -438,7 +433,7 @@ void GpuRDLayer<D>::load(const StateReader& in) {
     if (isFrozen_[size_t(s)]) {
       std::vector<double> v(n_);
       in.getVector("gpu.rd." + std::to_string(s) + ".frozen", &v);
-      frozen_[size_t(s)] = reals(v);
+      frozen_[size_t(s)] = realBuffer(v, real_);
     }
 }
 

@@ -81,7 +81,6 @@ class GpuRDLayer {
   void lobeKernel(LobeMode mode, int species, GpuLaplace* target, GpuBuffer* faces);
 
   static constexpr int kMax = ReactionModel::kMaxSpecies;
-  GpuBuffer reals(const std::vector<double>& values) const;  // a buffer of values in the layer's precision
   LayerUpload<D> up_;
   GpuPrecision real_;
   int species_ = 2;
