@@ -25,5 +25,6 @@ void addInspectCommands(CLI::App& app, Commands* commands);    // validate, info
 void addBenchCommand(CLI::App& app, Commands* commands);       // bench (bench_command.cpp)
 void addTextureCommands(CLI::App& app, Commands* commands);    // analyze, plot, texton (texture_commands.cpp)
 void addStudioCommand(CLI::App& app, Commands* commands);      // studio (studio_command.cpp)
+void addBlenderCommand(CLI::App& app, Commands* commands);     // blender (blender_command.cpp)
 
 }  // namespace morphoflow

@@ -29,6 +29,7 @@ int main(int argc, char** argv) {
   addInspectCommands(app, &commands);
   addBenchCommand(app, &commands);
   addStudioCommand(app, &commands);
+  addBlenderCommand(app, &commands);
   addTextureCommands(app, &commands);
 
   try {

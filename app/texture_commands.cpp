@@ -11,16 +11,17 @@
 
 #include "app/commands.h"
 #include "app/option_checks.h"
-#include "core/output_file.h"
 #include "core/error.h"
+#include "core/output_file.h"
+#include "rd/generalized_diffusion.h"
+#include "rd/variogram.h"
 #include "render/colormap.h"
 #include "render/field_dump.h"
 #include "render/field_image.h"
 #include "render/image_io.h"
+#include "render/legibility.h"
 #include "render/polar_plot.h"
-#include "rd/generalized_diffusion.h"
 #include "scenes/scene_loader.h"
-#include "rd/variogram.h"
 
 namespace morphoflow {
 
@@ -33,9 +34,23 @@ void printReg(const std::string& what, const Variogram& v) {
                            v.regLag, kDirectionNames[v.regDirection]);
 }
 
+// A rendered element's legibility (render/legibility.h), one measure a line.
+int legibilityCommand(const AnalyzeOptions& o) {
+  int w = 0, h = 0;
+  std::vector<uint8_t> rgb;
+  std::string err;
+  if (!readRgb8(o.file, &w, &h, &rgb, &err))
+    throw UserError({o.file, 0, 0}, "", "cannot read: " + err, "give a rendered frame (PNG, EXR)");
+  const Legibility m = measureLegibility(rgb, w, h);
+  std::cout << fmt::format("plume_pixels {} ({:.1f}% of {} x {})\nmedian_luminance {:.4f}\nband_contrast {:.4f}\n",
+                           m.plumePixels, 100.0 * m.plumeFraction, w, h, m.medianLuminance, m.bandContrast);
+  return 0;
+}
+
 }  // namespace
 
 int analyzeCommand(const AnalyzeOptions& o) {
+  if (o.legibility) return legibilityCommand(o);
   if (!o.csv.empty()) checkOutputFile(o.csv, "--csv");
   FieldDump d;
   std::string err;
@@ -164,6 +179,8 @@ void addTextureCommands(CLI::App& app, Commands* commands) {
   analyzeCmd->add_option("--slice", analyze->slice, "z slice of a 3D dump (default: the middle)")
       ->check(CLI::Range(0, 1 << 20));
   analyzeCmd->add_option("--csv", analyze->csv, "also write the variogram per lag and direction");
+  analyzeCmd->add_flag("--legibility", analyze->legibility,
+                       "instead: a rendered element's median luminance and band-passed contrast (docs/vfx.md)");
   commands->add(analyzeCmd, [analyze] { return analyzeCommand(*analyze); });
 
   auto plot = std::make_shared<PlotOptions>();

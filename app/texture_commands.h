@@ -16,6 +16,7 @@ struct AnalyzeOptions {
   bool periodic = false;
   int slice = -1;        // 3D dumps: z slice (-1 = middle)
   std::string csv;       // also write the variogram table here
+  bool legibility = false;  // a rendered element's legibility instead (render/legibility.h)
 };
 int analyzeCommand(const AnalyzeOptions& options);
 

@@ -1,5 +1,7 @@
 #include "render/image_io.h"
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 
 #include <OpenImageIO/filesystem.h>
@@ -61,6 +63,20 @@ bool readGrayImage(const std::string& path, GrayImage* image, std::string* error
     // Luminance for colour images, the channel itself otherwise.
     image->pixels[i] = nc >= 3 ? 0.2126f * p[0] + 0.7152f * p[1] + 0.0722f * p[2] : p[0];
   }
+  return true;
+}
+
+bool readRgb8(const std::string& path, int* width, int* height, std::vector<uint8_t>* rgb, std::string* error) {
+  OIIO::ImageSpec spec;
+  std::vector<float> all;
+  if (!readImageFloat(path, &spec, &all, error)) return false;
+  *width = spec.width;
+  *height = spec.height;
+  const size_t n = size_t(spec.width) * size_t(spec.height), nc = size_t(spec.nchannels);
+  rgb->resize(n * 3);
+  for (size_t i = 0; i < n; ++i)
+    for (size_t k = 0; k < 3; ++k)
+      (*rgb)[i * 3 + k] = uint8_t(std::lround(255.0f * std::clamp(all[i * nc + std::min(k, nc - 1)], 0.0f, 1.0f)));
   return true;
 }
 

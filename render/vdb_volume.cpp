@@ -418,4 +418,56 @@ bool readVdbVelocity(const std::string& path, VelocityVolume* out, std::string* 
   }
 }
 
+bool readVdbFrameSummary(const std::string& path, VdbFrameSummary* out, std::string* error) {
+  initialiseOnce();
+  std::string answer;
+  // The names, each ended by a newline, a NUL, then the density's values.
+  const auto work = [&]() -> std::string {
+    try {
+      AllocationLimit limit(size_t(4) << 30);
+      openvdb::io::File file(path);
+      file.open();
+      std::string names, values;
+      openvdb::GridPtrVecPtr grids = file.getGrids();
+      openvdb::MetaMap::Ptr meta = file.getMetadata();
+      file.close();
+      openvdb::Vec3d domain(0.0);
+      if (auto m = meta->getMetadata<openvdb::Vec3DMetadata>("domain_size")) domain = m->value();
+      values.append(reinterpret_cast<const char*>(&domain[0]), 3 * sizeof(double));
+      for (const openvdb::GridBase::Ptr& g : *grids) {
+        names += g->getName() + "\n";
+        auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
+        if (g->getName() != "density" || !f) continue;
+        for (auto v = f->cbeginValueOn(); v; ++v) {
+          const float x = *v;
+          for (openvdb::Index64 k = 0; k < v.getVoxelCount(); ++k) values.append(reinterpret_cast<const char*>(&x), 4);
+        }
+      }
+      return "N" + names + std::string(1, '\0') + values;
+    } catch (const std::bad_alloc&) {
+      return std::string("E") + kClaimsTooMuch;
+    } catch (const std::exception& e) {
+      return std::string("E") + e.what();
+    }
+  };
+  if (!runIsolated(work, readerLimits(60.0), &answer, error)) return false;
+  const size_t nul = answer.find('\0');
+  if (answer.empty() || answer[0] != 'N' || nul == std::string::npos || answer.size() < nul + 1 + 3 * sizeof(double)) {
+    *error =
+        answer.size() > 1 && answer[0] == 'E' ? answer.substr(1) : "the file is damaged: its reader gave no answer";
+    return false;
+  }
+  out->grids.clear();
+  for (size_t at = 1; at < nul;) {
+    const size_t end = answer.find('\n', at);
+    out->grids.push_back(answer.substr(at, end - at));
+    at = end + 1;
+  }
+  const size_t at = nul + 1 + 3 * sizeof(double);
+  std::memcpy(out->domain.data(), answer.data() + nul + 1, 3 * sizeof(double));
+  out->density.resize((answer.size() - at) / 4);
+  std::memcpy(out->density.data(), answer.data() + at, out->density.size() * 4);
+  return true;
+}
+
 }  // namespace morphoflow

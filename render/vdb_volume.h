@@ -93,4 +93,13 @@ bool readVdbVelocity(const std::string& path, VelocityVolume* out, std::string* 
 // The file's `time` metadata (*has false when it has none), without reading its grids.
 bool readVdbTime(const std::string& path, double* time, bool* has, std::string* error);
 
+// A frame's grids by name and the active values of its `density` grid, for
+// the Blender set-up (app's `blender` command) to choose its density scale.
+struct VdbFrameSummary {
+  std::vector<std::string> grids;
+  std::vector<float> density;                   // the active voxels' values (empty without a `density` grid)
+  std::array<double, 3> domain{0.0, 0.0, 0.0};  // its domain_size metadata (0: none)
+};
+bool readVdbFrameSummary(const std::string& path, VdbFrameSummary* out, std::string* error);
+
 }  // namespace morphoflow

@@ -1,8 +1,10 @@
-// A 3D field seen whole: emission-absorption ray marching through the
-// palette (each sample emits its palette colour and absorbs in proportion
-// to its value in the range), from a fixed three-quarter camera looking at
-// the domain's centre, y up, the box's edges drawn faintly. Pixels are
-// independent, so the image does not depend on the thread count.
+// A 3D field seen whole, inside and out: emission-absorption ray marching
+// through the palette (each sample emits its palette colour and absorbs in
+// proportion to its value in the range), from the previews' fixed camera
+// (render/volume_camera.h), the box's edges drawn faintly: the view of a
+// field that fills its box. A smoke element is rendered lit instead
+// (render/lit_volume.h). Pixels are independent, so the image does not
+// depend on the thread count.
 #pragma once
 
 #include <cstdint>

@@ -9,6 +9,7 @@
 #include "render/field_dump.h"
 #include "render/field_image.h"
 #include "render/image_io.h"
+#include "render/lit_volume.h"
 #include "render/normal_map.h"
 #include "render/volume_preview.h"
 #include "run/output_kinds.h"
@@ -48,6 +49,29 @@ ImageSink<D>::ImageSink(const std::filesystem::path& out, const Scene& scene)
   createOutputFolder(dir_);
 }
 
+namespace {
+
+// The lit volume of the `density` the VDB frames hold, coloured by the shown
+// field, glowing by the smoke's temperature (output.emission).
+std::vector<uint8_t> litPreview(const Simulation<3>& sim, const Grid<float, 3>& shown, const FieldImageOptions& io) {
+  const Scene& scene = sim.scene();
+  const Grid<float, 3> density = sim.field(fields::kDensity).front();
+  Grid<float, 3> temperature;
+  LitVolume v;
+  v.density = &density;
+  v.shown = &shown;
+  v.options = io;
+  if (scene.output.emission > 0) {
+    temperature = sim.field(fields::kTemperature).front();
+    v.temperature = &temperature;
+    v.ambientTemperature = scene.fluid.smoke.ambient;
+    v.emission = scene.output.emission;
+  }
+  return renderLitVolume(v, scene.output.imageSize).rgb;
+}
+
+}  // namespace
+
 template <int D>
 void ImageSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
   const long frame = at.frame;
@@ -63,7 +87,12 @@ void ImageSink<D>::write(const FrameInfo& at, const Simulation<D>& sim) {
     cells_ += shown.size();
   }
   if constexpr (D == 3) {
-    if (o.view == "volume") {
+    // A smoke element is lit; a field that fills its box is seen inside and out.
+    const bool element = scene_.hasFluid && scene_.fluid.smoke.enabled && !two;
+    if (o.view == "volume" && element) {
+      rgb = litPreview(sim, shown, io);
+      w = h = o.imageSize;
+    } else if (o.view == "volume") {
       rgb = two ? volumeTwoToRgb(shown, sim.field(sp[1]).front(), io, o.imageSize, &w, &h)
                 : volumeToRgb(shown, io, o.imageSize, &w, &h);
     }

@@ -35,8 +35,10 @@ FieldCatalogue::FieldCatalogue(const Scene& s) {
     fields_.push_back({fields::kVelocityMac, G::Faces, K::Vector, S::State,
                        "u on the MAC faces: component a on the faces normal to axis a"});
   }
-  fields_.push_back({fields::kDensity, G::Density, K::Scalar, S::Derived,
-                     "output.vdb_density: a field, or an expression of fields evaluated per cell"});
+  fields_.push_back(
+      {fields::kDensity, G::Density, K::Scalar, S::Derived,
+       "output.vdb_density (a field, or an expression of fields evaluated per cell); a patterned smoke's default: "
+       "the smoke shaped by the shown species"});
   fields_.push_back(
       {fields::kColor, G::Shown, K::Colour, S::Derived, "the frames' palette applied to output.field, as linear RGB"});
   fields_.push_back({fields::kHeight, G::Shown, K::Scalar, S::Derived,

@@ -37,7 +37,7 @@ enum class FieldGrid {
   Fluid,      // the fluid's cells
   Faces,      // the fluid's cells + 1 per axis (MAC faces, the last of each row unused)
   Shown,      // the grid of the shown field (output.field)
-  Density,    // the chemicals' when output.vdb_density names a species, else the fluid's
+  Density,  // the chemicals' when output.vdb_density names a species or the pattern shapes the smoke, else the fluid's
 };
 
 enum class FieldKind {

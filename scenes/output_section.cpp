@@ -36,6 +36,23 @@ std::string parseVdbDensity(Reader& r, const toml::table* out, const std::string
   return density;
 }
 
+// output.pattern_contrast: with smoke and a pattern, the density is by
+// default the smoke shaped by the shown species (kernels/pattern_density.inc).
+void parsePatternDensity(Reader& r, const toml::table* out, bool patterned, OutputSettings& o) {
+  const toml::node* pc = r.node(out, "output.", "pattern_contrast");
+  const toml::node* given = r.node(out, "output.", "vdb_density");
+  if (pc && !patterned)
+    r.fail(pc, "output.pattern_contrast",
+           "it shapes a smoke's density by the species it shows; this scene has no [smoke], no [rd], or "
+           "shows no species (output.field)",
+           "drop output.pattern_contrast, or show a species");
+  if (pc && given)
+    r.fail(pc, "output.pattern_contrast", "output.vdb_density is given, and it replaces the shaped smoke",
+           "drop one of output.pattern_contrast and output.vdb_density");
+  o.patternContrast = r.number(out, "output.", "pattern_contrast", o.patternContrast, 0.0, 1.0);
+  o.patternDensity = patterned && !given;
+}
+
 // output.vdb and its options: every named field must be one the scene has.
 void parseVdbOutput(SceneContext& c, const toml::table* out, Scene& s) {
   Reader& r = c.r;
@@ -47,6 +64,8 @@ void parseVdbOutput(SceneContext& c, const toml::table* out, Scene& s) {
   const FieldCatalogue catalogue(s);
   const std::vector<std::string> fluidScalars = catalogue.fluidOutputNames();
   o.vdbDensity = parseVdbDensity(r, out, smoke ? fields::kDye : o.field, catalogue.outputNames());
+  const bool showsSpecies = std::find(c.species.begin(), c.species.end(), o.field) != c.species.end();
+  parsePatternDensity(r, out, smoke && s.rd.enabled && showsSpecies, o);
   if (const toml::node* vf = r.node(out, "output.", "vdb_fields")) {
     const toml::array* arr = vf->as_array();
     if (!arr) r.fail(vf, "output.vdb_fields", "expected an array of field names, e.g. [\"speed\", \"vorticity\"]");
@@ -115,7 +134,7 @@ void parsePalette(const SceneContext& c, const toml::table* out, OutputSettings&
 
 // How frames show the field: the 3D view, the image size, the slice, and
 // 2D normal and height maps.
-void parseView(const SceneContext& c, const toml::table* out, OutputSettings& o) {
+void parseView(const SceneContext& c, const toml::table* out, bool smoke, OutputSettings& o) {
   Reader& r = c.r;
   const int D = c.D;
   // 3D frames show the whole volume by default; a 2D field is its own slice.
@@ -125,6 +144,12 @@ void parseView(const SceneContext& c, const toml::table* out, OutputSettings& o)
     r.fail(viewNode, "output.view", "a 2D scene's frames show its field itself; \"volume\" is for 3D scenes",
            "drop output.view, or set it to \"slice\"");
   o.imageSize = int(r.integer(out, "output.", "image_size", 512, 16, 8192));
+  // The lit volume's blackbody emission from the smoke's temperature.
+  const toml::node* em = r.node(out, "output.", "emission");
+  o.emission = r.number(out, "output.", "emission", 0.0, 0.0, 1e3);
+  if (em && !(D == 3 && smoke))
+    r.fail(em, "output.emission", "it is the glow of a 3D smoke's temperature, and this scene has no 3D [smoke]",
+           "drop output.emission");
   o.slice = int(r.integer(out, "output.", "slice", -1, -1, D == 3 ? long(c.res[2]) - 1 : -1));
   // Normal and height maps of the shown field (seed 000 fig. 7).
   const toml::node* nm = r.node(out, "output.", "normal_map");
@@ -159,7 +184,7 @@ void parseOutput(SceneContext& c, Scene* sp) {
   s.output.field = r.string(out, "output.", "field", byDefault, FieldCatalogue(s).outputNames());
   parseVdbOutput(c, out, s);
   parsePalette(c, out, s.output);
-  parseView(c, out, s.output);
+  parseView(c, out, s.hasFluid && s.fluid.smoke.enabled, s.output);
 }
 
 }  // namespace morphoflow

@@ -45,6 +45,10 @@ struct OutputSettings {
   bool fields = false;
   bool vdb = false;                 // DIR/vdb/<name>.NNNNNN.vdb every frame
   std::string vdbDensity;           // the field in the "density" grid (default: field), or an expression of fields
+  // A patterned smoke scene's default density: the smoke shaped by the shown
+  // species (kernels/pattern_density.inc), unless output.vdb_density is given.
+  bool patternDensity = false;
+  double patternContrast = 1.0;        // output.pattern_contrast: 0 the smoke as is, 1 none between the features
   std::vector<std::string> vdbFields;  // fluid scalars as grids of their own
   double vdbTolerance = 0.0;        // |value| <= this: inactive voxel (with [smoke]: of the smoke, in every grid)
   bool vdbSparse = false;  // with [smoke]: every grid active where the smoke exceeds vdbTolerance (false: every voxel)
@@ -63,6 +67,7 @@ struct OutputSettings {
   int slice = -1;                  // 3D: z slice for images (-1 = middle)
   std::string view = "slice";      // 3D: "volume" (ray marched, the default) or "slice"; 2D: "slice"
   int imageSize = 512;             // frames are at least this many pixels wide
+  double emission = 0.0;           // 3D smoke: the lit preview's blackbody emission strength (render/lit_volume.h)
   bool normalMap = false;           // 2D: DIR/normals/NNNNNN.png and DIR/height/NNNNNN.exr of the shown field
   double normalStrength = 4.0;      // normal map slope per unit of height (0..1 over the range) per cell
   int checkpointEvery = 10;        // frames between checkpoints (0: only at the end and on a stop)

@@ -14,6 +14,7 @@
 #include "core/sampling.h"
 #include "render/colormap.h"
 #include "sim/frame_palette.h"
+#include "sim/pattern_density.h"
 #include "sim/simulation.h"
 
 namespace morphoflow {
@@ -52,8 +53,46 @@ bool usesName(const std::string& text, const std::string& n) {
   return false;
 }
 
+// The shown field (output.field) and where each value lies in the frames'
+// range: (v - lo) / span.
+template <int D>
+struct Shown {
+  Grid<float, D> f;
+  FieldImageOptions io;
+  double lo = 0.0, span = 1.0;
+  double at(size_t i) const { return (double(f[i]) - lo) / span; }
+};
+
+template <int D>
+Shown<D> shown(const Simulation<D>& sim) {
+  const OutputSettings& o = sim.scene().output;
+  const std::string name = shownField(o, sim.species());
+  Shown<D> s{sim.field(name).front(), frameImageOptions(o, sim.symmetric(name))};
+  const std::array<double, 2> range = valueRange(s.f.data(), s.f.size(), s.io);
+  s.lo = range[0];
+  s.span = range[1] > range[0] ? range[1] - range[0] : 1.0;
+  return s;
+}
+
+// The smoke shaped by the shown species, on the species' grid (the smoke
+// sampled at its centres): kernels/pattern_density.inc.
+template <int D>
+std::vector<Grid<float, D>> shapedSmoke(const Simulation<D>& sim) {
+  const Shown<D> s = shown(sim);
+  const Grid<float, D> dye = sim.field(fields::kDye).front();
+  const OnCells<D> smoke(dye, s.f.dims(), sim.scene().fluid.size[0]);
+  const double contrast = sim.scene().output.patternContrast;
+  Grid<float, D> out(s.f.dims(), 0.0f);
+  forEachCell<D>(out.dims(), [&](const IVec<D>& k, size_t i) {
+    const double t = s.at(i);
+    out[i] = float(patternDensity(smoke(k, i), std::isfinite(t) ? t : 0.0, contrast));
+  });
+  return {out};
+}
+
 template <int D>
 std::vector<Grid<float, D>> density(const Simulation<D>& sim) {
+  if (sim.scene().output.patternDensity) return shapedSmoke(sim);
   const Scene& scene = sim.scene();
   const std::string& text = scene.output.vdbDensity;
   const FieldCatalogue catalogue(scene);
@@ -86,27 +125,6 @@ std::vector<Grid<float, D>> density(const Simulation<D>& sim) {
     out[i] = std::abs(d) <= double(std::numeric_limits<float>::max()) ? float(d) : 0.0f;
   });
   return {out};
-}
-
-// The shown field (output.field) and where each value lies in the frames'
-// range: (v - lo) / span.
-template <int D>
-struct Shown {
-  Grid<float, D> f;
-  FieldImageOptions io;
-  double lo = 0.0, span = 1.0;
-  double at(size_t i) const { return (double(f[i]) - lo) / span; }
-};
-
-template <int D>
-Shown<D> shown(const Simulation<D>& sim) {
-  const OutputSettings& o = sim.scene().output;
-  const std::string name = shownField(o, sim.species());
-  Shown<D> s{sim.field(name).front(), frameImageOptions(o, sim.symmetric(name))};
-  const std::array<double, 2> range = valueRange(s.f.data(), s.f.size(), s.io);
-  s.lo = range[0];
-  s.span = range[1] > range[0] ? range[1] - range[0] : 1.0;
-  return s;
 }
 
 template <int D>

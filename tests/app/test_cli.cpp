@@ -105,6 +105,8 @@ INSTANTIATE_TEST_SUITE_P(
                  "[rd]\nmodel = \"gray-scott\"\n[output]\nvdb = true\nvdb_fields = [\"speed\"]\n", "5:14",
                  "has no fluid"},
         BadScene{"unknown_view", "[output]\nview = \"volum\"\n", "2:8", "did you mean 'volume'"},
+        BadScene{"pattern_contrast_without_smoke", "[output]\npattern_contrast = 0.5\n", "2:20", "no [smoke]"},
+        BadScene{"emission_in_2d", "[output]\nemission = 2.0\n", "2:12", "no 3D [smoke]"},
         BadScene{"volume_view_in_2d", "[output]\nview = \"volume\"\n", "2:8", "for 3D scenes"},
         BadScene{"vdb_option_without_vdb", "[output]\nvdb_half = true\n", "2:12",
                  "only applies with output.vdb = true"},
@@ -835,5 +837,37 @@ TEST(Cli, VideoWithAndWithoutFfmpeg) {
   std::string log;
   std::getline(std::ifstream(dir / "failed" / "cavity_gray_scott.ffmpeg.log"), log);
   EXPECT_EQ(log, "no encoder here");
+  fs::remove_all(dir);
+}
+
+// `morphoflow blender OUT_DIR`: a run's VDB sequence becomes a Blender
+// script (valid Python, the sequence's facts in its header); a folder
+// without volumes, or with a gap in the sequence, is exit 2 naming it.
+TEST(Cli, BlenderWritesTheSetUpOfARunsSequence) {
+  auto dir = tempDir("blender_set_up");
+  const CommandResult r = runMorphoflow("run " + sceneFile("vfx/plume_gray_scott_3d.toml") +
+                                        " --set grid.resolution=[12,20,12] --set rd.resolution=[12,20,12]"
+                                        " --set time.duration=0.3 --set output.every=10 --set output.images=false"
+                                        " --quiet --out " +
+                                        (dir / "run").string());
+  ASSERT_EQ(r.status, 0) << r.output;
+  const CommandResult b = runMorphoflow("blender " + (dir / "run").string());
+  ASSERT_EQ(b.status, 0) << b.output;
+  const fs::path script = dir / "run" / "blender_scene.py";
+  std::ifstream in(script);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\"frames\": 4,"), std::string::npos) << text.substr(0, 2000);
+  EXPECT_NE(text.find("\"first\": \"vdb/plume_gray_scott_3d.000000.vdb\""), std::string::npos);
+  for (const char* grid : {"\"density\"", "\"color\"", "\"temperature\"", "\"vel\""})
+    EXPECT_NE(text.find(grid), std::string::npos) << grid;
+  EXPECT_EQ(std::system(("/usr/bin/python3 -m py_compile " + script.string()).c_str()), 0);
+
+  const CommandResult none = runMorphoflow("blender " + dir.string());
+  EXPECT_EQ(none.status, 2) << none.output;
+  EXPECT_NE(none.output.find("output.vdb = true"), std::string::npos) << none.output;
+  fs::remove(dir / "run" / "vdb" / "plume_gray_scott_3d.000002.vdb");
+  const CommandResult gap = runMorphoflow("blender " + (dir / "run").string());
+  EXPECT_EQ(gap.status, 2) << gap.output;
+  EXPECT_NE(gap.output.find("gap"), std::string::npos) << gap.output;
   fs::remove_all(dir);
 }

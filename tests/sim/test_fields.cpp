@@ -148,6 +148,49 @@ TEST(DerivedFields, DensityIsTheExpressionOfTheFieldsPerCell) {
   }
 }
 
+// A patterned smoke scene's default density is the smoke shaped by its
+// shown species (kernels/pattern_density.inc): the smoke itself where the
+// species is at the top quarter of its range, (1 - c) of it at the bottom
+// quarter, in between never more than the smoke; output.vdb_density and
+// output.pattern_contrast = 0 give the smoke itself.
+TEST(DerivedFields, ThePatternShapesTheSmokeByDefault) {
+  const std::string plume = sceneFile("vfx/plume_gray_scott_2d.toml");
+  const std::vector<std::string> small{"grid.resolution=[16,24]", "rd.resolution=[16,24]"};
+  const double c = 0.7;
+  std::vector<std::string> sets = small;
+  sets.push_back("output.pattern_contrast=0.7");
+  auto sim = stepped<2>(loadScene(plume, sets), 30);
+  const Grid<float, 2> d = sim->field(fields::kDensity).front(), smoke = sim->field(fields::kDye).front(),
+                       v = sim->field("v").front();
+  float lo = v[0], hi = v[0];
+  for (float x : v.values()) lo = std::min(lo, x), hi = std::max(hi, x);
+  ASSERT_GT(hi, lo);
+  size_t top = 0, bottom = 0;
+  for (size_t i = 0; i < d.size(); ++i) {
+    const double t = (double(v[i]) - lo) / (double(hi) - lo);
+    const double tiny = 1e-6 * smoke[i] + 1e-30;  // (float rounding, and subnormal smoke)
+    if (t >= 0.75) {
+      EXPECT_NEAR(d[i], smoke[i], tiny);
+      ++top;
+    }
+    if (t <= 0.25) {
+      EXPECT_NEAR(d[i], (1 - c) * smoke[i], tiny);
+      ++bottom;
+    }
+    EXPECT_LE(d[i], smoke[i] + tiny);
+    EXPECT_GE(d[i], (1 - c) * smoke[i] - tiny);
+  }
+  EXPECT_GT(top, 0u);
+  EXPECT_GT(bottom, 0u);
+  for (const char* plain : {"output.pattern_contrast=0", "output.vdb_density=\"dye\""}) {
+    sets = small;
+    sets.push_back(plain);
+    if (std::string(plain).find("vdb_density") != std::string::npos) sets.push_back("output.vdb=true");
+    auto flat = stepped<2>(loadScene(plume, sets), 30);
+    EXPECT_EQ(flat->field(fields::kDensity).front().values(), flat->field(fields::kDye).front().values()) << plain;
+  }
+}
+
 // active: 1 exactly where the smoke exceeds output.vdb_tolerance, on both
 // grids; everywhere with output.vdb_sparse = false.
 TEST(DerivedFields, ActiveIsWhereTheSmokeExceedsTheTolerance) {
