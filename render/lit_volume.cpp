@@ -93,6 +93,29 @@ Grid<float, 3> depthToward(const Grid<float, 3>& rho, const V3& toward) {
   return tau;
 }
 
+// blackbodyColour tabulated every 10 K up to 20,000 K (hotter: its value
+// there) and interpolated linearly, so that a frame does not integrate
+// Planck's law once a cell.
+class BlackbodyTable {
+ public:
+  BlackbodyTable() {
+    for (int k = 0; k <= kSteps; ++k) table_.push_back(blackbodyColour(kStep * k));
+  }
+  Rgb operator()(double kelvin) const {
+    const double x = std::clamp(kelvin / kStep, 0.0, double(kSteps));
+    const int k = std::min(int(x), kSteps - 1);
+    const double w = x - k;
+    Rgb c;
+    for (size_t j = 0; j < 3; ++j) c[j] = (1.0 - w) * table_[size_t(k)][j] + w * table_[size_t(k) + 1][j];
+    return c;
+  }
+
+ private:
+  static constexpr int kSteps = 2000;
+  static constexpr double kStep = 10.0;
+  std::vector<Rgb> table_;
+};
+
 // What a cell sends toward the camera per unit of its extinction (linear
 // RGB), and its density: the ray march's one sample.
 struct Radiance {
@@ -114,6 +137,7 @@ Grid<Radiance, 3> radiance(const LitVolume& v, double kappa, const V3& toKey) {
   std::array<double, 2> range{0.0, 1.0};
   if (v.shown) range = valueRange(v.shown->data(), v.shown->size(), v.options);
   const double span = range[1] > range[0] ? range[1] - range[0] : 1.0;
+  const BlackbodyTable planck;
   Grid<Radiance, 3> out(n, Radiance{0, 0, 0, 0});
   forEachCell<3>(n, [&](const IVec<3>& x, size_t i) {
     const double d = std::max(0.0f, rho[i]);
@@ -127,7 +151,7 @@ Grid<Radiance, 3> radiance(const LitVolume& v, double kappa, const V3& toKey) {
     const double lit = scattered(kappa * key[i]), open = scattered(kappa * sky[i]);
     Rgb glow{0, 0, 0};
     if (v.temperature && v.emission > 0)
-      glow = blackbodyColour(kKelvinAtAmbient + kKelvinPerUnit * (at(*v.temperature, n, x, i) - v.ambientTemperature));
+      glow = planck(kKelvinAtAmbient + kKelvinPerUnit * (at(*v.temperature, n, x, i) - v.ambientTemperature));
     Rgb r;
     for (int k = 0; k < 3; ++k)
       r[size_t(k)] =
