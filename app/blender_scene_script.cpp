@@ -55,7 +55,7 @@ def volume_object(scene):
 
 
 def material():
-    """A Principled Volume on the grids by name; the temperature glows as blackbody where RUN asks."""
+    """A Principled Volume on the grids by name; the temperature glows as blackbody at RUN's emission."""
     m = bpy.data.materials.new(RUN["name"] + "_volume")
     m.use_nodes = True
     nodes, links = m.node_tree.nodes, m.node_tree.links
@@ -67,7 +67,7 @@ def material():
         shader.inputs["Color Attribute"].default_value = "color"
     else:
         shader.inputs["Color"].default_value = (0.8, 0.8, 0.8, 1.0)
-    if "temperature" in RUN["grids"] and RUN["emission"] > 0:
+    if "temperature" in RUN["grids"]:  # wired always: raising Blackbody Intensity makes it glow
         attr = nodes.new("ShaderNodeAttribute")
         attr.attribute_name = "temperature"
         kelvin = nodes.new("ShaderNodeMapRange")
