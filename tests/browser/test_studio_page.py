@@ -21,7 +21,7 @@ import urllib.request
 import numpy as np
 import pytest
 from selenium import webdriver
-from selenium.common.exceptions import NoSuchElementException, StaleElementReferenceException
+from selenium.common.exceptions import WebDriverException
 from selenium.webdriver.chrome.service import Service
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
@@ -98,7 +98,7 @@ def wait_for(check, what, seconds=20.0):
     while True:
         try:
             value = check()
-        except (NoSuchElementException, StaleElementReferenceException):  # (a page loading)
+        except WebDriverException:  # (a page loading or replacing its nodes: asked again)
             value = None
         if value:
             return value
@@ -365,11 +365,14 @@ def test_without_a_scene_the_page_offers_the_shipped_ones(browser):
     s = Studio()
     try:
         browser.get(s.url)
-        items = wait_for(lambda: browser.find_elements(By.CSS_SELECTOR, "#scenes li"), "the list of scenes")
-        names = [li.text for li in items]
+        # Read and clicked in one script each: the page may still be replacing its address (and its nodes).
+        names = wait_for(lambda: browser.execute_script(
+            "return [...document.querySelectorAll('#scenes li')].map((li) => li.textContent);"), "the list of scenes")
         assert any("cavity_gray_scott" in n for n in names), names
-        pick = next(li for li in items if li.text.endswith("coupled/cavity_passive.toml"))
-        pick.click()
+        wait_for(lambda: browser.execute_script(
+            "const li = [...document.querySelectorAll('#scenes li')]"
+            ".find((li) => li.textContent.endsWith('coupled/cavity_passive.toml'));"
+            "if (li) li.click(); return !!li;"), "the scene clicked")
         wait_for(lambda: "step" in browser.find_element(By.ID, "info").text, "the opened scene's state")
         assert s.state()["scene"] == "cavity_passive"
         no_console_errors(browser)

@@ -112,8 +112,8 @@ TEST(LitVolume, ThePaletteColoursTheAlbedo) {
     const LitImage img = renderLitVolume(v, 48);
     const size_t centre = 24 * 48 + 24;
     EXPECT_EQ(img.rgb[3 * centre + 1], 0);
-    if (t == 0) EXPECT_GT(img.rgb[3 * centre], 10 * img.rgb[3 * centre + 2] + 10);
-    if (t == 1) EXPECT_GT(img.rgb[3 * centre + 2], 10 * img.rgb[3 * centre] + 10);
+    const int lo = img.rgb[3 * centre + (t == 0 ? 2 : 0)], hi = img.rgb[3 * centre + (t == 0 ? 0 : 2)];
+    EXPECT_GT(hi, 10 * lo + 10) << "t = " << t;  // red at the bottom of the range, blue at the top
   }
 }
 
