@@ -10,11 +10,33 @@ namespace morphoflow {
 
 namespace {
 
+// d: the derivative of the call from its arguments a and their derivatives
+// da; clears *smooth where the function has none there (a kink or a jump).
 struct Function {
   const char* name;
   int arity;
   double (*f)(const double*);
+  double (*d)(const double* a, const double* da, bool* smooth);
 };
+
+// A jump of a piecewise-constant function at a, crossed when da != 0.
+double flat(bool atJump, double da, bool* smooth) {
+  if (atJump && da != 0.0) *smooth = false;
+  return 0.0;
+}
+// d/dx x^y, for y's derivative dy too (x > 0; else y must not vary).
+double powDerivative(double x, double y, double dx, double dy, bool* smooth) {
+  if (x > 0.0) return std::pow(x, y) * (dy * std::log(x) + y * dx / x);
+  if (dy != 0.0 || (x == 0.0 && y < 1.0 && dx != 0.0)) *smooth = false;
+  return y * std::pow(x, y - 1.0) * dx;
+}
+double smoothstepDerivative(const double* a, const double* da, bool* smooth) {
+  if (!(a[1] > a[0])) return flat(a[2] == a[0], da[2], smooth);
+  const double w = a[1] - a[0], t = (a[2] - a[0]) / w;
+  if (t <= 0.0 || t >= 1.0) return flat(t == 0.0 || t == 1.0, da[2] - da[0], smooth);
+  const double dt = ((da[2] - da[0]) * w - (a[2] - a[0]) * (da[1] - da[0])) / (w * w);
+  return 6.0 * t * (1.0 - t) * dt;
+}
 
 double clamp3(const double* a) { return std::min(std::max(a[0], a[1]), a[2]); }
 double smoothstep3(const double* a) {
@@ -25,28 +47,83 @@ double smoothstep3(const double* a) {
 
 const std::vector<Function>& functions() {
   static const std::vector<Function> f = {
-      {"sin", 1, [](const double* a) { return std::sin(a[0]); }},
-      {"cos", 1, [](const double* a) { return std::cos(a[0]); }},
-      {"tan", 1, [](const double* a) { return std::tan(a[0]); }},
-      {"asin", 1, [](const double* a) { return std::asin(a[0]); }},
-      {"acos", 1, [](const double* a) { return std::acos(a[0]); }},
-      {"atan", 1, [](const double* a) { return std::atan(a[0]); }},
-      {"atan2", 2, [](const double* a) { return std::atan2(a[0], a[1]); }},
-      {"exp", 1, [](const double* a) { return std::exp(a[0]); }},
-      {"log", 1, [](const double* a) { return std::log(a[0]); }},
-      {"sqrt", 1, [](const double* a) { return std::sqrt(a[0]); }},
-      {"abs", 1, [](const double* a) { return std::abs(a[0]); }},
-      {"floor", 1, [](const double* a) { return std::floor(a[0]); }},
-      {"ceil", 1, [](const double* a) { return std::ceil(a[0]); }},
-      {"round", 1, [](const double* a) { return std::round(a[0]); }},
-      {"min", 2, [](const double* a) { return std::min(a[0], a[1]); }},
-      {"max", 2, [](const double* a) { return std::max(a[0], a[1]); }},
-      {"pow", 2, [](const double* a) { return std::pow(a[0], a[1]); }},
-      {"mod", 2, [](const double* a) { return a[0] - a[1] * std::floor(a[0] / a[1]); }},
-      {"step", 2, [](const double* a) { return a[1] < a[0] ? 0.0 : 1.0; }},
-      {"clamp", 3, clamp3},
-      {"lerp", 3, [](const double* a) { return a[0] + (a[1] - a[0]) * a[2]; }},
-      {"smoothstep", 3, smoothstep3},
+      {"sin", 1, [](const double* a) { return std::sin(a[0]); },
+       [](const double* a, const double* d, bool*) { return std::cos(a[0]) * d[0]; }},
+      {"cos", 1, [](const double* a) { return std::cos(a[0]); },
+       [](const double* a, const double* d, bool*) { return -std::sin(a[0]) * d[0]; }},
+      {"tan", 1, [](const double* a) { return std::tan(a[0]); },
+       [](const double* a, const double* d, bool*) { return d[0] / (std::cos(a[0]) * std::cos(a[0])); }},
+      {"asin", 1, [](const double* a) { return std::asin(a[0]); },
+       [](const double* a, const double* d, bool* s) {
+         if (!(std::abs(a[0]) < 1.0)) *s = false;
+         return d[0] / std::sqrt(1.0 - a[0] * a[0]);
+       }},
+      {"acos", 1, [](const double* a) { return std::acos(a[0]); },
+       [](const double* a, const double* d, bool* s) {
+         if (!(std::abs(a[0]) < 1.0)) *s = false;
+         return -d[0] / std::sqrt(1.0 - a[0] * a[0]);
+       }},
+      {"atan", 1, [](const double* a) { return std::atan(a[0]); },
+       [](const double* a, const double* d, bool*) { return d[0] / (1.0 + a[0] * a[0]); }},
+      {"atan2", 2, [](const double* a) { return std::atan2(a[0], a[1]); },
+       [](const double* a, const double* d, bool* s) {
+         const double r2 = a[0] * a[0] + a[1] * a[1];
+         if (!(r2 > 0.0)) *s = false;
+         return (a[1] * d[0] - a[0] * d[1]) / r2;
+       }},
+      {"exp", 1, [](const double* a) { return std::exp(a[0]); },
+       [](const double* a, const double* d, bool*) { return std::exp(a[0]) * d[0]; }},
+      {"log", 1, [](const double* a) { return std::log(a[0]); },
+       [](const double* a, const double* d, bool* s) {
+         if (!(a[0] > 0.0)) *s = false;
+         return d[0] / a[0];
+       }},
+      {"sqrt", 1, [](const double* a) { return std::sqrt(a[0]); },
+       [](const double* a, const double* d, bool* s) {
+         if (!(a[0] > 0.0)) *s = false;
+         return d[0] / (2.0 * std::sqrt(a[0]));
+       }},
+      {"abs", 1, [](const double* a) { return std::abs(a[0]); },
+       [](const double* a, const double* d, bool* s) {
+         if (a[0] == 0.0 && d[0] != 0.0) *s = false;
+         return a[0] < 0.0 ? -d[0] : d[0];
+       }},
+      {"floor", 1, [](const double* a) { return std::floor(a[0]); },
+       [](const double* a, const double* d, bool* s) { return flat(std::floor(a[0]) == a[0], d[0], s); }},
+      {"ceil", 1, [](const double* a) { return std::ceil(a[0]); },
+       [](const double* a, const double* d, bool* s) { return flat(std::ceil(a[0]) == a[0], d[0], s); }},
+      {"round", 1, [](const double* a) { return std::round(a[0]); },
+       [](const double* a, const double* d, bool* s) {
+         return flat(std::abs(a[0] - std::trunc(a[0])) == 0.5, d[0], s);
+       }},
+      {"min", 2, [](const double* a) { return std::min(a[0], a[1]); },
+       [](const double* a, const double* d, bool* s) {
+         if (a[0] == a[1] && d[0] != d[1]) *s = false;
+         return a[0] <= a[1] ? d[0] : d[1];
+       }},
+      {"max", 2, [](const double* a) { return std::max(a[0], a[1]); },
+       [](const double* a, const double* d, bool* s) {
+         if (a[0] == a[1] && d[0] != d[1]) *s = false;
+         return a[0] >= a[1] ? d[0] : d[1];
+       }},
+      {"pow", 2, [](const double* a) { return std::pow(a[0], a[1]); },
+       [](const double* a, const double* d, bool* s) { return powDerivative(a[0], a[1], d[0], d[1], s); }},
+      {"mod", 2, [](const double* a) { return a[0] - a[1] * std::floor(a[0] / a[1]); },
+       [](const double* a, const double* d, bool* s) {
+         const double q = a[0] / a[1];
+         if (std::floor(q) == q && (d[0] != 0.0 || d[1] != 0.0)) *s = false;
+         return d[0] - d[1] * std::floor(q);
+       }},
+      {"step", 2, [](const double* a) { return a[1] < a[0] ? 0.0 : 1.0; },
+       [](const double* a, const double* d, bool* s) { return flat(a[1] == a[0], d[1] - d[0], s); }},
+      {"clamp", 3, clamp3,
+       [](const double* a, const double* d, bool* s) {
+         if ((a[0] == a[1] && d[0] != d[1]) || (a[0] == a[2] && d[0] != d[2])) *s = false;
+         return a[0] < a[1] ? d[1] : a[0] > a[2] ? d[2] : d[0];
+       }},
+      {"lerp", 3, [](const double* a) { return a[0] + (a[1] - a[0]) * a[2]; },
+       [](const double* a, const double* d, bool*) { return d[0] + (d[1] - d[0]) * a[2] + (a[1] - a[0]) * d[2]; }},
+      {"smoothstep", 3, smoothstep3, smoothstepDerivative},
   };
   return f;
 }
@@ -108,6 +185,44 @@ struct Expression::Node {
       case Op::Eq: return a == b;
       case Op::Ne: return a != b;
       default: return 0.0;
+    }
+  }
+  // Forward-mode differentiation along variable `var`: the value's derivative
+  // by the chain rule; *smooth cleared where a kink or jump is crossed.
+  double derive(const double* v, size_t var, bool* smooth) const {
+    switch (kind) {
+      case Kind::Number:
+        return 0.0;
+      case Kind::Variable:
+        return index == var ? 1.0 : 0.0;
+      case Kind::Negate:
+        return -args[0]->derive(v, var, smooth);
+      case Kind::Not:
+        return 0.0;
+      case Kind::Conditional:
+        return args[0]->eval(v) != 0.0 ? args[1]->derive(v, var, smooth) : args[2]->derive(v, var, smooth);
+      case Kind::Call: {
+        double a[3], d[3];
+        for (size_t i = 0; i < args.size(); ++i) a[i] = args[i]->eval(v), d[i] = args[i]->derive(v, var, smooth);
+        return function->d(a, d, smooth);
+      }
+      case Kind::Binary:
+        break;
+    }
+    if (op != Op::Add && op != Op::Sub && op != Op::Mul && op != Op::Div && op != Op::Pow) return 0.0;
+    const double a = args[0]->eval(v), b = args[1]->eval(v);
+    const double da = args[0]->derive(v, var, smooth), db = args[1]->derive(v, var, smooth);
+    switch (op) {
+      case Op::Add:
+        return da + db;
+      case Op::Sub:
+        return da - db;
+      case Op::Mul:
+        return da * b + a * db;
+      case Op::Div:
+        return (da * b - a * db) / (b * b);
+      default:
+        return powDerivative(a, b, da, db, smooth);
     }
   }
 };
@@ -342,6 +457,20 @@ Expression::~Expression() = default;
 
 double Expression::evaluate(const double* values) const { return root_->eval(values); }
 bool Expression::constant() const { return !root_->usesVariables(); }
+
+double Expression::derivative(const double* values, size_t variable, bool* analytic) const {
+  bool smooth = true;
+  const double d = root_->derive(values, variable, &smooth);
+  if (analytic) *analytic = smooth && std::isfinite(d);
+  if (smooth && std::isfinite(d)) return d;
+  // Not differentiable here: the centred difference over a step of 1e-6 (relative).
+  std::vector<double> x(values, values + variables_.size());
+  const double at = x[variable], step = 1e-6 * std::max(1.0, std::abs(at));
+  x[variable] = at + step;
+  const double hi = root_->eval(x.data());
+  x[variable] = at - step;
+  return (hi - root_->eval(x.data())) / (2.0 * step);
+}
 
 std::vector<std::string> expressionFunctions() {
   std::vector<std::string> names;

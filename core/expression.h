@@ -43,6 +43,11 @@ class Expression {
   double evaluate(const double* values) const;
   double evaluate(const std::vector<double>& values) const { return evaluate(values.data()); }
   const std::string& text() const { return text_; }
+  // The derivative along variable number `variable` at `values`: analytic
+  // (forward mode, the chain rule through every operator and function)
+  // where the expression is differentiable there, else the centred
+  // difference over a relative step of 1e-6; *analytic says which.
+  double derivative(const double* values, size_t variable, bool* analytic = nullptr) const;
   // True when no variable occurs (the expression is a constant).
   bool constant() const;
 

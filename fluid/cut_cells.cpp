@@ -6,13 +6,35 @@
 
 namespace morphoflow {
 
-CutSurface::CutSurface(const std::vector<ObstacleSpec>& obstacles, int dims, const double* domainSize) : dims_(dims) {
-  for (const ObstacleSpec& o : obstacles)
-    if (o.boundary == ObstacleBoundary::Cut) {
-      obstacles_.push_back(o);
-      exact_ = exact_ && o.shape != ObstacleShape::Image;
+CutSurface::CutSurface(const std::vector<ObstacleSpec>& obstacles, int dims, const double* domainSize,
+                       const std::vector<RigidMotion>& motions, bool everyBoundary)
+    : dims_(dims) {
+  bool moves = false;
+  for (size_t i = 0; i < obstacles.size(); ++i)
+    if (everyBoundary || obstacles[i].boundary == ObstacleBoundary::Cut) {
+      obstacles_.push_back(obstacles[i]);
+      motions_.push_back(i < motions.size() ? motions[i] : RigidMotion{});
+      moves = moves || (i < motions.size() && movesAtAll(obstacles[i]));
+      exact_ = exact_ && obstacles[i].shape != ObstacleShape::Image;
     }
+  if (!moves) motions_.clear();
   for (int a = 0; a < dims; ++a) size_[a] = domainSize[a];
+}
+
+std::array<double, 3> CutSurface::velocity(const double* x) const {
+  if (motions_.empty()) return {0, 0, 0};
+  size_t nearest = 0;
+  double d = std::numeric_limits<double>::infinity();
+  for (size_t i = 0; i < obstacles_.size(); ++i) {
+    const double di = obstacleDistance(obstacles_[i], x, dims_, size_);
+    if (di < d) d = di, nearest = i;
+  }
+  // Where the obstacle wraps, the point's image nearest its centre.
+  const ObstacleSpec& o = obstacles_[nearest];
+  double image[3] = {x[0], x[1], dims_ == 3 ? x[2] : 0.0};
+  for (int a = 0; a < dims_; ++a)
+    if (o.wrap[size_t(a)]) image[a] -= size_[a] * std::round((x[a] - o.center[size_t(a)]) / size_[a]);
+  return motions_[nearest].at(image, dims_);
 }
 
 double CutSurface::distance(const double* x) const {

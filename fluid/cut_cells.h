@@ -15,6 +15,7 @@
 
 #include "core/grid.h"
 #include "fluid/obstacle.h"
+#include "fluid/obstacle_motion.h"
 
 namespace morphoflow {
 
@@ -23,15 +24,23 @@ namespace morphoflow {
 class CutSurface {
  public:
   CutSurface() = default;
-  CutSurface(const std::vector<ObstacleSpec>& obstacles, int dims, const double* domainSize);
+  // The cut obstacles (every obstacle with `everyBoundary`), moving as
+  // `motions` says (index by index; empty: all at rest).
+  CutSurface(const std::vector<ObstacleSpec>& obstacles, int dims, const double* domainSize,
+             const std::vector<RigidMotion>& motions = {}, bool everyBoundary = false);
   bool empty() const { return obstacles_.empty(); }
   double distance(const double* x) const;
+  // Whether any of its obstacles moves.
+  bool moving() const { return !motions_.empty(); }
+  // The velocity of the solid nearest x (0 when none moves).
+  std::array<double, 3> velocity(const double* x) const;
   // Whether distance() is one (an image shape only has a sign: -1 inside, 1 outside).
   bool exact() const { return exact_; }
   static constexpr double kMinTheta = 0.01;
 
  private:
   std::vector<ObstacleSpec> obstacles_;
+  std::vector<RigidMotion> motions_;  // empty unless one moves
   bool exact_ = true;
   int dims_ = 2;
   double size_[3] = {0, 0, 0};

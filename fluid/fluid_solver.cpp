@@ -7,9 +7,11 @@
 
 #include "core/parallel.h"
 #include "fluid/advection.h"
+#include "fluid/extrapolation.h"
 #include "fluid/fluid_step.h"
 #include "fluid/forces.h"
 #include "fluid/obstacle.h"
+#include "fluid/obstacle_motion.h"
 #include "fluid/smoke.h"
 
 namespace morphoflow {
@@ -46,13 +48,7 @@ FluidSolver<D>::FluidSolver(const FluidSettings& s)
     bool hi = s.boundaries.side(a, true).kind == BoundaryKind::Periodic;
     if (lo != hi) throw std::invalid_argument("a periodic axis must be periodic on both sides");
   }
-  std::vector<ObstacleSpec> voxel;  // the staircase obstacles; the others are cut
-  for (const ObstacleSpec& o : s.obstacles)
-    if (o.boundary == ObstacleBoundary::Voxel) voxel.push_back(o);
-  double size[3] = {0, 0, 0};
-  for (int a = 0; a < D; ++a) size[a] = cells_[a] * h_;
-  constraints_ = VelocityConstraints<D>(cells_, h_, s.boundaries, solidMask<D>(s.obstacles, cells_, h_),
-                                        solidMask<D>(voxel, cells_, h_), CutSurface(s.obstacles, D, size));
+  constraints_ = constraintsAt(0.0);
   SolverOptions p{s.pressureTolerance, s.pressureMaxIterations};
   projection_ = std::make_unique<PressureProjection<D>>(constraints_, s.pressureSolver, p);
   viscosity_ = std::make_unique<ViscositySolver<D>>(constraints_, SolverOptions{s.viscosityTolerance, 500});
@@ -64,6 +60,45 @@ FluidSolver<D>::FluidSolver(const FluidSettings& s)
     sourceCoverage_ = sourceCoverage<D>(s.smoke.sources, cells_, h_, constraints_.solid);
     if (!s.smoke.sources.empty()) materialisedDye();
   }
+}
+
+// The domain's sides and the obstacles where they are at time t.
+template <int D>
+VelocityConstraints<D> FluidSolver<D>::constraintsAt(double t) const {
+  std::vector<RigidMotion> motions;
+  std::vector<ObstacleSpec> placed = placedAt(settings_.obstacles, D, t, &motions);
+  for (ObstacleSpec& o : placed)
+    for (int a = 0; a < D; ++a) o.wrap[size_t(a)] = settings_.boundaries.periodic(a);
+  std::vector<ObstacleSpec> voxel;  // the staircase obstacles; the others are cut
+  for (const ObstacleSpec& o : placed)
+    if (o.boundary == ObstacleBoundary::Voxel) voxel.push_back(o);
+  double size[3] = {0, 0, 0};
+  for (int a = 0; a < D; ++a) size[a] = cells_[a] * h_;
+  return VelocityConstraints<D>(cells_, h_, settings_.boundaries, solidMask<D>(placed, cells_, h_),
+                                solidMask<D>(voxel, cells_, h_), CutSurface(placed, D, size),
+                                CutSurface(placed, D, size, motions, true));
+}
+
+// Moving obstacles (fluid/obstacle_motion.h): the constraints, pressure
+// and viscous systems at time t. With `fill`, the cells and faces the
+// solid uncovers take the mean of their fluid neighbours (repeated
+// outward), and those it covers are emptied: no smoke, the ambient
+// temperature, the solid's velocity.
+template <int D>
+void FluidSolver<D>::placeObstacles(double t, bool fill) {
+  if (!anyMoves(settings_.obstacles)) return;
+  const Grid<uint8_t, D> wasSolid = constraints_.solid;
+  const std::array<Grid<uint8_t, D>, D> wasFixed = constraints_.fixed;
+  constraints_ = constraintsAt(t);
+  projection_->rebuild();
+  viscosity_->rebuild();
+  cutSurfaceMade_ = false;
+  if (!fill) return;
+  const Grid<uint8_t, D>& solid = constraints_.solid;
+  if (!dye_.empty()) fillUncovered<float, D>(&dye_, wasSolid, solid, 0.0f);
+  if (!temperature_.empty()) fillUncovered<float, D>(&temperature_, wasSolid, solid, float(settings_.smoke.ambient));
+  for (int a = 0; a < D; ++a) fillUncovered<float, D>(&u_[a], wasFixed[a], constraints_.fixed[a], std::nullopt);
+  constraints_.apply(&u_);
 }
 
 // The CPU's stages of the fluid step, whose order is fluid/fluid_step.h's.
@@ -120,6 +155,7 @@ struct FluidSolver<D>::Stages {
 
 template <int D>
 void FluidSolver<D>::step(double dt, const std::function<void()>& afterAdvection) {
+  placeObstacles(time_ + dt, true);  // the solid where the step ends, which the projection meets
   Stages stages{*this};
   stepFluid(stages, dt, afterAdvection);
 }
@@ -168,6 +204,7 @@ double FluidSolver<D>::maxSpeed() const {
 template <int D>
 double FluidSolver<D>::cflTimeStep(double cfl, double dtMax) const {
   double umax = maxSpeed();
+  for (const ObstacleSpec& o : settings_.obstacles) umax = std::max(umax, obstacleSpeedBound(o, D, time_));
   if (umax <= 0) return dtMax;
   return std::min(dtMax, cfl * h_ / umax);
 }
@@ -191,6 +228,7 @@ void FluidSolver<D>::load(const StateReader& in) {
   if (!temperature_.empty()) in.getGrid("fluid.temperature", &temperature_);
   in.get("fluid.time", &time_);
   in.get("fluid.steps", &steps_);
+  placeObstacles(time_, false);
   projection_->load(in);
   viscosity_->load(in);
 }

@@ -84,6 +84,8 @@ class FluidSolver {
 
  private:
   struct Stages;  // the step's stages (fluid/fluid_step.h)
+  VelocityConstraints<D> constraintsAt(double t) const;
+  void placeObstacles(double t, bool fill);
   void injectInflowDye();
   void advectScalar(Grid<float, D>* field, double dt, const std::optional<std::array<int, D>>& reach);
   Grid<float, D>& materialisedDye() const {

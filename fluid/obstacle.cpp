@@ -24,21 +24,29 @@ double sampleField(const ObstacleSpec& o, double s, double t) {
 }  // namespace
 
 double obstacleDistance(const ObstacleSpec& o, const double* x, int dims, const double* size) {
+  // The point in the body's frame: R^T (x - centre).
+  double r[3] = {0, 0, 0}, q[3] = {0, 0, 0};
+  for (int a = 0; a < dims; ++a) {
+    r[a] = x[a] - o.center[size_t(a)];
+    if (o.wrap[size_t(a)]) r[a] -= size[a] * std::round(r[a] / size[a]);  // the nearest image
+  }
+  for (int a = 0; a < 3; ++a)
+    for (int b = 0; b < 3; ++b) q[a] += o.orientation[size_t(3 * b + a)] * r[b];
   switch (o.shape) {
     case ObstacleShape::Circle:
     case ObstacleShape::Sphere: {
-      // A circle in 3D is a cylinder along z; a sphere in 2D is a circle.
+      // A circle in 3D is a cylinder along the body's z; a sphere in 2D is a circle.
       int n = (o.shape == ObstacleShape::Circle) ? 2 : dims;
       double r2 = 0;
-      for (int a = 0; a < n; ++a) r2 += (x[a] - o.center[size_t(a)]) * (x[a] - o.center[size_t(a)]);
+      for (int a = 0; a < n; ++a) r2 += q[a] * q[a];
       return std::sqrt(r2) - o.radius;
     }
     case ObstacleShape::Box: {
       double outside = 0, inside = -1e300;
       for (int a = 0; a < dims; ++a) {
-        double q = std::abs(x[a] - o.center[size_t(a)]) - o.halfSize[size_t(a)];
-        outside += std::max(q, 0.0) * std::max(q, 0.0);
-        inside = std::max(inside, q);
+        double qa = std::abs(q[a]) - o.halfSize[size_t(a)];
+        outside += std::max(qa, 0.0) * std::max(qa, 0.0);
+        inside = std::max(inside, qa);
       }
       return std::sqrt(outside) + std::min(inside, 0.0);
     }

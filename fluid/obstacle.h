@@ -32,6 +32,15 @@ struct ObstacleSpec {
   double threshold = 0.5;
   bool invert = false;  // image: solid where value <= threshold
   ObstacleBoundary boundary = ObstacleBoundary::Cut;  // obstacles only (sources ignore it)
+  // Obstacles only: the centre per axis as expressions in t, and the angles
+  // (2D: one, about z; 3D: about x, y and z, applied x first) as
+  // expressions in t (fluid/obstacle_motion.h). Empty: fixed.
+  std::vector<std::string> motion, rotation;
+  // Per axis: the domain is periodic there, and the shape wraps across it
+  // (its nearest image counts).
+  std::array<bool, 3> wrap{false, false, false};
+  // The body's orientation now, row-major, body to world (placedAt() sets it).
+  std::array<double, 9> orientation{1, 0, 0, 0, 1, 0, 0, 0, 1};
 };
 
 // Signed distance (negative inside) of the obstacle at a world position.

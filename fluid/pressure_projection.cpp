@@ -56,6 +56,17 @@ PressureProjection<D>::PressureProjection(const VelocityConstraints<D>& vc, Pres
 }
 
 template <int D>
+void PressureProjection<D>::rebuild() {
+  A_ = pressureSystem(vc_);
+  if (solver_ == PressureSolver::ICPCG) mic_ = std::make_unique<MIC0Preconditioner<D>>(A_);
+  else multigrid_ = std::make_unique<Multigrid<D>>(A_);
+  // Cells the solid covers hold no pressure.
+  const std::vector<float> diag = A_.diag.expanded();
+  for (size_t i = 0; i < phi_.size(); ++i)
+    if (diag[i] == 0.0f) phi_[i] = 0.0;
+}
+
+template <int D>
 void PressureProjection<D>::divergence(const MacVelocity<D>& u, Vector* div) const {
   divergenceTimes(u, 1.0 / vc_.h, div);
 }
@@ -98,6 +109,10 @@ void PressureProjection<D>::divergenceTimes(const MacVelocity<D>& u, double fact
       for (int a = 0; a < D; ++a)
         d += ppAxisFlux(double(openHi[a][x]), double(hi[a][x]), double(openLo[a][x]), double(lo[a][x]));
       out[x] = active[x] == 0.0f ? 0.0 : d * factor;
+    }
+    if (!vc_.solidFlux.empty()) {  // a moving solid's flux through the closed parts
+      const double* solid = vc_.solidFlux.data() + row * nx;
+      for (size_t x = 0; x < nx; ++x) out[x] += active[x] == 0.0f ? 0.0 : solid[x] * factor;
     }
   });
 }

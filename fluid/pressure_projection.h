@@ -31,6 +31,9 @@ class PressureProjection {
 
   // Its work vectors come from `pool` (when given) and go back to it.
   SolverResult project(MacVelocity<D>* u, double dt, double density, WorkPool* pool = nullptr);
+  // The system again from the constraints (a moving obstacle changed them);
+  // the warm start stays.
+  void rebuild();
   // Cell divergence of u (0 on solid cells).
   void divergence(const MacVelocity<D>& u, Vector* div) const;
   // Takes phi of a projection computed elsewhere (the GPU backend) as the

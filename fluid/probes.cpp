@@ -70,12 +70,17 @@ std::array<double, 3> obstacleForce(const FluidSolver<D>& f) {
           if (fl[a] < 0 || fl[a] >= n[a] || solid(fl)) return 0.0;
           if (b == a) return -double(p(fl)) * dir * area;     // pressure along the normal
           double ut = f.velocity().atCell(fl)[b];
+          if (vc.bodies.moving()) {  // relative to the wall
+            double x[3] = {0, 0, 0};
+            for (int c = 0; c < D; ++c) x[c] = (fl[c] + 0.5) * h - (c == a ? dir * 0.5 * h : 0.0);
+            ut -= vc.bodies.velocity(x)[size_t(b)];
+          }
           return mu * ut / (0.5 * h) * area;                    // shear along the wall
         });
       }
     }
   }
-  const std::array<double, 3> cut = surfaceForce<D>(f.cutSurface(), f.velocity(), p, mu);
+  const std::array<double, 3> cut = surfaceForce<D>(f.cutSurface(), f.velocity(), p, mu, &vc.bodies);
   for (int b = 0; b < 3; ++b) force[size_t(b)] += cut[size_t(b)];
   return force;
 }

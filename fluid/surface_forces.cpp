@@ -52,7 +52,7 @@ std::vector<SurfaceElement> cutSurfaceElements(const VelocityConstraints<D>& vc)
 
 template <int D>
 std::array<double, 3> surfaceForce(const std::vector<SurfaceElement>& elements, const MacVelocity<D>& u,
-                                   const Grid<float, D>& p, double mu) {
+                                   const Grid<float, D>& p, double mu, const CutSurface* bodies) {
   const double h = u.h(), d1 = 2.0 * h, d2 = 3.0 * h;
   const Layout<D> cells = Layout<D>::cellCentred(h, u.cells(), u.periodic());
   std::array<double, 3> force{0, 0, 0};
@@ -69,7 +69,11 @@ std::array<double, 3> surfaceForce(const std::vector<SurfaceElement>& elements, 
     // p at the wall, extrapolated linearly; du/dn from u(0) = 0, u(d1), u(d2).
     const double p1 = sampleLinear(p, cells, x1), p2 = sampleLinear(p, cells, x2);
     const double pw = (d2 * p1 - d1 * p2) / (d2 - d1);
-    const Vec<D> u1 = u.sample(x1), u2 = u.sample(x2);
+    Vec<D> u1 = u.sample(x1), u2 = u.sample(x2);
+    if (bodies && bodies->moving()) {  // relative to the wall's velocity at the surface point
+      const std::array<double, 3> w = bodies->velocity(e.x.data());
+      for (int a = 0; a < D; ++a) u1[a] -= w[size_t(a)], u2[a] -= w[size_t(a)];
+    }
     for (int a = 0; a < D; ++a) {
       const double dudn = (d2 * d2 * u1[a] - d1 * d1 * u2[a]) / (d1 * d2 * (d2 - d1));
       force[size_t(a)] += -pw * e.area[size_t(a)] + mu * dudn * len;
@@ -81,8 +85,8 @@ std::array<double, 3> surfaceForce(const std::vector<SurfaceElement>& elements, 
 template std::vector<SurfaceElement> cutSurfaceElements<2>(const VelocityConstraints<2>&);
 template std::vector<SurfaceElement> cutSurfaceElements<3>(const VelocityConstraints<3>&);
 template std::array<double, 3> surfaceForce<2>(const std::vector<SurfaceElement>&, const MacVelocity<2>&,
-                                               const Grid<float, 2>&, double);
+                                               const Grid<float, 2>&, double, const CutSurface*);
 template std::array<double, 3> surfaceForce<3>(const std::vector<SurfaceElement>&, const MacVelocity<3>&,
-                                               const Grid<float, 3>&, double);
+                                               const Grid<float, 3>&, double, const CutSurface*);
 
 }  // namespace morphoflow

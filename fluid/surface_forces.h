@@ -1,6 +1,6 @@
 // The force the fluid exerts on the cut obstacles, integrated on their
 // surface rather than on a staircase: the traction -p n + mu du/dn
-// (a no-slip rigid wall: the normal derivative is the whole velocity
+// (u relative to the wall; a no-slip rigid wall: the normal derivative is the whole velocity
 // gradient's), at one point per cut cell, weighted by the cell's piece of
 // the surface as the open fractions give it (the fluid part of the cell is
 // closed, so its surface's area vector is the sum of its faces' open area
@@ -27,9 +27,10 @@ template <int D>
 std::vector<SurfaceElement> cutSurfaceElements(const VelocityConstraints<D>& vc);
 
 // The force on the surface `elements` from the velocity u, the pressure p
-// (cell-centred) and the dynamic viscosity mu.
+// (cell-centred) and the dynamic viscosity mu; on a moving body the shear
+// is the fluid's velocity relative to the body's (`bodies`, when given).
 template <int D>
 std::array<double, 3> surfaceForce(const std::vector<SurfaceElement>& elements, const MacVelocity<D>& u,
-                                   const Grid<float, D>& p, double mu);
+                                   const Grid<float, D>& p, double mu, const CutSurface* bodies = nullptr);
 
 }  // namespace morphoflow

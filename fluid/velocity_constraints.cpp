@@ -14,8 +14,8 @@ VelocityConstraints<D>::VelocityConstraints(const IVec<D>& c, double hh, const D
 template <int D>
 VelocityConstraints<D>::VelocityConstraints(const IVec<D>& c, double hh, const DomainBoundaries& b,
                                             const Grid<uint8_t, D>& s, const Grid<uint8_t, D>& voxel,
-                                            const CutSurface& cutSurface)
-    : cells(c), h(hh), boundaries(b), solid(s), cut(cutSurface) {
+                                            const CutSurface& cutSurface, const CutSurface& solidBodies)
+    : cells(c), h(hh), boundaries(b), solid(s), cut(cutSurface), bodies(solidBodies) {
   for (int a = 0; a < D; ++a) {
     IVec<D> fd = cells + unitVector<D>(a);
     fixed[a] = Grid<uint8_t, D>(fd, 0);
@@ -36,7 +36,7 @@ VelocityConstraints<D>::VelocityConstraints(const IVec<D>& c, double hh, const D
         }
       }
       // A face touching a staircase solid cell, or wholly inside a cut
-      // obstacle, is held at the obstacle's (zero) velocity.
+      // obstacle, is held at the obstacle's velocity.
       IVec<D> lo = k - unitVector<D>(a);
       if (boundaries.periodic(a) && lo[a] < 0) lo[a] += cells[a];
       IVec<D> hi = k;
@@ -48,7 +48,7 @@ VelocityConstraints<D>::VelocityConstraints(const IVec<D>& c, double hh, const D
       open[a].at(i) = o;
       if (o == 0.0f) {
         fixed[a][i] = 1;
-        value[i] = 0.0f;
+        value[i] = bodies.moving() ? float(bodies.velocity(facePosition(a, k).data())[size_t(a)]) : 0.0f;
       }
     });
     open[a].compact();
@@ -58,6 +58,22 @@ VelocityConstraints<D>::VelocityConstraints(const IVec<D>& c, double hh, const D
         fixedValues[a].push_back(value[i]);
       }
   }
+  if (bodies.moving()) computeSolidFlux();
+}
+
+template <int D>
+void VelocityConstraints<D>::computeSolidFlux() {
+  solidFlux.assign(solid.size(), 0.0);
+  forEachCell<D>(cells, [&](const IVec<D>& k, size_t i) {
+    double flux = 0.0;
+    for (int a = 0; a < D; ++a)
+      for (int side = 0; side < 2; ++side) {
+        const IVec<D> f = k + (side ? unitVector<D>(a) : IVec<D>(0));
+        const double closed = 1.0 - double(open[a](f));
+        if (closed > 0.0) flux += (side ? closed : -closed) * bodies.velocity(facePosition(a, f).data())[size_t(a)];
+      }
+    solidFlux[i] = flux;
+  });
 }
 
 template <int D>

@@ -27,6 +27,13 @@ struct VelocityConstraints {
   // sides too). The pressure projection weighs the faces by it.
   std::array<RowField<D>, D> open;
   CutSurface cut;  // the cut obstacles' surface (empty: none)
+  // Every obstacle with its motion: the solid's velocity where one moves.
+  CutSurface bodies;
+  // With a moving obstacle, per cell: the flux the solid's velocity carries
+  // through the closed part of its faces, times h^{1-D} (Batty et al. 2007
+  // with u_solid: a face's flux is open u + (1 - open) u_solid . n); the
+  // projection's divergence adds it. Empty when nothing moves.
+  std::vector<double> solidFlux;
   // The indices of each grid's prescribed faces, ascending, and their
   // values: apply() visits these only, not the whole grid (a cavity
   // prescribes about 1 face in 20 at 128^3, and apply() runs several times
@@ -39,8 +46,10 @@ struct VelocityConstraints {
   // prescribed); `cut`: the surface of the others. Without them every solid
   // cell is a staircase one.
   VelocityConstraints(const IVec<D>& cells, double h, const DomainBoundaries& b, const Grid<uint8_t, D>& solid);
+  // `bodies`: every obstacle with its motion (fluid/obstacle_motion.h);
+  // faces inside a moving solid are held at its velocity.
   VelocityConstraints(const IVec<D>& cells, double h, const DomainBoundaries& b, const Grid<uint8_t, D>& solid,
-                      const Grid<uint8_t, D>& voxel, const CutSurface& cut);
+                      const Grid<uint8_t, D>& voxel, const CutSurface& cut, const CutSurface& bodies = {});
 
   std::array<bool, D> periodic() const;
   // Sets every prescribed face and copies face 0 onto face n on periodic axes.
@@ -53,6 +62,9 @@ struct VelocityConstraints {
   double inflowSpeed(int axis, const Vec<D>& x) const;
   // The world position of face k of grid a (x, y, z; 0 beyond D).
   std::array<double, 3> facePosition(int a, const IVec<D>& k) const;
+
+ private:
+  void computeSolidFlux();
 };
 
 }  // namespace morphoflow

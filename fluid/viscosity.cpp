@@ -56,9 +56,15 @@ ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
         }
         size_t ni = fixed.index(nb);
         if (cut && phi[ni] < 0.0f) {
-          // Gibou et al. 2002: the obstacle's (zero) velocity at the surface,
-          // a fraction theta of the way to the neighbour.
-          c += 1.0 / cutTheta(phi[gi], phi[ni]);
+          // Gibou et al. 2002: the obstacle's velocity at the surface, a
+          // fraction theta of the way to the neighbour.
+          const double theta = cutTheta(phi[gi], phi[ni]);
+          c += 1.0 / theta;
+          if (vc.bodies.moving()) {
+            std::array<double, 3> x = vc.facePosition(a, k);
+            x[size_t(bx)] += dir * theta * vc.h;
+            extra += vc.bodies.velocity(x.data())[size_t(a)] / theta;
+          }
         } else if (fixed[ni]) {
           c += 1.0;
           extra += double(vc.prescribed(a, ni));
@@ -74,6 +80,17 @@ ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
   C.boundaryRhs.compact();
   C.A.finalize();  // the weights compacted now; c follows at setRate
   return C;
+}
+
+template <int D>
+void ViscositySolver<D>::rebuild() {
+  for (int a = 0; a < D; ++a) {
+    Component& C = comp_[size_t(a)];
+    static_cast<ViscousSystem<D>&>(C) = viscousSystem<D>(vc_, a);
+    C.chebyshev.reset();
+    C.multigrid.reset();
+  }
+  s_ = -1.0;
 }
 
 template <int D>

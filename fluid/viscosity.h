@@ -59,6 +59,9 @@ template <int D>
 class ViscositySolver {
  public:
   ViscositySolver(const VelocityConstraints<D>& constraints, const SolverOptions& options);
+  // The systems again from the constraints (a moving obstacle changed
+  // them); the warm starts stay.
+  void rebuild();
   // Diffuses u in place; returns the worst of the component solves. Its
   // work vectors come from `pool` (when given) and go back to it.
   SolverResult diffuse(MacVelocity<D>* u, double viscosity, double dt, WorkPool* pool = nullptr);

@@ -1,9 +1,11 @@
 // [[obstacles]]: circles, spheres, boxes and image or signed-distance shapes.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 
 #include <fmt/format.h>
 
+#include "fluid/obstacle_motion.h"
 #include "render/image_io.h"
 #include "scenes/scene_reader.h"
 
@@ -87,17 +89,94 @@ const toml::array* tableArray(Reader& r, toml::table& root, const std::string& n
   return arr;
 }
 
+namespace {
+
+// obstacles.N.motion (the centre per axis) or obstacles.N.rotation (2D: one
+// angle; 3D: three), expressions in t.
+std::vector<std::string> parseKinematics(SceneContext& c, const toml::table* o, const std::string& p,
+                                         const std::string& key, size_t count, const std::string& example) {
+  Reader& r = c.r;
+  const toml::node* n = r.node(o, p, key);
+  if (!n) return {};
+  const toml::array* arr = n->as_array();
+  if (!arr || arr->size() != count)
+    r.fail(n, p + key, fmt::format("expected {} expressions in t", count), "e.g. " + key + " = " + example);
+  return expressionList(r, *arr, p + key, {"t"}, key, "the variable is t");
+}
+
+// A moving obstacle's motion over its window (to the run's end): finite,
+// and no point of it moving farther in one step than its own half
+// thickness (else it would pass through the fluid it should push aside).
+void checkMotion(SceneContext& c, const Scene& s, const ObstacleSpec& spec, const TimeWindow& w, const toml::table* o,
+                 const std::string& p) {
+  Reader& r = c.r;
+  const TimeSettings& ts = s.time;
+  double end = ts.steps > 0 ? double(ts.steps) * ts.dt : ts.duration > 0 ? ts.duration : TimeSettings::kSteadyCap;
+  end = std::min(end, w.end);
+  const double h = c.size[0] / c.res[0];
+  double thickness = spec.radius;
+  if (spec.shape == ObstacleShape::Box) {
+    thickness = spec.halfSize[0];
+    for (int a = 1; a < c.D; ++a) thickness = std::min(thickness, spec.halfSize[size_t(a)]);
+  }
+  const long samples = std::clamp(long(std::ceil((end - w.start) / ts.dt)), 1L, 100000L);
+  const std::string key = spec.motion.empty() ? "rotation" : "motion";
+  for (long k = 0; k <= samples; ++k) {
+    const double t = w.start + (end - w.start) * double(k) / double(samples);
+    RigidMotion m;
+    const ObstacleSpec at = placedAt(spec, c.D, t, &m);
+    bool finite = true;
+    for (int a = 0; a < 3; ++a)
+      finite = finite && std::isfinite(at.center[size_t(a)]) && std::isfinite(m.velocity[size_t(a)]) &&
+               std::isfinite(m.omega[size_t(a)]);
+    for (double v : at.orientation) finite = finite && std::isfinite(v);
+    if (!finite)
+      r.fail(r.node(o, p, key), p + key,
+             fmt::format("the {} is not finite at t = {:g} (its centre, angle or their rate)", key, t),
+             "give expressions finite over the obstacle's window (start to end, or to the run's end)");
+    const double speed = obstacleSpeedBound(spec, c.D, t);
+    const double dt = ts.cfl > 0 && speed > 0 ? std::min(ts.dt, ts.cfl * h / speed) : ts.dt;
+    if (speed * dt > thickness)
+      r.fail(r.node(o, p, key), p + key,
+             fmt::format("at t = {:g} a point of the obstacle moves {:g} in one step of {:g}, more than its half "
+                         "thickness {:g}: it would pass through the fluid it should push",
+                         t, speed * dt, dt, thickness),
+             "use a smaller time.dt, set time.cfl, or slow the motion");
+  }
+}
+
+}  // namespace
+
 void parseObstacles(SceneContext& c, Scene* s) {
   if (const toml::array* arr = tableArray(c.r, c.root, "obstacles"))
     for (size_t i = 0; i < arr->size(); ++i) {
       const toml::table* o = arr->get(i)->as_table();
       const std::string p = "obstacles." + std::to_string(i) + ".";
+      Reader& r = c.r;
       ObstacleSpec spec = parseRegion(c, o, p);
       // Where the fluid meets it: its own surface (cut cells) or its cells' staircase.
       spec.boundary = c.r.string(o, p, "boundary", "cut", {"cut", "voxel"}) == "voxel" ? ObstacleBoundary::Voxel
                                                                                     : ObstacleBoundary::Cut;
+      const bool fromFile = spec.shape == ObstacleShape::Image || spec.shape == ObstacleShape::Sdf;
+      spec.motion =
+          parseKinematics(c, o, p, "motion", size_t(c.D),
+                          c.D == 2 ? "[\"0.5 + 0.2 * t\", \"0.5\"]" : "[\"0.5 + 0.2 * t\", \"0.5\", \"0.5\"]");
+      spec.rotation = parseKinematics(c, o, p, "rotation", c.D == 2 ? 1 : 3,
+                                      c.D == 2 ? "[\"2 * t\"]" : "[\"0\", \"0\", \"2 * t\"]");
+      for (const char* key : {"motion", "rotation"})
+        if (fromFile && r.node(o, p, key))
+          r.fail(r.node(o, p, key), p + key,
+                 fmt::format("an {} obstacle is its file stretched over the whole domain: it has no centre to {}",
+                             spec.shape == ObstacleShape::Image ? "image" : "sdf",
+                             key == std::string("motion") ? "move" : "turn about"),
+                 "remove " + std::string(key) + ", or give the obstacle a circle, sphere or box shape");
+      if (!spec.motion.empty() && r.node(o, p, "center"))
+        r.fail(r.node(o, p, "center"), p + "center", "the motion gives the centre at every time: center does not apply",
+               "remove center, and start the motion where the obstacle starts");
+      const TimeWindow window = parseWindow(c.r, o, p);
+      if (movesAtAll(spec)) checkMotion(c, *s, spec, window, o, p);
       s->fluid.obstacles.push_back(std::move(spec));
-      s->timeline.obstacles.push_back(parseWindow(c.r, o, p));
+      s->timeline.obstacles.push_back(window);
     }
 }
 

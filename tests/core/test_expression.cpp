@@ -133,3 +133,34 @@ TEST(SpatialField, ImageIsBilinearYUpAndMappedToTheRange) {
   std::vector<double> w = sampleSpatialField<2>(f, IVec<2>(1, 2));
   EXPECT_LT(w[0], w[1]);
 }
+
+TEST(Expression, DerivativesAreAnalyticWhereTheExpressionIsSmooth) {
+  const double t = 0.7;
+  bool analytic = false;
+  Expression a("0.5 + 0.2 * sin(3 * t) + t^2 / (1 + t)", {"t"});
+  const double exact = 0.6 * std::cos(3 * t) + (2 * t * (1 + t) - t * t) / ((1 + t) * (1 + t));
+  EXPECT_NEAR(a.derivative(&t, 0, &analytic), exact, 1e-14);
+  EXPECT_TRUE(analytic);
+  Expression b("t < 1 ? smoothstep(0, 2, t) : exp(-t)", {"t"});
+  EXPECT_NEAR(b.derivative(&t, 0, &analytic), 6 * 0.35 * 0.65 / 2, 1e-14);
+  EXPECT_TRUE(analytic);
+  Expression c("atan2(sqrt(t), 1 - t) + mod(t, 0.3) + pow(t, t) + clamp(t, 0, 2) + lerp(1, t, t)", {"t"});
+  const double h = 1e-6;
+  double lo = t - h, hi = t + h;
+  EXPECT_NEAR(c.derivative(&t, 0, &analytic), (c.evaluate(&hi) - c.evaluate(&lo)) / (2 * h), 1e-7);
+  EXPECT_TRUE(analytic);
+}
+
+TEST(Expression, AtAKinkTheDerivativeIsACentredDifference) {
+  bool analytic = true;
+  const double zero = 0.0, one = 1.0;
+  Expression kink("abs(t)", {"t"});
+  EXPECT_NEAR(kink.derivative(&zero, 0, &analytic), 0.0, 1e-12);  // the mean of the sides
+  EXPECT_FALSE(analytic);
+  Expression jump("floor(t)", {"t"});
+  EXPECT_GT(jump.derivative(&one, 0, &analytic), 1e4);  // a jump is a huge rate, as a teleport is
+  EXPECT_FALSE(analytic);
+  const double half = 0.5;
+  EXPECT_EQ(jump.derivative(&half, 0, &analytic), 0.0);  // flat between the jumps
+  EXPECT_TRUE(analytic);
+}

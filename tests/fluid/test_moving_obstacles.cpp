@@ -1,0 +1,107 @@
+// Obstacles that move: the solid's velocity reaches the fluid at its own
+// surface (the projection's flux, the viscosity's no-slip), the force on
+// a moving body, and what the body uncovers and covers.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "fluid/fluid_solver.h"
+#include "fluid/obstacle_motion.h"
+#include "tests/fluid/towed_body.h"
+
+using namespace morphoflow;
+using namespace morphoflow::testing;
+
+TEST(MovingObstacles, ATowedCylinderFeelsTheDragOfAFixedOneInAStream) {
+  const ForceSeries towed = towedBody<2>(true, 40.0, 12, 1.2);
+  const ForceSeries fixed = towedBody<2>(false, 40.0, 12, 1.2);
+  const double a = meanOver(towed, towed.drag, 0.7, 1.2), b = meanOver(fixed, fixed.drag, 0.7, 1.2);
+  std::printf("towed %.4f fixed %.4f\n", a, b);
+  for (size_t i = 0; i < towed.t.size(); i += 20) std::printf("%.3f %.4f\n", towed.t[i], towed.drag[i]);
+  for (size_t i = 0; i < fixed.t.size(); i += 20) std::printf("%.3f %.4f\n", fixed.t[i], fixed.drag[i]);
+  EXPECT_NEAR(a, b, 0.02 * b);
+}
+
+namespace {
+
+// Couette-Poiseuille flow between a cut wall moving along x at speed U (the
+// top of a box obstacle sliding along a channel periodic in x, its surface
+// at y = yw, between cell faces) and the domain's top wall at rest, driven
+// by a body force f: nu u'' = -f, u(yw) = U, u(1) = 0. The largest error
+// of the steady u over the fluid's faces, on n x n cells.
+double couetteError(int n) {
+  const double U = 1.0, f = 4.0, nu = 0.5, yw = 0.1234567;
+  FluidSettings s;
+  s.resolution = {n, n};
+  s.size = {1.0, 1.0};
+  s.viscosity = nu;
+  s.viscosityTolerance = 1e-11;
+  s.pressureTolerance = 1e-10;
+  s.force = {f, 0.0, 0.0};
+  s.boundaries.sides[0].kind = s.boundaries.sides[1].kind = BoundaryKind::Periodic;
+  ObstacleSpec wall;
+  wall.shape = ObstacleShape::Box;
+  wall.halfSize = {100.0, 0.5 * yw + 0.05, 0.0};  // reaches below the domain's floor
+  const double cy = yw - wall.halfSize[1];
+  wall.motion = {"0.5 + t", std::to_string(cy)};
+  s.obstacles = {wall};
+  FluidSolver<2> solver(s);
+  for (int k = 0; k < 80; ++k) solver.step(0.1);
+  const Grid<float, 2>& u = solver.velocity()[0];
+  double worst = 0.0;
+  for (int j = 0; j < n; ++j) {
+    const double y = (j + 0.5) / n;
+    if (y <= yw) continue;
+    const double exact = U * (1.0 - y) / (1.0 - yw) + f / (2.0 * nu) * (y - yw) * (1.0 - y);
+    for (int i = 0; i < n; ++i) worst = std::max(worst, std::abs(double(u(IVec<2>(i, j))) - exact));
+  }
+  return worst;
+}
+
+}  // namespace
+
+TEST(MovingObstacles, TheCutNoSlipOfAMovingWallIsSecondOrder) {
+  const double e16 = couetteError(16), e32 = couetteError(32), e64 = couetteError(64);
+  std::printf("errors %.3e %.3e %.3e\n", e16, e32, e64);
+  EXPECT_GT(std::log2(e16 / e32), 1.8);
+  EXPECT_GT(std::log2(e32 / e64), 1.8);
+  EXPECT_LT(e64, 2e-3);
+}
+
+TEST(MovingObstacles, TheSolidsVelocityIsTheMotionsRateAndOmegaCrossR) {
+  ObstacleSpec box;
+  box.shape = ObstacleShape::Box;
+  box.halfSize = {0.2, 0.1, 0.05};
+  box.motion = {"0.5 + 0.1 * t", "0.5 - t^2", "0.5"};
+  box.rotation = {"0.3 * t", "sin(t)", "2 * t"};
+  const double t = 0.4, dt = 1e-6;
+  RigidMotion m;
+  const ObstacleSpec now = placedAt(box, 3, t, &m);
+  EXPECT_NEAR(m.velocity[0], 0.1, 1e-14);
+  EXPECT_NEAR(m.velocity[1], -0.8, 1e-14);
+  // omega is the axial vector of R' R^T, R' by a centred difference.
+  const ObstacleSpec before = placedAt(box, 3, t - dt, nullptr), after = placedAt(box, 3, t + dt, nullptr);
+  auto rdot = [&](int i, int j) { return (after.orientation[3 * i + j] - before.orientation[3 * i + j]) / (2 * dt); };
+  double w[3][3] = {};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      for (int k = 0; k < 3; ++k) w[i][j] += rdot(i, k) * now.orientation[size_t(3 * j + k)];
+  EXPECT_NEAR(m.omega[0], w[2][1], 1e-8);
+  EXPECT_NEAR(m.omega[1], w[0][2], 1e-8);
+  EXPECT_NEAR(m.omega[2], w[1][0], 1e-8);
+  // A body point's velocity is the rate of its world position.
+  const double body[3] = {0.1, -0.05, 0.02};
+  auto world = [&](const ObstacleSpec& o, int a) {
+    double x = o.center[size_t(a)];
+    for (int b = 0; b < 3; ++b) x += o.orientation[size_t(3 * a + b)] * body[b];
+    return x;
+  };
+  double x[3];
+  for (int a = 0; a < 3; ++a) x[a] = world(now, a);
+  const std::array<double, 3> v = m.at(x, 3);
+  for (int a = 0; a < 3; ++a) EXPECT_NEAR(v[size_t(a)], (world(after, a) - world(before, a)) / (2 * dt), 1e-8);
+  // The point is on the body's surface or inside it (the distance sees the turned box).
+  const double size[3] = {1, 1, 1};
+  EXPECT_LT(obstacleDistance(now, x, 3, size), 0.0);
+}
