@@ -31,6 +31,7 @@ class ARDSolver {
   void advect(double dt, const MacVelocity<D>& u);
 
   RDSolver<D>& rd() { return *rd_; }
+  ChemicalAdvector<D>& advector() { return advector_; }
   const RDSolver<D>& rd() const { return *rd_; }
   CouplingMode mode() const { return mode_; }
   double time() const { return time_; }

@@ -48,6 +48,8 @@ class ChemicalAdvector {
   // for the call; the species go through the scratch one at a time.
   void advect(const MacVelocity<D>& u, double dt, const std::vector<Grid<double, D>*>& species,
               WorkPool* pool = nullptr);
+  // New solid cells (a moving obstacle; per RD cell, empty: none).
+  void setSolid(std::vector<uint8_t> solid) { domain_.solid = std::move(solid); }
   // Sets the solid cells of every species to the solid values.
   void emptySolids(const std::vector<Grid<double, D>*>& species) const;
 

@@ -5,6 +5,8 @@
 #include <atomic>
 #include <functional>
 
+#include "coupling/solid_on_layer.h"
+
 #if defined(__SANITIZE_THREAD__)
 #include <thread>
 #endif
@@ -30,9 +32,24 @@ template <int D>
 CpuCoupledStepper<D>::CpuCoupledStepper(FluidSolver<D>* fluid, ARDSolver<D>* ard, Backend backend)
     : fluid_(fluid), fluidStepper_(fluid), ard_(ard), backend_(backend) {}
 
+// A moving obstacle: the fluid's solid where this step ends, and the
+// chemicals' solid cells with it (coupling/solid_on_layer.h).
+template <int D>
+void CpuCoupledStepper<D>::moveSolids(double dt) {
+  RDSolver<D>& rd = ard_->rd();
+  const Grid<uint8_t, D> was = solidOnLayer<D>(fluid_->solid(), fluid_->h(), rd.cells(), rd.h());
+  fluid_->placeObstaclesFor(dt);
+  Grid<uint8_t, D> now = solidOnLayer<D>(fluid_->solid(), fluid_->h(), rd.cells(), rd.h());
+  std::vector<Grid<double, D>*> species;
+  for (int s = 0; s < rd.species(); ++s) species.push_back(&rd.field(s));
+  followSolid<D>(species, ard_->advector().domain().solidValues, was, now);
+  ard_->advector().setSolid(std::move(now.values()));
+}
+
 template <int D>
 void CpuCoupledStepper<D>::step(double dt) {
   const double t0 = traceClock();
+  if (fluid_->movesObstacles()) moveSolids(dt);
   auto fluidStep = [&](const std::function<void()>& afterAdvection) {
     const double b = traceClock();
     fluid_->step(dt, afterAdvection);

@@ -56,6 +56,7 @@ class CpuCoupledStepper final : public CoupledStepper<D> {
   void setTrace(StageTrace* trace) { trace_ = trace; }
 
  private:
+  void moveSolids(double dt);
   FluidSolver<D>* fluid_;
   CpuFluidStepper<D> fluidStepper_;
   ARDSolver<D>* ard_;

@@ -39,6 +39,12 @@ class FluidSolver {
   // afterAdvection (if given) runs once the step's advection is done, on the
   // step's thread: from then on advectedVelocity() holds what it advected.
   void step(double dt, const std::function<void()>& afterAdvection = {});
+  // Whether an obstacle moves (obstacles.N.motion or rotation).
+  bool movesObstacles() const { return moves_; }
+  // Puts the moving obstacles where the coming step of dt ends (step()
+  // does it itself unless this ran first, so that a coupled layer can
+  // follow the solid before the step).
+  void placeObstaclesFor(double dt) { placeObstacles(time_ + dt, true); }
   // Largest dt with |u|max dt <= cfl h (dtMax when the fluid is at rest).
   double cflTimeStep(double cfl, double dtMax) const;
   double maxSpeed() const;
@@ -110,6 +116,8 @@ class FluidSolver {
   WorkPool pool_;  // the stages' work vectors, lent to each in turn
   double time_ = 0.0;
   long steps_ = 0;
+  bool moves_ = false;
+  double placedAt_ = 0.0;  // the time the obstacles were placed for
   FluidStepStats stats_;
 };
 

@@ -153,23 +153,23 @@ void parseObstacles(SceneContext& c, Scene* s) {
       const toml::table* o = arr->get(i)->as_table();
       const std::string p = "obstacles." + std::to_string(i) + ".";
       Reader& r = c.r;
+      // An image or sdf is its file stretched over the domain: no centre to move or turn about.
+      const std::string shape = r.string(o, p, "shape", "circle", {"circle", "sphere", "box", "image", "sdf"});
+      for (const char* key : {"motion", "rotation"})
+        if ((shape == "image" || shape == "sdf") && r.node(o, p, key))
+          r.fail(r.node(o, p, key), p + key,
+                 fmt::format("an {} obstacle is its file stretched over the whole domain: it has no centre to {}",
+                             shape, key == std::string("motion") ? "move" : "turn about"),
+                 "remove " + std::string(key) + ", or give the obstacle a circle, sphere or box shape");
       ObstacleSpec spec = parseRegion(c, o, p);
       // Where the fluid meets it: its own surface (cut cells) or its cells' staircase.
       spec.boundary = c.r.string(o, p, "boundary", "cut", {"cut", "voxel"}) == "voxel" ? ObstacleBoundary::Voxel
-                                                                                    : ObstacleBoundary::Cut;
-      const bool fromFile = spec.shape == ObstacleShape::Image || spec.shape == ObstacleShape::Sdf;
+                                                                                       : ObstacleBoundary::Cut;
       spec.motion =
           parseKinematics(c, o, p, "motion", size_t(c.D),
                           c.D == 2 ? "[\"0.5 + 0.2 * t\", \"0.5\"]" : "[\"0.5 + 0.2 * t\", \"0.5\", \"0.5\"]");
       spec.rotation = parseKinematics(c, o, p, "rotation", c.D == 2 ? 1 : 3,
                                       c.D == 2 ? "[\"2 * t\"]" : "[\"0\", \"0\", \"2 * t\"]");
-      for (const char* key : {"motion", "rotation"})
-        if (fromFile && r.node(o, p, key))
-          r.fail(r.node(o, p, key), p + key,
-                 fmt::format("an {} obstacle is its file stretched over the whole domain: it has no centre to {}",
-                             spec.shape == ObstacleShape::Image ? "image" : "sdf",
-                             key == std::string("motion") ? "move" : "turn about"),
-                 "remove " + std::string(key) + ", or give the obstacle a circle, sphere or box shape");
       if (!spec.motion.empty() && r.node(o, p, "center"))
         r.fail(r.node(o, p, "center"), p + "center", "the motion gives the centre at every time: center does not apply",
                "remove center, and start the motion where the obstacle starts");

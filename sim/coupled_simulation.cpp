@@ -6,13 +6,14 @@
 
 #include <fmt/format.h>
 
-#include "sim/fluid_simulation.h"
-#include "sim/steppers.h"
-#include "sim/rd_scene_setup.h"
 #include "core/parallel.h"
 #include "core/sampling.h"
+#include "coupling/solid_on_layer.h"
 #include "fluid/smoke.h"
 #include "rd/model_registry.h"
+#include "sim/fluid_simulation.h"
+#include "sim/rd_scene_setup.h"
+#include "sim/steppers.h"
 
 namespace morphoflow {
 
@@ -31,17 +32,10 @@ ChemicalDomain<D> chemicalDomain(const Scene& scene, const FluidSolver<D>& fluid
       d.inflow[size_t(a)][size_t(hi)] = scene.fluid.boundaries.side(a, hi != 0).kind == BoundaryKind::Inflow;
   d.inflowValues = scene.coupling.inflowValues;
   d.solidValues = scene.coupling.solidValues;
-  const Grid<uint8_t, D>& solid = fluid.solid();
-  bool any = false;
-  std::vector<uint8_t> mask(rd.field(0).size(), 0);
-  forEachCell<D>(d.cells, [&](const IVec<D>& k, size_t i) {
-    IVec<D> f;
-    for (int a = 0; a < D; ++a)
-      f[a] = std::clamp(int(std::floor((k[a] + 0.5) * d.h / fluid.h())), 0, fluid.cells()[a] - 1);
-    mask[i] = solid(f);
-  });
-  for (uint8_t m : mask) any |= m != 0;
-  if (any) d.solid = std::move(mask);
+  Grid<uint8_t, D> mask = solidOnLayer<D>(fluid.solid(), fluid.h(), d.cells, d.h);
+  bool any = fluid.movesObstacles();  // (a moving obstacle's cells are followed, even from none)
+  for (uint8_t m : mask.values()) any |= m != 0;
+  if (any) d.solid = std::move(mask.values());
   return d;
 }
 
