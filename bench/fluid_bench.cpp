@@ -46,10 +46,39 @@ FluidSettings benchSmokyCavity(int n) {
   return s;
 }
 
+// What the cavity holds: nothing, smoke, or a cut sphere (circle) of
+// radius 0.15 at rest at the centre or circling it at radius 0.2 (a
+// moving obstacle rebuilds its cut cells and the systems every step).
+enum class BenchContent { Plain, Smoke, BodyAtRest, BodyMoving };
+const char* contentName(BenchContent c) {
+  const char* names[] = {"-", "smoke", "body at rest", "body moving"};
+  return names[int(c)];
+}
+
 template <int D>
-nlohmann::json benchFluid(int n, int threads, double minSeconds, double triad, bool smoke) {
+FluidSettings benchSettings(int n, BenchContent content) {
+  if (content == BenchContent::Smoke) return benchSmokyCavity<D>(n);
+  FluidSettings s = benchCavity<D>(n);
+  if (content == BenchContent::Plain) return s;
+  ObstacleSpec body;
+  body.shape = ObstacleShape::Sphere;
+  body.center = {0.5, 0.5, 0.5};
+  body.radius = 0.15;
+  if (content == BenchContent::BodyMoving) {
+    body.motion = {"0.5 + 0.2 * cos(t)", "0.5 + 0.2 * sin(t)"};
+    if (D == 3) body.motion.push_back("0.5");
+  } else {
+    body.center = {0.7, 0.5, 0.5};  // where the moving one starts
+  }
+  s.obstacles = {body};
+  return s;
+}
+
+template <int D>
+nlohmann::json benchFluid(int n, int threads, double minSeconds, double triad, BenchContent content) {
   ThreadLimit limit(threads);
-  FluidSolver<D> f(smoke ? benchSmokyCavity<D>(n) : benchCavity<D>(n));
+  const bool smoke = content == BenchContent::Smoke;
+  FluidSolver<D> f(benchSettings<D>(n, content));
   const double dt = f.h();  // CFL 1 at the lid speed
   for (int i = 0; i < 3; ++i) f.step(dt);  // warm-up: the flow starts to develop
   std::vector<double> pit, vit;
@@ -69,8 +98,12 @@ nlohmann::json benchFluid(int n, int threads, double minSeconds, double triad, b
   for (double v : vit) meanVit += v;
   meanIt /= double(pit.size());
   meanVit /= double(vit.size());
-  nlohmann::json j = {{"dim", D},       {"n", n},          {"smoke", smoke},
-                      {"threads", threads}, {"steps", times.size()},
+  nlohmann::json j = {{"dim", D},
+                      {"n", n},
+                      {"smoke", smoke},
+                      {"content", contentName(content)},
+                      {"threads", threads},
+                      {"steps", times.size()},
                       {"ms_per_step_median", 1e3 * median(times)},
                       {"pressure_iterations_mean", meanIt},
                       {"viscosity_iterations_mean", meanVit},
@@ -91,28 +124,32 @@ bool runFluidBench(const BenchOptions& o) {
       selectBenchCases({{2, 128}, {2, 256}, {2, 512}, {2, 1024}, {3, 64}, {3, 128}}, o.size);
   nlohmann::json all = nlohmann::json::array();
   const std::array<double, 3> triad = suiteTriads(o.minSeconds);
-  std::cout << fmt::format("{:>4} {:>6} {:>6} {:>7} {:>12} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9}\n", "dim", "n",
-                           "smoke", "threads", "ms/step(med)", "p-iters", "v-iters", "forces", "advect", "diffuse",
+  std::cout << fmt::format("{:>4} {:>6} {:>12} {:>7} {:>12} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>9}\n", "dim", "n",
+                           "content", "threads", "ms/step(med)", "p-iters", "v-iters", "forces", "advect", "diffuse",
                            "project", "of triad");
-  // 3D cases run again with smoke (sources, temperature, buoyancy, confinement), each right after the plain one.
-  std::vector<std::pair<BenchCase, bool>> runs;
+  // 3D cases run again with smoke (sources, temperature, buoyancy,
+  // confinement), and 3D and 2D 512^2 with a body at rest and moving, each
+  // right after the plain one.
+  std::vector<std::pair<BenchCase, BenchContent>> runs;
   for (BenchCase c : cases) {
-    runs.push_back({c, false});
-    if (c.dim == 3) runs.push_back({c, true});
+    runs.push_back({c, BenchContent::Plain});
+    if (c.dim == 3) runs.push_back({c, BenchContent::Smoke});
+    if (c.dim == 3 || c.n == 512)
+      for (BenchContent b : {BenchContent::BodyAtRest, BenchContent::BodyMoving}) runs.push_back({c, b});
   }
-  for (const auto& [c, smoke] : runs) {
+  for (const auto& [c, content] : runs) {
     for (int threads : {1, 2}) {
-      nlohmann::json j = c.dim == 2 ? benchFluid<2>(c.n, threads, o.minSeconds, triad[size_t(threads)], smoke)
-                                    : benchFluid<3>(c.n, threads, o.minSeconds, triad[size_t(threads)], smoke);
-      std::cout
-          << fmt::format(
-                 "{:>4} {:>6} {:>6} {:>7} {:>12.2f} {:>8.1f} {:>8.1f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f}{}\n",
-                 c.dim, c.n, smoke ? "yes" : "no", threads, j["ms_per_step_median"].get<double>(),
-                 j["pressure_iterations_mean"].get<double>(), j["viscosity_iterations_mean"].get<double>(),
-                 j["ms_forces"].get<double>(), j["ms_advect"].get<double>(), j["ms_diffuse"].get<double>(),
-                 j["ms_project"].get<double>(), j["of_triad"].get<double>(),
-                 j["pressure_converged"].get<bool>() ? "" : "  (unconverged)")
-          << std::flush;
+      nlohmann::json j = c.dim == 2 ? benchFluid<2>(c.n, threads, o.minSeconds, triad[size_t(threads)], content)
+                                    : benchFluid<3>(c.n, threads, o.minSeconds, triad[size_t(threads)], content);
+      std::cout << fmt::format(
+                       "{:>4} {:>6} {:>12} {:>7} {:>12.2f} {:>8.1f} {:>8.1f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f} "
+                       "{:>9.2f}{}\n",
+                       c.dim, c.n, contentName(content), threads, j["ms_per_step_median"].get<double>(),
+                       j["pressure_iterations_mean"].get<double>(), j["viscosity_iterations_mean"].get<double>(),
+                       j["ms_forces"].get<double>(), j["ms_advect"].get<double>(), j["ms_diffuse"].get<double>(),
+                       j["ms_project"].get<double>(), j["of_triad"].get<double>(),
+                       j["pressure_converged"].get<bool>() ? "" : "  (unconverged)")
+                << std::flush;
       all.push_back(j);
     }
   }

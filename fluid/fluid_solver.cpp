@@ -63,41 +63,97 @@ FluidSolver<D>::FluidSolver(const FluidSettings& s)
   }
 }
 
-// The domain's sides and the obstacles where they are at time t.
+// The obstacles where they are at time t (wrapping across periodic axes), with their motions.
 template <int D>
-VelocityConstraints<D> FluidSolver<D>::constraintsAt(double t) const {
-  std::vector<RigidMotion> motions;
-  std::vector<ObstacleSpec> placed = placedAt(settings_.obstacles, D, t, &motions);
+std::vector<ObstacleSpec> FluidSolver<D>::obstaclesAt(double t, std::vector<RigidMotion>* motions) const {
+  std::vector<ObstacleSpec> placed = placedAt(settings_.obstacles, D, t, motions);
   for (ObstacleSpec& o : placed)
     for (int a = 0; a < D; ++a) o.wrap[size_t(a)] = settings_.boundaries.periodic(a);
+  return placed;
+}
+
+// The domain's sides and the obstacles where they are at time t.
+template <int D>
+VelocityConstraints<D> FluidSolver<D>::constraintsAt(double t) {
+  std::vector<RigidMotion> motions;
+  placed_ = obstaclesAt(t, &motions);
   std::vector<ObstacleSpec> voxel;  // the staircase obstacles; the others are cut
-  for (const ObstacleSpec& o : placed)
+  for (const ObstacleSpec& o : placed_)
     if (o.boundary == ObstacleBoundary::Voxel) voxel.push_back(o);
   double size[3] = {0, 0, 0};
   for (int a = 0; a < D; ++a) size[a] = cells_[a] * h_;
-  return VelocityConstraints<D>(cells_, h_, settings_.boundaries, solidMask<D>(placed, cells_, h_),
-                                solidMask<D>(voxel, cells_, h_), CutSurface(placed, D, size),
-                                CutSurface(placed, D, size, motions, true));
+  if (moves_) voxel_ = solidMask<D>(voxel, cells_, h_);
+  return VelocityConstraints<D>(cells_, h_, settings_.boundaries, solidMask<D>(placed_, cells_, h_),
+                                moves_ ? voxel_ : solidMask<D>(voxel, cells_, h_), CutSurface(placed_, D, size),
+                                CutSurface(placed_, D, size, motions, true));
+}
+
+// The cells [lo, hi) that hold the moving obstacles of `placed`, two cells
+// more on every side, grown to hold what they held already; false when one
+// has no bounds.
+template <int D>
+bool FluidSolver<D>::movingCells(const std::vector<ObstacleSpec>& placed, IVec<D>* lo, IVec<D>* hi) const {
+  double size[3] = {0, 0, 0};
+  for (int a = 0; a < D; ++a) size[a] = cells_[a] * h_;
+  for (const ObstacleSpec& o : placed) {
+    if (!movesAtAll(o)) continue;
+    double blo[3], bhi[3];
+    if (!obstacleBounds(o, D, size, blo, bhi)) return false;
+    for (int a = 0; a < D; ++a) {
+      int l = int(std::floor(blo[a] / h_)) - 2, u = int(std::ceil(bhi[a] / h_)) + 2;
+      if (o.wrap[size_t(a)] && (l < 0 || u > cells_[a])) l = 0, u = cells_[a];  // across the seam: the whole axis
+      (*lo)[a] = std::min((*lo)[a], std::clamp(l, 0, cells_[a]));
+      (*hi)[a] = std::max((*hi)[a], std::clamp(u, 0, cells_[a]));
+    }
+  }
+  return true;
 }
 
 // Moving obstacles (fluid/obstacle_motion.h): the constraints, pressure
-// and viscous systems at time t. With `fill`, the cells and faces the
-// solid uncovers take the mean of their fluid neighbours (repeated
-// outward). Those it covers keep their smoke and temperature, which the
-// solid's velocity then carries with it: the fluid pushed ahead of the
-// solid traces back into them and takes them along, so that nothing is
-// lost at a moving wall (a closed box stirred by a paddle keeps its dye to
-// 0.2% a turn: tests/fluid/test_moving_obstacles.cpp). Their faces take the
-// solid's velocity.
+// and viscous systems at time t, recomputed in the cells that held or
+// hold a moving obstacle. With `fill`, the cells and faces the solid
+// uncovers take the mean of their fluid neighbours (repeated outward).
+// Those it covers keep their smoke and temperature, which the solid's
+// velocity then carries with it: the fluid pushed ahead of the solid traces
+// back into them and takes them along, so that nothing is lost at a moving
+// wall (a closed box stirred by a paddle keeps its dye to 0.2% a turn:
+// tests/fluid/test_moving_obstacles.cpp). Their faces take the solid's velocity.
 template <int D>
 void FluidSolver<D>::placeObstacles(double t, bool fill) {
   if (!moves_) return;
   placedAt_ = t;
   const Grid<uint8_t, D> wasSolid = constraints_.solid;
   const std::array<Grid<uint8_t, D>, D> wasFixed = constraints_.fixed;
-  constraints_ = constraintsAt(t);
+  std::vector<RigidMotion> motions;
+  std::vector<ObstacleSpec> placed = obstaclesAt(t, &motions);
+  IVec<D> lo = cells_, hi(0);
+  if (movingCells(placed_, &lo, &hi) && movingCells(placed, &lo, &hi)) {
+    for (int a = 0; a < D; ++a) hi[a] = std::max(hi[a], lo[a]);  // (none inside the domain: no cells)
+    Grid<uint8_t, D> solid = constraints_.solid;
+    std::vector<ObstacleSpec> voxel;
+    for (const ObstacleSpec& o : placed)
+      if (o.boundary == ObstacleBoundary::Voxel) voxel.push_back(o);
+    double size[3] = {0, 0, 0};
+    for (int a = 0; a < D; ++a) size[a] = cells_[a] * h_;
+    forEachCell<D>(hi - lo, [&](const IVec<D>& r, size_t) {
+      const IVec<D> k = lo + r;
+      double x[3] = {0, 0, 0};
+      for (int a = 0; a < D; ++a) x[a] = (k[a] + 0.5) * h_;
+      auto inside = [&](const std::vector<ObstacleSpec>& list) {
+        return std::any_of(list.begin(), list.end(),
+                           [&](const ObstacleSpec& o) { return obstacleDistance(o, x, D, size) < 0.0; });
+      };
+      solid(k) = inside(placed) ? 1 : 0;
+      voxel_(k) = inside(voxel) ? 1 : 0;
+    });
+    constraints_.move(solid, voxel_, CutSurface(placed, D, size), CutSurface(placed, D, size, motions, true), lo, hi);
+    placed_ = std::move(placed);
+  } else {
+    constraints_ = constraintsAt(t);
+    lo = IVec<D>(0), hi = cells_;
+  }
   projection_->rebuild();
-  viscosity_->rebuild();
+  viscosity_->rebuild(lo, hi);
   cutSurfaceMade_ = false;
   if (!fill) return;
   const Grid<uint8_t, D>& solid = constraints_.solid;

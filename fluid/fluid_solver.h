@@ -90,7 +90,9 @@ class FluidSolver {
 
  private:
   struct Stages;  // the step's stages (fluid/fluid_step.h)
-  VelocityConstraints<D> constraintsAt(double t) const;
+  std::vector<ObstacleSpec> obstaclesAt(double t, std::vector<RigidMotion>* motions) const;
+  VelocityConstraints<D> constraintsAt(double t);
+  bool movingCells(const std::vector<ObstacleSpec>& placed, IVec<D>* lo, IVec<D>* hi) const;
   void placeObstacles(double t, bool fill);
   void injectInflowDye();
   void advectScalar(Grid<float, D>* field, double dt, const std::optional<std::array<int, D>>& reach);
@@ -117,6 +119,8 @@ class FluidSolver {
   double time_ = 0.0;
   long steps_ = 0;
   bool moves_ = false;
+  std::vector<ObstacleSpec> placed_;  // the obstacles where they are now
+  Grid<uint8_t, D> voxel_;            // the staircase obstacles' cells (when one moves)
   double placedAt_ = 0.0;  // the time the obstacles were placed for
   FluidStepStats stats_;
 };

@@ -80,6 +80,24 @@ std::vector<ObstacleSpec> placedAt(const std::vector<ObstacleSpec>& obstacles, i
   return out;
 }
 
+bool obstacleBounds(const ObstacleSpec& o, int dims, const double* size, double* lo, double* hi) {
+  double reach = o.radius;
+  if (o.shape == ObstacleShape::Image || o.shape == ObstacleShape::Sdf) return false;
+  if (o.shape == ObstacleShape::Circle && dims == 3) return false;
+  if (o.shape == ObstacleShape::Box) {
+    double d2 = 0.0;
+    for (int a = 0; a < dims; ++a) d2 += o.halfSize[size_t(a)] * o.halfSize[size_t(a)];
+    reach = std::sqrt(d2);
+  }
+  for (int a = 0; a < dims; ++a) {
+    double c = o.center[size_t(a)];
+    if (o.wrap[size_t(a)]) c -= size[a] * std::floor(c / size[a]);
+    lo[a] = c - reach;
+    hi[a] = c + reach;
+  }
+  return true;
+}
+
 double obstacleSpeedBound(const ObstacleSpec& o, int dims, double t) {
   if (!movesAtAll(o)) return 0.0;
   RigidMotion m;

@@ -35,6 +35,11 @@ ObstacleSpec placedAt(const ObstacleSpec& o, int dims, double t, RigidMotion* mo
 std::vector<ObstacleSpec> placedAt(const std::vector<ObstacleSpec>& obstacles, int dims, double t,
                                    std::vector<RigidMotion>* motions);
 
+// The box [lo, hi] (world units) that holds the obstacle, its centre
+// wrapped into the domain on the axes it wraps across; false when it has
+// none (an image, an sdf, a circle's cylinder in 3D).
+bool obstacleBounds(const ObstacleSpec& o, int dims, const double* domainSize, double* lo, double* hi);
+
 // The largest speed of any point of the obstacle at t: |v| + |omega| times
 // its farthest point from the centre (0 for an image or sdf shape, which does not move).
 double obstacleSpeedBound(const ObstacleSpec& o, int dims, double t);

@@ -57,13 +57,12 @@ PressureProjection<D>::PressureProjection(const VelocityConstraints<D>& vc, Pres
 
 template <int D>
 void PressureProjection<D>::rebuild() {
-  A_ = pressureSystem(vc_);
+  A_ = pressureSystem(vc_);  // (same shape: the multigrid refers to A_ and derives its levels again)
   if (solver_ == PressureSolver::ICPCG) mic_ = std::make_unique<MIC0Preconditioner<D>>(A_);
-  else multigrid_ = std::make_unique<Multigrid<D>>(A_);
+  else multigrid_->refresh();
   // Cells the solid covers hold no pressure.
-  const std::vector<float> diag = A_.diag.expanded();
   for (size_t i = 0; i < phi_.size(); ++i)
-    if (diag[i] == 0.0f) phi_[i] = 0.0;
+    if (vc_.solid[i] && A_.diag[i] == 0.0f) phi_[i] = 0.0;
 }
 
 template <int D>

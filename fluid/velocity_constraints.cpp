@@ -20,51 +20,91 @@ VelocityConstraints<D>::VelocityConstraints(const IVec<D>& c, double hh, const D
     IVec<D> fd = cells + unitVector<D>(a);
     fixed[a] = Grid<uint8_t, D>(fd, 0);
     open[a] = RowField<D>(fd, 1.0f);
-    Grid<float, D> value(fd, 0.0f);
-    Layout<D> layout = Layout<D>::face(a, h, cells, periodic());
-    forEachCell<D>(fd, [&](const IVec<D>& k, size_t i) {
-      bool boundary = !boundaries.periodic(a) && (k[a] == 0 || k[a] == cells[a]);
-      if (boundary) {
-        bool high = k[a] == cells[a];
-        const DomainSide& side = boundaries.side(a, high);
-        if (side.kind == BoundaryKind::Wall) {
-          fixed[a][i] = 1;
-        } else if (side.kind == BoundaryKind::Inflow) {
-          fixed[a][i] = 1;
-          double speed = inflowSpeed(a, layout.toWorld(k));
-          value[i] = float(high ? -speed : speed);
-        }
-      }
-      // A face touching a staircase solid cell, or wholly inside a cut
-      // obstacle, is held at the obstacle's velocity.
-      IVec<D> lo = k - unitVector<D>(a);
-      if (boundaries.periodic(a) && lo[a] < 0) lo[a] += cells[a];
-      IVec<D> hi = k;
-      if (boundaries.periodic(a) && hi[a] >= cells[a]) hi[a] -= cells[a];
-      bool solidLo = lo[a] >= 0 && voxel(lo), solidHi = hi[a] < cells[a] && voxel(hi);
-      IVec<D> same = k;  // on a periodic axis face n is face 0
-      if (boundaries.periodic(a) && same[a] == cells[a]) same[a] = 0;
-      float o = solidLo || solidHi ? 0.0f : cut.empty() ? 1.0f : openFraction<D>(cut, a, same, h);
-      open[a].at(i) = o;
-      if (o == 0.0f) {
-        fixed[a][i] = 1;
-        value[i] = bodies.moving() ? float(bodies.velocity(facePosition(a, k).data())[size_t(a)]) : 0.0f;
-      }
-    });
+    std::vector<float> value(fixed[a].size(), 0.0f);
+    forEachCell<D>(fd, [&](const IVec<D>& k, size_t i) { constrainFace(a, k, i, voxel, value.data()); });
     open[a].compact();
-    for (size_t i = 0; i < fixed[a].size(); ++i)
-      if (fixed[a][i]) {
-        fixedFaces[a].push_back(i);
-        fixedValues[a].push_back(value[i]);
-      }
+    listFixed(a, value);
   }
-  if (bodies.moving()) computeSolidFlux();
+  if (bodies.moving()) computeSolidFlux(IVec<D>(0), cells);
 }
 
 template <int D>
-void VelocityConstraints<D>::computeSolidFlux() {
-  solidFlux.assign(solid.size(), 0.0);
-  forEachCell<D>(cells, [&](const IVec<D>& k, size_t i) {
+void VelocityConstraints<D>::move(const Grid<uint8_t, D>& s, const Grid<uint8_t, D>& voxel,
+                                  const CutSurface& cutSurface, const CutSurface& solidBodies, const IVec<D>& lo,
+                                  const IVec<D>& hi) {
+  solid = s;
+  cut = cutSurface;
+  bodies = solidBodies;
+  for (int a = 0; a < D; ++a) {
+    std::vector<float> value = prescribedGrid(a);
+    open[a].densify();
+    IVec<D> extent = hi - lo + unitVector<D>(a);  // the faces of the cells [lo, hi)
+    forEachCell<D>(extent, [&](const IVec<D>& r, size_t) {
+      const IVec<D> k = lo + r;
+      const size_t i = fixed[a].index(k);
+      fixed[a][i] = 0;
+      open[a].at(i) = 1.0f;
+      value[i] = 0.0f;
+      constrainFace(a, k, i, voxel, value.data());
+    });
+    open[a].compact();
+    listFixed(a, value);
+  }
+  if (solidFlux.empty()) solidFlux.assign(solid.size(), 0.0);
+  if (bodies.moving()) computeSolidFlux(lo, hi);
+}
+
+// Face k (index i) of grid a: held by a wall, an inflow or a solid, and
+// its open fraction.
+template <int D>
+void VelocityConstraints<D>::constrainFace(int a, const IVec<D>& k, size_t i, const Grid<uint8_t, D>& voxel,
+                                           float* value) {
+  bool boundary = !boundaries.periodic(a) && (k[a] == 0 || k[a] == cells[a]);
+  if (boundary) {
+    bool high = k[a] == cells[a];
+    const DomainSide& side = boundaries.side(a, high);
+    if (side.kind == BoundaryKind::Wall) {
+      fixed[a][i] = 1;
+    } else if (side.kind == BoundaryKind::Inflow) {
+      fixed[a][i] = 1;
+      double speed = inflowSpeed(a, Layout<D>::face(a, h, cells, periodic()).toWorld(k));
+      value[i] = float(high ? -speed : speed);
+    }
+  }
+  // A face touching a staircase solid cell, or wholly inside a cut
+  // obstacle, is held at the obstacle's velocity.
+  IVec<D> lo = k - unitVector<D>(a);
+  if (boundaries.periodic(a) && lo[a] < 0) lo[a] += cells[a];
+  IVec<D> hi = k;
+  if (boundaries.periodic(a) && hi[a] >= cells[a]) hi[a] -= cells[a];
+  bool solidLo = lo[a] >= 0 && voxel(lo), solidHi = hi[a] < cells[a] && voxel(hi);
+  IVec<D> same = k;  // on a periodic axis face n is face 0
+  if (boundaries.periodic(a) && same[a] == cells[a]) same[a] = 0;
+  float o = solidLo || solidHi ? 0.0f : cut.empty() ? 1.0f : openFraction<D>(cut, a, same, h);
+  open[a].at(i) = o;
+  if (o == 0.0f) {
+    fixed[a][i] = 1;
+    value[i] = bodies.moving() ? float(bodies.velocity(facePosition(a, k).data())[size_t(a)]) : 0.0f;
+  }
+}
+
+template <int D>
+void VelocityConstraints<D>::listFixed(int a, const std::vector<float>& value) {
+  fixedFaces[a].clear();
+  fixedValues[a].clear();
+  for (size_t i = 0; i < fixed[a].size(); ++i)
+    if (fixed[a][i]) {
+      fixedFaces[a].push_back(i);
+      fixedValues[a].push_back(value[i]);
+    }
+}
+
+// The moving solid's flux through the closed parts of the faces of the cells [lo, hi).
+template <int D>
+void VelocityConstraints<D>::computeSolidFlux(const IVec<D>& lo, const IVec<D>& hi) {
+  if (solidFlux.empty()) solidFlux.assign(solid.size(), 0.0);
+  forEachCell<D>(hi - lo, [&](const IVec<D>& r, size_t) {
+    const IVec<D> k = lo + r;
     double flux = 0.0;
     for (int a = 0; a < D; ++a)
       for (int side = 0; side < 2; ++side) {
@@ -72,7 +112,7 @@ void VelocityConstraints<D>::computeSolidFlux() {
         const double closed = 1.0 - double(open[a](f));
         if (closed > 0.0) flux += (side ? closed : -closed) * bodies.velocity(facePosition(a, f).data())[size_t(a)];
       }
-    solidFlux[i] = flux;
+    solidFlux[solid.index(k)] = flux;
   });
 }
 

@@ -63,8 +63,15 @@ struct VelocityConstraints {
   // The world position of face k of grid a (x, y, z; 0 beyond D).
   std::array<double, 3> facePosition(int a, const IVec<D>& k) const;
 
+  // The obstacles moved within the cells [lo, hi): the new solid cells,
+  // surfaces and motions; only the faces of those cells are recomputed.
+  void move(const Grid<uint8_t, D>& solid, const Grid<uint8_t, D>& voxel, const CutSurface& cut,
+            const CutSurface& bodies, const IVec<D>& lo, const IVec<D>& hi);
+
  private:
-  void computeSolidFlux();
+  void constrainFace(int a, const IVec<D>& k, size_t i, const Grid<uint8_t, D>& voxel, float* value);
+  void listFixed(int a, const std::vector<float>& value);
+  void computeSolidFlux(const IVec<D>& lo, const IVec<D>& hi);
 };
 
 }  // namespace morphoflow

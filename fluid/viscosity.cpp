@@ -2,34 +2,61 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "core/parallel.h"
 
 namespace morphoflow {
 
+namespace {
+
+// Rows [lo, hi) (unknown coordinates) of component a's system: each
+// unknown's couplings, and the terms walls, prescribed faces and cut
+// obstacles add (written into dense fields).
 template <int D>
-ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
-  ViscousSystem<D> C;
-  const IVec<D>& n = vc.cells;
+void viscousRows(ViscousSystem<D>* system, const VelocityConstraints<D>& vc, int a, const IVec<D>& lo,
+                 const IVec<D>& hi) {
+  ViscousSystem<D>& C = *system;
   const std::array<bool, D> periodic = vc.periodic();
   const Grid<uint8_t, D>& fixed = vc.fixed[a];
-  // Unknowns: the face grid, less the duplicate face n_a on a periodic axis.
-  C.dims = n + unitVector<D>(a);
-  if (periodic[size_t(a)]) C.dims[a] = n[a];
-  C.A = LaplaceSystem<D>(C.dims, periodic, 1.0);
-  C.cBoundary = RowField<D>(C.dims, 0.0f);
-  C.boundaryRhs = RowField<D>(C.dims, 0.0f);
-  // With cut obstacles, the distance to them at every face of the grid.
+  // With cut obstacles, the distance to them at the faces a cut obstacle
+  // closes in part (the only ones whose centre can lie inside), within one
+  // face of the rows; +infinity (outside) elsewhere.
   const bool cut = !vc.cut.empty();
+  auto distance = [&](const IVec<D>& k) { return float(vc.cut.distance(vc.facePosition(a, k).data())); };
   Grid<float, D> phi;
   if (cut) {
-    phi = Grid<float, D>(fixed.dims(), 0.0f);
-    forEachCell<D>(fixed.dims(),
-                   [&](const IVec<D>& k, size_t i) { phi[i] = float(vc.cut.distance(vc.facePosition(a, k).data())); });
-    C.insideCut.assign(C.A.size(), 0);
+    phi = Grid<float, D>(fixed.dims(), std::numeric_limits<float>::infinity());
+    IVec<D> plo, phiExtent;
+    for (int b = 0; b < D; ++b) {
+      plo[b] = std::max(lo[b] - 1, 0);
+      phiExtent[b] = std::min(hi[b] + 1, fixed.dims()[b]) - plo[b];
+    }
+    forEachCell<D>(phiExtent, [&](const IVec<D>& r, size_t) {
+      const IVec<D> k = plo + r;
+      if (vc.open[a](k) < 1.0f) phi(k) = distance(k);
+    });
+    for (int b = 0; b < D; ++b)  // the wrapped neighbours of a periodic axis's first and last faces
+      if (periodic[size_t(b)]) {
+        IVec<D> layer = fixed.dims();
+        layer[b] = 1;
+        forEachCell<D>(layer, [&](const IVec<D>& r, size_t) {
+          for (int edge : {0, C.dims[b] - 1}) {
+            IVec<D> k = r;
+            k[b] = edge;
+            if (vc.open[a](k) < 1.0f) phi(k) = distance(k);
+          }
+        });
+      }
+    if (C.insideCut.size() != C.A.size()) C.insideCut.assign(C.A.size(), 0);
   }
-  forEachCell<D>(C.dims, [&](const IVec<D>& k, size_t i) {
-    size_t gi = fixed.index(k);
+  forEachCell<D>(hi - lo, [&](const IVec<D>& r, size_t) {
+    const IVec<D> k = lo + r;
+    const size_t i = C.A.c.index(k);
+    for (int bx = 0; bx < D; ++bx) C.A.w[bx].at(i) = 0.0f;
+    if (cut) C.insideCut[i] = 0;
+    C.boundaryRhs.at(i) = 0.0f;
+    const size_t gi = fixed.index(k);
     if (fixed[gi] || (cut && phi[gi] < 0.0f)) {
       if (!fixed[gi]) C.insideCut[i] = 1;
       C.cBoundary.at(i) = -1.0f;
@@ -58,7 +85,7 @@ ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
         if (cut && phi[ni] < 0.0f) {
           // Gibou et al. 2002: the obstacle's velocity at the surface, a
           // fraction theta of the way to the neighbour.
-          const double theta = cutTheta(phi[gi], phi[ni]);
+          const double theta = cutTheta(distance(k), phi[ni]);
           c += 1.0 / theta;
           if (vc.bodies.moving()) {
             std::array<double, 3> x = vc.facePosition(a, k);
@@ -76,6 +103,21 @@ ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
     C.cBoundary.at(i) = float(c);  // whole: 2 per wall ghost, 1 per prescribed neighbour, 1/theta per cut one
     C.boundaryRhs.at(i) = float(extra);
   });
+}
+
+}  // namespace
+
+template <int D>
+ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
+  ViscousSystem<D> C;
+  const IVec<D>& n = vc.cells;
+  // Unknowns: the face grid, less the duplicate face n_a on a periodic axis.
+  C.dims = n + unitVector<D>(a);
+  if (vc.periodic()[size_t(a)]) C.dims[a] = n[a];
+  C.A = LaplaceSystem<D>(C.dims, vc.periodic(), 1.0);
+  C.cBoundary = RowField<D>(C.dims, 0.0f);
+  C.boundaryRhs = RowField<D>(C.dims, 0.0f);
+  viscousRows<D>(&C, vc, a, IVec<D>(0), C.dims);
   C.cBoundary.compact();
   C.boundaryRhs.compact();
   C.A.finalize();  // the weights compacted now; c follows at setRate
@@ -83,12 +125,30 @@ ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
 }
 
 template <int D>
-void ViscositySolver<D>::rebuild() {
+void updateViscousSystem(ViscousSystem<D>* C, const VelocityConstraints<D>& vc, int a, const IVec<D>& lo,
+                         const IVec<D>& hi) {
+  C->cBoundary.densify();
+  C->boundaryRhs.densify();
+  for (int b = 0; b < D; ++b) C->A.w[b].densify();
+  viscousRows<D>(C, vc, a, lo, hi);
+  C->cBoundary.compact();
+  C->boundaryRhs.compact();
+  C->A.finalize();
+}
+
+template <int D>
+void ViscositySolver<D>::rebuild(const IVec<D>& lo, const IVec<D>& hi) {
   for (int a = 0; a < D; ++a) {
+    // The unknowns of the faces of the cells [lo, hi), and one more layer
+    // (their neighbours' rows see them).
     Component& C = comp_[size_t(a)];
-    static_cast<ViscousSystem<D>&>(C) = viscousSystem<D>(vc_, a);
-    C.chebyshev.reset();
-    C.multigrid.reset();
+    IVec<D> ulo, uhi;
+    for (int b = 0; b < D; ++b) {
+      ulo[b] = std::max(lo[b] - 1, 0);
+      uhi[b] = std::min(hi[b] + (b == a ? 2 : 1), C.dims[b]);
+    }
+    // (the solvers refer to C.A, whose coefficients change, not its shape: they refresh at the next solve)
+    updateViscousSystem<D>(&C, vc_, a, ulo, uhi);
   }
   s_ = -1.0;
 }
@@ -267,6 +327,10 @@ void ViscositySolver<D>::load(const StateReader& in) {
 template struct ViscousSystem<2>;
 template struct ViscousSystem<3>;
 template ViscousSystem<2> viscousSystem<2>(const VelocityConstraints<2>&, int);
+template void updateViscousSystem<2>(ViscousSystem<2>*, const VelocityConstraints<2>&, int, const IVec<2>&,
+                                     const IVec<2>&);
+template void updateViscousSystem<3>(ViscousSystem<3>*, const VelocityConstraints<3>&, int, const IVec<3>&,
+                                     const IVec<3>&);
 template ViscousSystem<3> viscousSystem<3>(const VelocityConstraints<3>&, int);
 template class ViscositySolver<2>;
 template class ViscositySolver<3>;

@@ -54,14 +54,18 @@ struct ViscousSystem {
 };
 template <int D>
 ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& constraints, int axis);
+// Its rows of the unknowns [lo, hi) again, from changed constraints.
+template <int D>
+void updateViscousSystem(ViscousSystem<D>* system, const VelocityConstraints<D>& constraints, int axis,
+                         const IVec<D>& lo, const IVec<D>& hi);
 
 template <int D>
 class ViscositySolver {
  public:
   ViscositySolver(const VelocityConstraints<D>& constraints, const SolverOptions& options);
-  // The systems again from the constraints (a moving obstacle changed
-  // them); the warm starts stay.
-  void rebuild();
+  // The systems' rows again where the constraints changed (the faces of the
+  // cells [lo, hi): a moving obstacle); the warm starts stay.
+  void rebuild(const IVec<D>& lo, const IVec<D>& hi);
   // Diffuses u in place; returns the worst of the component solves. Its
   // work vectors come from `pool` (when given) and go back to it.
   SolverResult diffuse(MacVelocity<D>* u, double viscosity, double dt, WorkPool* pool = nullptr);
