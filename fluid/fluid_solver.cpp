@@ -153,7 +153,7 @@ void FluidSolver<D>::placeObstacles(double t, bool fill) {
     lo = IVec<D>(0), hi = cells_;
   }
   projection_->rebuild();
-  viscosity_->rebuild(lo, hi);
+  if (settings_.viscosity > 0) viscosity_->rebuild(lo, hi);  // (an inviscid fluid never solves it)
   cutSurfaceMade_ = false;
   if (!fill) return;
   const Grid<uint8_t, D>& solid = constraints_.solid;

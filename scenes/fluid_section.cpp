@@ -1,6 +1,7 @@
 // [fluid] (viscosity or Reynolds number, advection, pressure solver, forces), [dye] and [probes].
 #include <fmt/format.h>
 
+#include "fluid/obstacle_motion.h"
 #include "scenes/scene_reader.h"
 
 #include <cmath>
@@ -10,7 +11,9 @@ namespace morphoflow {
 namespace {
 
 // The probes' reference scales: the first obstacle's diameter and frontal
-// area with the mean inflow, else the domain's width and the lid's speed.
+// area with the mean inflow, or with its own speed at the start where it
+// moves (a towed body, a paddle's tip), else the domain's width and the
+// lid's speed.
 void setReferenceScales(const SceneContext& c, double lid, Scene& s) {
   const int D = c.D;
   const std::vector<double>& size = c.size;
@@ -18,11 +21,24 @@ void setReferenceScales(const SceneContext& c, double lid, Scene& s) {
   pr.referenceLength = size[0];
   pr.referenceSpeed = lid != 0.0 ? std::abs(lid) : 1.0;
   pr.referenceArea = D == 2 ? size[0] : size[0] * size[2];
-  if (c.inflowSide < 0) return;
-  pr.referenceSpeed = std::abs(s.fluid.boundaries.inflowMeanVelocity);
+  const bool towed = c.inflowSide < 0 && !s.fluid.obstacles.empty() && movesAtAll(s.fluid.obstacles.front()) &&
+                     obstacleSpeedBound(s.fluid.obstacles.front(), D, s.timeline.obstacles.front().start) > 0.0;
+  if (c.inflowSide < 0 && !towed) return;
+  int flow = c.inflowSide / 2;
+  if (towed) {
+    const ObstacleSpec& o = s.fluid.obstacles.front();
+    RigidMotion m;
+    placedAt(o, D, s.timeline.obstacles.front().start, &m);
+    pr.referenceSpeed = obstacleSpeedBound(o, D, s.timeline.obstacles.front().start);
+    flow = 0;  // the axis it moves along most
+    for (int a = 1; a < D; ++a)
+      if (std::abs(m.velocity[size_t(a)]) > std::abs(m.velocity[size_t(flow)])) flow = a;
+  } else {
+    pr.referenceSpeed = std::abs(s.fluid.boundaries.inflowMeanVelocity);
+  }
   if (s.fluid.obstacles.empty()) return;
   const ObstacleSpec& o = s.fluid.obstacles.front();
-  int flow = c.inflowSide / 2, across = flow == 1 ? 0 : 1;
+  int across = flow == 1 ? 0 : 1;
   if (o.shape == ObstacleShape::Box) {
     pr.referenceLength = 2 * o.halfSize[size_t(across)];
     pr.referenceArea = 1.0;

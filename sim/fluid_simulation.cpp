@@ -72,6 +72,17 @@ FluidSimulation<D>::FluidSimulation(const Scene& scene, Backend backend, Warn wa
   for (int a = 0; a < D; ++a)
     for (bool hi : {false, true})
       if (scene.fluid.boundaries.side(a, hi).kind == BoundaryKind::Inflow) flowAxis_ = a;
+  // A towed body (no inflow, the first obstacle moving): the drag opposes its motion at the start.
+  const std::vector<ObstacleSpec>& obstacles = scene.fluid.obstacles;
+  if (flowAxis_ < 0 && !obstacles.empty() && movesAtAll(obstacles.front())) {
+    RigidMotion m;
+    placedAt(obstacles.front(), D, scene.timeline.obstacles.front().start, &m);
+    flowAxis_ = 0;
+    for (int a = 1; a < D; ++a)
+      if (std::abs(m.velocity[size_t(a)]) > std::abs(m.velocity[size_t(flowAxis_)])) flowAxis_ = a;
+    if (m.velocity[size_t(flowAxis_)] > 0.0) dragSign_ = -1.0;
+  }
+  if (flowAxis_ < 0) flowAxis_ = 0;
   liftAxis_ = flowAxis_ == 1 ? 0 : 1;
 }
 
@@ -103,7 +114,7 @@ void FluidSimulation<D>::step(double dt) {
     host_.refresh();
     const auto F = obstacleForce<D>(fluid_);
     forceTime_.push_back(time());
-    drag_.push_back(F[size_t(flowAxis_)] / q);
+    drag_.push_back(dragSign_ * F[size_t(flowAxis_)] / q);
     lift_.push_back(F[size_t(liftAxis_)] / q);
   }
 }

@@ -86,7 +86,8 @@ class FluidSimulation : public Simulation<D> {
   mutable FluidSolver<D> fluid_;
   std::unique_ptr<FluidStepper<D>> stepper_;
   HostCopy host_;
-  int flowAxis_ = 0, liftAxis_ = 1;
+  int flowAxis_ = -1, liftAxis_ = 1;  // (the inflow's axis, or a towed body's)
+  double dragSign_ = 1.0;             // -1: a body towed along +axis, whose drag points back
   // Statistics over the run, and the force probe's signal.
   std::array<double, FluidStepStats::kStages> stageTotals_{};
   long pressureIterations_ = 0, viscosityIterations_ = 0;
