@@ -128,7 +128,12 @@ void FluidSolver<D>::placeObstacles(double t, bool fill) {
   std::vector<ObstacleSpec> placed = obstaclesAt(t, &motions);
   IVec<D> lo = cells_, hi(0);
   if (movingCells(placed_, &lo, &hi) && movingCells(placed, &lo, &hi)) {
-    for (int a = 0; a < D; ++a) hi[a] = std::max(hi[a], lo[a]);  // (none inside the domain: no cells)
+    bool none = false;  // no moving obstacle inside the domain, then or now: nothing changes
+    for (int a = 0; a < D; ++a) none = none || hi[a] <= lo[a];
+    if (none) {
+      placed_ = std::move(placed);
+      return;
+    }
     Grid<uint8_t, D> solid = constraints_.solid;
     std::vector<ObstacleSpec> voxel;
     for (const ObstacleSpec& o : placed)

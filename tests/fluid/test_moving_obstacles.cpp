@@ -62,6 +62,14 @@ double couetteError(int n) {
 
 }  // namespace
 
+TEST(MovingObstacles, ATowedSphereFeelsTheDragOfAFixedOneInAStream) {
+  const ForceSeries towed = towedBody<3>(true, 40.0, 6, 0.6, 16, 6);
+  const ForceSeries fixed = towedBody<3>(false, 40.0, 6, 0.6, 16, 6);
+  const double a = meanOver(towed, towed.drag, 0.3, 0.6), b = meanOver(fixed, fixed.drag, 0.3, 0.6);
+  std::printf("mean drag coefficient over t in [0.3, 0.6]: towed %.4f, fixed %.4f\n", a, b);
+  EXPECT_NEAR(a, b, 0.02 * b);
+}
+
 TEST(MovingObstacles, TheCutNoSlipOfAMovingWallIsSecondOrder) {
   const double e16 = couetteError(16), e32 = couetteError(32), e64 = couetteError(64);
   std::printf("errors %.3e %.3e %.3e\n", e16, e32, e64);
@@ -184,4 +192,32 @@ TEST(MovingObstacles, AVoxelObstacleMovesItsStaircase) {
   // The ball pushes the fluid ahead of it.
   const double ahead[2] = {0.5 + 0.5 * 0.4 + 0.1 + 0.03, 0.5};
   EXPECT_GT(f.velocity().sample(Vec<2>(ahead[0], ahead[1]))[0], 0.2);
+}
+
+TEST(MovingObstacles, AnObstacleComesInAndGoesOut) {
+  FluidSettings s;
+  s.resolution = {48, 24};
+  s.size = {2.0, 1.0};
+  s.viscosity = 1e-3;
+  ObstacleSpec ball;
+  ball.shape = ObstacleShape::Circle;
+  ball.radius = 0.15;
+  ball.motion = {"-0.4 + 2.8 * t", "0.5"};  // from wholly left of the box to wholly right of it
+  s.obstacles = {ball};
+  FluidSolver<2> f(s);
+  auto solidCells = [&] {
+    size_t n = 0;
+    for (uint8_t v : f.solid().values()) n += v;
+    return n;
+  };
+  EXPECT_EQ(solidCells(), 0u);
+  size_t most = 0;
+  for (int k = 0; k < 100; ++k) {
+    f.step(0.01);
+    most = std::max(most, solidCells());
+    ASSERT_TRUE(std::isfinite(f.maxSpeed()));
+  }
+  EXPECT_GT(most, 30u);  // (pi 0.15^2 / h^2: 41 cells)
+  EXPECT_EQ(solidCells(), 0u);
+  EXPECT_GT(f.maxSpeed(), 0.1);  // it stirred the fluid on its way
 }

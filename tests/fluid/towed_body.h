@@ -19,12 +19,14 @@ struct ForceSeries {
   std::vector<double> t, drag, lift;  // coefficients F / (rho U^2 D / 2), per unit span in 2D
 };
 
-// cellsPerD: the body's diameter in cells; the channel is 40 D long and 10 D wide (and deep).
+// cellsPerD: the body's diameter in cells; the channel is `lengthD` D long
+// and `widthD` D wide (and deep).
 template <int D>
-ForceSeries towedBody(bool towed, double reynolds, int cellsPerD, double duration, double cfl = 0.5) {
-  const double diameter = 0.1, U = 1.0, length = 4.0, width = 1.0;
+ForceSeries towedBody(bool towed, double reynolds, int cellsPerD, double duration, double lengthD = 40,
+                      double widthD = 10, double cfl = 0.5) {
+  const double diameter = 0.1, U = 1.0, length = lengthD * diameter, width = widthD * diameter;
   FluidSettings s;
-  const int nx = int(std::lround(length / diameter * cellsPerD)), ny = int(std::lround(width / diameter * cellsPerD));
+  const int nx = int(std::lround(lengthD * cellsPerD)), ny = int(std::lround(widthD * cellsPerD));
   s.resolution = D == 2 ? std::vector<int>{nx, ny} : std::vector<int>{nx, ny, ny};
   s.size = D == 2 ? std::vector<double>{length, width} : std::vector<double>{length, width, width};
   s.viscosity = U * diameter / reynolds;

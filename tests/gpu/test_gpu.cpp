@@ -125,7 +125,9 @@ TEST(Gpu, AStageWithNoGpuProgramIsRefusedNamingIt) {
         std::pair{sceneFile("coupled/cavity_gray_scott.toml") +
                       " --set 'rd.model=\"brusselator-coupled\"' --set 'rd.diffusion=[1,1,1,1]' --set "
                       "'rd.parameters={}' --set 'rd.initial={}' --set 'output.field=\"a1\"'",
-                  std::string("the chemicals' advection for a model of 4 species")}}) {
+                  std::string("the chemicals' advection for a model of 4 species")},
+        std::pair{sceneFile("flow/towed_cylinder.toml"), std::string("moving obstacles")},
+        std::pair{sceneFile("vfx/paddle_gray_scott.toml"), std::string("moving obstacles")}}) {
     CommandResult r = runMorphoflow("run " + args + " --backend gpu --quiet" + out);
     EXPECT_EQ(r.status, 2) << args << "\n" << r.output;
     EXPECT_NE(r.output.find("the gpu backend has no program yet for " + stage), std::string::npos) << args << "\n"
