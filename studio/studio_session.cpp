@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "core/parallel.h"
+#include "fluid/obstacle_motion.h"
 #include "gpu/gl_context.h"
 #include "run/memory_estimate.h"
 #include "run/run_clock.h"
@@ -282,7 +283,8 @@ nlohmann::json StudioSession::state() const {
   j["keys"] = keys;
   nlohmann::json elements = nlohmann::json::array();
   for (size_t q = 0; q < s.fluid.obstacles.size(); ++q) {
-    nlohmann::json e = region(s.fluid.obstacles[q], s.dimension);
+    // (a moving obstacle where it is now)
+    nlohmann::json e = region(placedAt(s.fluid.obstacles[q], s.dimension, time_, nullptr), s.dimension);
     e["target"] = fmt::format("obstacles.{}", q);
     e["active"] = q < s.timeline.obstacles.size() ? s.timeline.obstacles[q].contains(time_) : true;
     elements.push_back(e);

@@ -137,6 +137,14 @@ INSTANTIATE_TEST_SUITE_P(
                         kCheckpointOften)},
         ResumeCase{"fluid_probes", "flow_past_obstacle.toml",
                    with({"grid.resolution=[220,41]", "time.duration=4", "output.every=40"}, kCheckpointOften)},
+        // a moving obstacle: the constraints rebuilt where the checkpoint's time puts it
+        ResumeCase{"moving_obstacle", "vfx/paddle_gray_scott.toml",
+                   with({"grid.resolution=[48,48]", "rd.resolution=[64,64]", "time.steps=3000", "output.every=100",
+                         "output.video=false"},
+                        kCheckpointOften)},
+        ResumeCase{"towed_cylinder", "flow/towed_cylinder.toml",
+                   with({"grid.resolution=[160,40]", "time.duration=6", "output.every=40", "output.video=false"},
+                        kCheckpointOften)},
         // stops at steady state (time.until_steady): at the same step
         ResumeCase{"fluid_until_steady", "lid_driven_cavity.toml",
                    with({"grid.resolution=[96,96]", "time.until_steady=1e-5", "output.every=50", "output.images=false"},
