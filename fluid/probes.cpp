@@ -114,6 +114,27 @@ StrouhalEstimate estimateStrouhal(const std::vector<double>& t, const std::vecto
   return e;
 }
 
+std::vector<double> windowMean(const std::vector<double>& t, const std::vector<double>& y, double window) {
+  // Sample j stands for its step (t[j-1], t[j]]: the mean is the integral of
+  // that step function over [t - window / 2, t + window / 2] (cut at the
+  // series' ends), over the window's length there.
+  const size_t n = std::min(t.size(), y.size());
+  std::vector<double> out(n);
+  auto stepStart = [&](size_t j) { return j > 0 ? t[j - 1] : (n > 1 ? 2 * t[0] - t[1] : t[0]); };
+  size_t first = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const double a = t[i] - 0.5 * window, b = t[i] + 0.5 * window;
+    while (first < n && t[first] <= a) ++first;
+    double sum = 0.0, length = 0.0;
+    for (size_t j = first; j < n && stepStart(j) < b; ++j) {
+      const double overlap = std::min(b, t[j]) - std::max(a, stepStart(j));
+      if (overlap > 0) sum += overlap * y[j], length += overlap;
+    }
+    out[i] = length > 0 ? sum / length : y[i];
+  }
+  return out;
+}
+
 template <int D>
 Grid<float, D> speedField(const FluidSolver<D>& f) {
   Grid<float, D> s(f.cells(), 0.0f);

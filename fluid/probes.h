@@ -41,6 +41,12 @@ struct StrouhalEstimate {
 StrouhalEstimate estimateStrouhal(const std::vector<double>& time, const std::vector<double>& signal,
                                   double tStart, double length, double speed);
 
+// The signal's mean over the window of the given time centred on each
+// sample. A moving body's force flickers at the rate it crosses cells (its
+// cut fractions change step by step); a window of the time it takes to
+// cross one cell (h / speed) leaves the flow's own frequencies.
+std::vector<double> windowMean(const std::vector<double>& time, const std::vector<double>& signal, double window);
+
 // Cell-centred speed |u| and vorticity (2D: the scalar curl; 3D: |curl u|).
 template <int D>
 Grid<float, D> speedField(const FluidSolver<D>& fluid);

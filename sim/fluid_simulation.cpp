@@ -187,7 +187,10 @@ void FluidSimulation<D>::report(nlohmann::json* j) const {
   const ProbeSettings& pr = scene_.probes;
   if (!pr.forces) return;
   const double start = pr.strouhalStart >= 0 ? pr.strouhalStart : 0.5 * time();
-  const StrouhalEstimate st = estimateStrouhal(forceTime_, lift_, start, pr.referenceLength, pr.referenceSpeed);
+  // A moving body's lift, over the time it takes to cross a cell (fluid/probes.h).
+  const std::vector<double> lift =
+      fluid_.movesObstacles() ? windowMean(forceTime_, lift_, fluid_.h() / pr.referenceSpeed) : lift_;
+  const StrouhalEstimate st = estimateStrouhal(forceTime_, lift, start, pr.referenceLength, pr.referenceSpeed);
   double cdMean = 0, clMean = 0;
   int n = 0;
   for (size_t i = 0; i < drag_.size(); ++i)

@@ -221,3 +221,19 @@ TEST(MovingObstacles, AnObstacleComesInAndGoesOut) {
   EXPECT_EQ(solidCells(), 0u);
   EXPECT_GT(f.maxSpeed(), 0.1);  // it stirred the fluid on its way
 }
+
+TEST(MovingObstacles, TheWindowMeanTakesOutAStepToStepFlickerAndKeepsTheShedding) {
+  std::vector<double> t, y;
+  for (int i = 0; i < 2000; ++i) {
+    t.push_back(0.005 * i);
+    y.push_back(std::sin(2 * M_PI * 0.3 * t.back()) + (i % 2 ? 0.2 : -0.2));  // a 0.3 Hz swing, flickering
+  }
+  const std::vector<double> m = windowMean(t, y, 0.01);
+  double worst = 0.0;  // against the swing at the window's centre
+  for (size_t i = 10; i + 10 < t.size(); ++i)
+    worst = std::max(worst, std::abs(m[i] - std::sin(2 * M_PI * 0.3 * (t[i] + 0.0025))));
+  EXPECT_LT(worst, 1e-3);
+  const StrouhalEstimate raw = estimateStrouhal(t, y, 0.0, 1.0, 1.0), clean = estimateStrouhal(t, m, 0.0, 1.0, 1.0);
+  EXPECT_GT(raw.strouhal, 1.0);  // the flicker's crossings
+  EXPECT_NEAR(clean.strouhal, 0.3, 0.01);
+}

@@ -72,11 +72,13 @@ inline double meanOver(const ForceSeries& s, const std::vector<double>& v, doubl
     if (s.t[i] >= from && s.t[i] <= to) sum += v[i] * (s.t[i] - s.t[i - 1]), w += s.t[i] - s.t[i - 1];
   return w > 0 ? sum / w : 0.0;
 }
-// Half the peak-to-peak swing of v over t in [from, to].
-inline double amplitudeOver(const ForceSeries& s, const std::vector<double>& v, double from, double to) {
+// Half the peak-to-peak swing of v over t in [from, to], v first averaged
+// over `window` (the time the body crosses a cell: fluid/probes.h).
+inline double amplitudeOver(const ForceSeries& s, const std::vector<double>& v, double from, double to, double window) {
+  const std::vector<double> m = windowMean(s.t, v, window);
   double lo = 1e300, hi = -1e300;
   for (size_t i = 0; i < s.t.size(); ++i)
-    if (s.t[i] >= from && s.t[i] <= to) lo = std::min(lo, v[i]), hi = std::max(hi, v[i]);
+    if (s.t[i] >= from && s.t[i] <= to) lo = std::min(lo, m[i]), hi = std::max(hi, m[i]);
   return 0.5 * (hi - lo);
 }
 
