@@ -288,7 +288,8 @@ void warnOfEmptySources(const Scene& scene, const FluidSolver<D>& fluid,
                         const std::function<void(const std::string&)>& warn) {
   const std::vector<ObstacleSpec>& obstacles = scene.fluid.obstacles;
   for (size_t q = 0; q < obstacles.size() && warn; ++q)
-    if (!meetsGrid<D>(obstacles[q], fluid.cells(), fluid.h()))
+    if (!movesAtAll(obstacles[q]) &&
+        !meetsGrid<D>(obstacles[q], fluid.cells(), fluid.h()))  // (a moving one may come in)
       warn(fmt::format("warning: obstacles.{} meets no cell centre or face of the grid (it lies between the faces of "
                        "one cell): the flow does not see it, and its drag and lift are 0; make it larger than a cell "
                        "or refine grid.resolution",
