@@ -198,11 +198,43 @@ Grid<uint8_t, 3> occupiedBlocks(const Grid<float, 3>& rho) {
 struct Pixel {
   Rgb c{0, 0, 0};
   double transmittance = 1.0;
+  bool solid = false;  // the ray ended on an obstacle
 };
+
+// The obstacles' grid seen from the density's cell coordinates.
+struct SolidView {
+  const Grid<float, 3>* g = nullptr;
+  V3 scale{1, 1, 1};
+  double at(const V3& p) const { return sampleCells(*g, V3{p[0] * scale[0], p[1] * scale[1], p[2] * scale[2]}); }
+  // The outward normal: down the solid's gradient.
+  V3 normal(const V3& p) const {
+    V3 grad{0, 0, 0};
+    for (int a = 0; a < 3; ++a) {
+      V3 hi = p, lo = p;
+      hi[size_t(a)] += 1.0 / scale[size_t(a)];
+      lo[size_t(a)] -= 1.0 / scale[size_t(a)];
+      grad[size_t(a)] = at(lo) - at(hi);
+    }
+    const double len = std::sqrt(grad[0] * grad[0] + grad[1] * grad[1] + grad[2] * grad[2]);
+    return len > 0 ? scale3(grad, 1.0 / len) : V3{0, 1, 0};
+  }
+  static V3 scale3(const V3& v, double s) { return V3{v[0] * s, v[1] * s, v[2] * s}; }
+};
+
+// An obstacle's surface at p (normal n): grey, lit by the key and the sky.
+Rgb solidRadiance(const V3& n, const V3& toKey) {
+  const double key = std::max(0.0, n[0] * toKey[0] + n[1] * toKey[1] + n[2] * toKey[2]);
+  const double sky = 0.5 + 0.5 * n[1];
+  Rgb c;
+  for (int k = 0; k < 3; ++k)
+    c[size_t(k)] = kObstacleAlbedo * (kKeyLight[size_t(k)] * key + 4.0 * kSkyLight[size_t(k)] * sky);
+  return c;
+}
 
 // Emission-absorption along the ray of the precomputed radiance, samples at
 // t0 + (j + 1/2) ds; empty blocks are skipped without moving the samples.
-Pixel march(const Grid<Radiance, 3>& f, const Grid<uint8_t, 3>& occupied, double kappa, const V3& eye, const V3& d) {
+Pixel march(const Grid<Radiance, 3>& f, const Grid<uint8_t, 3>& occupied, double kappa, const V3& eye, const V3& d,
+            const SolidView& solid, const V3& toKey) {
   Pixel px;
   double t0, t1;
   if (!clipToBox(eye, d, f.dims(), &t0, &t1)) return px;
@@ -223,6 +255,18 @@ Pixel march(const Grid<Radiance, 3>& f, const Grid<uint8_t, 3>& occupied, double
       }
       j = std::max(j, long(std::ceil((exit - t0) / ds - 0.5)) - 1);
       continue;
+    }
+    if (solid.g && solid.at(p) >= 0.5) {  // an obstacle: its surface, found by bisection since the last sample
+      double lo = t - ds, hi = t;
+      for (int it = 0; it < 12; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (solid.at(add(eye, scale(d, mid))) >= 0.5 ? hi : lo) = mid;
+      }
+      const Rgb c = solidRadiance(solid.normal(add(eye, scale(d, hi))), toKey);
+      for (int k = 0; k < 3; ++k) px.c[size_t(k)] += px.transmittance * c[size_t(k)];
+      px.transmittance = 0.0;
+      px.solid = true;
+      break;
     }
     const Radiance s = sampleRadiance(f, p);
     if (s.rho <= 0) continue;
@@ -266,17 +310,30 @@ LitImage renderLitVolume(const LitVolume& v, int size) {
   img.size = size;
   img.extinction = extinctionScale(rho);
   const Grid<Radiance, 3> f = radiance(v, img.extinction, toKey);
-  const Grid<uint8_t, 3> occupied = occupiedBlocks(rho);
+  Grid<uint8_t, 3> occupied = occupiedBlocks(rho);
+  SolidView solid;
+  if (v.solid) {  // the blocks that hold an obstacle are marched too
+    solid.g = v.solid;
+    for (int a = 0; a < 3; ++a) solid.scale[size_t(a)] = double(v.solid->dim(a)) / rho.dim(a);
+    Grid<float, 3> held(rho.dims(), 0.0f);
+    for (size_t i = 0; i < held.size(); ++i) {
+      const IVec<3> x = held.coord(i);
+      held[i] = at(*v.solid, rho.dims(), x, i) > 0.0f ? 1.0f : 0.0f;
+    }
+    const Grid<uint8_t, 3> more = occupiedBlocks(held);
+    for (size_t i = 0; i < occupied.size(); ++i) occupied[i] = occupied[i] || more[i];
+  }
   std::vector<Pixel> px(size_t(size) * size_t(size));
   parallelFor(size_t(size), [&](size_t py) {
     for (int x = 0; x < size; ++x)
-      px[py * size_t(size) + size_t(x)] = march(f, occupied, img.extinction, cam.eye, cam.ray(x, int(py), size));
+      px[py * size_t(size) + size_t(x)] =
+          march(f, occupied, img.extinction, cam.eye, cam.ray(x, int(py), size), solid, toKey);
   });
   // The exposure, from the plume's own radiance (its pixels' colour over
-  // their opacity, where that is at least a tenth).
+  // their opacity, where that is at least a tenth; not an obstacle's).
   std::vector<double> seen;
   for (const Pixel& p : px)
-    if (1.0 - p.transmittance >= 0.1) seen.push_back(luminance(p.c) / (1.0 - p.transmittance));
+    if (!p.solid && 1.0 - p.transmittance >= 0.1) seen.push_back(luminance(p.c) / (1.0 - p.transmittance));
   const double m = quantile(seen, 0.5), high = quantile(seen, 0.95);
   img.exposure = m > 0 ? std::min(kMiddle / m, kHigh / high) : 1.0;
   img.rgb.resize(px.size() * 3);

@@ -37,7 +37,14 @@ struct LitVolume {
   const Grid<float, 3>* temperature = nullptr;
   double ambientTemperature = 0.0;
   double emission = 0.0;
+  // The obstacles (1 inside, 0 in the fluid; none: no obstacle): drawn as
+  // an opaque grey surface, lit by the key and the sky, that hides what lies
+  // behind it. The exposure is the smoke's alone.
+  const Grid<float, 3>* solid = nullptr;
 };
+
+// The obstacles' grey (linear albedo).
+inline constexpr double kObstacleAlbedo = 0.15;
 
 // The temperature (scene units above the ambient) to kelvin, as the Blender
 // set-up maps it too (app's `blender` command).

@@ -61,6 +61,11 @@ std::vector<uint8_t> litPreview(const Simulation<3>& sim, const Grid<float, 3>& 
   v.density = &density;
   v.shown = &shown;
   v.options = io;
+  Grid<float, 3> solid;
+  if (!scene.fluid.obstacles.empty()) {
+    solid = sim.field(fields::kObstacle).front();
+    v.solid = &solid;
+  }
   if (scene.output.emission > 0) {
     temperature = sim.field(fields::kTemperature).front();
     v.temperature = &temperature;

@@ -173,3 +173,57 @@ TEST(Legibility, MeasuresAFlatDiscAndAStripedOne) {
     }
   }
 }
+
+// An obstacle is an opaque grey surface in front of the smoke: it hides the
+// ball behind it, its side toward the key is brighter, and the exposure is
+// the smoke's alone.
+TEST(LitVolume, AnObstacleIsAnOpaqueGreySurfaceThatHidesTheSmoke) {
+  const int n = 48, size = 128;
+  const Grid<float, 3> rho = ball(n, 14.0);
+  // A solid ball of radius 6 cells between the smoke and the camera, on a grid half as fine.
+  const VolumeCamera cam(rho.dims());
+  const V3 centre = add(V3{0.5 * n, 0.5 * n, 0.5 * n}, scale(cam.towardEye, 19.0));
+  Grid<float, 3> solid(IVec<3>{n / 2, n / 2, n / 2}, 0.0f);
+  for (size_t i = 0; i < solid.size(); ++i) {
+    const IVec<3> x = solid.coord(i);
+    double d2 = 0;
+    for (int a = 0; a < 3; ++a) d2 += std::pow(2.0 * (x[a] + 0.5) - centre[size_t(a)], 2);
+    solid[i] = d2 < 36.0 ? 1.0f : 0.0f;
+  }
+  LitVolume plain;
+  plain.density = &rho;
+  LitVolume with = plain;
+  with.solid = &solid;
+  const LitImage a = renderLitVolume(plain, size), b = renderLitVolume(with, size);
+  double x, y;
+  ASSERT_TRUE(cam.project(centre, size, &x, &y));
+  const size_t i = size_t(std::lround(y)) * size_t(size) + size_t(std::lround(x));
+  EXPECT_EQ(b.opacity[i], 1.0f);
+  // Grey: the key's warmth only, unlike the smoke's colour there before.
+  EXPECT_NEAR(double(b.rgb[3 * i]), double(b.rgb[3 * i + 2]), 40.0);
+  EXPECT_NE(a.rgb[3 * i], b.rgb[3 * i]);
+  // Its side toward the key light is the brighter.
+  const std::array<double, 3> key = keyLightDirection();
+  double lit = 0, dark = 0;
+  for (const double sign : {1.0, -1.0}) {
+    const V3 p = add(centre, scale(unit(add(scale(key, sign), scale(cam.towardEye, 1.5))), 5.5));
+    ASSERT_TRUE(cam.project(p, size, &x, &y));
+    (sign > 0 ? lit : dark) = luminance(b, size_t(std::lround(y)) * size_t(size) + size_t(std::lround(x)));
+  }
+  EXPECT_GT(lit, 1.3 * dark) << lit << " " << dark;
+  // An obstacle that hides no smoke (above the ball in the picture) leaves the smoke's exposure as it was.
+  const V3 above = add(V3{0.5 * n, 0.5 * n, 0.5 * n}, add(scale(cam.up, 20.0), scale(cam.towardEye, 8.0)));
+  Grid<float, 3> aside(solid.dims(), 0.0f);
+  for (size_t k = 0; k < aside.size(); ++k) {
+    const IVec<3> x = aside.coord(k);
+    double d2 = 0;
+    for (int a2 = 0; a2 < 3; ++a2) d2 += std::pow(2.0 * (x[a2] + 0.5) - above[size_t(a2)], 2);
+    aside[k] = d2 < 16.0 ? 1.0f : 0.0f;
+  }
+  with.solid = &aside;
+  const LitImage c = renderLitVolume(with, size);
+  EXPECT_EQ(a.exposure, c.exposure);
+  int grey = 0;
+  for (size_t k = 0; k < c.opacity.size(); ++k) grey += c.opacity[k] == 1.0f && a.opacity[k] < 0.5f;
+  EXPECT_GT(grey, 10) << "the obstacle aside is drawn";
+}
