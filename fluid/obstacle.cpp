@@ -79,6 +79,23 @@ Grid<uint8_t, D> solidMask(const std::vector<ObstacleSpec>& obstacles, const IVe
   return mask;
 }
 
+template <int D>
+Grid<float, D> solidOccupancy(const std::vector<ObstacleSpec>& obstacles, const IVec<D>& cells, double h) {
+  Grid<float, D> occupancy(cells, 0.0f);
+  double size[3] = {0, 0, 0};
+  for (int a = 0; a < D; ++a) size[a] = cells[a] * h;
+  forEachCell<D>(cells, [&](const IVec<D>& c, size_t i) {
+    double x[3] = {0, 0, 0};
+    for (int a = 0; a < D; ++a) x[a] = (c[a] + 0.5) * h;
+    double d = 1e300;
+    for (const ObstacleSpec& o : obstacles) d = std::min(d, obstacleDistance(o, x, D, size));
+    occupancy[i] = float(std::clamp(0.5 - d / h, 0.0, 1.0));
+  });
+  return occupancy;
+}
+
+template Grid<float, 2> solidOccupancy<2>(const std::vector<ObstacleSpec>&, const IVec<2>&, double);
+template Grid<float, 3> solidOccupancy<3>(const std::vector<ObstacleSpec>&, const IVec<3>&, double);
 template Grid<uint8_t, 2> solidMask<2>(const std::vector<ObstacleSpec>&, const IVec<2>&, double);
 template Grid<uint8_t, 3> solidMask<3>(const std::vector<ObstacleSpec>&, const IVec<3>&, double);
 

@@ -50,4 +50,10 @@ double obstacleDistance(const ObstacleSpec& spec, const double* x, int dims, con
 template <int D>
 Grid<uint8_t, D> solidMask(const std::vector<ObstacleSpec>& obstacles, const IVec<D>& cells, double h);
 
+// How much of each cell the obstacles hold, from their distance d at its
+// centre: clamp(1/2 - d / h, 0, 1), whose half level is their surface (a
+// smooth picture of them; solidMask() is what the fluid sees).
+template <int D>
+Grid<float, D> solidOccupancy(const std::vector<ObstacleSpec>& obstacles, const IVec<D>& cells, double h);
+
 }  // namespace morphoflow

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "core/output_file.h"
+#include "fluid/obstacle_motion.h"
 #include "render/field_dump.h"
 #include "render/field_image.h"
 #include "render/image_io.h"
@@ -62,8 +63,16 @@ std::vector<uint8_t> litPreview(const Simulation<3>& sim, const Grid<float, 3>& 
   v.shown = &shown;
   v.options = io;
   Grid<float, 3> solid;
-  if (!scene.fluid.obstacles.empty()) {
-    solid = sim.field(fields::kObstacle).front();
+  if (!scene.fluid.obstacles.empty()) {  // where they are now, their own smooth surface
+    const FluidSettings& f = scene.fluid;
+    std::vector<ObstacleSpec> placed;
+    for (size_t q = 0; q < f.obstacles.size(); ++q) {
+      if (q < scene.timeline.obstacles.size() && !scene.timeline.obstacles[q].contains(sim.time())) continue;
+      placed.push_back(placedAt(f.obstacles[q], 3, sim.time(), nullptr));
+      for (int a = 0; a < 3; ++a) placed.back().wrap[size_t(a)] = f.boundaries.periodic(a);
+    }
+    const IVec<3> cells{f.resolution[0], f.resolution[1], f.resolution[2]};
+    solid = solidOccupancy<3>(placed, cells, f.size[0] / f.resolution[0]);
     v.solid = &solid;
   }
   if (scene.output.emission > 0) {
