@@ -109,15 +109,54 @@ bool FluidSolver<D>::movingCells(const std::vector<ObstacleSpec>& placed, IVec<D
   return true;
 }
 
+// The constraints with the moving obstacles at `placed`, recomputed in the
+// cells that held or hold one ([lo, hi), set; the whole grid when one has
+// no bounds). False when none is in the domain, then or now: nothing changed.
+template <int D>
+bool FluidSolver<D>::moveConstraints(std::vector<ObstacleSpec> placed, const std::vector<RigidMotion>& motions,
+                                     IVec<D>* lo, IVec<D>* hi) {
+  *lo = cells_, *hi = IVec<D>(0);
+  if (!movingCells(placed_, lo, hi) || !movingCells(placed, lo, hi)) {
+    constraints_ = constraintsAt(placedAt_);  // (which places them itself)
+    *lo = IVec<D>(0), *hi = cells_;
+    return true;
+  }
+  for (int a = 0; a < D; ++a)
+    if ((*hi)[a] <= (*lo)[a]) {
+      placed_ = std::move(placed);
+      return false;
+    }
+  Grid<uint8_t, D> solid = constraints_.solid;
+  std::vector<ObstacleSpec> voxel;
+  for (const ObstacleSpec& o : placed)
+    if (o.boundary == ObstacleBoundary::Voxel) voxel.push_back(o);
+  double size[3] = {0, 0, 0};
+  for (int a = 0; a < D; ++a) size[a] = cells_[a] * h_;
+  forEachCell<D>(*hi - *lo, [&](const IVec<D>& r, size_t) {
+    const IVec<D> k = *lo + r;
+    double x[3] = {0, 0, 0};
+    for (int a = 0; a < D; ++a) x[a] = (k[a] + 0.5) * h_;
+    auto inside = [&](const std::vector<ObstacleSpec>& list) {
+      return std::any_of(list.begin(), list.end(),
+                         [&](const ObstacleSpec& o) { return obstacleDistance(o, x, D, size) < 0.0; });
+    };
+    solid(k) = inside(placed) ? 1 : 0;
+    voxel_(k) = inside(voxel) ? 1 : 0;
+  });
+  constraints_.move(solid, voxel_, CutSurface(placed, D, size), CutSurface(placed, D, size, motions, true), *lo, *hi);
+  placed_ = std::move(placed);
+  return true;
+}
+
 // Moving obstacles (fluid/obstacle_motion.h): the constraints, pressure
-// and viscous systems at time t, recomputed in the cells that held or
-// hold a moving obstacle. With `fill`, the cells and faces the solid
-// uncovers take the mean of their fluid neighbours (repeated outward).
-// Those it covers keep their smoke and temperature, which the solid's
-// velocity then carries with it: the fluid pushed ahead of the solid traces
-// back into them and takes them along, so that nothing is lost at a moving
-// wall (a closed box stirred by a paddle keeps its dye to 0.2% a turn:
-// tests/fluid/test_moving_obstacles.cpp). Their faces take the solid's velocity.
+// and viscous systems at time t. With `fill`, the cells and faces the
+// solid uncovers take the mean of their fluid neighbours (repeated
+// outward). Those it covers keep their smoke and temperature, which the
+// solid's velocity then carries with it: the fluid pushed ahead of the
+// solid traces back into them and takes them along, so that nothing is
+// lost at a moving wall (a closed box stirred by a paddle keeps its dye to
+// 0.2% a turn: tests/fluid/test_moving_obstacles.cpp). Their faces take the
+// solid's velocity.
 template <int D>
 void FluidSolver<D>::placeObstacles(double t, bool fill) {
   if (!moves_) return;
@@ -126,37 +165,8 @@ void FluidSolver<D>::placeObstacles(double t, bool fill) {
   const std::array<Grid<uint8_t, D>, D> wasFixed = constraints_.fixed;
   std::vector<RigidMotion> motions;
   std::vector<ObstacleSpec> placed = obstaclesAt(t, &motions);
-  IVec<D> lo = cells_, hi(0);
-  if (movingCells(placed_, &lo, &hi) && movingCells(placed, &lo, &hi)) {
-    bool none = false;  // no moving obstacle inside the domain, then or now: nothing changes
-    for (int a = 0; a < D; ++a) none = none || hi[a] <= lo[a];
-    if (none) {
-      placed_ = std::move(placed);
-      return;
-    }
-    Grid<uint8_t, D> solid = constraints_.solid;
-    std::vector<ObstacleSpec> voxel;
-    for (const ObstacleSpec& o : placed)
-      if (o.boundary == ObstacleBoundary::Voxel) voxel.push_back(o);
-    double size[3] = {0, 0, 0};
-    for (int a = 0; a < D; ++a) size[a] = cells_[a] * h_;
-    forEachCell<D>(hi - lo, [&](const IVec<D>& r, size_t) {
-      const IVec<D> k = lo + r;
-      double x[3] = {0, 0, 0};
-      for (int a = 0; a < D; ++a) x[a] = (k[a] + 0.5) * h_;
-      auto inside = [&](const std::vector<ObstacleSpec>& list) {
-        return std::any_of(list.begin(), list.end(),
-                           [&](const ObstacleSpec& o) { return obstacleDistance(o, x, D, size) < 0.0; });
-      };
-      solid(k) = inside(placed) ? 1 : 0;
-      voxel_(k) = inside(voxel) ? 1 : 0;
-    });
-    constraints_.move(solid, voxel_, CutSurface(placed, D, size), CutSurface(placed, D, size, motions, true), lo, hi);
-    placed_ = std::move(placed);
-  } else {
-    constraints_ = constraintsAt(t);
-    lo = IVec<D>(0), hi = cells_;
-  }
+  IVec<D> lo, hi;
+  if (!moveConstraints(std::move(placed), motions, &lo, &hi)) return;
   projection_->rebuild();
   if (settings_.viscosity > 0) viscosity_->rebuild(lo, hi);  // (an inviscid fluid never solves it)
   cutSurfaceMade_ = false;

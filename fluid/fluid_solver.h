@@ -93,6 +93,8 @@ class FluidSolver {
   std::vector<ObstacleSpec> obstaclesAt(double t, std::vector<RigidMotion>* motions) const;
   VelocityConstraints<D> constraintsAt(double t);
   bool movingCells(const std::vector<ObstacleSpec>& placed, IVec<D>* lo, IVec<D>* hi) const;
+  bool moveConstraints(std::vector<ObstacleSpec> placed, const std::vector<RigidMotion>& motions, IVec<D>* lo,
+                       IVec<D>* hi);
   void placeObstacles(double t, bool fill);
   void injectInflowDye();
   void advectScalar(Grid<float, D>* field, double dt, const std::optional<std::array<int, D>>& reach);
