@@ -3,24 +3,29 @@
 // lift of the same cylinder fixed in a uniform stream (tests/fluid/
 // towed_body.h), at Re 40 (steady wake) and Re 100 (shedding), and a
 // sphere the same way in 3D: the mean drag within 2% (Re 100 in 2D: 3.5%),
-// the lift's swing within 5%.
+// the lift's swing within 5%. By default Re 40 alone, with 16 cells across
+// the cylinder; MORPHOFLOW_FULL_VALIDATION=1 runs all three at full size
+// (20 cells across the cylinder, 10 across the sphere; about 20 minutes).
 #include <gtest/gtest.h>
 
 #include <cstdio>
 
 #include "tests/fluid/towed_body.h"
+#include "tests/test_support.h"
 
 using namespace morphoflow;
 using namespace morphoflow::testing;
 
 TEST(MovingValidation, TowedCylinderAtRe40) {
-  const ForceSeries towed = towedBody<2>(true, 40.0, 20, 3.0), fixed = towedBody<2>(false, 40.0, 20, 3.0);
+  const int cells = fullValidation() ? 20 : 16;
+  const ForceSeries towed = towedBody<2>(true, 40.0, cells, 3.0), fixed = towedBody<2>(false, 40.0, cells, 3.0);
   const double a = meanOver(towed, towed.drag, 2.0, 3.0), b = meanOver(fixed, fixed.drag, 2.0, 3.0);
   std::printf("Re 40, mean drag coefficient over t in [2, 3]: towed %.4f, fixed %.4f\n", a, b);
   EXPECT_NEAR(a, b, 0.02 * b);
 }
 
 TEST(MovingValidation, TowedCylinderAtRe100) {
+  if (!fullValidation()) GTEST_SKIP() << "MORPHOFLOW_FULL_VALIDATION=1 runs it (about 10 minutes)";
   const ForceSeries towed = towedBody<2>(true, 100.0, 20, 8.0), fixed = towedBody<2>(false, 100.0, 20, 8.0);
   const double a = meanOver(towed, towed.drag, 5.0, 8.0), b = meanOver(fixed, fixed.drag, 5.0, 8.0);
   const double cell = 0.1 / 20;  // the time the body takes to cross a cell at U = 1
@@ -37,6 +42,7 @@ TEST(MovingValidation, TowedCylinderAtRe100) {
 }
 
 TEST(MovingValidation, TowedSphereAtRe100) {
+  if (!fullValidation()) GTEST_SKIP() << "MORPHOFLOW_FULL_VALIDATION=1 runs it (about 5 minutes)";
   const ForceSeries towed = towedBody<3>(true, 100.0, 10, 1.5, 20, 8);
   const ForceSeries fixed = towedBody<3>(false, 100.0, 10, 1.5, 20, 8);
   const double a = meanOver(towed, towed.drag, 1.0, 1.5), b = meanOver(fixed, fixed.drag, 1.0, 1.5);
