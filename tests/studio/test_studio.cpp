@@ -494,3 +494,28 @@ TEST(StudioServer, FiftyClientsWatchAndLeave) {
   EXPECT_EQ(s.server.clients(), 0u);
   EXPECT_EQ(s.call(http::verb::get, "/api/state").result(), http::status::ok);
 }
+
+// A moving obstacle is shown where its motion has it now, and a hand's move
+// of it is refused: its motion gives its centre.
+TEST(Studio, AMovingObstacleIsShownWhereItIsAndIsNotMovedByHand) {
+  const std::string scene = R"(
+name = "towed"
+[grid]
+resolution = [32, 16]
+[domain]
+size = [2.0, 1.0]
+[time]
+dt = 0.01
+steps = 1000
+[[obstacles]]
+radius = 0.1
+motion = ["0.3 + t", "0.5"]
+)";
+  StudioSession s(scene, kPath, StudioOptions{});
+  stepTo(s, 20);
+  const nlohmann::json j = s.state();
+  const double t = j["t"].get<double>();
+  EXPECT_NEAR(j["elements"][0]["center"][0].get<double>(), 0.3 + t, 1e-12);
+  EXPECT_NEAR(t, 0.2, 1e-9);
+  EXPECT_THROW(s.paint({{"kind", "move"}, {"target", "obstacles.0"}, {"center", {0.5, 0.5}}}), UserError);
+}
