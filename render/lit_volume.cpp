@@ -197,6 +197,7 @@ Grid<uint8_t, 3> occupiedBlocks(const Grid<float, 3>& rho) {
 
 struct Pixel {
   Rgb c{0, 0, 0};
+  Rgb surface{0, 0, 0};  // an obstacle's radiance, seen through the smoke before it
   double transmittance = 1.0;
   bool solid = false;  // the ray ended on an obstacle
 };
@@ -263,7 +264,7 @@ Pixel march(const Grid<Radiance, 3>& f, const Grid<uint8_t, 3>& occupied, double
         (solid.at(add(eye, scale(d, mid))) >= 0.5 ? hi : lo) = mid;
       }
       const Rgb c = solidRadiance(solid.normal(add(eye, scale(d, hi))), toKey);
-      for (int k = 0; k < 3; ++k) px.c[size_t(k)] += px.transmittance * c[size_t(k)];
+      for (int k = 0; k < 3; ++k) px.surface[size_t(k)] = px.transmittance * c[size_t(k)];
       px.transmittance = 0.0;
       px.solid = true;
       break;
@@ -342,7 +343,8 @@ LitImage renderLitVolume(const LitVolume& v, int size) {
     img.opacity[i] = float(1.0 - px[i].transmittance);
     for (int k = 0; k < 3; ++k)  // the tone curve 1 - exp(-x), over the background
       img.rgb[i * 3 + size_t(k)] =
-          encode(-std::expm1(-img.exposure * px[i].c[size_t(k)]) + px[i].transmittance * kBackdrop[size_t(k)]);
+          encode(-std::expm1(-img.exposure * px[i].c[size_t(k)] - kObstacleExposure * px[i].surface[size_t(k)]) +
+                 px[i].transmittance * kBackdrop[size_t(k)]);
   }
   return img;
 }

@@ -39,12 +39,14 @@ struct LitVolume {
   double emission = 0.0;
   // The obstacles (1 inside, 0 in the fluid; none: no obstacle): drawn as
   // an opaque grey surface, lit by the key and the sky, that hides what lies
-  // behind it. The exposure is the smoke's alone.
+  // behind it. The exposure is the smoke's alone; the obstacles have their
+  // own, fixed, so that they keep their brightness from frame to frame.
   const Grid<float, 3>* solid = nullptr;
 };
 
-// The obstacles' grey (linear albedo).
-inline constexpr double kObstacleAlbedo = 0.15;
+// The obstacles' grey (linear albedo) and exposure.
+inline constexpr double kObstacleAlbedo = 0.3;
+inline constexpr double kObstacleExposure = 2.0;
 
 // The temperature (scene units above the ambient) to kelvin, as the Blender
 // set-up maps it too (app's `blender` command).

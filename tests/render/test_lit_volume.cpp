@@ -223,6 +223,25 @@ TEST(LitVolume, AnObstacleIsAnOpaqueGreySurfaceThatHidesTheSmoke) {
   with.solid = &aside;
   const LitImage c = renderLitVolume(with, size);
   EXPECT_EQ(a.exposure, c.exposure);
+  // The obstacle keeps its brightness whatever the smoke's exposure: with a
+  // dimmer smoke (an albedo through a dark palette) the picture's exposure
+  // rises, the obstacle's pixels stay the same bytes.
+  LitVolume dim = with;
+  dim.shown = &rho;
+  dim.options.palette = namedPalette("magma");
+  dim.options.autoRange = false;
+  dim.options.range[0] = 0.0, dim.options.range[1] = 4.0;  // the smoke's values low in the palette: dark
+  const LitImage d = renderLitVolume(dim, size);
+  EXPECT_GT(d.exposure, 1.5 * c.exposure);
+  int same = 0, seen = 0;
+  for (size_t k = 0; k < c.opacity.size(); ++k)
+    if (c.opacity[k] == 1.0f && a.opacity[k] < 0.01f) {
+      ++seen;
+      same +=
+          c.rgb[3 * k] == d.rgb[3 * k] && c.rgb[3 * k + 1] == d.rgb[3 * k + 1] && c.rgb[3 * k + 2] == d.rgb[3 * k + 2];
+    }
+  EXPECT_GT(seen, 10);
+  EXPECT_EQ(same, seen);
   int grey = 0;
   for (size_t k = 0; k < c.opacity.size(); ++k) grey += c.opacity[k] == 1.0f && a.opacity[k] < 0.5f;
   EXPECT_GT(grey, 10) << "the obstacle aside is drawn";
