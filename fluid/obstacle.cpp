@@ -62,26 +62,10 @@ double obstacleDistance(const ObstacleSpec& o, const double* x, int dims, const 
   return 1.0;
 }
 
-template <int D>
-Grid<uint8_t, D> solidMask(const std::vector<ObstacleSpec>& obstacles, const IVec<D>& cells, double h) {
-  Grid<uint8_t, D> mask(cells, 0);
-  double size[3] = {0, 0, 0};
-  for (int a = 0; a < D; ++a) size[a] = cells[a] * h;
-  forEachCell<D>(cells, [&](const IVec<D>& c, size_t i) {
-    double x[3] = {0, 0, 0};
-    for (int a = 0; a < D; ++a) x[a] = (c[a] + 0.5) * h;
-    for (const ObstacleSpec& o : obstacles)
-      if (obstacleDistance(o, x, D, size) < 0) {
-        mask[i] = 1;
-        break;
-      }
-  });
-  return mask;
-}
-
-template <int D>
-Grid<float, D> solidOccupancy(const std::vector<ObstacleSpec>& obstacles, const IVec<D>& cells, double h) {
-  Grid<float, D> occupancy(cells, 0.0f);
+namespace {
+// fn(i, d) for every cell i of the grid, d the obstacles' least distance at its centre.
+template <int D, class Fn>
+void eachCellDistance(const std::vector<ObstacleSpec>& obstacles, const IVec<D>& cells, double h, Fn&& fn) {
   double size[3] = {0, 0, 0};
   for (int a = 0; a < D; ++a) size[a] = cells[a] * h;
   forEachCell<D>(cells, [&](const IVec<D>& c, size_t i) {
@@ -89,8 +73,23 @@ Grid<float, D> solidOccupancy(const std::vector<ObstacleSpec>& obstacles, const 
     for (int a = 0; a < D; ++a) x[a] = (c[a] + 0.5) * h;
     double d = 1e300;
     for (const ObstacleSpec& o : obstacles) d = std::min(d, obstacleDistance(o, x, D, size));
-    occupancy[i] = float(std::clamp(0.5 - d / h, 0.0, 1.0));
+    fn(i, d);
   });
+}
+}  // namespace
+
+template <int D>
+Grid<uint8_t, D> solidMask(const std::vector<ObstacleSpec>& obstacles, const IVec<D>& cells, double h) {
+  Grid<uint8_t, D> mask(cells, 0);
+  eachCellDistance<D>(obstacles, cells, h, [&](size_t i, double d) { mask[i] = d < 0 ? 1 : 0; });
+  return mask;
+}
+
+template <int D>
+Grid<float, D> solidOccupancy(const std::vector<ObstacleSpec>& obstacles, const IVec<D>& cells, double h) {
+  Grid<float, D> occupancy(cells, 0.0f);
+  eachCellDistance<D>(obstacles, cells, h,
+                      [&](size_t i, double d) { occupancy[i] = float(std::clamp(0.5 - d / h, 0.0, 1.0)); });
   return occupancy;
 }
 

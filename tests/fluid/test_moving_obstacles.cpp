@@ -158,17 +158,26 @@ TEST(MovingObstacles, APaddleStirringAClosedBoxKeepsItsDye) {
   EXPECT_LT(std::abs(moving), 0.005);
 }
 
-TEST(MovingObstacles, AVoxelObstacleMovesItsStaircase) {
+namespace {
+// A 2 x 1 box of nx x nx/2 cells (nu = 1e-3) with a circle moving as `motion` says.
+FluidSettings boxWithMovingCircle(int nx, double radius, std::vector<std::string> motion,
+                                  ObstacleBoundary boundary = ObstacleBoundary::Cut) {
   FluidSettings s;
-  s.resolution = {96, 48};
+  s.resolution = {nx, nx / 2};
   s.size = {2.0, 1.0};
   s.viscosity = 1e-3;
   ObstacleSpec ball;
   ball.shape = ObstacleShape::Circle;
-  ball.radius = 0.1;
-  ball.boundary = ObstacleBoundary::Voxel;
-  ball.motion = {"0.5 + 0.5 * t", "0.5"};
+  ball.radius = radius;
+  ball.boundary = boundary;
+  ball.motion = std::move(motion);
   s.obstacles = {ball};
+  return s;
+}
+}  // namespace
+
+TEST(MovingObstacles, AVoxelObstacleMovesItsStaircase) {
+  const FluidSettings s = boxWithMovingCircle(96, 0.1, {"0.5 + 0.5 * t", "0.5"}, ObstacleBoundary::Voxel);
   FluidSolver<2> f(s);
   for (int k = 0; k < 40; ++k) f.step(0.01);
   const VelocityConstraints<2>& vc = f.constraints();
@@ -195,16 +204,8 @@ TEST(MovingObstacles, AVoxelObstacleMovesItsStaircase) {
 }
 
 TEST(MovingObstacles, AnObstacleComesInAndGoesOut) {
-  FluidSettings s;
-  s.resolution = {48, 24};
-  s.size = {2.0, 1.0};
-  s.viscosity = 1e-3;
-  ObstacleSpec ball;
-  ball.shape = ObstacleShape::Circle;
-  ball.radius = 0.15;
-  ball.motion = {"-0.4 + 2.8 * t", "0.5"};  // from wholly left of the box to wholly right of it
-  s.obstacles = {ball};
-  FluidSolver<2> f(s);
+  // From wholly left of the box to wholly right of it.
+  FluidSolver<2> f(boxWithMovingCircle(48, 0.15, {"-0.4 + 2.8 * t", "0.5"}));
   auto solidCells = [&] {
     size_t n = 0;
     for (uint8_t v : f.solid().values()) n += v;
