@@ -30,8 +30,9 @@ Grid<uint8_t, D> solidOnLayer(const Grid<uint8_t, D>& fluidSolid, double fluidH,
 template <int D>
 void followSolid(const std::vector<Grid<double, D>*>& species, const std::vector<double>& solidValues,
                  const Grid<uint8_t, D>& was, const Grid<uint8_t, D>& now) {
+  const FillPlan plan = fillPlan<D>(was, now);
   for (size_t s = 0; s < species.size(); ++s)
-    fillUncovered<double, D>(species[s], was, now, s < solidValues.size() ? solidValues[s] : 0.0);
+    applyFill<double>(plan, species[s]->data(), s < solidValues.size() ? solidValues[s] : 0.0);
 }
 
 }  // namespace morphoflow

@@ -48,8 +48,9 @@ FluidSolver<D>::FluidSolver(const FluidSettings& s)
     bool hi = s.boundaries.side(a, true).kind == BoundaryKind::Periodic;
     if (lo != hi) throw std::invalid_argument("a periodic axis must be periodic on both sides");
   }
-  moves_ = anyMoves(s.obstacles);
-  constraints_ = constraintsAt(0.0);
+  placement_ = ObstaclePlacement<D>(s, cells_, h_);
+  moves_ = placement_.moves();
+  constraints_ = placement_.constraintsAt(0.0);
   SolverOptions p{s.pressureTolerance, s.pressureMaxIterations};
   projection_ = std::make_unique<PressureProjection<D>>(constraints_, s.pressureSolver, p);
   viscosity_ = std::make_unique<ViscositySolver<D>>(constraints_, SolverOptions{s.viscosityTolerance, 500});
@@ -61,91 +62,6 @@ FluidSolver<D>::FluidSolver(const FluidSettings& s)
     sourceCoverage_ = sourceCoverage<D>(s.smoke.sources, cells_, h_, constraints_.solid);
     if (!s.smoke.sources.empty()) materialisedDye();
   }
-}
-
-// The obstacles where they are at time t (wrapping across periodic axes), with their motions.
-template <int D>
-std::vector<ObstacleSpec> FluidSolver<D>::obstaclesAt(double t, std::vector<RigidMotion>* motions) const {
-  std::vector<ObstacleSpec> placed = placedAt(settings_.obstacles, D, t, motions);
-  for (ObstacleSpec& o : placed)
-    for (int a = 0; a < D; ++a) o.wrap[size_t(a)] = settings_.boundaries.periodic(a);
-  return placed;
-}
-
-// The domain's sides and the obstacles where they are at time t.
-template <int D>
-VelocityConstraints<D> FluidSolver<D>::constraintsAt(double t) {
-  std::vector<RigidMotion> motions;
-  placed_ = obstaclesAt(t, &motions);
-  std::vector<ObstacleSpec> voxel;  // the staircase obstacles; the others are cut
-  for (const ObstacleSpec& o : placed_)
-    if (o.boundary == ObstacleBoundary::Voxel) voxel.push_back(o);
-  double size[3] = {0, 0, 0};
-  for (int a = 0; a < D; ++a) size[a] = cells_[a] * h_;
-  if (moves_) voxel_ = solidMask<D>(voxel, cells_, h_);
-  return VelocityConstraints<D>(cells_, h_, settings_.boundaries, solidMask<D>(placed_, cells_, h_),
-                                moves_ ? voxel_ : solidMask<D>(voxel, cells_, h_), CutSurface(placed_, D, size),
-                                CutSurface(placed_, D, size, motions, true));
-}
-
-// The cells [lo, hi) that hold the moving obstacles of `placed`, two cells
-// more on every side, grown to hold what they held already; false when one
-// has no bounds.
-template <int D>
-bool FluidSolver<D>::movingCells(const std::vector<ObstacleSpec>& placed, IVec<D>* lo, IVec<D>* hi) const {
-  double size[3] = {0, 0, 0};
-  for (int a = 0; a < D; ++a) size[a] = cells_[a] * h_;
-  for (const ObstacleSpec& o : placed) {
-    if (!movesAtAll(o)) continue;
-    double blo[3], bhi[3];
-    if (!obstacleBounds(o, D, size, blo, bhi)) return false;
-    for (int a = 0; a < D; ++a) {
-      int l = int(std::floor(blo[a] / h_)) - 2, u = int(std::ceil(bhi[a] / h_)) + 2;
-      if (o.wrap[size_t(a)] && (l < 0 || u > cells_[a])) l = 0, u = cells_[a];  // across the seam: the whole axis
-      (*lo)[a] = std::min((*lo)[a], std::clamp(l, 0, cells_[a]));
-      (*hi)[a] = std::max((*hi)[a], std::clamp(u, 0, cells_[a]));
-    }
-  }
-  return true;
-}
-
-// The constraints with the moving obstacles at `placed`, recomputed in the
-// cells that held or hold one ([lo, hi), set; the whole grid when one has
-// no bounds). False when none is in the domain, then or now: nothing changed.
-template <int D>
-bool FluidSolver<D>::moveConstraints(std::vector<ObstacleSpec> placed, const std::vector<RigidMotion>& motions,
-                                     IVec<D>* lo, IVec<D>* hi) {
-  *lo = cells_, *hi = IVec<D>(0);
-  if (!movingCells(placed_, lo, hi) || !movingCells(placed, lo, hi)) {
-    constraints_ = constraintsAt(placedAt_);  // (which places them itself)
-    *lo = IVec<D>(0), *hi = cells_;
-    return true;
-  }
-  for (int a = 0; a < D; ++a)
-    if ((*hi)[a] <= (*lo)[a]) {
-      placed_ = std::move(placed);
-      return false;
-    }
-  Grid<uint8_t, D> solid = constraints_.solid;
-  std::vector<ObstacleSpec> voxel;
-  for (const ObstacleSpec& o : placed)
-    if (o.boundary == ObstacleBoundary::Voxel) voxel.push_back(o);
-  double size[3] = {0, 0, 0};
-  for (int a = 0; a < D; ++a) size[a] = cells_[a] * h_;
-  forEachCell<D>(*hi - *lo, [&](const IVec<D>& r, size_t) {
-    const IVec<D> k = *lo + r;
-    double x[3] = {0, 0, 0};
-    for (int a = 0; a < D; ++a) x[a] = (k[a] + 0.5) * h_;
-    auto inside = [&](const std::vector<ObstacleSpec>& list) {
-      return std::any_of(list.begin(), list.end(),
-                         [&](const ObstacleSpec& o) { return obstacleDistance(o, x, D, size) < 0.0; });
-    };
-    solid(k) = inside(placed) ? 1 : 0;
-    voxel_(k) = inside(voxel) ? 1 : 0;
-  });
-  constraints_.move(solid, voxel_, CutSurface(placed, D, size), CutSurface(placed, D, size, motions, true), *lo, *hi);
-  placed_ = std::move(placed);
-  return true;
 }
 
 // Moving obstacles (fluid/obstacle_motion.h): the constraints, pressure
@@ -160,21 +76,19 @@ bool FluidSolver<D>::moveConstraints(std::vector<ObstacleSpec> placed, const std
 template <int D>
 void FluidSolver<D>::placeObstacles(double t, bool fill) {
   if (!moves_) return;
-  placedAt_ = t;
   const Grid<uint8_t, D> wasSolid = constraints_.solid;
   const std::array<Grid<uint8_t, D>, D> wasFixed = constraints_.fixed;
-  std::vector<RigidMotion> motions;
-  std::vector<ObstacleSpec> placed = obstaclesAt(t, &motions);
   IVec<D> lo, hi;
-  if (!moveConstraints(std::move(placed), motions, &lo, &hi)) return;
+  if (!placement_.moveTo(t, &constraints_, &lo, &hi)) return;
   projection_->rebuild();
   if (settings_.viscosity > 0) viscosity_->rebuild(lo, hi);  // (an inviscid fluid never solves it)
   cutSurfaceMade_ = false;
   if (!fill) return;
-  const Grid<uint8_t, D>& solid = constraints_.solid;
-  if (!dye_.empty()) fillUncovered<float, D>(&dye_, wasSolid, solid, std::nullopt);
-  if (!temperature_.empty()) fillUncovered<float, D>(&temperature_, wasSolid, solid, std::nullopt);
-  for (int a = 0; a < D; ++a) fillUncovered<float, D>(&u_[a], wasFixed[a], constraints_.fixed[a], std::nullopt);
+  const FillPlan cells = fillPlan<D>(wasSolid, constraints_.solid);
+  if (!dye_.empty()) applyFill<float>(cells, dye_.data(), std::nullopt);
+  if (!temperature_.empty()) applyFill<float>(cells, temperature_.data(), std::nullopt);
+  for (int a = 0; a < D; ++a)
+    applyFill<float>(fillPlan<D>(wasFixed[a], constraints_.fixed[a]), u_[a].data(), std::nullopt);
   constraints_.apply(&u_);
 }
 
@@ -233,7 +147,7 @@ struct FluidSolver<D>::Stages {
 template <int D>
 void FluidSolver<D>::step(double dt, const std::function<void()>& afterAdvection) {
   // The solid where the step ends, which the projection meets.
-  if (moves_ && placedAt_ != time_ + dt) placeObstacles(time_ + dt, true);
+  if (moves_ && placement_.time() != time_ + dt) placeObstacles(time_ + dt, true);
   Stages stages{*this};
   stepFluid(stages, dt, afterAdvection);
 }
@@ -313,6 +227,7 @@ void FluidSolver<D>::load(const StateReader& in) {
 
 template <int D>
 void FluidSolver<D>::adopt(double time, long steps, const std::vector<double>& phi, double dt) {
+  if (moves_ && placement_.time() != time) placeObstacles(time, false);  // (the probes meet the solid there)
   time_ = time;
   steps_ = steps;
   projection_->adopt(phi, dt, settings_.density);

@@ -13,6 +13,7 @@
 #include "core/state_archive.h"
 #include "fluid/advection.h"
 #include "fluid/fluid_settings.h"
+#include "fluid/obstacle_placement.h"
 #include "fluid/pressure_projection.h"
 #include "fluid/surface_forces.h"
 #include "fluid/velocity_constraints.h"
@@ -90,11 +91,6 @@ class FluidSolver {
 
  private:
   struct Stages;  // the step's stages (fluid/fluid_step.h)
-  std::vector<ObstacleSpec> obstaclesAt(double t, std::vector<RigidMotion>* motions) const;
-  VelocityConstraints<D> constraintsAt(double t);
-  bool movingCells(const std::vector<ObstacleSpec>& placed, IVec<D>* lo, IVec<D>* hi) const;
-  bool moveConstraints(std::vector<ObstacleSpec> placed, const std::vector<RigidMotion>& motions, IVec<D>* lo,
-                       IVec<D>* hi);
   void placeObstacles(double t, bool fill);
   void injectInflowDye();
   void advectScalar(Grid<float, D>* field, double dt, const std::optional<std::array<int, D>>& reach);
@@ -120,10 +116,8 @@ class FluidSolver {
   WorkPool pool_;  // the stages' work vectors, lent to each in turn
   double time_ = 0.0;
   long steps_ = 0;
+  ObstaclePlacement<D> placement_;
   bool moves_ = false;
-  std::vector<ObstacleSpec> placed_;  // the obstacles where they are now
-  Grid<uint8_t, D> voxel_;            // the staircase obstacles' cells (when one moves)
-  double placedAt_ = 0.0;  // the time the obstacles were placed for
   FluidStepStats stats_;
 };
 

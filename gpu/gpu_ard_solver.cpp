@@ -8,6 +8,7 @@
 
 #include "coupling/ard_step.h"
 #include "gpu/compute_program.h"
+#include "gpu/fluid/gpu_fill.h"
 #include "gpu/gpu_programs.h"
 #include "gpu/gpu_reals.h"
 #include "gpu/gpu_stage_timer.h"
@@ -55,6 +56,19 @@ void GpuARDSolver<D>::emptySolids() {
   solid_.bind(5);
   dispatchFlat(layer_->cells(), 4.0 + 2.0 * double(realBytes(layer_->precision())));  // the mask, both species written
   storageBarrier();
+}
+
+template <int D>
+void GpuARDSolver<D>::moveSolid(const Grid<uint8_t, D>& was, const Grid<uint8_t, D>& now) {
+  const GpuFill fill(fillPlan<D>(was, now));
+  for (int s = 0; s < 2; ++s)
+    fill.apply(layer_->field(s), 0, layer_->precision(),
+               size_t(s) < domain_.solidValues.size() ? domain_.solidValues[size_t(s)] : 0.0);
+  domain_.solid.assign(now.values().begin(), now.values().end());
+  const std::vector<uint32_t> flags(now.values().begin(), now.values().end());
+  if (solid_.bytes() == flags.size() * sizeof(uint32_t)) solid_.upload(flags);
+  else solid_ = GpuBuffer::of(flags);
+  hasSolids_ = true;
 }
 
 // Each species' B-spline coefficients (coupling/bspline.h): a copy, then

@@ -33,6 +33,10 @@ class GpuARDSolver {
   void step(double dt, const GpuFluid<D>& fluid);
   // Sets the solid cells of both species to the solid values.
   void emptySolids();
+  // A moving solid went from `was` to `now` (layer cells): the cells it
+  // uncovers take their fluid neighbours' mean, those it covers the solid
+  // values (coupling/solid_on_layer.h's followSolid), and the solid cells are `now`'s.
+  void moveSolid(const Grid<uint8_t, D>& was, const Grid<uint8_t, D>& now);
   // The GPU's seconds of the two stages of the step before the last (timer queries).
   const std::array<double, ARDSolver<D>::kStages>& stageSeconds() const { return stageSeconds_; }
   // The stages' dispatches and host waits (gpu_counts.h).

@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "core/stage_trace.h"
+#include "coupling/solid_on_layer.h"
 #include "gpu/compute_program.h"
 #include "gpu/gl_context.h"
 #include "gpu/gpu_programs.h"
@@ -20,7 +21,8 @@ GpuCoupledStepper<D>::GpuCoupledStepper(const FluidSolver<D>& fluid, const RDSol
     : fluid_(fluid.settings(), fluid.constraints(), real),
       layer_(layerUpload(rd), real),
       ard_(&layer_, domain, interpolation, mode, rdTimeScale, fluid.cells(), fluid.h()),
-      none_(sizeof(int)) {
+      none_(sizeof(int)),
+      rdH_(rd.h()) {
   fluid_.fromHost(fluid);
   for (int a = 0; a < D; ++a) {
     rdCells_[size_t(a)] = rd.cells()[a];
@@ -32,6 +34,7 @@ template <int D>
 void GpuCoupledStepper<D>::step(double dt) {
   const double t0 = traceClock();
   counts_.add([&] {
+    if (fluid_.movesObstacles()) moveSolids(dt);
     fluid_.step(dt);
     ard_.step(dt, fluid_);
   });
@@ -41,6 +44,17 @@ void GpuCoupledStepper<D>::step(double dt) {
   for (double s : fluid_.lastStats().seconds) seconds_[0] += s;
   for (double s : ard_.stageSeconds()) seconds_[1] += s;
   seconds_[2] = traceClock() - t0;
+}
+
+// A moving obstacle: the fluid's solid where this step ends, and the
+// chemicals' solid cells with it (as CpuCoupledStepper::moveSolids).
+template <int D>
+void GpuCoupledStepper<D>::moveSolids(double dt) {
+  IVec<D> rdCells;
+  for (int a = 0; a < D; ++a) rdCells[a] = rdCells_[size_t(a)];
+  const Grid<uint8_t, D> was = solidOnLayer<D>(fluid_.movingSolid(), fluid_.h(), rdCells, rdH_);
+  fluid_.placeObstaclesFor(dt);
+  ard_.moveSolid(was, solidOnLayer<D>(fluid_.movingSolid(), fluid_.h(), rdCells, rdH_));
 }
 
 template <int D>

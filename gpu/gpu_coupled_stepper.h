@@ -47,7 +47,9 @@ class GpuCoupledStepper final : public CoupledStepper<D> {
   std::map<int, GpuBuffer> covers_;
   StepCounts counts_;
   GpuBuffer taps_, none_;
+  double rdH_;
   std::array<int, 3> rdCells_{1, 1, 1}, fluidCells_{1, 1, 1}, tapOff_{};
+  void moveSolids(double dt);
   void layerKernel(bool blend, const GpuBuffer& cover, const std::vector<double>& values, double threshold);
 };
 

@@ -6,7 +6,9 @@
 #include <fmt/format.h>
 
 #include "fluid/fluid_step.h"
+#include "fluid/obstacle_motion.h"
 #include "gpu/compute_program.h"
+#include "gpu/fluid/gpu_fill.h"
 #include "gpu/gl_context.h"
 #include "gpu/gpu_gate.h"
 #include "gpu/gpu_programs.h"
@@ -27,15 +29,17 @@ template <int D>
 GpuFluid<D>::GpuFluid(const FluidSettings& s, const VelocityConstraints<D>& vc, GpuPrecision real)
     : settings_(withFloors(s, real)),
       real_(real),
-      grid_(vc),
+      placement_(s, vc.cells, vc.h),
+      vc_(placement_.moves() ? placement_.constraintsAt(0.0) : VelocityConstraints<D>()),
+      grid_(constraints(vc)),
       advection_(grid_, s.advection, real),
-      viscosity_(vc, &grid_, real),
-      projection_(vc, &grid_, real, viscosity_.work()) {  // (their solves share the work vectors)
+      viscosity_(constraints(vc), &grid_, real),
+      projection_(constraints(vc), &grid_, real, viscosity_.work()) {  // (their solves share the work vectors)
   dye_ = GpuBuffer(grid_.cellCount * sizeof(float));
   dyeScratch_ = GpuBuffer(grid_.cellCount * sizeof(float));
   dye_.zero();
   dyeActive_ = s.inflowDyeStripes > 0 || s.smoke.enabled;
-  if (s.smoke.enabled) smoke_ = std::make_unique<GpuSmoke<D>>(settings_, vc, &grid_, real);
+  if (s.smoke.enabled) smoke_ = std::make_unique<GpuSmoke<D>>(settings_, constraints(vc), &grid_, real);
   speed_ = std::make_unique<GpuReduction>();
   timer_ = std::make_unique<GpuStageTimer>(FluidStepStats::kStages);
 }
@@ -74,7 +78,8 @@ size_t GpuFluid<D>::deviceBytes() const {
 
 template <int D>
 double GpuFluid<D>::cflTimeStep(double cfl, double dtMax) const {
-  const double umax = maxSpeed();
+  double umax = maxSpeed();
+  for (const ObstacleSpec& o : settings_.obstacles) umax = std::max(umax, obstacleSpeedBound(o, D, time_));
   return umax > 0 ? std::min(dtMax, cfl * grid_.h / umax) : dtMax;
 }
 
@@ -154,6 +159,31 @@ void GpuFluid<D>::injectInflowDye() {
     }
 }
 
+// Moving obstacles, as FluidSolver::placeObstacles: the constraints, the
+// pressure and viscous systems at time t, and with `fill` the cells and
+// faces the solid uncovers filled from their fluid neighbours (the host's
+// plan, gpu/fluid/gpu_fill.h).
+template <int D>
+void GpuFluid<D>::placeObstacles(double t, bool fill) {
+  if (!placement_.moves()) return;
+  const Grid<uint8_t, D> wasSolid = vc_.solid;
+  const std::array<Grid<uint8_t, D>, D> wasFixed = vc_.fixed;
+  IVec<D> lo, hi;
+  if (!placement_.moveTo(t, &vc_, &lo, &hi)) return;
+  grid_.refresh(vc_);
+  projection_.rebuild(vc_);
+  if (settings_.viscosity > 0) viscosity_.rebuild(vc_, lo, hi);  // (an inviscid fluid never solves it)
+  if (smoke_) smoke_->setSolid(vc_.solid);
+  if (!fill) return;
+  const GpuFill cells(fillPlan<D>(wasSolid, vc_.solid));
+  cells.apply(dye_, 0, GpuPrecision::Float);
+  if (smoke_) cells.apply(smoke_->temperature(), 0, GpuPrecision::Float);
+  for (int a = 0; a < D; ++a)
+    GpuFill(fillPlan<D>(wasFixed[a], vc_.fixed[a])).apply(grid_.vel, grid_.off[size_t(a)], GpuPrecision::Float);
+  grid_.constrain(grid_.vel, real_);
+  speed_cached_ = -1.0;
+}
+
 // The GPU's stages of the fluid step, whose order is fluid/fluid_step.h's.
 template <int D>
 struct GpuFluid<D>::Stages {
@@ -193,6 +223,8 @@ struct GpuFluid<D>::Stages {
 template <int D>
 void GpuFluid<D>::step(double dt) {
   counts_.add([&] {
+    // The solid where the step ends, which the projection meets.
+    if (placement_.moves() && placement_.time() != time_ + dt) placeObstacles(time_ + dt, true);
     Stages stages{*this};
     stepFluid(stages, dt);
     speed_cached_ = -1.0;
@@ -209,6 +241,7 @@ void GpuFluid<D>::toHost(FluidSolver<D>* host) const {
 
 template <int D>
 void GpuFluid<D>::fromHost(const FluidSolver<D>& host) {
+  if (placement_.moves() && placement_.time() != host.time()) placeObstacles(host.time(), false);
   upload(host.velocity(), host.dye(), host.temperature().empty() ? nullptr : &host.temperature());
   time_ = host.time();
   steps_ = host.steps();

@@ -10,7 +10,10 @@
 // stay on the GPU and leave it only when asked for (toHost). What it takes
 // from the CPU is read once, at construction: the settings and the
 // assembled VelocityConstraints (fixed faces, prescribed values, solids,
-// periodic axes); nothing of the CPU solver is read while stepping.
+// periodic axes); nothing of the CPU solver is read while stepping. Moving
+// obstacles are placed on the host by this fluid's own ObstaclePlacement
+// at every step (their geometry depends on the time alone) and what they
+// change is uploaded; the cells they uncover are filled on the device.
 #pragma once
 
 #include <array>
@@ -26,6 +29,7 @@
 #include "fluid/fluid_settings.h"
 #include "fluid/fluid_solver.h"
 #include "fluid/fluid_stepper.h"
+#include "fluid/obstacle_placement.h"
 #include "fluid/velocity_constraints.h"
 #include "fluid/viscosity.h"
 #include "gpu/fluid/gpu_advection.h"
@@ -53,6 +57,15 @@ class GpuFluid final : public FluidStepper<D> {
   GpuFluid& operator=(const GpuFluid&) = delete;
 
   void step(double dt) override;
+  // Whether an obstacle moves (obstacles.N.motion or rotation).
+  bool movesObstacles() const { return placement_.moves(); }
+  // Puts the moving obstacles where the coming step of dt ends (step() does
+  // it itself unless this ran first, so that a coupled layer can follow the
+  // solid before the step), as FluidSolver::placeObstaclesFor.
+  void placeObstaclesFor(double dt) { placeObstacles(time_ + dt, true); }
+  // The solid cells where the moving obstacles are (with none moving: empty).
+  const Grid<uint8_t, D>& movingSolid() const { return vc_.solid; }
+  double h() const { return grid_.h; }
   double time() const override { return time_; }
   long steps() const override { return steps_; }
   // The solvers' results, and each stage's time on the GPU in the step
@@ -111,11 +124,21 @@ class GpuFluid final : public FluidStepper<D> {
   void advect(double dt);
   void injectInflowDye();
   void readSolverStats() const;  // the solves' tallies into stats_
+  void placeObstacles(double t, bool fill);
+  // The constraints the device's are made from: the given ones, or with a
+  // moving obstacle this fluid's own, placed at its time (placement_).
+  const VelocityConstraints<D>& constraints(const VelocityConstraints<D>& given) const {
+    return placement_.moves() ? vc_ : given;
+  }
 
   FluidSettings settings_;
   GpuPrecision real_;
   double time_ = 0.0;
   long steps_ = 0;
+  // A moving obstacle's geometry, placed on the host at every step (it
+  // depends on the time alone) and uploaded: nothing is read back.
+  ObstaclePlacement<D> placement_;
+  VelocityConstraints<D> vc_;
   // the stages, one a CPU file (gpu/fluid/)
   GpuMacGrid<D> grid_;
   GpuAdvection<D> advection_;

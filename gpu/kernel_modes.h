@@ -7,8 +7,19 @@ namespace morphoflow {
 
 // The fluid's stage shaders, one a CPU file (shader() names each mode's)
 enum class FluidOp {
-  Forces, InflowDye, Fixed, Periodic, MacCormack, BfeccCorrect, BfeccLimit,
-  ViscousSetup, ViscousStore, Divergence, WarmStart, Gradient
+  Forces,
+  InflowDye,
+  Fixed,
+  Periodic,
+  MacCormack,
+  BfeccCorrect,
+  BfeccLimit,
+  ViscousSetup,
+  ViscousStore,
+  Divergence,
+  WarmStart,
+  Gradient,
+  ClearPhi
 };
 // shaders/smoke.comp
 enum class SmokeOp { Emit, Inject, Buoyancy, Centre, Vorticity, Confine, AddFaces, Decay };
@@ -38,6 +49,8 @@ constexpr const char* define(FluidOp m) {
     case FluidOp::Divergence: return "MODE_DIVERGENCE";
     case FluidOp::WarmStart: return "MODE_WARM_START";
     case FluidOp::Gradient: return "MODE_GRADIENT";
+    case FluidOp::ClearPhi:
+      return "MODE_CLEAR_PHI";
   }
   return "";
 }
@@ -61,6 +74,7 @@ constexpr const char* shader(FluidOp m) {
     case FluidOp::Divergence:
     case FluidOp::WarmStart:
     case FluidOp::Gradient:
+    case FluidOp::ClearPhi:
       return "pressure_projection.comp";
   }
   return "";

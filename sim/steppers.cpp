@@ -1,12 +1,9 @@
 #include "sim/steppers.h"
 
-#include "fluid/obstacle_motion.h"
-
 #include <fmt/format.h>
 
 #include "core/error.h"
 #include "coupling/cpu_coupled_stepper.h"
-#include "fluid/obstacle_motion.h"
 #include "gpu/gl_context.h"
 #include "gpu/gpu_coupled_stepper.h"
 #include "gpu/gpu_fluid.h"
@@ -22,7 +19,6 @@ namespace {
 // The first stage of the scene with no GPU program, or "".
 std::string missingGpuStage(const Scene& s) {
   const RDScene& rd = s.rd;
-  if (s.hasFluid && anyMoves(s.fluid.obstacles)) return "moving obstacles (obstacles.N.motion or rotation)";
   if (s.hasFluid && !rd.enabled) return "";
   if (gpuSpecies(rd.settings.model) == 0) return "the reaction of model " + rd.settings.model;
   if (s.hasFluid && gpuSpecies(rd.settings.model) != 2)

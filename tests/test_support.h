@@ -83,6 +83,8 @@ inline pid_t startMorphoflow(const std::vector<std::string>& args, const std::fi
   std::vector<char*> argv;
   for (std::string& a : all) argv.push_back(a.data());
   argv.push_back(nullptr);
+  std::error_code ec;
+  std::filesystem::create_directories(log.parent_path(), ec);  // (a log it cannot open: no child)
   posix_spawn_file_actions_t fa;
   posix_spawn_file_actions_init(&fa);
   posix_spawn_file_actions_addopen(&fa, STDOUT_FILENO, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);

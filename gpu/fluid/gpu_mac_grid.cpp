@@ -10,25 +10,36 @@
 
 namespace morphoflow {
 
+namespace {
+// The constraints' per-face arrays, component after component: the fixed flags, values and open fractions.
 template <int D>
-GpuMacGrid<D>::GpuMacGrid(const VelocityConstraints<D>& vc) : h(vc.h), cut(!vc.cut.empty()) {
+void faceArrays(const VelocityConstraints<D>& vc, std::vector<uint32_t>* flags, std::vector<float>* values,
+                std::vector<float>* fractions) {
+  for (int a = 0; a < D; ++a) {
+    flags->insert(flags->end(), vc.fixed[a].values().begin(), vc.fixed[a].values().end());
+    const std::vector<float> v = vc.prescribedGrid(a), o = vc.open[a].expanded();
+    values->insert(values->end(), v.begin(), v.end());
+    fractions->insert(fractions->end(), o.begin(), o.end());
+  }
+}
+}  // namespace
+
+template <int D>
+GpuMacGrid<D>::GpuMacGrid(const VelocityConstraints<D>& vc) : h(vc.h), cut(!vc.cut.empty() || vc.bodies.moving()) {
   cellCount = 1;
   for (int a = 0; a < D; ++a) {
     cells[size_t(a)] = vc.cells[a];
     periodic[size_t(a)] = vc.boundaries.periodic(a) ? 1 : 0;
     cellCount *= size_t(vc.cells[a]);
   }
-  std::vector<uint32_t> flags;
-  std::vector<float> values, fractions;
   for (int a = 0; a < D; ++a) {
     off[size_t(a)] = faceCount;
     faceCount += faces(a);
     maxGrid = std::max(maxGrid, faces(a));
-    flags.insert(flags.end(), vc.fixed[a].values().begin(), vc.fixed[a].values().end());
-    const std::vector<float> v = vc.prescribedGrid(a), o = vc.open[a].expanded();
-    values.insert(values.end(), v.begin(), v.end());
-    fractions.insert(fractions.end(), o.begin(), o.end());
   }
+  std::vector<uint32_t> flags;
+  std::vector<float> values, fractions;
+  faceArrays<D>(vc, &flags, &values, &fractions);
   open = cut ? GpuBuffer::of(fractions) : GpuBuffer(sizeof(float));  // (read for cut obstacles only)
   vel = GpuBuffer(faceCount * sizeof(float));
   velScratch = GpuBuffer(faceCount * sizeof(float));
@@ -37,6 +48,23 @@ GpuMacGrid<D>::GpuMacGrid(const VelocityConstraints<D>& vc) : h(vc.h), cut(!vc.c
   fixed = GpuBuffer::of(flags);
   value = GpuBuffer::of(values);
   solid = GpuBuffer::of(std::vector<uint32_t>(vc.solid.values().begin(), vc.solid.values().end()));
+  if (vc.bodies.moving()) solidFlux = GpuBuffer(cellCount * sizeof(double));
+  refresh(vc);
+}
+
+template <int D>
+void GpuMacGrid<D>::refresh(const VelocityConstraints<D>& vc) {
+  std::vector<uint32_t> flags;
+  std::vector<float> values, fractions;
+  faceArrays<D>(vc, &flags, &values, &fractions);
+  fixed.upload(flags);
+  value.upload(values);
+  if (cut) open.upload(fractions);
+  solid.upload(std::vector<uint32_t>(vc.solid.values().begin(), vc.solid.values().end()));
+  if (solidFlux.bytes()) {
+    if (vc.solidFlux.empty()) solidFlux.zero();
+    else solidFlux.upload(vc.solidFlux);
+  }
 }
 
 template <int D>

@@ -1,7 +1,8 @@
 // The fluid's grid on the GPU (fluid/velocity_constraints.h's, on the
 // device): the MAC velocity as one buffer (component a at offset(a) floats)
 // and its scratch, the constraints' fixed flags and prescribed values, the
-// solid cells and, with cut obstacles, the faces' open fractions; the
+// solid cells and, with cut obstacles, the faces' open fractions (a moving
+// obstacle's also its flux); the
 // programs of the stage shaders that read them (shaders/fluid_faces.glsl).
 #pragma once
 
@@ -27,6 +28,8 @@ inline constexpr GpuPrecision kPhiPrecision = GpuPrecision::Double;
 template <int D>
 struct GpuMacGrid {
   explicit GpuMacGrid(const VelocityConstraints<D>& vc);
+  // The constraints changed (a moving obstacle), not the grid: their flags, values, fractions and solid flux again.
+  void refresh(const VelocityConstraints<D>& vc);
 
   size_t faces(int a) const;                   // the faces of component a
   std::array<int, 3> velocityOffsets() const;  // the components' offsets in the velocity buffer (uniform velOff)
@@ -40,8 +43,9 @@ struct GpuMacGrid {
   std::array<size_t, 3> off{};
   size_t cellCount = 0, faceCount = 0, maxGrid = 0;
   double h = 1.0;
-  bool cut = false;  // cut obstacles (open fractions between 0 and 1)
+  bool cut = false;  // cut or moving obstacles (open fractions between 0 and 1)
   GpuBuffer vel, velScratch, fixed, value, solid, open;
+  GpuBuffer solidFlux;  // a moving obstacle's: VelocityConstraints::solidFlux in double (else none)
 };
 
 }  // namespace morphoflow

@@ -13,23 +13,44 @@
 
 namespace morphoflow {
 
+namespace {
+// The cells without a pressure: 1, or 2 where they lie inside a solid (a moving one's phi is cleared there).
+template <int D>
+std::vector<uint32_t> inactiveCells(const LaplaceSystem<D>& P, const VelocityConstraints<D>& vc) {
+  const std::vector<float> diag = P.diag.expanded();
+  std::vector<uint32_t> inactive(diag.size());
+  for (size_t i = 0; i < diag.size(); ++i) inactive[i] = diag[i] != 0.0f ? 0u : vc.solid[i] ? 2u : 1u;
+  return inactive;
+}
+}  // namespace
+
 template <int D>
 GpuProjection<D>::GpuProjection(const VelocityConstraints<D>& vc, GpuMacGrid<D>* grid, GpuPrecision real,
                                 std::shared_ptr<GpuPcgWork> work)
-    : grid_(*grid), real_(real) {
-  // The CPU's system and multigrid levels, uploaded once.
-  const LaplaceSystem<D> P = pressureSystem<D>(vc);
-  const std::vector<float> diag = P.diag.expanded();
-  std::vector<uint32_t> inactive(diag.size());
-  for (size_t i = 0; i < diag.size(); ++i) inactive[i] = diag[i] == 0.0f ? 1u : 0u;
-  inactive_ = GpuBuffer::of(inactive);
-  A_ = std::make_unique<GpuLaplace>(P);
+    : grid_(*grid), real_(real), P_(pressureSystem<D>(vc)) {
+  // The CPU's system and multigrid levels (kept on the host to follow a moving obstacle).
+  inactive_ = GpuBuffer::of(inactiveCells<D>(P_, vc));
+  A_ = std::make_unique<GpuLaplace>(P_);
   A_->setPrecision(real_, kPhiPrecision);
-  multigrid_ = std::make_unique<GpuMultigrid>(Multigrid<D>(P), *A_, MultigridOptions{});
+  levels_ = std::make_unique<Multigrid<D>>(P_);
+  multigrid_ = std::make_unique<GpuMultigrid>(*levels_, *A_, MultigridOptions{});
+  if (!vc.bodies.moving()) levels_.reset(), P_ = LaplaceSystem<D>();  // (at rest: uploaded once)
   pcg_ = std::make_unique<GpuPcg>(*A_, std::move(work));
   rhs_ = realBuffer(grid_.cellCount, real_);
   ratePrev_ = realBuffer(grid_.cellCount, GpuPrecision::Float);
   phi_ = realBuffer(grid_.cellCount, kPhiPrecision);
+}
+
+// As PressureProjection::rebuild: the system and its levels again, and no
+// pressure in the cells the solid covers.
+template <int D>
+void GpuProjection<D>::rebuild(const VelocityConstraints<D>& vc) {
+  P_ = pressureSystem<D>(vc);
+  levels_->refresh();
+  A_->update(P_);
+  multigrid_->update(*levels_);
+  inactive_.upload(inactiveCells<D>(P_, vc));
+  run(FluidOp::ClearPhi, 0, grid_.cellCount, 0.0);
 }
 
 template <int D>
@@ -38,7 +59,9 @@ GpuProjection<D>::~GpuProjection() = default;
 template <int D>
 void GpuProjection<D>::run(FluidOp mode, int axis, size_t n, double dt) {
   const bool cut = mode == FluidOp::Divergence && grid_.cut;  // (made for cut obstacles only)
-  const ComputeProgram& p = grid_.stage(mode, real_, cut ? "\n#define CUT_FACES" : "");
+  const bool flux = mode == FluidOp::Divergence && grid_.solidFlux.bytes();
+  const ComputeProgram& p =
+      grid_.stage(mode, real_, std::string(cut ? "\n#define CUT_FACES" : "") + (flux ? "\n#define SOLID_FLUX" : ""));
   setUniform(p, "cells", grid_.cells);
   setUniform(p, "periodic", grid_.periodic);
   setUniform(p, "axis", axis);
@@ -54,6 +77,7 @@ void GpuProjection<D>::run(FluidOp mode, int axis, size_t n, double dt) {
   ratePrev_.bind(8);
   inactive_.bind(10);  // (the divergence's "solid": the cells without a pressure)
   grid_.open.bind(12);
+  if (flux) grid_.solidFlux.bind(13);
   dispatchFlat(n, mode == FluidOp::Divergence ? 12.0 * D + 12.0 : 32.0);
   storageBarrier();
 }

@@ -9,6 +9,8 @@
 #include <memory>
 #include <vector>
 
+#include "core/laplace_system.h"
+#include "core/multigrid.h"
 #include "core/pcg.h"
 #include "core/solver_result.h"
 #include "core/state_archive.h"
@@ -32,6 +34,8 @@ class GpuProjection {
   // solve's result is the last tally's (tally(): one host wait).
   SolverResult project(double dt, const SolverOptions& options);
   SolverResult tally();
+  // The constraints changed (a moving obstacle): the system and its levels follow.
+  void rebuild(const VelocityConstraints<D>& vc);
   std::vector<double> phi() const;  // p = rho phi / dt
   double lastDt() const { return lastDt_; }
   void save(StateWriter* out) const;  // phi, the rate before and the clock of the warm start
@@ -41,6 +45,8 @@ class GpuProjection {
   void run(FluidOp mode, int axis, size_t n, double dt);
   GpuMacGrid<D>& grid_;
   GpuPrecision real_;
+  LaplaceSystem<D> P_;                    // the host's system and levels: a moving obstacle's only
+  std::unique_ptr<Multigrid<D>> levels_;  // (refers to P_)
   std::unique_ptr<GpuLaplace> A_;
   std::unique_ptr<GpuMultigrid> multigrid_;
   std::unique_ptr<GpuPcg> pcg_;

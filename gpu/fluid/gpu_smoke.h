@@ -22,6 +22,8 @@ class GpuSmoke {
            GpuPrecision real);
   // Each source over the part of [time, time + dt] inside its window, where it is at mid-step.
   void emit(double time, double dt, GpuBuffer* dye);
+  // The solid cells now (a moving obstacle's), which a moving source's cover leaves out.
+  void setSolid(const Grid<uint8_t, D>& solid) { solid_ = solid; }
   // Buoyancy and confinement onto the faces of grid.vel.
   void forces(double dt, const GpuBuffer& dye);
   void decay(double dt, GpuBuffer* dye);

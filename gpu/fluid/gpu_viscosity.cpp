@@ -40,16 +40,39 @@ GpuViscosity<D>::GpuViscosity(const VelocityConstraints<D>& vc, GpuMacGrid<D>* g
   for (auto& c : components_) c->pcg = std::make_unique<GpuPcg>(*c->A, work_);
   b_ = realBuffer(most, real_);
   x_ = realBuffer(most, real_);
-  if (grid_.cut) {  // the viscosity holds the faces inside cut obstacles too
-    std::vector<uint32_t> held;
-    for (int a = 0; a < D; ++a) held.insert(held.end(), vc.fixed[a].values().begin(), vc.fixed[a].values().end());
-    for (int a = 0; a < D; ++a) {
-      const ViscousSystem<D>& V = components_[size_t(a)]->host;
-      for (size_t i = 0; i < V.insideCut.size(); ++i)
-        if (V.insideCut[i]) held[grid_.off[size_t(a)] + vc.fixed[a].index(latticeCoord<D>(V.dims, i))] = 1u;
-    }
-    held_ = GpuBuffer::of(held);
+  if (grid_.cut) held_ = GpuBuffer::of(heldFaces(vc));  // the viscosity holds the faces inside cut obstacles too
+}
+
+// The faces the viscous solves hold: the prescribed ones and those inside a cut obstacle.
+template <int D>
+std::vector<uint32_t> GpuViscosity<D>::heldFaces(const VelocityConstraints<D>& vc) const {
+  std::vector<uint32_t> held;
+  for (int a = 0; a < D; ++a) held.insert(held.end(), vc.fixed[a].values().begin(), vc.fixed[a].values().end());
+  for (int a = 0; a < D; ++a) {
+    const ViscousSystem<D>& V = components_[size_t(a)]->host;
+    for (size_t i = 0; i < V.insideCut.size(); ++i)
+      if (V.insideCut[i]) held[grid_.off[size_t(a)] + vc.fixed[a].index(latticeCoord<D>(V.dims, i))] = 1u;
   }
+  return held;
+}
+
+// As ViscositySolver::rebuild: the rows of the faces of the cells [lo, hi)
+// and of one more layer, and the held faces and boundary terms again.
+template <int D>
+void GpuViscosity<D>::rebuild(const VelocityConstraints<D>& vc, const IVec<D>& lo, const IVec<D>& hi) {
+  for (int a = 0; a < D; ++a) {
+    Component& c = *components_[size_t(a)];
+    IVec<D> ulo, uhi;
+    for (int b = 0; b < D; ++b) {
+      ulo[b] = std::max(lo[b] - 1, 0);
+      uhi[b] = std::min(hi[b] + (b == a ? 2 : 1), c.host.dims[b]);
+    }
+    updateViscousSystem<D>(&c.host, vc, a, ulo, uhi);
+    const std::vector<float> rhs = c.host.boundaryRhs.expanded();
+    uploadReals(&c.boundaryRhs, std::vector<double>(rhs.begin(), rhs.end()), real_);
+  }
+  held_.upload(heldFaces(vc));
+  s_ = -1.0;  // (the systems' diagonals follow at the next solve)
 }
 
 template <int D>

@@ -30,12 +30,15 @@ class GpuViscosity {
   // solve's result is the last tally's (tally(): one host wait).
   SolverResult diffuse(double nu, double dt, double tolerance);
   SolverResult tally();
+  // The constraints changed in the cells [lo, hi) (a moving obstacle): the systems follow.
+  void rebuild(const VelocityConstraints<D>& vc, const IVec<D>& lo, const IVec<D>& hi);
   // The solve's work vectors, for solves that never overlap it (the pressure's).
   std::shared_ptr<GpuPcgWork> work() const;
 
  private:
   struct Component;  // a component's host system and boundary terms
   void run(FluidOp mode, int a, double s);
+  std::vector<uint32_t> heldFaces(const VelocityConstraints<D>& vc) const;
   GpuMacGrid<D>& grid_;
   GpuPrecision real_;
   std::array<std::unique_ptr<Component>, D> components_;

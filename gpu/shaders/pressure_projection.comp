@@ -5,6 +5,8 @@
 // MODE_WARM_START       phi = dt (2 rate - rate_prev) (or dt rate), rate = phi / last dt
 //                       (rate_prev in float, as the CPU keeps it)
 // MODE_GRADIENT         u_a -= d phi / d x_a on free faces (outflow: ghost phi = -phi)
+// MODE_CLEAR_PHI        phi = 0 in the cells a moving solid covers (solid flag 2: no pressure, inside)
+// SOLID_FLUX            the divergence adds a moving solid's flux through the closed parts of the faces
 #if !defined(MODE_DIVERGENCE)
 #define D0_REAL XREAL  // phi, the pressure solve's solution
 #endif
@@ -13,6 +15,9 @@
 #define PP_FN XREAL
 #define PP_REAL XREAL
 #include "projection.inc"
+#if defined(SOLID_FLUX)
+layout(std430, binding = 13) readonly buffer SolidFlux { double solidFlux[]; };
+#endif
 
 void main() {
   const int i = flatIndex();
@@ -31,7 +36,13 @@ void main() {
     d += ppAxisFlux(XREAL(1), XREAL(vel[hi]), XREAL(1), XREAL(vel[lo]));
 #endif
   }
-  d0[i] = solid[i] != 0u ? REAL(0) : REAL(d * -invH);  // (solid: the cells without a pressure)
+  XREAL r = d * -invH;
+#if defined(SOLID_FLUX)
+  r += XREAL(solidFlux[i]) * -invH;
+#endif
+  d0[i] = solid[i] != 0u ? REAL(0) : REAL(r);  // (solid: the cells without a pressure)
+#elif defined(MODE_CLEAR_PHI)  // d0 = phi
+  if (solid[i] == 2u) d0[i] = XREAL(0);
 #elif defined(MODE_WARM_START)  // d0 = phi, d1 = rate_prev
   const XREAL rate = d0[i] * invLastDt;
   d0[i] = ppWarmStart(rate, XREAL(d1[i]), dt, extrapolate);
