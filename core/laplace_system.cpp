@@ -2,8 +2,9 @@
 
 #include <algorithm>
 #include <bit>
-#include <cstdint>
 #include <cmath>
+#include <cstdint>
+#include <map>
 #include <type_traits>
 
 #include "core/parallel.h"
@@ -255,9 +256,31 @@ void LaplaceSystem<D>::finalize() {
       });
   // The longest run of interior cells per row that are uniform among
   // themselves (one weight wu > 0 on every face, one c, hence one diagonal).
-  uniformSpan_.assign(rows, {});
-  sweepSpan_.assign(rows, {});
-  parallelForRows<D>(dims, [&](size_t row) {
+  // Rows alike in their stored rows and domain edges (a box's, whatever its
+  // size) share one computed span.
+  std::map<std::array<uintptr_t, 2 * D + 1>, uint32_t> ids;
+  std::vector<size_t> first;
+  std::vector<uint32_t> idOf(rows);
+  for (size_t row = 0; row < rows; ++row) {
+    const RowStencil<D, double> s = stencil(row);
+    std::array<uintptr_t, 2 * D + 1> key{reinterpret_cast<uintptr_t>(c.row(row)),
+                                         reinterpret_cast<uintptr_t>(w[0].row(row))};
+    uintptr_t edges = 0;
+    const int k[3] = {0, int(row % size_t(dims[1])), D == 3 ? int(row / size_t(dims[1])) : 0};
+    for (int a = 1; a < D; ++a) {
+      key[size_t(2 * a)] = reinterpret_cast<uintptr_t>(w[a].row(row));
+      key[size_t(2 * a + 1)] = reinterpret_cast<uintptr_t>(s.wlo[a]);
+      edges |= uintptr_t(k[a] == 0 && !periodic[a]) << (2 * a);
+      edges |= uintptr_t(k[a] == dims[a] - 1 && !periodic[a]) << (2 * a + 1);
+    }
+    key[size_t(2 * D)] = edges;
+    const auto [it, added] = ids.emplace(key, uint32_t(first.size()));
+    if (added) first.push_back(row);
+    idOf[row] = it->second;
+  }
+  std::vector<Span> uniformOf(first.size()), sweepOf(first.size());
+  parallelFor(first.size(), [&](size_t id) {
+    const size_t row = first[id];
     if (nx < 3) return;
     const RowStencil<D, double> s = stencil(row);
     const float* cr = c.row(row);
@@ -298,17 +321,27 @@ void LaplaceSystem<D>::finalize() {
       }
       return best;
     };
-    uniformSpan_[row] = longest(false);
-    sweepSpan_[row] = longest(true);
+    uniformOf[id] = longest(false);
+    sweepOf[id] = longest(true);
   });
-  active_ = size_t(deterministicRowSum<D>(dims, [&](size_t row) {
-    const float* d = diag.row(row);
-    return double(std::count_if(d, d + nx, [](float v) { return v > 0; }));
-  }));
-  singular_ = deterministicRowSum<D>(dims, [&](size_t row) {
-    const float* cr = c.row(row);
-    return double(std::count_if(cr, cr + nx, [](float v) { return v > 0; }));
-  }) == 0.0;
+  uniformSpan_.resize(rows);
+  sweepSpan_.resize(rows);
+  for (size_t row = 0; row < rows; ++row)
+    uniformSpan_[row] = uniformOf[idOf[row]], sweepSpan_[row] = sweepOf[idOf[row]];
+  // The active cells and whether any c is positive, counted once per stored row.
+  auto positives = [&](const RowField<D>& f) {
+    std::map<const float*, size_t> counted;
+    size_t total = 0;
+    for (size_t row = 0; row < rows; ++row) {
+      const float* r = f.row(row);
+      auto [it, added] = counted.emplace(r, 0);
+      if (added) it->second = size_t(std::count_if(r, r + nx, [](float v) { return v > 0; }));
+      total += it->second;
+    }
+    return total;
+  };
+  active_ = positives(diag);
+  singular_ = positives(c) == 0;
 }
 
 template <int D>
