@@ -1,6 +1,7 @@
 #include "core/row_field.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <cstring>
 #include <functional>
 #include <string_view>
@@ -62,6 +63,39 @@ void RowField<D>::densify() {
   if (dense_) return;
   pool_ = expanded();
   identity();
+}
+
+template <int D>
+void RowField<D>::storeRows(const std::vector<size_t>& rows, std::vector<float>* fresh) {
+  requireCompact();
+  std::vector<float>& f = *fresh;
+  // The rows that changed, their new values gathered and kept once each.
+  std::vector<size_t> changed;
+  for (size_t k = 0; k < rows.size(); ++k)
+    if (std::memcmp(f.data() + k * nx_, row(rows[k]), nx_ * sizeof(float)) != 0) changed.push_back(k);
+  if (changed.empty()) return;
+  std::vector<float> block(changed.size() * nx_);
+  for (size_t j = 0; j < changed.size(); ++j) std::copy_n(f.data() + changed[j] * nx_, nx_, block.data() + j * nx_);
+  std::vector<size_t> off(changed.size() + 1);
+  for (size_t j = 0; j < off.size(); ++j) off[j] = j * nx_;
+  keepDistinctSegments(&block, &off);
+  const size_t base = pool_.size();
+  pool_.insert(pool_.end(), block.begin(), block.end());
+  for (size_t j = 0; j < changed.size(); ++j) rowOf_[rows[changed[j]]] = uint32_t((base + off[j]) / nx_);
+  // Stored rows no row uses: dropped once they are most of the pool.
+  std::vector<uint32_t> to(storedRows(), UINT32_MAX);
+  for (uint32_t s : rowOf_) to[s] = 0;
+  const size_t used = size_t(std::count(to.begin(), to.end(), 0u));
+  if (2 * used > to.size()) return;
+  uint32_t next = 0;
+  for (size_t s = 0; s < to.size(); ++s)
+    if (to[s] == 0) {
+      if (next != s) std::memmove(pool_.data() + size_t(next) * nx_, pool_.data() + s * nx_, nx_ * sizeof(float));
+      to[s] = next++;
+    }
+  pool_.resize(size_t(next) * nx_);
+  pool_.shrink_to_fit();
+  for (uint32_t& s : rowOf_) s = to[s];
 }
 
 template <int D>

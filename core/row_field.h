@@ -95,6 +95,12 @@ class RowField {
   void compact();
   // Back to one row per row, writable.
   void densify();
+  // Rows `rows` of a compact field take new values, fresh[k nx ..] for rows[k]
+  // (rewriteRows() below): a row that comes out as it was keeps its stored
+  // row, equal new rows share one; stored rows no row uses any more are
+  // dropped once they are most of them. The values read are the dense
+  // field's after the same writes, whatever rows end up shared.
+  void storeRows(const std::vector<size_t>& rows, std::vector<float>* fresh);
   // v -> f(v) on every value, applied to the stored rows only.
   template <class F>
   void transform(F&& f) {
@@ -113,6 +119,9 @@ class RowField {
     for (int a = 0; a < D; ++a) size_ *= size_t(dims[a]);
     rowOf_.resize(size_ / nx_);
   }
+  void requireCompact() const {
+    if (dense_) throw std::logic_error("RowField: storeRows() on a dense field (write it in place)");
+  }
   void requireDense() const {
     if (!dense_) throw std::logic_error("RowField: written after compact() (densify() it first)");
   }
@@ -129,5 +138,44 @@ class RowField {
   std::vector<uint32_t> rowOf_;    // row -> its stored row
   bool dense_ = false;
 };
+
+// The rows (along x) that cross the box [lo, hi) of a grid of `dims`, ascending.
+template <int D>
+std::vector<size_t> rowsOf(const IVec<D>& dims, const IVec<D>& lo, const IVec<D>& hi) {
+  std::vector<size_t> rows;
+  for (int a = 0; a < D; ++a)
+    if (hi[a] <= lo[a]) return rows;
+  const int zlo = D == 3 ? lo[D - 1] : 0, zhi = D == 3 ? hi[D - 1] : 1;
+  for (int z = zlo; z < zhi; ++z)
+    for (int y = lo[1]; y < hi[1]; ++y) rows.push_back(size_t(y) + (D == 3 ? size_t(z) * size_t(dims[1]) : 0));
+  return rows;
+}
+
+// Rows `rows` of fields of one shape written again: write(r, v) changes
+// row r's values of field q in v[q] (given as they are). A dense field is
+// written in place; a compact one stays compact (RowField::storeRows), so
+// a few rows change without a pass over the whole field. The rows are
+// written in parallel, each once.
+template <int D, size_t K, class Write>
+void rewriteRows(const std::array<RowField<D>*, K>& fields, const std::vector<size_t>& rows, Write&& write) {
+  const size_t nx = size_t(fields[0]->dim(0));
+  std::array<std::vector<float>, K> fresh;
+  for (size_t q = 0; q < K; ++q)
+    if (!fields[q]->dense()) fresh[q].resize(rows.size() * nx);
+  parallelFor(rows.size(), [&](size_t k) {
+    std::array<float*, K> v;
+    for (size_t q = 0; q < K; ++q) {
+      if (fields[q]->dense()) {
+        v[q] = fields[q]->mutableRow(rows[k]);
+      } else {
+        v[q] = fresh[q].data() + k * nx;
+        std::copy_n(fields[q]->row(rows[k]), nx, v[q]);
+      }
+    }
+    write(rows[k], v);
+  });
+  for (size_t q = 0; q < K; ++q)
+    if (!fields[q]->dense()) fields[q]->storeRows(rows, &fresh[q]);
+}
 
 }  // namespace morphoflow

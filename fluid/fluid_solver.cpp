@@ -80,7 +80,7 @@ void FluidSolver<D>::placeObstacles(double t, bool fill) {
   const std::array<Grid<uint8_t, D>, D> wasFixed = constraints_.fixed;
   IVec<D> lo, hi;
   if (!placement_.moveTo(t, &constraints_, &lo, &hi)) return;
-  projection_->rebuild();
+  projection_->rebuild(lo, hi);
   if (settings_.viscosity > 0) viscosity_->rebuild(lo, hi);  // (an inviscid fluid never solves it)
   cutSurfaceMade_ = false;
   if (!fill) return;

@@ -16,33 +16,70 @@ namespace {
 #undef PP_REAL
 }  // namespace
 
+namespace {
+// Cell k's row of the pressure system: its upper faces' weights w[a] and
+// its c. Each face weighs its open fraction (Batty et al. 2007 eq. 9): 1
+// between two fluid cells, 0 at a staircase solid or inside a cut one, and
+// beyond a non-periodic side of the domain (finalize's zeros, so that a
+// system written a few rows at a time has them too).
+template <int D>
+void pressureCell(const VelocityConstraints<D>& vc, const IVec<D>& k, float* w, float* c) {
+  const IVec<D>& n = vc.cells;
+  const std::array<bool, D> periodic = vc.periodic();
+  bool fluid = false;  // any open face: the cell holds fluid and a pressure
+  for (int a = 0; a < D; ++a) {
+    const IVec<D> up = k + unitVector<D>(a);  // the face between k and k + e_a
+    const float below = vc.open[a](k);
+    w[a] = vc.open[a](up);  // wraps on periodic axes
+    fluid = fluid || w[a] > 0.0f || below > 0.0f;
+    if (k[a] == n[a] - 1 && !periodic[size_t(a)]) w[a] = 0.0f;
+  }
+  *c = 0.0f;
+  if (!fluid) return;
+  for (int a = 0; a < D; ++a) {
+    // p = 0 on an outflow side, through a ghost cell mirrored about the face.
+    if (k[a] == 0 && vc.boundaries.side(a, false).kind == BoundaryKind::Outflow) *c += 2.0f * vc.open[a](k);
+    if (k[a] == n[a] - 1 && vc.boundaries.side(a, true).kind == BoundaryKind::Outflow)
+      *c += 2.0f * vc.open[a](k + unitVector<D>(a));
+  }
+}
+}  // namespace
+
 template <int D>
 LaplaceSystem<D> pressureSystem(const VelocityConstraints<D>& vc) {
-  const IVec<D>& n = vc.cells;
-  LaplaceSystem<D> A(n, vc.periodic(), 1.0 / (vc.h * vc.h));
-  // Each face weighs its open fraction (Batty et al. 2007 eq. 9): 1 between
-  // two fluid cells, 0 at a staircase solid or inside a cut one.
-  forEachCell<D>(n, [&](const IVec<D>& k, size_t i) {
-    bool fluid = false;  // any open face: the cell holds fluid and a pressure
-    for (int a = 0; a < D; ++a) {
-      const IVec<D> up = k + unitVector<D>(a);  // the face between k and k + e_a
-      const float w = vc.open[a](up), below = vc.open[a](k);
-      A.w[a].at(i) = w;  // wraps on periodic axes; zeroed by finalize on the domain's sides
-      fluid = fluid || w > 0.0f || below > 0.0f;
-    }
-    if (!fluid) return;
-    for (int a = 0; a < D; ++a) {
-      // p = 0 on an outflow side, through a ghost cell mirrored about the face.
-      if (k[a] == 0 && vc.boundaries.side(a, false).kind == BoundaryKind::Outflow) A.c.at(i) += 2.0f * vc.open[a](k);
-      if (k[a] == n[a] - 1 && vc.boundaries.side(a, true).kind == BoundaryKind::Outflow)
-        A.c.at(i) += 2.0f * vc.open[a](k + unitVector<D>(a));
-    }
+  LaplaceSystem<D> A(vc.cells, vc.periodic(), 1.0 / (vc.h * vc.h));
+  forEachCell<D>(vc.cells, [&](const IVec<D>& k, size_t i) {
+    float w[D], c;
+    pressureCell<D>(vc, k, w, &c);
+    for (int a = 0; a < D; ++a) A.w[a].at(i) = w[a];
+    A.c.at(i) = c;
   });
   A.finalize();
   return A;
 }
 template LaplaceSystem<2> pressureSystem<2>(const VelocityConstraints<2>&);
 template LaplaceSystem<3> pressureSystem<3>(const VelocityConstraints<3>&);
+
+template <int D>
+void updatePressureSystem(LaplaceSystem<D>* A, const VelocityConstraints<D>& vc, const IVec<D>& lo, const IVec<D>& hi) {
+  // A cell's row reads the faces of its own and its neighbours' cells.
+  IVec<D> clo, chi;
+  for (int a = 0; a < D; ++a) clo[a] = std::max(lo[a] - 1, 0), chi[a] = std::min(hi[a] + 1, vc.cells[a]);
+  std::array<RowField<D>*, D + 1> fields;
+  for (int a = 0; a < D; ++a) fields[size_t(a)] = &A->w[a];
+  fields[D] = &A->c;
+  rewriteRows<D, D + 1>(fields, rowsOf<D>(vc.cells, clo, chi), [&](size_t r, const std::array<float*, D + 1>& v) {
+    IVec<D> k = latticeCoord<D>(vc.cells, r * size_t(vc.cells[0]));
+    for (k[0] = clo[0]; k[0] < chi[0]; ++k[0]) {
+      float w[D];
+      pressureCell<D>(vc, k, w, &v[D][k[0]]);
+      for (int a = 0; a < D; ++a) v[size_t(a)][k[0]] = w[a];
+    }
+  });
+  A->finalize();
+}
+template void updatePressureSystem<2>(LaplaceSystem<2>*, const VelocityConstraints<2>&, const IVec<2>&, const IVec<2>&);
+template void updatePressureSystem<3>(LaplaceSystem<3>*, const VelocityConstraints<3>&, const IVec<3>&, const IVec<3>&);
 
 template <int D>
 PressureProjection<D>::PressureProjection(const VelocityConstraints<D>& vc, PressureSolver solver,
@@ -56,8 +93,8 @@ PressureProjection<D>::PressureProjection(const VelocityConstraints<D>& vc, Pres
 }
 
 template <int D>
-void PressureProjection<D>::rebuild() {
-  A_ = pressureSystem(vc_);  // (same shape: the multigrid refers to A_ and derives its levels again)
+void PressureProjection<D>::rebuild(const IVec<D>& lo, const IVec<D>& hi) {
+  updatePressureSystem<D>(&A_, vc_, lo, hi);  // (same shape: the multigrid refers to A_ and derives its levels again)
   if (solver_ == PressureSolver::ICPCG) mic_ = std::make_unique<MIC0Preconditioner<D>>(A_);
   else multigrid_->refresh();
   // Cells the solid covers hold no pressure.

@@ -22,6 +22,11 @@ namespace morphoflow {
 // solids, p = 0 at outflow through a mirrored ghost.
 template <int D>
 LaplaceSystem<D> pressureSystem(const VelocityConstraints<D>& constraints);
+// The rows of the cells [lo, hi) (and their neighbours') written again
+// from the constraints, which changed only there (a moving obstacle).
+template <int D>
+void updatePressureSystem(LaplaceSystem<D>* A, const VelocityConstraints<D>& constraints, const IVec<D>& lo,
+                          const IVec<D>& hi);
 
 template <int D>
 class PressureProjection {
@@ -31,9 +36,9 @@ class PressureProjection {
 
   // Its work vectors come from `pool` (when given) and go back to it.
   SolverResult project(MacVelocity<D>* u, double dt, double density, WorkPool* pool = nullptr);
-  // The system again from the constraints (a moving obstacle changed them);
-  // the warm start stays.
-  void rebuild();
+  // The system again from the constraints (a moving obstacle changed them
+  // in the cells [lo, hi)); the warm start stays.
+  void rebuild(const IVec<D>& lo, const IVec<D>& hi);
   // Cell divergence of u (0 on solid cells).
   void divergence(const MacVelocity<D>& u, Vector* div) const;
   // Takes phi of a projection computed elsewhere (the GPU backend) as the

@@ -21,7 +21,7 @@ VelocityConstraints<D>::VelocityConstraints(const IVec<D>& c, double hh, const D
     fixed[a] = Grid<uint8_t, D>(fd, 0);
     open[a] = RowField<D>(fd, 1.0f);
     std::vector<float> value(fixed[a].size(), 0.0f);
-    forEachCell<D>(fd, [&](const IVec<D>& k, size_t i) { constrainFace(a, k, i, voxel, value.data()); });
+    forEachCell<D>(fd, [&](const IVec<D>& k, size_t i) { open[a].at(i) = constrainFace(a, k, i, voxel, &value[i]); });
     open[a].compact();
     listFixed(a, value);
   }
@@ -36,19 +36,48 @@ void VelocityConstraints<D>::move(const Grid<uint8_t, D>& s, const Grid<uint8_t,
   cut = cutSurface;
   bodies = solidBodies;
   for (int a = 0; a < D; ++a) {
-    std::vector<float> value = prescribedGrid(a);
-    open[a].densify();
-    IVec<D> extent = hi - lo + unitVector<D>(a);  // the faces of the cells [lo, hi)
-    forEachCell<D>(extent, [&](const IVec<D>& r, size_t) {
-      const IVec<D> k = lo + r;
-      const size_t i = fixed[a].index(k);
-      fixed[a][i] = 0;
-      open[a].at(i) = 1.0f;
-      value[i] = 0.0f;
-      constrainFace(a, k, i, voxel, value.data());
+    // The faces of the cells [lo, hi): their rows of the open fractions
+    // written again, and their prescribed faces listed again.
+    const IVec<D> flo = lo, fhi = hi + unitVector<D>(a);
+    const IVec<D>& fd = fixed[a].dims();
+    const std::vector<size_t> rows = rowsOf<D>(fd, flo, fhi);
+    std::vector<std::vector<std::pair<size_t, float>>> held(rows.size());
+    rewriteRows<D, 1>({&open[a]}, rows, [&](size_t r, const std::array<float*, 1>& o) {
+      const size_t k = size_t(std::lower_bound(rows.begin(), rows.end(), r) - rows.begin());
+      IVec<D> c = fixed[a].coord(r * size_t(fd[0]));
+      for (c[0] = flo[0]; c[0] < fhi[0]; ++c[0]) {
+        const size_t i = fixed[a].index(c);
+        float value = 0.0f;
+        fixed[a][i] = 0;
+        o[0][c[0]] = constrainFace(a, c, i, voxel, &value);
+        if (fixed[a][i]) held[k].emplace_back(i, value);
+      }
     });
-    open[a].compact();
-    listFixed(a, value);
+    // The list less the region's faces, merged with the region's (both ascending).
+    std::vector<uint8_t> inRows(fixed[a].size() / size_t(fd[0]), 0);
+    for (size_t r : rows) inRows[r] = 1;
+    std::vector<size_t> faces;
+    std::vector<float> values;
+    size_t next = 0, q = 0;  // the region's next row, and its next face
+    auto takeRegionUpTo = [&](size_t limit) {
+      for (; next < held.size(); ++next, q = 0) {
+        for (; q < held[next].size(); ++q) {
+          if (held[next][q].first >= limit) return;
+          faces.push_back(held[next][q].first);
+          values.push_back(held[next][q].second);
+        }
+      }
+    };
+    for (size_t j = 0; j < fixedFaces[a].size(); ++j) {
+      const size_t i = fixedFaces[a][j], x = i % size_t(fd[0]);
+      if (inRows[i / size_t(fd[0])] && int(x) >= flo[0] && int(x) < fhi[0]) continue;
+      takeRegionUpTo(i);
+      faces.push_back(i);
+      values.push_back(fixedValues[a][j]);
+    }
+    takeRegionUpTo(SIZE_MAX);
+    fixedFaces[a].swap(faces);
+    fixedValues[a].swap(values);
   }
   if (solidFlux.empty()) solidFlux.assign(solid.size(), 0.0);
   if (bodies.moving()) computeSolidFlux(lo, hi);
@@ -57,8 +86,8 @@ void VelocityConstraints<D>::move(const Grid<uint8_t, D>& s, const Grid<uint8_t,
 // Face k (index i) of grid a: held by a wall, an inflow or a solid, and
 // its open fraction.
 template <int D>
-void VelocityConstraints<D>::constrainFace(int a, const IVec<D>& k, size_t i, const Grid<uint8_t, D>& voxel,
-                                           float* value) {
+float VelocityConstraints<D>::constrainFace(int a, const IVec<D>& k, size_t i, const Grid<uint8_t, D>& voxel,
+                                            float* value) {
   bool boundary = !boundaries.periodic(a) && (k[a] == 0 || k[a] == cells[a]);
   if (boundary) {
     bool high = k[a] == cells[a];
@@ -68,7 +97,7 @@ void VelocityConstraints<D>::constrainFace(int a, const IVec<D>& k, size_t i, co
     } else if (side.kind == BoundaryKind::Inflow) {
       fixed[a][i] = 1;
       double speed = inflowSpeed(a, Layout<D>::face(a, h, cells, periodic()).toWorld(k));
-      value[i] = float(high ? -speed : speed);
+      *value = float(high ? -speed : speed);
     }
   }
   // A face touching a staircase solid cell, or wholly inside a cut
@@ -81,11 +110,11 @@ void VelocityConstraints<D>::constrainFace(int a, const IVec<D>& k, size_t i, co
   IVec<D> same = k;  // on a periodic axis face n is face 0
   if (boundaries.periodic(a) && same[a] == cells[a]) same[a] = 0;
   float o = solidLo || solidHi ? 0.0f : cut.empty() ? 1.0f : openFraction<D>(cut, a, same, h);
-  open[a].at(i) = o;
   if (o == 0.0f) {
     fixed[a][i] = 1;
-    value[i] = bodies.moving() ? float(bodies.velocity(facePosition(a, k).data())[size_t(a)]) : 0.0f;
+    *value = bodies.moving() ? float(bodies.velocity(facePosition(a, k).data())[size_t(a)]) : 0.0f;
   }
+  return o;
 }
 
 template <int D>

@@ -69,7 +69,8 @@ struct VelocityConstraints {
             const CutSurface& bodies, const IVec<D>& lo, const IVec<D>& hi);
 
  private:
-  void constrainFace(int a, const IVec<D>& k, size_t i, const Grid<uint8_t, D>& voxel, float* value);
+  // Face k (index i) of grid a: its fixed flag and *value set, its open fraction returned.
+  float constrainFace(int a, const IVec<D>& k, size_t i, const Grid<uint8_t, D>& voxel, float* value);
   void listFixed(int a, const std::vector<float>& value);
   void computeSolidFlux(const IVec<D>& lo, const IVec<D>& hi);
 };

@@ -12,7 +12,8 @@ namespace {
 
 // Rows [lo, hi) (unknown coordinates) of component a's system: each
 // unknown's couplings, and the terms walls, prescribed faces and cut
-// obstacles add (written into dense fields).
+// obstacles add (written in place while dense; a compact system's rows
+// are written again without a pass over the rest: core/row_field.h).
 template <int D>
 void viscousRows(ViscousSystem<D>* system, const VelocityConstraints<D>& vc, int a, const IVec<D>& lo,
                  const IVec<D>& hi) {
@@ -20,88 +21,74 @@ void viscousRows(ViscousSystem<D>* system, const VelocityConstraints<D>& vc, int
   const std::array<bool, D> periodic = vc.periodic();
   const Grid<uint8_t, D>& fixed = vc.fixed[a];
   // With cut obstacles, the distance to them at the faces a cut obstacle
-  // closes in part (the only ones whose centre can lie inside), within one
-  // face of the rows; +infinity (outside) elsewhere.
+  // closes in part (the only ones whose centre can lie inside); +infinity
+  // (outside) elsewhere.
   const bool cut = !vc.cut.empty();
   auto distance = [&](const IVec<D>& k) { return float(vc.cut.distance(vc.facePosition(a, k).data())); };
-  Grid<float, D> phi;
-  if (cut) {
-    phi = Grid<float, D>(fixed.dims(), std::numeric_limits<float>::infinity());
-    IVec<D> plo, phiExtent;
-    for (int b = 0; b < D; ++b) {
-      plo[b] = std::max(lo[b] - 1, 0);
-      phiExtent[b] = std::min(hi[b] + 1, fixed.dims()[b]) - plo[b];
-    }
-    forEachCell<D>(phiExtent, [&](const IVec<D>& r, size_t) {
-      const IVec<D> k = plo + r;
-      if (vc.open[a](k) < 1.0f) phi(k) = distance(k);
-    });
-    for (int b = 0; b < D; ++b)  // the wrapped neighbours of a periodic axis's first and last faces
-      if (periodic[size_t(b)]) {
-        IVec<D> layer = fixed.dims();
-        layer[b] = 1;
-        forEachCell<D>(layer, [&](const IVec<D>& r, size_t) {
-          for (int edge : {0, C.dims[b] - 1}) {
-            IVec<D> k = r;
-            k[b] = edge;
-            if (vc.open[a](k) < 1.0f) phi(k) = distance(k);
-          }
-        });
+  auto phi = [&](const IVec<D>& k) {
+    return vc.open[a](k) < 1.0f ? distance(k) : std::numeric_limits<float>::infinity();
+  };
+  if (cut && C.insideCut.size() != C.A.size()) C.insideCut.assign(C.A.size(), 0);
+  std::array<RowField<D>*, D + 2> fields;
+  for (int bx = 0; bx < D; ++bx) fields[size_t(bx)] = &C.A.w[bx];
+  fields[D] = &C.cBoundary;
+  fields[D + 1] = &C.boundaryRhs;
+  rewriteRows<D, D + 2>(fields, rowsOf<D>(C.dims, lo, hi), [&](size_t row, const std::array<float*, D + 2>& v) {
+    IVec<D> k = latticeCoord<D>(C.dims, row * size_t(C.dims[0]));
+    for (k[0] = lo[0]; k[0] < hi[0]; ++k[0]) {
+      const int x = k[0];
+      const size_t i = C.A.c.index(k);
+      for (int bx = 0; bx < D; ++bx) v[size_t(bx)][x] = 0.0f;
+      if (cut) C.insideCut[i] = 0;
+      v[D + 1][x] = 0.0f;
+      const size_t gi = fixed.index(k);
+      if (fixed[gi] || (cut && phi(k) < 0.0f)) {
+        if (!fixed[gi]) C.insideCut[i] = 1;
+        v[D][x] = -1.0f;
+        continue;
       }
-    if (C.insideCut.size() != C.A.size()) C.insideCut.assign(C.A.size(), 0);
-  }
-  forEachCell<D>(hi - lo, [&](const IVec<D>& r, size_t) {
-    const IVec<D> k = lo + r;
-    const size_t i = C.A.c.index(k);
-    for (int bx = 0; bx < D; ++bx) C.A.w[bx].at(i) = 0.0f;
-    if (cut) C.insideCut[i] = 0;
-    C.boundaryRhs.at(i) = 0.0f;
-    const size_t gi = fixed.index(k);
-    if (fixed[gi] || (cut && phi[gi] < 0.0f)) {
-      if (!fixed[gi]) C.insideCut[i] = 1;
-      C.cBoundary.at(i) = -1.0f;
-      return;
-    }
-    double c = 0.0, extra = 0.0;
-    for (int bx = 0; bx < D; ++bx) {
-      for (int dir = -1; dir <= 1; dir += 2) {
-        IVec<D> nb = k;
-        nb[bx] += dir;
-        if (nb[bx] < 0 || nb[bx] >= C.dims[bx]) {
-          if (periodic[size_t(bx)]) {
-            nb[bx] = (nb[bx] + C.dims[bx]) % C.dims[bx];
-          } else {
-            if (bx == a) continue;  // an outflow face: zero gradient
-            const DomainSide& side = vc.boundaries.side(bx, dir > 0);
-            if (side.kind == BoundaryKind::Outflow) continue;
-            // Ghost mirrored about the wall: u_g = 2 u_wall - u.
-            double uw = side.kind == BoundaryKind::Wall ? side.wallVelocity[size_t(a)] : 0.0;
-            c += 2.0;
-            extra += 2.0 * uw;
-            continue;
+      double c = 0.0, extra = 0.0;
+      for (int bx = 0; bx < D; ++bx) {
+        for (int dir = -1; dir <= 1; dir += 2) {
+          IVec<D> nb = k;
+          nb[bx] += dir;
+          if (nb[bx] < 0 || nb[bx] >= C.dims[bx]) {
+            if (periodic[size_t(bx)]) {
+              nb[bx] = (nb[bx] + C.dims[bx]) % C.dims[bx];
+            } else {
+              if (bx == a) continue;  // an outflow face: zero gradient
+              const DomainSide& side = vc.boundaries.side(bx, dir > 0);
+              if (side.kind == BoundaryKind::Outflow) continue;
+              // Ghost mirrored about the wall: u_g = 2 u_wall - u.
+              double uw = side.kind == BoundaryKind::Wall ? side.wallVelocity[size_t(a)] : 0.0;
+              c += 2.0;
+              extra += 2.0 * uw;
+              continue;
+            }
+          }
+          const size_t ni = fixed.index(nb);
+          const float phiNb = cut ? phi(nb) : 0.0f;
+          if (cut && phiNb < 0.0f) {
+            // Gibou et al. 2002: the obstacle's velocity at the surface, a
+            // fraction theta of the way to the neighbour.
+            const double theta = cutTheta(distance(k), phiNb);
+            c += 1.0 / theta;
+            if (vc.bodies.moving()) {
+              std::array<double, 3> xs = vc.facePosition(a, k);
+              xs[size_t(bx)] += dir * theta * vc.h;
+              extra += vc.bodies.velocity(xs.data())[size_t(a)] / theta;
+            }
+          } else if (fixed[ni]) {
+            c += 1.0;
+            extra += double(vc.prescribed(a, ni));
+          } else if (dir > 0) {
+            v[size_t(bx)][x] = 1.0f;
           }
         }
-        size_t ni = fixed.index(nb);
-        if (cut && phi[ni] < 0.0f) {
-          // Gibou et al. 2002: the obstacle's velocity at the surface, a
-          // fraction theta of the way to the neighbour.
-          const double theta = cutTheta(distance(k), phi[ni]);
-          c += 1.0 / theta;
-          if (vc.bodies.moving()) {
-            std::array<double, 3> x = vc.facePosition(a, k);
-            x[size_t(bx)] += dir * theta * vc.h;
-            extra += vc.bodies.velocity(x.data())[size_t(a)] / theta;
-          }
-        } else if (fixed[ni]) {
-          c += 1.0;
-          extra += double(vc.prescribed(a, ni));
-        } else if (dir > 0) {
-          C.A.w[bx].at(i) = 1.0f;
-        }
       }
+      v[D][x] = float(c);  // whole: 2 per wall ghost, 1 per prescribed neighbour, 1/theta per cut one
+      v[D + 1][x] = float(extra);
     }
-    C.cBoundary.at(i) = float(c);  // whole: 2 per wall ghost, 1 per prescribed neighbour, 1/theta per cut one
-    C.boundaryRhs.at(i) = float(extra);
   });
 }
 
@@ -127,9 +114,6 @@ ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
 template <int D>
 void updateViscousSystem(ViscousSystem<D>* C, const VelocityConstraints<D>& vc, int a, const IVec<D>& lo,
                          const IVec<D>& hi) {
-  C->cBoundary.densify();
-  C->boundaryRhs.densify();
-  for (int b = 0; b < D; ++b) C->A.w[b].densify();
   viscousRows<D>(C, vc, a, lo, hi);
   C->cBoundary.compact();
   C->boundaryRhs.compact();

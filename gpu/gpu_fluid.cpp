@@ -171,7 +171,7 @@ void GpuFluid<D>::placeObstacles(double t, bool fill) {
   IVec<D> lo, hi;
   if (!placement_.moveTo(t, &vc_, &lo, &hi)) return;
   grid_.refresh(vc_);
-  projection_.rebuild(vc_);
+  projection_.rebuild(vc_, lo, hi);
   if (settings_.viscosity > 0) viscosity_.rebuild(vc_, lo, hi);  // (an inviscid fluid never solves it)
   if (smoke_) smoke_->setSolid(vc_.solid);
   if (!fill) return;

@@ -44,8 +44,8 @@ GpuProjection<D>::GpuProjection(const VelocityConstraints<D>& vc, GpuMacGrid<D>*
 // As PressureProjection::rebuild: the system and its levels again, and no
 // pressure in the cells the solid covers.
 template <int D>
-void GpuProjection<D>::rebuild(const VelocityConstraints<D>& vc) {
-  P_ = pressureSystem<D>(vc);
+void GpuProjection<D>::rebuild(const VelocityConstraints<D>& vc, const IVec<D>& lo, const IVec<D>& hi) {
+  updatePressureSystem<D>(&P_, vc, lo, hi);
   levels_->refresh();
   A_->update(P_);
   multigrid_->update(*levels_);

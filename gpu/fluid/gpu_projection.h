@@ -34,8 +34,8 @@ class GpuProjection {
   // solve's result is the last tally's (tally(): one host wait).
   SolverResult project(double dt, const SolverOptions& options);
   SolverResult tally();
-  // The constraints changed (a moving obstacle): the system and its levels follow.
-  void rebuild(const VelocityConstraints<D>& vc);
+  // The constraints changed in the cells [lo, hi) (a moving obstacle): the system and its levels follow.
+  void rebuild(const VelocityConstraints<D>& vc, const IVec<D>& lo, const IVec<D>& hi);
   std::vector<double> phi() const;  // p = rho phi / dt
   double lastDt() const { return lastDt_; }
   void save(StateWriter* out) const;  // phi, the rate before and the clock of the warm start

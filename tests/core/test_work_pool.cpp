@@ -98,5 +98,47 @@ TEST(RowField, KeepsDistinctRowsAndReadsBackTheDenseValues) {
   }
 }
 
+// A compact field's rows written again (a moving obstacle's few rows) read
+// back as the dense field written the same way; a row that comes out as it
+// was keeps its stored row, equal new rows share one, and rows no row uses
+// any more do not pile up over many rewrites.
+TEST(RowField, RowsWrittenAgainReadAsTheDenseFieldAndStayCompact) {
+  const IVec<3> dims(16, 12, 10);
+  RowField<3> f(dims, 1.0f), g(dims, 2.0f);
+  RowField<3> dense(dims, 1.0f), denseG(dims, 2.0f);
+  f.compact();
+  g.compact();
+  for (int step = 0; step < 40; ++step) {
+    // a ball of radius 3 moving along x, y and z: its rows, its cells set to 0 (f) and to their x (g)
+    const IVec<3> was(3 + (step + 9) % 10, 3 + (step + 5) % 6, 3 + (step + 3) % 4);
+    const IVec<3> centre(3 + step % 10, 3 + step % 6, 3 + step % 4);
+    IVec<3> lo, hi;  // the cells that held or hold it
+    for (int a = 0; a < 3; ++a) lo[a] = std::min(was[a], centre[a]) - 3, hi[a] = std::max(was[a], centre[a]) + 4;
+    auto write = [&](size_t r, const std::array<float*, 2>& v) {
+      IVec<3> k = latticeCoord<3>(dims, r * size_t(dims[0]));
+      for (k[0] = lo[0]; k[0] < hi[0]; ++k[0]) {
+        const IVec<3> d = k - centre;
+        const bool inside = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] <= 9;
+        v[0][k[0]] = inside ? 0.0f : 1.0f;
+        v[1][k[0]] = inside ? float(k[0]) : 2.0f;
+      }
+    };
+    const std::vector<size_t> rows = rowsOf<3>(dims, lo, hi);
+    rewriteRows<3, 2>({&f, &g}, rows, write);
+    rewriteRows<3, 2>({&dense, &denseG}, rows, write);
+    ASSERT_EQ(f.expanded(), dense.expanded()) << "step " << step;
+    ASSERT_EQ(g.expanded(), denseG.expanded()) << "step " << step;
+    EXPECT_FALSE(f.dense());
+    // in use: at most the ball's 49 rows and the uniform row; unused ones are
+    // dropped before they outnumber them, with one step's new rows on top
+    EXPECT_LE(f.storedRows(), 2u * 50u + 49u) << "step " << step;
+  }
+  // A rewrite that changes nothing keeps every stored row.
+  const size_t stored = f.storedRows();
+  rewriteRows<3, 1>({&f}, rowsOf<3>(dims, IVec<3>(0), dims), [](size_t, const std::array<float*, 1>&) {});
+  EXPECT_EQ(f.storedRows(), stored);
+  EXPECT_TRUE(rowsOf<3>(dims, IVec<3>(2), IVec<3>(2)).empty());
+}
+
 }  // namespace
 }  // namespace morphoflow
