@@ -1,6 +1,7 @@
 #include "fluid/velocity_constraints.h"
 
 #include <algorithm>
+#include <cstdint>
 
 #include "core/parallel.h"
 
@@ -53,34 +54,41 @@ void VelocityConstraints<D>::move(const Grid<uint8_t, D>& s, const Grid<uint8_t,
         if (fixed[a][i]) held[k].emplace_back(i, value);
       }
     });
-    // The list less the region's faces, merged with the region's (both ascending).
-    std::vector<uint8_t> inRows(fixed[a].size() / size_t(fd[0]), 0);
-    for (size_t r : rows) inRows[r] = 1;
-    std::vector<size_t> faces;
-    std::vector<float> values;
-    size_t next = 0, q = 0;  // the region's next row, and its next face
-    auto takeRegionUpTo = [&](size_t limit) {
-      for (; next < held.size(); ++next, q = 0) {
-        for (; q < held[next].size(); ++q) {
-          if (held[next][q].first >= limit) return;
-          faces.push_back(held[next][q].first);
-          values.push_back(held[next][q].second);
-        }
-      }
-    };
-    for (size_t j = 0; j < fixedFaces[a].size(); ++j) {
-      const size_t i = fixedFaces[a][j], x = i % size_t(fd[0]);
-      if (inRows[i / size_t(fd[0])] && int(x) >= flo[0] && int(x) < fhi[0]) continue;
-      takeRegionUpTo(i);
-      faces.push_back(i);
-      values.push_back(fixedValues[a][j]);
-    }
-    takeRegionUpTo(SIZE_MAX);
-    fixedFaces[a].swap(faces);
-    fixedValues[a].swap(values);
+    relistFixed(a, rows, flo[0], fhi[0], held);
   }
   if (solidFlux.empty()) solidFlux.assign(solid.size(), 0.0);
   if (bodies.moving()) computeSolidFlux(lo, hi);
+}
+
+// Grid a's prescribed faces: the list less the faces x in [xlo, xhi) of
+// `rows`, merged with `held`, theirs row by row (both ascending).
+template <int D>
+void VelocityConstraints<D>::relistFixed(int a, const std::vector<size_t>& rows, int xlo, int xhi,
+                                         const std::vector<std::vector<std::pair<size_t, float>>>& held) {
+  const size_t nx = size_t(fixed[a].dims()[0]);
+  std::vector<uint8_t> inRows(fixed[a].size() / nx, 0);
+  for (size_t r : rows) inRows[r] = 1;
+  std::vector<size_t> faces;
+  std::vector<float> values;
+  size_t next = 0, q = 0;  // the region's next row, and its next face
+  auto takeRegionUpTo = [&](size_t limit) {
+    for (; next < held.size(); ++next, q = 0)
+      for (; q < held[next].size(); ++q) {
+        if (held[next][q].first >= limit) return;
+        faces.push_back(held[next][q].first);
+        values.push_back(held[next][q].second);
+      }
+  };
+  for (size_t j = 0; j < fixedFaces[a].size(); ++j) {
+    const size_t i = fixedFaces[a][j], x = i % nx;
+    if (inRows[i / nx] && int(x) >= xlo && int(x) < xhi) continue;
+    takeRegionUpTo(i);
+    faces.push_back(i);
+    values.push_back(fixedValues[a][j]);
+  }
+  takeRegionUpTo(SIZE_MAX);
+  fixedFaces[a].swap(faces);
+  fixedValues[a].swap(values);
 }
 
 // Face k (index i) of grid a: held by a wall, an inflow or a solid, and

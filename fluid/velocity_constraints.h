@@ -72,6 +72,8 @@ struct VelocityConstraints {
   // Face k (index i) of grid a: its fixed flag and *value set, its open fraction returned.
   float constrainFace(int a, const IVec<D>& k, size_t i, const Grid<uint8_t, D>& voxel, float* value);
   void listFixed(int a, const std::vector<float>& value);
+  void relistFixed(int a, const std::vector<size_t>& rows, int xlo, int xhi,
+                   const std::vector<std::vector<std::pair<size_t, float>>>& held);
   void computeSolidFlux(const IVec<D>& lo, const IVec<D>& hi);
 };
 
