@@ -100,8 +100,14 @@ void RowField<D>::storeRows(const std::vector<size_t>& rows, std::vector<float>*
 
 template <int D>
 std::vector<float> RowField<D>::expanded() const {
-  std::vector<float> out(size_);
-  parallelFor(rowOf_.size(), [&](size_t r) { std::memcpy(out.data() + r * nx_, row(r), nx_ * sizeof(float)); }, 64);
+  return expandedRows(0, rowOf_.size());
+}
+
+template <int D>
+std::vector<float> RowField<D>::expandedRows(size_t begin, size_t end) const {
+  std::vector<float> out((end - begin) * nx_);
+  parallelFor(
+      end - begin, [&](size_t r) { std::memcpy(out.data() + r * nx_, row(begin + r), nx_ * sizeof(float)); }, 64);
   return out;
 }
 

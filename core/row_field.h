@@ -106,8 +106,9 @@ class RowField {
   void transform(F&& f) {
     for (float& v : pool_) v = f(v);
   }
-  // Every value, in grid order (a GPU upload's copy).
+  // Every value, in grid order (a GPU upload's copy); those of rows [begin, end).
   std::vector<float> expanded() const;
+  std::vector<float> expandedRows(size_t begin, size_t end) const;
   // Rows stored (the footprint is storedRows() * nx floats plus 4 bytes a row).
   size_t storedRows() const { return pool_.size() / (nx_ ? nx_ : 1); }
 
@@ -149,6 +150,11 @@ std::vector<size_t> rowsOf(const IVec<D>& dims, const IVec<D>& lo, const IVec<D>
   for (int z = zlo; z < zhi; ++z)
     for (int y = lo[1]; y < hi[1]; ++y) rows.push_back(size_t(y) + (D == 3 ? size_t(z) * size_t(dims[1]) : 0));
   return rows;
+}
+
+// The rows [first, last] of `rows` (ascending), as [begin, end); {0, 0} when there are none.
+inline std::pair<size_t, size_t> rowSpan(const std::vector<size_t>& rows) {
+  return rows.empty() ? std::pair<size_t, size_t>{0, 0} : std::pair<size_t, size_t>{rows.front(), rows.back() + 1};
 }
 
 // Rows `rows` of fields of one shape written again: write(r, v) changes

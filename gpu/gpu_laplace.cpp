@@ -45,9 +45,15 @@ void GpuLaplace::update(const AnisotropicSystem<D>& A) {
 
 template <int D>
 void GpuLaplace::update(const LaplaceSystem<D>& A) {
-  for (int a = 0; a < D; ++a) w_[size_t(a)].upload(A.w[a].expanded());
-  diag_.upload(A.diag.expanded());
-  c_.upload(A.c.expanded());
+  update(A, 0, A.size() / size_t(A.dims[0]));
+}
+
+template <int D>
+void GpuLaplace::update(const LaplaceSystem<D>& A, size_t rowBegin, size_t rowEnd) {
+  const size_t at = rowBegin * size_t(A.dims[0]) * sizeof(float);
+  for (int a = 0; a < D; ++a) w_[size_t(a)].upload(A.w[a].expandedRows(rowBegin, rowEnd), at);
+  diag_.upload(A.diag.expandedRows(rowBegin, rowEnd), at);
+  c_.upload(A.c.expandedRows(rowBegin, rowEnd), at);
   scale_ = A.scale;
   singular_ = A.singular();
 }
@@ -201,6 +207,8 @@ template GpuLaplace::GpuLaplace(const LaplaceSystem<2>&);
 template GpuLaplace::GpuLaplace(const LaplaceSystem<3>&);
 template void GpuLaplace::update(const LaplaceSystem<2>&);
 template void GpuLaplace::update(const LaplaceSystem<3>&);
+template void GpuLaplace::update(const LaplaceSystem<2>&, size_t, size_t);
+template void GpuLaplace::update(const LaplaceSystem<3>&, size_t, size_t);
 template GpuLaplace::GpuLaplace(const AnisotropicSystem<2>&);
 template GpuLaplace::GpuLaplace(const AnisotropicSystem<3>&);
 template void GpuLaplace::update(const AnisotropicSystem<2>&);

@@ -50,9 +50,12 @@ class GpuLaplace {
   // the axis part: the preconditioner is the axis part's, as on the CPU).
   template <int D>
   explicit GpuLaplace(const AnisotropicSystem<D>& A);
-  // The system's coefficients changed, not its shape.
+  // The system's coefficients changed, not its shape (only in the rows
+  // [rowBegin, rowEnd) along x: the rest is not uploaded again).
   template <int D>
   void update(const LaplaceSystem<D>& A);
+  template <int D>
+  void update(const LaplaceSystem<D>& A, size_t rowBegin, size_t rowEnd);
   template <int D>
   void update(const AnisotropicSystem<D>& A);
 

@@ -10,20 +10,6 @@
 
 namespace morphoflow {
 
-namespace {
-// The constraints' per-face arrays, component after component: the fixed flags, values and open fractions.
-template <int D>
-void faceArrays(const VelocityConstraints<D>& vc, std::vector<uint32_t>* flags, std::vector<float>* values,
-                std::vector<float>* fractions) {
-  for (int a = 0; a < D; ++a) {
-    flags->insert(flags->end(), vc.fixed[a].values().begin(), vc.fixed[a].values().end());
-    const std::vector<float> v = vc.prescribedGrid(a), o = vc.open[a].expanded();
-    values->insert(values->end(), v.begin(), v.end());
-    fractions->insert(fractions->end(), o.begin(), o.end());
-  }
-}
-}  // namespace
-
 template <int D>
 GpuMacGrid<D>::GpuMacGrid(const VelocityConstraints<D>& vc) : h(vc.h), cut(!vc.cut.empty() || vc.bodies.moving()) {
   cellCount = 1;
@@ -37,33 +23,46 @@ GpuMacGrid<D>::GpuMacGrid(const VelocityConstraints<D>& vc) : h(vc.h), cut(!vc.c
     faceCount += faces(a);
     maxGrid = std::max(maxGrid, faces(a));
   }
-  std::vector<uint32_t> flags;
-  std::vector<float> values, fractions;
-  faceArrays<D>(vc, &flags, &values, &fractions);
-  open = cut ? GpuBuffer::of(fractions) : GpuBuffer(sizeof(float));  // (read for cut obstacles only)
+  open = GpuBuffer((cut ? faceCount : 1) * sizeof(float));  // (read for cut obstacles only)
   vel = GpuBuffer(faceCount * sizeof(float));
   velScratch = GpuBuffer(faceCount * sizeof(float));
   vel.zero();
   velScratch.zero();
-  fixed = GpuBuffer::of(flags);
-  value = GpuBuffer::of(values);
-  solid = GpuBuffer::of(std::vector<uint32_t>(vc.solid.values().begin(), vc.solid.values().end()));
+  fixed = GpuBuffer(faceCount * sizeof(uint32_t));
+  value = GpuBuffer(faceCount * sizeof(float));
+  solid = GpuBuffer(cellCount * sizeof(uint32_t));
   if (vc.bodies.moving()) solidFlux = GpuBuffer(cellCount * sizeof(double));
   refresh(vc);
 }
 
 template <int D>
 void GpuMacGrid<D>::refresh(const VelocityConstraints<D>& vc) {
-  std::vector<uint32_t> flags;
-  std::vector<float> values, fractions;
-  faceArrays<D>(vc, &flags, &values, &fractions);
-  fixed.upload(flags);
-  value.upload(values);
-  if (cut) open.upload(fractions);
-  solid.upload(std::vector<uint32_t>(vc.solid.values().begin(), vc.solid.values().end()));
+  refresh(vc, IVec<D>(0), vc.cells);
+}
+
+// The rows that hold the faces of the cells [lo, hi), and those cells, uploaded again.
+template <int D>
+void GpuMacGrid<D>::refresh(const VelocityConstraints<D>& vc, const IVec<D>& lo, const IVec<D>& hi) {
+  for (int a = 0; a < D; ++a) {
+    const IVec<D>& fd = vc.fixed[a].dims();
+    const auto [r0, r1] = rowSpan(rowsOf<D>(fd, lo, hi + unitVector<D>(a)));
+    const size_t b = r0 * size_t(fd[0]), e = r1 * size_t(fd[0]), at = (off[size_t(a)] + b) * sizeof(float);
+    const std::vector<uint8_t>& flags = vc.fixed[a].values();
+    fixed.upload(std::vector<uint32_t>(flags.begin() + ptrdiff_t(b), flags.begin() + ptrdiff_t(e)), at);
+    std::vector<float> v(e - b, 0.0f);  // the prescribed values (0 elsewhere)
+    const std::vector<size_t>& held = vc.fixedFaces[size_t(a)];
+    for (auto it = std::lower_bound(held.begin(), held.end(), b); it != held.end() && *it < e; ++it)
+      v[*it - b] = vc.fixedValues[size_t(a)][size_t(it - held.begin())];
+    value.upload(v, at);
+    if (cut) open.upload(vc.open[a].expandedRows(r0, r1), at);
+  }
+  const auto [r0, r1] = rowSpan(rowsOf<D>(vc.cells, lo, hi));
+  const size_t b = r0 * size_t(vc.cells[0]), e = r1 * size_t(vc.cells[0]);
+  const std::vector<uint8_t>& s = vc.solid.values();
+  solid.upload(std::vector<uint32_t>(s.begin() + ptrdiff_t(b), s.begin() + ptrdiff_t(e)), b * sizeof(uint32_t));
   if (solidFlux.bytes()) {
     if (vc.solidFlux.empty()) solidFlux.zero();
-    else solidFlux.upload(vc.solidFlux);
+    else solidFlux.upload(vc.solidFlux.data() + b, (e - b) * sizeof(double), b * sizeof(double));
   }
 }
 

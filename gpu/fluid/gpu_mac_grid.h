@@ -28,8 +28,10 @@ inline constexpr GpuPrecision kPhiPrecision = GpuPrecision::Double;
 template <int D>
 struct GpuMacGrid {
   explicit GpuMacGrid(const VelocityConstraints<D>& vc);
-  // The constraints changed (a moving obstacle), not the grid: their flags, values, fractions and solid flux again.
+  // The constraints changed (a moving obstacle), not the grid: their flags,
+  // values, fractions and solid flux again (only for the faces of the cells [lo, hi)).
   void refresh(const VelocityConstraints<D>& vc);
+  void refresh(const VelocityConstraints<D>& vc, const IVec<D>& lo, const IVec<D>& hi);
 
   size_t faces(int a) const;                   // the faces of component a
   std::array<int, 3> velocityOffsets() const;  // the components' offsets in the velocity buffer (uniform velOff)

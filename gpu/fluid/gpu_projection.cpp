@@ -16,10 +16,12 @@ namespace morphoflow {
 namespace {
 // The cells without a pressure: 1, or 2 where they lie inside a solid (a moving one's phi is cleared there).
 template <int D>
-std::vector<uint32_t> inactiveCells(const LaplaceSystem<D>& P, const VelocityConstraints<D>& vc) {
-  const std::vector<float> diag = P.diag.expanded();
+std::vector<uint32_t> inactiveCells(const LaplaceSystem<D>& P, const VelocityConstraints<D>& vc, size_t rowBegin,
+                                    size_t rowEnd) {
+  const std::vector<float> diag = P.diag.expandedRows(rowBegin, rowEnd);
+  const size_t first = rowBegin * size_t(P.dims[0]);
   std::vector<uint32_t> inactive(diag.size());
-  for (size_t i = 0; i < diag.size(); ++i) inactive[i] = diag[i] != 0.0f ? 0u : vc.solid[i] ? 2u : 1u;
+  for (size_t i = 0; i < diag.size(); ++i) inactive[i] = diag[i] != 0.0f ? 0u : vc.solid[first + i] ? 2u : 1u;
   return inactive;
 }
 }  // namespace
@@ -29,7 +31,7 @@ GpuProjection<D>::GpuProjection(const VelocityConstraints<D>& vc, GpuMacGrid<D>*
                                 std::shared_ptr<GpuPcgWork> work)
     : grid_(*grid), real_(real), P_(pressureSystem<D>(vc)) {
   // The CPU's system and multigrid levels (kept on the host to follow a moving obstacle).
-  inactive_ = GpuBuffer::of(inactiveCells<D>(P_, vc));
+  inactive_ = GpuBuffer::of(inactiveCells<D>(P_, vc, 0, P_.size() / size_t(P_.dims[0])));
   A_ = std::make_unique<GpuLaplace>(P_);
   A_->setPrecision(real_, kPhiPrecision);
   levels_ = std::make_unique<Multigrid<D>>(P_);
@@ -47,9 +49,13 @@ template <int D>
 void GpuProjection<D>::rebuild(const VelocityConstraints<D>& vc, const IVec<D>& lo, const IVec<D>& hi) {
   updatePressureSystem<D>(&P_, vc, lo, hi);
   levels_->refresh();
-  A_->update(P_);
+  // The rows whose weights, c or diagonal can have changed (a margin of two cells), uploaded again.
+  IVec<D> clo, chi;
+  for (int a = 0; a < D; ++a) clo[a] = std::max(lo[a] - 2, 0), chi[a] = std::min(hi[a] + 2, vc.cells[a]);
+  const auto [r0, r1] = rowSpan(rowsOf<D>(vc.cells, clo, chi));
+  A_->update(P_, r0, r1);
   multigrid_->update(*levels_);
-  inactive_.upload(inactiveCells<D>(P_, vc));
+  inactive_.upload(inactiveCells<D>(P_, vc, r0, r1), r0 * size_t(vc.cells[0]) * sizeof(uint32_t));
   run(FluidOp::ClearPhi, 0, grid_.cellCount, 0.0);
 }
 

@@ -40,24 +40,35 @@ GpuViscosity<D>::GpuViscosity(const VelocityConstraints<D>& vc, GpuMacGrid<D>* g
   for (auto& c : components_) c->pcg = std::make_unique<GpuPcg>(*c->A, work_);
   b_ = realBuffer(most, real_);
   x_ = realBuffer(most, real_);
-  if (grid_.cut) held_ = GpuBuffer::of(heldFaces(vc));  // the viscosity holds the faces inside cut obstacles too
+  if (grid_.cut) {  // the viscosity holds the faces inside cut obstacles too
+    held_ = GpuBuffer(grid_.faceCount * sizeof(uint32_t));
+    for (int a = 0; a < D; ++a) uploadHeld(vc, a, 0, vc.fixed[a].size() / size_t(vc.fixed[a].dims()[0]));
+  }
 }
 
-// The faces the viscous solves hold: the prescribed ones and those inside a cut obstacle.
+// The faces of grid a's rows [rowBegin, rowEnd) that the viscous solves
+// hold (the prescribed ones and those inside a cut obstacle), uploaded.
 template <int D>
-std::vector<uint32_t> GpuViscosity<D>::heldFaces(const VelocityConstraints<D>& vc) const {
-  std::vector<uint32_t> held;
-  for (int a = 0; a < D; ++a) held.insert(held.end(), vc.fixed[a].values().begin(), vc.fixed[a].values().end());
-  for (int a = 0; a < D; ++a) {
-    const ViscousSystem<D>& V = components_[size_t(a)]->host;
-    for (size_t i = 0; i < V.insideCut.size(); ++i)
-      if (V.insideCut[i]) held[grid_.off[size_t(a)] + vc.fixed[a].index(latticeCoord<D>(V.dims, i))] = 1u;
-  }
-  return held;
+void GpuViscosity<D>::uploadHeld(const VelocityConstraints<D>& vc, int a, size_t rowBegin, size_t rowEnd) {
+  const Grid<uint8_t, D>& fixed = vc.fixed[a];
+  const ViscousSystem<D>& V = components_[size_t(a)]->host;
+  const size_t nx = size_t(fixed.dims()[0]), first = rowBegin * nx;
+  std::vector<uint32_t> held(fixed.values().begin() + ptrdiff_t(first),
+                             fixed.values().begin() + ptrdiff_t(rowEnd * nx));
+  if (!V.insideCut.empty())
+    for (size_t j = 0; j < held.size(); ++j) {
+      const IVec<D> k = fixed.coord(first + j);
+      bool unknown = true;  // (not the duplicate layer a periodic axis drops)
+      for (int b = 0; b < D; ++b) unknown = unknown && k[b] < V.dims[b];
+      if (unknown && V.insideCut[V.A.c.index(k)]) held[j] = 1u;
+    }
+  held_.upload(held, (grid_.off[size_t(a)] + first) * sizeof(uint32_t));
 }
 
 // As ViscositySolver::rebuild: the rows of the faces of the cells [lo, hi)
-// and of one more layer, and the held faces and boundary terms again.
+// and of one more layer, and the held faces and boundary terms again; the
+// rows that changed are uploaded, at the systems' rate (or whole at the
+// next solve when there is none yet).
 template <int D>
 void GpuViscosity<D>::rebuild(const VelocityConstraints<D>& vc, const IVec<D>& lo, const IVec<D>& hi) {
   for (int a = 0; a < D; ++a) {
@@ -68,11 +79,24 @@ void GpuViscosity<D>::rebuild(const VelocityConstraints<D>& vc, const IVec<D>& l
       uhi[b] = std::min(hi[b] + (b == a ? 2 : 1), c.host.dims[b]);
     }
     updateViscousSystem<D>(&c.host, vc, a, ulo, uhi);
-    const std::vector<float> rhs = c.host.boundaryRhs.expanded();
-    uploadReals(&c.boundaryRhs, std::vector<double>(rhs.begin(), rhs.end()), real_);
+    // The unknowns' rows that changed, and one more layer (the diagonal reads the faces below).
+    IVec<D> plo, phi;
+    for (int b = 0; b < D; ++b) plo[b] = std::max(ulo[b] - 1, 0), phi[b] = std::min(uhi[b] + 1, c.host.dims[b]);
+    const auto [r0, r1] = rowSpan(rowsOf<D>(c.host.dims, plo, phi));
+    const std::vector<float> rhs = c.host.boundaryRhs.expandedRows(r0, r1);  // (the shader reads reals)
+    uploadReals(&c.boundaryRhs, std::vector<double>(rhs.begin(), rhs.end()), real_, r0 * size_t(c.host.dims[0]));
+    if (s_ > 0.0) {
+      c.host.setRate(s_);
+      c.A->update(c.host.A, r0, r1);
+    }
+    if (held_.bytes()) {
+      const IVec<D>& fd = vc.fixed[a].dims();
+      IVec<D> flo, fhi;
+      for (int b = 0; b < D; ++b) flo[b] = std::max(lo[b] - 1, 0), fhi[b] = std::min(hi[b] + 2, fd[b]);
+      const auto [f0, f1] = rowSpan(rowsOf<D>(fd, flo, fhi));
+      uploadHeld(vc, a, f0, f1);
+    }
   }
-  held_.upload(heldFaces(vc));
-  s_ = -1.0;  // (the systems' diagonals follow at the next solve)
 }
 
 template <int D>

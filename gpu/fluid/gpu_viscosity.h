@@ -38,7 +38,7 @@ class GpuViscosity {
  private:
   struct Component;  // a component's host system and boundary terms
   void run(FluidOp mode, int a, double s);
-  std::vector<uint32_t> heldFaces(const VelocityConstraints<D>& vc) const;
+  void uploadHeld(const VelocityConstraints<D>& vc, int a, size_t rowBegin, size_t rowEnd);
   GpuMacGrid<D>& grid_;
   GpuPrecision real_;
   std::array<std::unique_ptr<Component>, D> components_;

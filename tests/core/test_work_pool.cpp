@@ -128,6 +128,10 @@ TEST(RowField, RowsWrittenAgainReadAsTheDenseFieldAndStayCompact) {
     rewriteRows<3, 2>({&dense, &denseG}, rows, write);
     ASSERT_EQ(f.expanded(), dense.expanded()) << "step " << step;
     ASSERT_EQ(g.expanded(), denseG.expanded()) << "step " << step;
+    const auto [r0, r1] = rowSpan(rows);  // the rows a GPU upload takes again
+    const std::vector<float> all = f.expanded();
+    ASSERT_EQ(f.expandedRows(r0, r1),
+              std::vector<float>(all.begin() + ptrdiff_t(r0 * 16), all.begin() + ptrdiff_t(r1 * 16)));
     EXPECT_FALSE(f.dense());
     // in use: at most the ball's 49 rows and the uniform row; unused ones are
     // dropped before they outnumber them, with one step's new rows on top
