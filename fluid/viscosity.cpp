@@ -113,27 +113,24 @@ ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& vc, int a) {
 
 template <int D>
 void updateViscousSystem(ViscousSystem<D>* C, const VelocityConstraints<D>& vc, int a, const IVec<D>& lo,
-                         const IVec<D>& hi) {
-  viscousRows<D>(C, vc, a, lo, hi);
+                         const IVec<D>& hi, IVec<D>* ulo, IVec<D>* uhi) {
+  IVec<D> from, to;
+  for (int b = 0; b < D; ++b) {
+    from[b] = std::max(lo[b] - 1, 0);
+    to[b] = std::min(hi[b] + (b == a ? 2 : 1), C->dims[b]);
+  }
+  viscousRows<D>(C, vc, a, from, to);
   C->cBoundary.compact();
   C->boundaryRhs.compact();
   C->A.finalize();
+  if (ulo) *ulo = from;
+  if (uhi) *uhi = to;
 }
 
 template <int D>
 void ViscositySolver<D>::rebuild(const IVec<D>& lo, const IVec<D>& hi) {
-  for (int a = 0; a < D; ++a) {
-    // The unknowns of the faces of the cells [lo, hi), and one more layer
-    // (their neighbours' rows see them).
-    Component& C = comp_[size_t(a)];
-    IVec<D> ulo, uhi;
-    for (int b = 0; b < D; ++b) {
-      ulo[b] = std::max(lo[b] - 1, 0);
-      uhi[b] = std::min(hi[b] + (b == a ? 2 : 1), C.dims[b]);
-    }
-    // (the solvers refer to C.A, whose coefficients change, not its shape: they refresh at the next solve)
-    updateViscousSystem<D>(&C, vc_, a, ulo, uhi);
-  }
+  // (the solvers refer to C.A, whose coefficients change, not its shape: they refresh at the next solve)
+  for (int a = 0; a < D; ++a) updateViscousSystem<D>(&comp_[size_t(a)], vc_, a, lo, hi);
   s_ = -1.0;
 }
 
@@ -312,9 +309,9 @@ template struct ViscousSystem<2>;
 template struct ViscousSystem<3>;
 template ViscousSystem<2> viscousSystem<2>(const VelocityConstraints<2>&, int);
 template void updateViscousSystem<2>(ViscousSystem<2>*, const VelocityConstraints<2>&, int, const IVec<2>&,
-                                     const IVec<2>&);
+                                     const IVec<2>&, IVec<2>*, IVec<2>*);
 template void updateViscousSystem<3>(ViscousSystem<3>*, const VelocityConstraints<3>&, int, const IVec<3>&,
-                                     const IVec<3>&);
+                                     const IVec<3>&, IVec<3>*, IVec<3>*);
 template ViscousSystem<3> viscousSystem<3>(const VelocityConstraints<3>&, int);
 template class ViscositySolver<2>;
 template class ViscositySolver<3>;

@@ -54,10 +54,12 @@ struct ViscousSystem {
 };
 template <int D>
 ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& constraints, int axis);
-// Its rows of the unknowns [lo, hi) again, from changed constraints.
+// Its rows again where changed constraints touch them: the unknowns of the
+// faces of the cells [lo, hi) and one more layer (their neighbours' rows
+// see them), which it returns in [*ulo, *uhi) when asked.
 template <int D>
 void updateViscousSystem(ViscousSystem<D>* system, const VelocityConstraints<D>& constraints, int axis,
-                         const IVec<D>& lo, const IVec<D>& hi);
+                         const IVec<D>& lo, const IVec<D>& hi, IVec<D>* ulo = nullptr, IVec<D>* uhi = nullptr);
 
 template <int D>
 class ViscositySolver {

@@ -74,11 +74,7 @@ void GpuViscosity<D>::rebuild(const VelocityConstraints<D>& vc, const IVec<D>& l
   for (int a = 0; a < D; ++a) {
     Component& c = *components_[size_t(a)];
     IVec<D> ulo, uhi;
-    for (int b = 0; b < D; ++b) {
-      ulo[b] = std::max(lo[b] - 1, 0);
-      uhi[b] = std::min(hi[b] + (b == a ? 2 : 1), c.host.dims[b]);
-    }
-    updateViscousSystem<D>(&c.host, vc, a, ulo, uhi);
+    updateViscousSystem<D>(&c.host, vc, a, lo, hi, &ulo, &uhi);
     // The unknowns' rows that changed, and one more layer (the diagonal reads the faces below).
     IVec<D> plo, phi;
     for (int b = 0; b < D; ++b) plo[b] = std::max(ulo[b] - 1, 0), phi[b] = std::min(uhi[b] + 1, c.host.dims[b]);
