@@ -5,9 +5,9 @@
 // built for AVX2) and used when the CPU has it. A wide kernel does each
 // lane's arithmetic in the scalar loop's order and without FMA, so both
 // variants give bitwise the same fields: the choice is one of speed only.
-// The 5 x 5 kernel of the fused explicit step also has a sixteen-lane
-// AVX-512 variant (its 25 weights stay in AVX-512's 32 registers), under the
-// same rule. MORPHOFLOW_SIMD=4 in the environment keeps the four-lane
+// The 5 x 5 kernel of the fused explicit step (its 25 weights stay in
+// AVX-512's 32 registers) and the fluid's advection rows also have a
+// sixteen-lane AVX-512 variant, under the same rule. MORPHOFLOW_SIMD=4 in the environment keeps the four-lane
 // kernels, MORPHOFLOW_SIMD=8 the eight-lane ones.
 #pragma once
 
@@ -27,6 +27,9 @@ namespace morphoflow {
 // AVX2 register inside a target("avx2") kernel.
 typedef float vf8 __attribute__((vector_size(32)));
 typedef int vi8 __attribute__((vector_size(32)));
+// Sixteen: one AVX-512 register inside a target("avx512f") kernel.
+typedef float vf16 __attribute__((vector_size(64)));
+typedef int vi16 __attribute__((vector_size(64)));
 
 // True when the CPU (and this build) can run the AVX2 kernels.
 bool cpuHasAvx2();

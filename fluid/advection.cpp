@@ -17,10 +17,10 @@ namespace morphoflow {
 
 namespace {
 
-// Four samples at once (core/simd4.h), or eight in the AVX2 variant
-// (core/simd_dispatch.h): the helpers below take the vector type V (vf4 or
-// vf8) and are always inlined, so inside the AVX2 row kernel they compile
-// for AVX2 too. Used where every axis clamps (walls, inflow, outflow);
+// Four samples at once (core/simd4.h), or eight in the AVX2 variant and
+// sixteen in the AVX-512 one (core/simd_dispatch.h): the helpers below take
+// the vector type V (vf4, vf8 or vf16) and are always inlined, so inside a
+// wide row kernel they compile for its target too. Used where every axis clamps (walls, inflow, outflow);
 // periodic domains take the scalar path. The arithmetic is the scalar
 // path's, operation for operation, so every path gives bitwise the same
 // fields.
@@ -39,6 +39,11 @@ template <>
 struct Lanes<vf8> {
   using I = vi8;
   static constexpr int n = 8;
+};
+template <>
+struct Lanes<vf16> {
+  using I = vi16;
+  static constexpr int n = 16;
 };
 template <class V>
 using IntLanes = typename Lanes<V>::I;
@@ -113,22 +118,46 @@ MF_INLINE V blendCorners(At&& at, size_t sy, size_t sz, const V* t, V* lo = null
   }
 }
 
+// Whether every lane of a comparison's result (-1 or 0 a lane) is set.
+template <class I>
+MF_INLINE bool allLanes(I m) {
+  constexpr int n = sizeof(I) / sizeof(int);
+  long long q[n / 2];
+  std::memcpy(q, &m, sizeof m);
+  long long all = q[0];
+  for (int k = 1; k < n / 2; ++k) all &= q[k];
+  return all == -1;
+}
+
 // interpolate<D> on a vector of positions; lo/hi receive the stencil's min and max.
 template <int D, class V>
 MF_INLINE V vinterpolate(const float* data, const size_t* s, const VTap<V>* tap, V* lo = nullptr, V* hi = nullptr) {
-  IntLanes<V> idx = tap[0].lo + tap[1].lo * int(s[1]);
+  constexpr int n = Lanes<V>::n;
+  using I = IntLanes<V>;
+  I idx = tap[0].lo + tap[1].lo * int(s[1]);
   if constexpr (D == 3) idx += tap[2].lo * int(s[2]);
   V t[D];
   for (int a = 0; a < D; ++a) t[a] = tap[a].t;
   const size_t sy = s[1], sz = D == 3 ? s[D - 1] : 0;
   // Where the lanes' stencils are consecutive cells of one row (a smooth
-  // flow moves neighbours alike), every corner is one contiguous load.
-  bool consecutive = true;
-  for (int k = 1; k < Lanes<V>::n; ++k) consecutive &= idx[k] == idx[0] + k;
-  if (consecutive) {
-    const float* d = data + idx[0];
+  // flow moves neighbours alike), every corner is one contiguous load; where
+  // they are two such runs (the lanes cross a cell boundary, or a row), two
+  // loads and a blend.
+  I lane;
+  for (int k = 0; k < n; ++k) lane[k] = k;
+  const I run = idx - lane, first = I{} + run[0], last = I{} + run[n - 1];
+  const I inFirst = run == first;
+  if (allLanes(inFirst)) {
+    const float* d = data + run[0];
     return blendCorners<D, V>([d](size_t off) __attribute__((always_inline)) { return vload<V>(d + off); }, sy, sz,
                               t, lo, hi);
+  }
+  if (allLanes(inFirst | (run == last))) {
+    const float *d0 = data + run[0], *d1 = data + run[n - 1];
+    return blendCorners<D, V>(
+        [ d0, d1, inFirst ](size_t off)
+            __attribute__((always_inline)) { return inFirst ? vload<V>(d0 + off) : vload<V>(d1 + off); },
+        sy, sz, t, lo, hi);
   }
   return blendCorners<D, V>(
       [ data, idx ](size_t off) __attribute__((always_inline)) { return gather<V>(data + off, idx); }, sy, sz, t, lo,
@@ -277,6 +306,10 @@ template <int D>
 __attribute__((target("avx2"))) int simdRow8(const SimdRow<D>& j, int x) {
   return simdRow<D, vf8>(j, x);
 }
+template <int D>
+__attribute__((target("avx2,avx512f,avx512vl"))) int simdRow16(const SimdRow<D>& j, int x) {
+  return simdRow<D, vf16>(j, x);
+}
 #endif
 
 // The feet of one row of another grid's cell centres (cell size r fluid
@@ -322,6 +355,10 @@ int feetRow4(const FeetRow<D>& j, int x) {
 template <int D>
 __attribute__((target("avx2"))) int feetRow8(const FeetRow<D>& j, int x) {
   return feetRow<D, vf8>(j, x);
+}
+template <int D>
+__attribute__((target("avx2,avx512f,avx512vl"))) int feetRow16(const FeetRow<D>& j, int x) {
+  return feetRow<D, vf16>(j, x);
 }
 #endif
 
@@ -407,7 +444,7 @@ size_t semiLagrangian(const Grid<float, D>& src, const Layout<D>& layout, const 
   const float c = float(dt / u.h());
   const IVec<D> dims = src.dims();
   const bool simd = allClamped<D>(field, vel);
-  [[maybe_unused]] const bool wide = useAvx2();
+  [[maybe_unused]] const bool wide = useAvx2(), wider = useAvx512();
   parallelForRows<D>(dims, [&](size_t row) {
     const size_t base = row * size_t(dims[0]);
     if (uniform && uniform->skip[row]) {
@@ -430,6 +467,7 @@ size_t semiLagrangian(const Grid<float, D>& src, const Layout<D>& layout, const 
       const RowVelocity<D> rv(vel, p, field.axis[0].offset, dims[0]);
       const SimdRow<D> job{field, vel, rv, p, c, dims[0], base, start, dst, lo, hi};
 #if MORPHOFLOW_AVX2_KERNELS
+      if (wider) x = simdRow16<D>(job, x);
       if (wide) x = simdRow8<D>(job, x);
 #endif
       x = simdRow4<D>(job, x);
@@ -559,7 +597,7 @@ bool traceCellFeet(const MacVelocity<D>& u, double dt, const IVec<D>& cells, dou
   // On the velocity's own cells the first velocity needs no gathers.
   bool same = true;
   for (int a = 0; a < D; ++a) same = same && cells[a] == u.cells()[a];
-  [[maybe_unused]] const bool wide = useAvx2();
+  [[maybe_unused]] const bool wide = useAvx2(), wider = useAvx512();
   parallelForRows<D>(cells, [&](size_t row) {
     float p[D], m[D], v[D];
     size_t rest = row;
@@ -574,6 +612,7 @@ bool traceCellFeet(const MacVelocity<D>& u, double dt, const IVec<D>& cells, dou
     for (int a = 0; a < D; ++a) job.out[a] = (*feet)[size_t(a)].data();
     int x = 0;
 #if MORPHOFLOW_AVX2_KERNELS
+    if (wider) x = feetRow16<D>(job, x);
     if (wide) x = feetRow8<D>(job, x);
 #endif
     x = feetRow4<D>(job, x);

@@ -88,14 +88,15 @@ TEST(Advection, CavityAtCfl5StaysBounded) {
   }
 }
 
-// The fast semi-Lagrangian pass (four or eight samples at a time on walled domains,
+// The fast semi-Lagrangian pass (four, eight or sixteen samples at a time on walled domains,
 // the start velocity from contiguous loads inside each row, scalar on
 // periodic ones and at row ends) against the plain definition:
 // foot = x - dt u(x - dt/2 u(x)) traced in double with sampleLinear, then
 // the field sampled there. Odd sizes put cells in every code path.
 template <int D>
 void expectMatchesReferenceTrace(const std::array<bool, D>& periodic, double amplitude) {
-  IVec<D> cells(D == 2 ? 37 : 13);
+  IVec<D> cells(13);
+  cells[0] = 37;  // two groups of sixteen lanes, one of eight and the scalar end
   cells[1] = D == 2 ? 29 : 11;
   const double h = 1.0 / cells[0], dt = 2.5 * h;  // CFL ~ 2.5 amplitude: feet leave the domain
   MacVelocity<D> u(cells, h, periodic);
@@ -128,15 +129,21 @@ void expectMatchesReferenceTrace(const std::array<bool, D>& periodic, double amp
       worst = std::max(worst, std::abs(double(out[i]) - double(sampleLinear(q, layout, foot))));
     }
     EXPECT_LT(worst, 2e-5) << "layout axis " << layoutAxis;  // single against double precision
-    // Eight lanes at a time (where the CPU has AVX2) and four give bitwise
-    // the same fields, the MacCormack pass's stencil bounds included.
+    // Sixteen lanes at a time (where the CPU has AVX-512), eight (AVX2)
+    // and four give bitwise the same fields, the MacCormack pass's stencil
+    // bounds included.
     for (AdvectionScheme scheme : {AdvectionScheme::SemiLagrangian, AdvectionScheme::MacCormack}) {
-      Grid<float, D> wide(dims), narrow(dims);
-      const bool was = useAvx2();
+      Grid<float, D> widest(dims), wide(dims), narrow(dims);
+      const bool was = useAvx2(), was512 = useAvx512();
+      advectField<D>(q, layout, u, dt, scheme, &widest);
+      setUseAvx512(false);
       advectField<D>(q, layout, u, dt, scheme, &wide);
       setUseAvx2(false);
       advectField<D>(q, layout, u, dt, scheme, &narrow);
       setUseAvx2(was);
+      setUseAvx512(was512);
+      EXPECT_EQ(0, std::memcmp(widest.data(), narrow.data(), wide.size() * sizeof(float)))
+          << "layout axis " << layoutAxis;
       EXPECT_EQ(0, std::memcmp(wide.data(), narrow.data(), wide.size() * sizeof(float)))
           << "layout axis " << layoutAxis;
     }
@@ -159,7 +166,7 @@ namespace {
 // The vector kernels' feet (traceCellFeet, single precision) against the
 // double-precision traceBack, from the cell centres of the velocity's own
 // grid and of a finer and a coarser one, in a swirling flow that carries
-// feet out of the domain (clamped) at CFL ~ 3; both vector widths.
+// feet out of the domain (clamped) at CFL ~ 3; every vector width.
 template <int D>
 void checkCellFeet(int n, int gridCells) {
   const double h = 1.0 / n;
@@ -172,12 +179,14 @@ void checkCellFeet(int n, int gridCells) {
     }
   const double dt = 1.0 * h, gh = 1.0 / gridCells;
   const IVec<D> cells(gridCells);
-  const bool wide = useAvx2();
-  for (bool narrow : {false, true}) {
-    if (narrow) setUseAvx2(false);
+  const bool wide = useAvx2(), widest = useAvx512();
+  for (int lanes : {16, 8, 4}) {
+    setUseAvx512(widest && lanes == 16);
+    setUseAvx2(wide && lanes >= 8);
     std::array<std::vector<float>, D> feet;
     const bool done = traceCellFeet<D>(u, dt, cells, gh, &feet);
     setUseAvx2(wide);
+    setUseAvx512(widest);
     ASSERT_TRUE(done);
     double worst = 0.0, moved = 0.0;
     for (size_t k = 0; k < feet[0].size(); ++k) {  // cells in row order
@@ -195,7 +204,7 @@ void checkCellFeet(int n, int gridCells) {
       }
     }
     EXPECT_GT(moved, 1.0) << "the flow moves feet by cells";
-    EXPECT_LT(worst, 1e-4) << D << "D, " << n << " fluid cells, " << gridCells << " grid cells, narrow " << narrow;
+    EXPECT_LT(worst, 1e-4) << D << "D, " << n << " fluid cells, " << gridCells << " grid cells, " << lanes << " lanes";
   }
 }
 
