@@ -14,6 +14,9 @@ namespace {
 
 template <int D>
 constexpr size_t kPacked = 2 * D + 1;  // floats per cell outside a uniform span
+// A cyclic round ends within about 1.25 of the full iteration's residual
+// (tests/core/test_chebyshev.cpp): its steps are asked for this much more.
+constexpr double kCyclicMargin = 1.3;
 
 // The interval [1 - rho, 1 + rho] is centred on 1 (theta = 1), so a step is
 // e_k = e_{k-2} + w_k (J e_{k-1} - e_{k-2}), with the Jacobi map
@@ -23,13 +26,13 @@ constexpr size_t kPacked = 2 * D + 1;  // floats per cell outside a uniform span
 // One row's uniform span (every face weighs wu, one diagonal): the loop
 // vectorises; `first` is step 2, whose e_0 is 0 (its buffer unset).
 template <int D, bool First, bool Weighted>
-__attribute__((always_inline)) inline void uniformSteps(size_t lo, size_t hi, const float* __restrict c,
-                                                        const float* __restrict yl, const float* __restrict yh,
-                                                        const float* __restrict zl, const float* __restrict zh,
-                                                        const float* __restrict g, float* __restrict e, float wu,
-                                                        float inv, float omega) {
+__attribute__((always_inline)) inline void uniformSteps(size_t lo, size_t hi, const float* __restrict xl,
+                                                        const float* __restrict xh, const float* __restrict yl,
+                                                        const float* __restrict yh, const float* __restrict zl,
+                                                        const float* __restrict zh, const float* __restrict g,
+                                                        float* __restrict e, float wu, float inv, float omega) {
   for (size_t i = lo; i < hi; ++i) {
-    float nb = (c[i + 1] + c[i - 1]) + (yh[i] + yl[i]);
+    float nb = (xh[i] + xl[i]) + (yh[i] + yl[i]);
     if constexpr (D == 3) nb += zh[i] + zl[i];
     if constexpr (Weighted) nb *= wu;
     const float jacobi = g[i] + inv * nb;
@@ -40,20 +43,38 @@ __attribute__((always_inline)) inline void uniformSteps(size_t lo, size_t hi, co
   }
 }
 
+// The neighbours' rows: x low and high (this row's values shifted), then y and z.
+struct NeighbourRows {
+  const float *xl, *xh, *yl, *yh, *zl, *zh;
+};
+
 template <int D, bool First, bool Weighted>
-void uniformStepsSse(size_t lo, size_t hi, const float* c, const float* yl, const float* yh, const float* zl,
-                     const float* zh, const float* g, float* e, float wu, float inv, float omega) {
-  uniformSteps<D, First, Weighted>(lo, hi, c, yl, yh, zl, zh, g, e, wu, inv, omega);
+void uniformStepsSse(size_t lo, size_t hi, const NeighbourRows& n, const float* g, float* e, float wu, float inv,
+                     float omega) {
+  uniformSteps<D, First, Weighted>(lo, hi, n.xl, n.xh, n.yl, n.yh, n.zl, n.zh, g, e, wu, inv, omega);
 }
 #if MORPHOFLOW_AVX2_KERNELS
 // The same loop compiled for AVX2 (eight lanes; no FMA, so the same bits).
 template <int D, bool First, bool Weighted>
-__attribute__((target("avx2"))) void uniformStepsAvx(size_t lo, size_t hi, const float* c, const float* yl,
-                                                     const float* yh, const float* zl, const float* zh,
-                                                     const float* g, float* e, float wu, float inv, float omega) {
-  uniformSteps<D, First, Weighted>(lo, hi, c, yl, yh, zl, zh, g, e, wu, inv, omega);
+__attribute__((target("avx2"))) void uniformStepsAvx(size_t lo, size_t hi, const NeighbourRows& n, const float* g,
+                                                     float* e, float wu, float inv, float omega) {
+  uniformSteps<D, First, Weighted>(lo, hi, n.xl, n.xh, n.yl, n.yh, n.zl, n.zh, g, e, wu, inv, omega);
 }
 #endif
+
+// uniformSteps over [lo, hi), AVX2 where the CPU has it.
+template <int D, bool First>
+void uniformRun(size_t lo, size_t hi, const NeighbourRows& n, const float* g, float* e, float wu, float inv,
+                float omega) {
+  const bool weighted = wu != 1.0f;
+#if MORPHOFLOW_AVX2_KERNELS
+  if (useAvx2()) {
+    (weighted ? uniformStepsAvx<D, First, true> : uniformStepsAvx<D, First, false>)(lo, hi, n, g, e, wu, inv, omega);
+    return;
+  }
+#endif
+  (weighted ? uniformStepsSse<D, First, true> : uniformStepsSse<D, First, false>)(lo, hi, n, g, e, wu, inv, omega);
+}
 
 // Step `First ? 2 : k` on one row, cur = e_{k-1}, e = e_{k-2} (overwritten).
 // The cells outside the row's uniform span take their coefficients from
@@ -84,21 +105,47 @@ void stepRow(const LaplaceSystem<D>& A, size_t row, size_t y, size_t z, const fl
     return;
   }
   general(0, span.lo);
-  const float inv = A.invDiag(s.base + span.lo);
-  const bool weighted = span.w != 1.0f;
   // The neighbour rows (their cell 0); in 2D the z pair repeats the y pair, unused.
-  const float *yl = s.xlo[1], *yh = s.xhi[1], *zl = s.xlo[D - 1], *zh = s.xhi[D - 1];
-#if MORPHOFLOW_AVX2_KERNELS
-  if (useAvx2()) {
-    (weighted ? uniformStepsAvx<D, First, true> : uniformStepsAvx<D, First, false>)(
-        span.lo, span.hi, cr, yl, yh, zl, zh, gr, er, span.w, inv, omega);
-  } else
-#endif
-  {
-    (weighted ? uniformStepsSse<D, First, true> : uniformStepsSse<D, First, false>)(
-        span.lo, span.hi, cr, yl, yh, zl, zh, gr, er, span.w, inv, omega);
-  }
+  const NeighbourRows n{cr - 1, cr + 1, s.xlo[1], s.xhi[1], s.xlo[D - 1], s.xhi[D - 1]};
+  uniformRun<D, First>(span.lo, span.hi, n, gr, er, span.w, A.invDiag(s.base + span.lo), omega);
   general(span.hi, nx);
+}
+
+// Step `First ? 2 : k` on the cells of one colour of one row, in the
+// cyclic layout (each colour's cells of a row in slots x / 2): e = that
+// colour's e_{k-2} (overwritten), g its g, cur the other colour's e_{k-1}
+// (this row's, and the neighbour rows' along y and z in ylo..zhi: the
+// other colour's cells there sit at the same x, so in the same slots).
+// s: the colour's first x in this row. The arithmetic is stepRow's, term
+// for term.
+template <int D, bool First>
+void colourRow(const LaplaceSystem<D>& A, size_t row, size_t s, const float* cur, const float* const* lo,
+               const float* const* hi, float* e, const float* g, const float* packed, float omega) {
+  const size_t nx = size_t(A.dims[0]);
+  const auto& span = A.sweepSpan(row);
+  const size_t spanLo = std::min<size_t>(span.lo, span.hi), spanHi = span.hi;
+  auto general = [&](size_t from, size_t to) {  // cells x = from, from + 2, .. < to of this colour
+    for (size_t x = from + ((from + s) & 1); x < to; x += 2) {
+      const float* pk = packed + kPacked<D> * (x < spanLo ? x : x - (spanHi - spanLo));
+      const size_t xl = x == 0 ? nx - 1 : x - 1, xh = x + 1 == nx ? 0 : x + 1;  // weight 0 unless periodic
+      const size_t j = x / 2;
+      float nb = pk[1] * cur[xh / 2] + pk[2] * cur[xl / 2];
+      for (int a = 1; a < D; ++a) nb += pk[2 * a + 1] * hi[a][j] + pk[2 * a + 2] * lo[a][j];
+      const float jacobi = g[j] + pk[0] * nb;  // inactive: 1 / diag = 0 and g = 0 keep e = 0
+      e[j] = First ? omega * jacobi : e[j] + omega * (jacobi - e[j]);
+    }
+  };
+  if (spanLo >= spanHi) {
+    general(0, nx);
+    return;
+  }
+  general(0, spanLo);
+  // The span's cells of this colour: x = 2 j + s; their x neighbours are
+  // the other colour's slots j - 1 + s (x - 1) and j + s (x + 1).
+  const size_t jlo = (spanLo + 1 - s) / 2, jhi = (spanHi + 1 - s) / 2;
+  const NeighbourRows n{cur + s - 1, cur + s, lo[1], hi[1], lo[D - 1], hi[D - 1]};
+  uniformRun<D, First>(jlo, jhi, n, g, e, span.w, LaplaceSystem<D>::inverse(A.diag.row(row)[spanLo]), omega);
+  general(spanHi, nx);
 }
 
 }  // namespace
@@ -132,6 +179,10 @@ void Chebyshev<D>::refresh() {
   const double dmax = maxOver([](double d, double) { return d; });
   const double dminInv = maxOver([](double d, double) { return d > 0 ? 1.0 / d : 0.0; });
   diagRatio_ = dmax > 0 ? dmax * dminInv : 1.0;
+  // Two colours like a chessboard's where every periodic axis is even.
+  cyclic_ = layout_.cyclic && nx >= 2;
+  for (int a = 0; a < D; ++a) cyclic_ = cyclic_ && !(A_.periodic[a] && A_.dims[a] % 2);
+  hx_ = (nx + 1) / 2;
   // The coefficients of the cells outside each row's uniform span, packed.
   packedStart_.assign(rows + 1, 0);
   for (size_t row = 0; row < rows; ++row) {
@@ -220,7 +271,8 @@ void Chebyshev<D>::rows(size_t q, auto&& fn) const {
 }
 
 template <int D>
-void Chebyshev<D>::step(int level, size_t q) {
+void Chebyshev<D>::step(int level, size_t q, bool jacobi) {
+  if (cyclic_) return colourStep(level, q, jacobi);
   const float* cur = work_->e[(level - 1) & 1].data();
   float* e = work_->e[level & 1].data();
   const float omega = omega_[std::min(size_t(level), omega_.size() - 1)];
@@ -233,6 +285,32 @@ void Chebyshev<D>::step(int level, size_t q) {
 }
 
 template <int D>
+void Chebyshev<D>::colourStep(int level, size_t q, bool jacobi) {
+  const size_t colour = size_t(level & 1), rowsTotal = A_.size() / size_t(A_.dims[0]);
+  const float* cur = work_->e[1 - colour].data();
+  float* e = work_->e[colour].data();
+  const float* g = work_->g.data() + colour * rowsTotal * hx_;
+  const float omega = jacobi ? 1.0f : omega_[std::min(size_t(level), omega_.size() - 1)];
+  const size_t ny = size_t(A_.dims[1]);
+  rows(q, [&](size_t row, size_t y, size_t z) {
+    // The neighbour rows along y and z (the other colour's slots), zeros
+    // across a non-periodic edge, as rowStencil.
+    const float *lo[D] = {}, *hi[D] = {};
+    for (int a = 1; a < D; ++a) {
+      const size_t k = a == 1 ? y : z, n = size_t(A_.dims[a]), stride = a == 1 ? 1 : ny;
+      const bool p = A_.periodic[a];
+      lo[a] = k > 0 ? cur + (row - stride) * hx_ : p ? cur + (row + (n - 1) * stride) * hx_ : zerosOf();
+      hi[a] = k + 1 < n ? cur + (row + stride) * hx_ : p ? cur + (row - (n - 1) * stride) * hx_ : zerosOf();
+    }
+    const size_t s = (colour + y + z) & 1;  // this colour's first x in the row
+    const size_t at = row * hx_;
+    if (level == 2 || jacobi)  // e = omega J e_{k-1}
+      colourRow<D, true>(A_, row, s, cur + at, lo, hi, e + at, g + at, packedRow(row), omega);
+    else colourRow<D, false>(A_, row, s, cur + at, lo, hi, e + at, g + at, packedRow(row), omega);
+  });
+}
+
+template <int D>
 void Chebyshev<D>::residualPlane(const Vector& b, const Vector& x, size_t q) {
   // r = b - A x row by row into a row buffer (r itself never goes to
   // memory), then step 1: e_1 = g = rscale D^-1 r / scale.
@@ -241,34 +319,58 @@ void Chebyshev<D>::residualPlane(const Vector& b, const Vector& x, size_t q) {
   buffer.resize(nx);
   const double sc = rscale_ / A_.scale;
   double sum = 0.0;
-  rows(q, [&](size_t row, size_t, size_t) {
+  const size_t half = A_.size() / nx * hx_;  // cyclic: colour 1's g from here
+  rows(q, [&](size_t row, size_t y, size_t z) {
     sum += A_.residualRow(row, b, x, buffer.data());
     const size_t base = row * nx;
-    const double* __restrict rr = buffer.data();
-    float* __restrict g = work_->g.data() + base;
-    float* __restrict e = work_->e[1].data() + base;
     // D^-1: one value on the row's uniform span, packed (first of each
     // cell's coefficients) outside it.
     const auto& span = A_.sweepSpan(row);
     const size_t lo = std::min<size_t>(span.lo, span.hi), hi = span.hi;
     const float* packed = packedRow(row);
+    double* __restrict v = buffer.data();  // r, then g
     auto outside = [&](size_t from, size_t to) {
-      for (size_t i = from; i < to; ++i, packed += kPacked<D>) {
-        g[i] = float(rr[i] * sc * double(*packed));
-        e[i] = g[i];
-      }
+      for (size_t i = from; i < to; ++i, packed += kPacked<D>) v[i] = double(float(v[i] * sc * double(*packed)));
     };
     outside(0, lo);
     if (lo < hi) {
-      const double inv = double(A_.invDiag(base + lo));
-      for (size_t i = lo; i < hi; ++i) {
-        g[i] = float(rr[i] * sc * inv);
-        e[i] = g[i];
-      }
+      const double inv = double(LaplaceSystem<D>::inverse(A_.diag.row(row)[lo]));
+      for (size_t i = lo; i < hi; ++i) v[i] = double(float(v[i] * sc * inv));
     }
     outside(hi, nx);
+    if (!cyclic_) {
+      float* __restrict g = work_->g.data() + base;
+      float* __restrict e = work_->e[1].data() + base;
+      for (size_t i = 0; i < nx; ++i) g[i] = e[i] = float(v[i]);
+      return;
+    }
+    // Each colour's cells to its slots; e_1 = g in both (a round of one
+    // step uses both).
+    for (size_t colour = 0; colour < 2; ++colour) {
+      const size_t at = splitIndex(row, 0);
+      float* __restrict g = work_->g.data() + colour * half + at;
+      float* __restrict e = work_->e[colour].data() + at;
+      for (size_t i = (colour + y + z) & 1; i < nx; i += 2) g[i / 2] = e[i / 2] = float(v[i]);
+    }
   });
   planeSquares_[q] = sum;
+}
+
+template <int D>
+void Chebyshev<D>::addCorrection(Vector* x, const float* e0, const float* e1, size_t q) const {
+  const size_t nx = size_t(A_.dims[0]);
+  const double inv = 1.0 / rscale_;
+  rows(q, [&](size_t row, size_t y, size_t z) {
+    double* __restrict xr = x->data() + row * nx;
+    if (!cyclic_) {
+      const float* __restrict er = e0 + row * nx;
+      for (size_t i = 0; i < nx; ++i) xr[i] += double(er[i]) * inv;
+      return;
+    }
+    const float* e[2] = {e0 + row * hx_, e1 + row * hx_};
+    for (size_t colour = 0; colour < 2; ++colour)
+      for (size_t i = (colour + y + z) & 1; i < nx; i += 2) xr[i] += double(e[colour][i / 2]) * inv;
+  });
 }
 
 template <int D>
@@ -291,8 +393,9 @@ SolverResult Chebyshev<D>::solve(const Vector& b, Vector* xp, const SolverOption
     result.converged = true;
     return result;
   }
-  for (auto& v : work_->e) v.resize(n);
-  work_->g.resize(n);
+  const size_t slots = cyclic_ ? n / nx * hx_ : n;  // per colour where cyclic
+  for (auto& v : work_->e) v.resize(slots);
+  work_->g.resize(cyclic_ ? 2 * slots : n);
   planeSquares_.assign(size_t(A_.dims[D - 1]), 0.0);
   // g of order 1 in float for any residual from 1e-30 ||b|| up.
   rscale_ = std::sqrt(double(n)) / bnorm;
@@ -307,25 +410,26 @@ SolverResult Chebyshev<D>::solve(const Vector& b, Vector* xp, const SolverOption
   const double kRoundFactor = stepsFor(1e6) <= 48 ? 1e6 : 1e5;
   int rounds = 0;
   while (rnorm > budget && result.iterations < options.maxIterations && rounds < 16) {
-    const int steps =
-        std::min(stepsFor(std::min(rnorm / budget, kRoundFactor)), options.maxIterations - result.iterations);
-    // Steps 2.. (step 1 came with the residual), layout_.stepsPerPass per pass.
-    for (int done = 1; done < steps;) {
-      const int m = std::min(layout_.stepsPerPass, steps - done);
-      pipeline(m, [&](int t, size_t q) { step(done + t, q); });
+    // (Cyclic: the reduced system's residual, up to about 1.25 times the
+    // full iteration's, whose bound stepsFor follows.)
+    const double factor = std::min(rnorm / budget, kRoundFactor) * (cyclic_ ? kCyclicMargin : 1.0);
+    const int steps = std::min(stepsFor(factor), options.maxIterations - result.iterations);
+    // Steps 2.. (step 1 came with the residual), layout_.stepsPerPass per
+    // pass; cyclic, then the colour left at e_{k-1} from the other's e_k
+    // by a Jacobi half step, so that its residual is 0.
+    const int last = cyclic_ && steps > 1 ? steps + 1 : steps;
+    for (int done = 1; done < last;) {
+      const int m = std::min(layout_.stepsPerPass, last - done);
+      pipeline(m, [&](int t, size_t q) { step(done + t, q, done + t > steps); });
       done += m;
     }
     // x += e / rscale on plane q, then the new residual (and the next
     // round's g) on plane q - 1, whose neighbours are then all updated.
-    const float* e = work_->e[steps & 1].data();
-    const double inv = 1.0 / rscale_;
+    const float* e0 = work_->e[cyclic_ ? 0 : steps & 1].data();
+    const float* e1 = work_->e[1].data();
     pipeline(2, [&](int t, size_t q) {
       if (t == 2) return residualPlane(b, x, q);
-      rows(q, [&](size_t row, size_t, size_t) {
-        const float* __restrict er = e + row * nx;
-        double* __restrict xr = x.data() + row * nx;
-        for (size_t i = 0; i < nx; ++i) xr[i] += double(er[i]) * inv;
-      });
+      addCorrection(&x, e0, e1, q);
     });
     rnorm = residualNorm();
     result.iterations += steps;

@@ -10,6 +10,19 @@
 // Jacobi-like sweep, e_k = w_k (e_{k-1} - e_{k-2} + (g - M e_{k-1}) / theta) + e_{k-2},
 // whose writes go to the e_{k-2} vector in place.
 //
+// Where the grid is two-coloured like a chessboard (the stencil couples a
+// cell to the other colour only; every periodic axis has an even length),
+// the steps take the colours in turn (Golub & Varga's cyclic Chebyshev
+// semi-iteration): step k updates only the cells of colour k mod 2, whose
+// e_k reads the other colour's e_{k-1} and its own e_{k-2}, so the cells
+// of the other colour's e_k are never needed. Each colour is stored apart,
+// contiguous along x, so a step is half a sweep; the values are the full
+// iteration's, bitwise. A round of k steps ends with a plain Jacobi half
+// step that takes the colour left at e_{k-1} from the other's e_k, which
+// zeroes its residual: the rest is the reduced (Schur complement) system's,
+// on which the even steps are the optimal Chebyshev polynomial in (D^-1 W)^2.
+// About k / 2 sweeps' work for the full iteration's k steps of reduction.
+//
 // The steps run on the correction, in single precision, inside a double
 // precision outer loop (r = b - A x; x += e; mixed-precision refinement).
 // They are blocked in time: one pass over memory advances several steps,
@@ -34,13 +47,14 @@ namespace morphoflow {
 struct ChebyshevLayout {
   int stepsPerPass = 4;  // steps per pass over memory; 1: plain sweeps
   int slabs = 0;         // tasks per pass (at most); 0: one per thread
+  bool cyclic = true;    // the colours in turn where the grid has two (false: every cell every step)
 };
 
 // The iteration's work vectors (single precision). Solvers that run one
 // after another may share one (the viscosity's components do).
 struct ChebyshevWork {
-  std::vector<float> e[2];  // step k lives in e[k & 1]
-  std::vector<float> g;     // D^-1 r, scaled
+  std::vector<float> e[2];  // step k lives in e[k & 1] (cyclic: colour k & 1's cells)
+  std::vector<float> g;     // D^-1 r, scaled (cyclic: colour 0's cells, then colour 1's)
 };
 
 template <int D>
@@ -55,6 +69,10 @@ class Chebyshev {
   bool applicable() const { return rho_ < 1.0; }
   // The Gershgorin radius rho of D^-1 W.
   double rho() const { return rho_; }
+  // Whether the steps take the colours in turn (see above), and the cells
+  // a step updates: half the system's where they do.
+  bool cyclic() const { return cyclic_; }
+  double cellsPerStep() const { return double(A_.size()) * (cyclic_ ? 0.5 : 1.0); }
   // Steps that reduce the residual's 2-norm by `factor` in exact arithmetic:
   // the least k with T_k(1 / rho) >= factor sqrt(max diag / min diag).
   int stepsFor(double factor) const;
@@ -80,8 +98,16 @@ class Chebyshev {
   void pipeline(int m, Op&& op);
   // fn(row, y, z) for each row of plane q.
   void rows(size_t q, auto&& fn) const;
-  // Chebyshev step `level` (>= 2) on plane q.
-  void step(int level, size_t q);
+  // Chebyshev step `level` (>= 2) on plane q; `jacobi`: cyclic, a round's
+  // closing half step (e = J e_{k-1}).
+  void step(int level, size_t q, bool jacobi = false);
+  // The same on the cells of colour level & 1 (cyclic).
+  void colourStep(int level, size_t q, bool jacobi);
+  // Where cell x of a row lives in its colour's vector (cyclic): the
+  // colour of x is (x + y + z) mod 2.
+  size_t splitIndex(size_t row, size_t x) const { return row * hx_ + x / 2; }
+  // x += e / rscale on plane q.
+  void addCorrection(Vector* x, const float* e0, const float* e1, size_t q) const;
   // r = b - A x on plane q; writes step 1 (e_1 = g = rscale D^-1 r / scale)
   // and the plane's ||r||^2.
   void residualPlane(const Vector& b, const Vector& x, size_t q);
@@ -91,6 +117,8 @@ class Chebyshev {
   ChebyshevLayout layout_;
   double rho_ = 1.0;
   double diagRatio_ = 1.0;    // max / min diagonal over active cells
+  bool cyclic_ = false;
+  size_t hx_ = 0;  // cyclic: a row's slots in each colour's vector
   ChebyshevWork own_;
   ChebyshevWork* work_;       // &own_ unless shared
   std::vector<float> zeros_;  // a row of zeros: beyond a non-periodic edge

@@ -166,11 +166,20 @@ template <int D>
 static void eachUnknownRow(const IVec<D>& dims, const Grid<float, D>& g, auto&& fn) {
   forEachRow<D>(dims, [&](size_t row, const IVec<D>& k) { fn(row, row * size_t(dims[0]), g.index(k)); });
 }
-// fn(i, gi) for every unknown.
+
+// One row of component a's unknowns as the passes below read it: held[x]
+// is nonzero where unknown i0 + x is held (its face prescribed, or inside
+// a cut obstacle), so the loops over a row have no branches.
+struct UnknownRow {
+  size_t row, i0, g0;
+  const uint8_t* fixed;  // the face's flag
+  const uint8_t* cut;    // inside a cut obstacle (a row of zeros without one)
+};
 template <int D>
-static void eachUnknown(const IVec<D>& dims, const Grid<float, D>& g, auto&& fn) {
-  eachUnknownRow<D>(dims, g, [&](size_t, size_t i0, size_t g0) {
-    for (size_t x = 0; x < size_t(dims[0]); ++x) fn(i0 + x, g0 + x);
+static void eachRowOf(const ViscousSystem<D>& C, const Grid<uint8_t, D>& fixed, const Grid<float, D>& g, auto&& fn) {
+  static const std::vector<uint8_t> none(size_t(1) << 16, 0);
+  eachUnknownRow<D>(C.dims, g, [&](size_t row, size_t i0, size_t g0) {
+    fn(UnknownRow{row, i0, g0, fixed.data() + g0, C.insideCut.empty() ? none.data() : C.insideCut.data() + i0});
   });
 }
 
@@ -181,10 +190,12 @@ double ViscositySolver<D>::rightHandSide(const MacVelocity<D>& u, int a, double 
   const Grid<uint8_t, D>& fixed = vc_.fixed[a];
   b_.resize(C.A.size());
   // Row by row: the boundary terms are stored a row at a time.
-  eachUnknownRow<D>(C.dims, g, [&](size_t row, size_t i0, size_t g0) {
-    const float* rhs = C.boundaryRhs.row(row);
+  eachRowOf<D>(C, fixed, g, [&](const UnknownRow& r) {
+    const float* __restrict rhs = C.boundaryRhs.row(r.row);
+    const float* __restrict gr = g.data() + r.g0;
+    double* __restrict b = b_.data() + r.i0;
     for (size_t x = 0; x < size_t(C.dims[0]); ++x)
-      b_[i0 + x] = C.held(fixed, i0 + x, g0 + x) ? 0.0 : double(g[g0 + x]) + s * double(rhs[x]);
+      b[x] = (r.fixed[x] | r.cut[x]) ? 0.0 : double(gr[x]) + s * double(rhs[x]);
   });
   return dot(b_, b_);
 }
@@ -248,10 +259,20 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
     // (2 r1 - r0 = r1 + (r1 - r0)).
     const int history = C.history;
     x_.resize(C.A.size());
-    eachUnknown<D>(C.dims, g, [&](size_t i, size_t gi) {
-      const double rate =
-          history >= 1 ? double(C.rate[i]) + (history >= 2 ? double(fromBfloat16(C.change[i])) : 0.0) : 0.0;
-      x_[i] = C.held(fixed, i, gi) ? 0.0 : double(g[gi]) + s * rate;
+    eachRowOf<D>(C, fixed, g, [&](const UnknownRow& r) {
+      const float* __restrict gr = g.data() + r.g0;
+      double* __restrict x = x_.data() + r.i0;
+      const size_t nx = size_t(C.dims[0]);
+      if (history == 0) {
+        for (size_t k = 0; k < nx; ++k) x[k] = (r.fixed[k] | r.cut[k]) ? 0.0 : double(gr[k]) + s * 0.0;
+        return;
+      }
+      const float* __restrict rate = C.rate.data() + r.i0;
+      const uint16_t* __restrict change = C.change.data() + r.i0;
+      for (size_t k = 0; k < nx; ++k) {
+        const double v = double(rate[k]) + (history >= 2 ? double(fromBfloat16(change[k])) : 0.0);
+        x[k] = (r.fixed[k] | r.cut[k]) ? 0.0 : double(gr[k]) + s * v;
+      }
     });
     SolverOptions options = options_;
     if (ba > 0.0) options.tolerance = options_.tolerance * std::sqrt(0.5 * (ba + bAll / D) / ba);
@@ -259,18 +280,24 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
                                        : C.chebyshev->solve(b_, &x_, options, std::sqrt(ba));
     rAll += r.residual * r.residual * ba;
     result.iterations = std::max(result.iterations, r.iterations);
-    cellUpdates_ += double(r.iterations) * double(C.A.size());
+    cellUpdates_ += double(r.iterations) * (C.multigrid ? double(C.A.size()) : C.chebyshev->cellsPerStep());
     usedCG_ = usedCG_ || C.multigrid != nullptr;
     std::vector<float>& rate = C.rate;
     rate.resize(C.A.size(), 0.0f);  // zeros before the first solve: change = the first rate, unused
     C.change.resize(C.A.size());
     const double invS = 1.0 / s;
-    eachUnknown<D>(C.dims, g, [&](size_t i, size_t gi) {
-      const bool held = C.held(fixed, i, gi);
-      const float next = held ? 0.0f : float((x_[i] - double(g[gi])) * invS);
-      C.change[i] = toBfloat16(next - rate[i]);
-      rate[i] = next;
-      if (!held) g[gi] = float(x_[i]);
+    eachRowOf<D>(C, fixed, g, [&](const UnknownRow& r) {
+      float* __restrict gr = g.data() + r.g0;
+      const double* __restrict x = x_.data() + r.i0;
+      float* __restrict rt = rate.data() + r.i0;
+      uint16_t* __restrict change = C.change.data() + r.i0;
+      for (size_t k = 0; k < size_t(C.dims[0]); ++k) {
+        const bool held = r.fixed[k] | r.cut[k];
+        const float next = held ? 0.0f : float((x[k] - double(gr[k])) * invS);
+        change[k] = toBfloat16(next - rt[k]);
+        rt[k] = next;
+        gr[k] = held ? gr[k] : float(x[k]);
+      }
     });
     C.history = std::min(C.history + 1, 2);
   }

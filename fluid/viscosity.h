@@ -42,15 +42,11 @@ struct ViscousSystem {
   RowField<D> cBoundary;    // diagonal terms from walls and prescribed neighbours; -1 on a prescribed face (inactive)
   RowField<D> boundaryRhs;  // their prescribed values, times the coupling
   // With cut obstacles: 1 on a face inside one, which the viscosity leaves
-  // as the projection made it (its no-slip is at the surface, where the
+  // as the projection made it (held, as a prescribed face is) (its no-slip is at the surface, where the
   // neighbours' stencils put it); empty without cut obstacles.
   std::vector<uint8_t> insideCut;
   // A for s = nu dt / h^2: c = 1/s + boundary terms, 0 on prescribed faces.
   void setRate(double s);
-  // Whether unknown i is held by the viscosity (prescribed face gi, or inside a cut obstacle).
-  bool held(const Grid<uint8_t, D>& fixed, size_t i, size_t gi) const {
-    return fixed[gi] || (!insideCut.empty() && insideCut[i]);
-  }
 };
 template <int D>
 ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& constraints, int axis);
@@ -71,8 +67,9 @@ class ViscositySolver {
   // Diffuses u in place; returns the worst of the component solves. Its
   // work vectors come from `pool` (when given) and go back to it.
   SolverResult diffuse(MacVelocity<D>* u, double viscosity, double dt, WorkPool* pool = nullptr);
-  // The last diffuse's work: its solves' iterations times their unknowns,
-  // summed over the components, and whether multigrid-preconditioned CG
+  // The last diffuse's work: its solves' iterations times the unknowns each
+  // updates (a cyclic Chebyshev step half of them), summed over the
+  // components, and whether multigrid-preconditioned CG
   // (not the Chebyshev iteration) did any of it.
   double lastCellUpdates() const { return cellUpdates_; }
   bool lastUsedCG() const { return usedCG_; }

@@ -100,7 +100,9 @@ void checkChebyshevBound(const IVec<D>& dims, double s, bool periodicLast) {
   const LaplaceSystem<D> A = viscousSystem<D>(dims, s, periodicLast);
   double rho, diagRatio;
   spectrumBounds<D>(A, &rho, &diagRatio);
-  Chebyshev<D> cheb(A);
+  ChebyshevLayout full;
+  full.cyclic = false;
+  Chebyshev<D> cheb(A, full);
   ASSERT_TRUE(cheb.applicable());
   EXPECT_GE(cheb.rho(), rho);
   EXPECT_LE(cheb.rho(), rho * (1.0 + 1e-4));
@@ -125,6 +127,8 @@ void checkChebyshevBound(const IVec<D>& dims, double s, bool periodicLast) {
 
 }  // namespace
 
+// (The full iteration's: the cyclic one's round ends otherwise; see
+// CyclicStepsAreTheFullIterationsOwn.)
 TEST(Chebyshev, ResidualObeysTheChebyshevBound) {
   checkChebyshevBound<2>(IVec<2>(40, 33), 1.28, false);
   checkChebyshevBound<2>(IVec<2>(40, 33), 12.0, true);
@@ -173,26 +177,27 @@ TEST(Chebyshev, SolvesManufacturedSystems) {
 namespace {
 
 template <int D>
-void checkLayouts(const IVec<D>& dims, bool periodicLast) {
+void checkLayouts(const IVec<D>& dims, bool periodicLast, bool cyclic) {
   const LaplaceSystem<D> A = viscousSystem<D>(dims, 2.0, periodicLast);
   const Vector b = wavyVector<D>(A, 1.0);
   const SolverOptions fixed{1e-300, 23};  // 23 steps, whatever they reach
   Vector ref(A.size(), 0.0);
   {
     ThreadLimit one(1);
-    Chebyshev<D>(A, ChebyshevLayout{1, 1}).solve(b, &ref, fixed);  // plain sweeps, one task
+    Chebyshev<D>(A, ChebyshevLayout{1, 1, cyclic}).solve(b, &ref, fixed);  // plain sweeps, one task
   }
   const bool wide = useAvx2();
-  for (const ChebyshevLayout& layout : {ChebyshevLayout{4, 0}, ChebyshevLayout{3, 5}, ChebyshevLayout{6, 2},
-                                        ChebyshevLayout{2, 9}, ChebyshevLayout{8, 3}})
+  for (ChebyshevLayout layout : {ChebyshevLayout{4, 0}, ChebyshevLayout{3, 5}, ChebyshevLayout{6, 2},
+                                 ChebyshevLayout{2, 9}, ChebyshevLayout{8, 3}})
     for (bool narrow : {false, true}) {
+      layout.cyclic = cyclic;
       if (narrow) setUseAvx2(false);
       Vector x(A.size(), 0.0);
       Chebyshev<D>(A, layout).solve(b, &x, fixed);
       setUseAvx2(wide);
       EXPECT_EQ(0, std::memcmp(x.data(), ref.data(), x.size() * sizeof(double)))
-          << name<D>(dims) << " steps/pass " << layout.stepsPerPass << " slabs " << layout.slabs << " narrow "
-          << narrow;
+          << name<D>(dims) << " steps/pass " << layout.stepsPerPass << " slabs " << layout.slabs << " narrow " << narrow
+          << " cyclic " << cyclic;
     }
 }
 
@@ -202,11 +207,58 @@ void checkLayouts(const IVec<D>& dims, bool periodicLast) {
 // (walled or periodic along the cut), thread count and vector width change
 // nothing: every step of every plane reads the same values.
 TEST(Chebyshev, LayoutDoesNotChangeTheResult) {
-  checkLayouts<2>(IVec<2>(41, 90), false);
-  checkLayouts<2>(IVec<2>(41, 90), true);
-  checkLayouts<3>(IVec<3>(37, 9, 40), false);
-  checkLayouts<3>(IVec<3>(37, 9, 40), true);
-  checkLayouts<3>(IVec<3>(20, 8, 7), true);  // too thin to cut: plain sweeps
+  for (bool cyclic : {true, false}) {
+    checkLayouts<2>(IVec<2>(41, 90), false, cyclic);
+    checkLayouts<2>(IVec<2>(41, 90), true, cyclic);
+    checkLayouts<3>(IVec<3>(37, 9, 40), false, cyclic);
+    checkLayouts<3>(IVec<3>(37, 9, 40), true, cyclic);
+    checkLayouts<3>(IVec<3>(20, 8, 7), true, cyclic);  // too thin to cut: plain sweeps; odd and periodic: not cyclic
+  }
+}
+
+namespace {
+
+// The cyclic iteration's steps are the full iteration's own values: one
+// round of k steps from x = 0 leaves x = e / rscale, and on the cells of
+// colour k mod 2 (those whose e_k it computed) its x is the full
+// iteration's, bit for bit. Its round then takes the other colour from
+// them by a Jacobi half step, which zeroes that colour's residual: the
+// residual is the reduced system's, on which the k steps are the optimal
+// polynomial's, within a little of the full iteration's (at the spectrum's
+// ends, where the full one's is exactly 1 / T_k(1 / rho), 1.2-1.25 of it).
+template <int D>
+void checkCyclic(const IVec<D>& dims, double s, bool periodicLast) {
+  const LaplaceSystem<D> A = viscousSystem<D>(dims, s, periodicLast);
+  const Vector b = wavyVector<D>(A, 0.7);
+  ChebyshevLayout full;
+  full.cyclic = false;
+  Chebyshev<D> cyclic(A), plain(A, full);
+  ASSERT_TRUE(cyclic.cyclic());
+  ASSERT_FALSE(plain.cyclic());
+  for (int k : {2, 3, 6, 11}) {
+    Vector xc(A.size(), 0.0), xf(A.size(), 0.0);
+    const SolverOptions steps{1e-300, k};
+    const SolverResult rc = cyclic.solve(b, &xc, steps), rf = plain.solve(b, &xf, steps);
+    size_t same = 0, compared = 0;
+    forEachCell<D>(dims, [&](const IVec<D>& c, size_t i) {
+      int parity = 0;
+      for (int a = 0; a < D; ++a) parity += c[a];
+      if (parity % 2 != k % 2) return;
+      ++compared;
+      same += xc[i] == xf[i];
+    });
+    EXPECT_EQ(same, compared) << name<D>(dims) << " k = " << k;
+    EXPECT_LE(rc.residual, 1.3 * rf.residual) << name<D>(dims) << " k = " << k;
+  }
+}
+
+}  // namespace
+
+TEST(Chebyshev, CyclicStepsAreTheFullIterationsOwn) {
+  checkCyclic<2>(IVec<2>(40, 33), 1.28, false);
+  checkCyclic<2>(IVec<2>(41, 34), 12.0, true);
+  checkCyclic<3>(IVec<3>(19, 14, 23), 1.28, false);
+  checkCyclic<3>(IVec<3>(19, 14, 24), 0.2, true);
 }
 
 // A pure Laplacian (no identity term) has 0 in its spectrum: the iteration
@@ -236,7 +288,9 @@ void checkExtremalModes(const IVec<D>& dims, double s) {
   for (int a = 0; a < D; ++a) A.w[a].fill(1.0f);
   A.c.fill(float(1.0 / s));
   A.finalize();
-  Chebyshev<D> cheb(A);
+  ChebyshevLayout full;
+  full.cyclic = false;
+  Chebyshev<D> cheb(A, full), cyclic(A);
   const double rho = 2.0 * D / (double(float(1.0 / s)) + 2.0 * D);  // sum w / diag, diag = c + sum w
   EXPECT_NEAR(cheb.rho(), rho, 2e-5 * rho);
   Vector b(A.size());
@@ -250,6 +304,10 @@ void checkExtremalModes(const IVec<D>& dims, double s) {
     const SolverResult r = cheb.solve(b, &x, SolverOptions{1e-14, k});
     const double exact = 1.0 / std::cosh(k * std::acosh(1.0 / cheb.rho()));
     EXPECT_NEAR(r.residual, exact, 2e-3 * exact + 1e-6) << name<D>(dims) << " k = " << k;
+    Vector xc(A.size(), 0.0);  // the cyclic iteration: a little above it (CyclicStepsAreTheFullIterationsOwn)
+    const SolverResult rc = cyclic.solve(b, &xc, SolverOptions{1e-14, k});
+    EXPECT_GE(rc.residual, exact * (1.0 - 2e-3)) << name<D>(dims) << " k = " << k;
+    EXPECT_LE(rc.residual, 1.3 * exact) << name<D>(dims) << " k = " << k;
   }
 }
 
