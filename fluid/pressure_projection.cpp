@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "core/masked_select.h"
 #include "core/parallel.h"
 #include "core/pcg.h"
 
@@ -144,11 +145,11 @@ void PressureProjection<D>::divergenceTimes(const MacVelocity<D>& u, double fact
       double d = 0.0;
       for (int a = 0; a < D; ++a)
         d += ppAxisFlux(double(openHi[a][x]), double(hi[a][x]), double(openLo[a][x]), double(lo[a][x]));
-      out[x] = active[x] == 0.0f ? 0.0 : d * factor;
+      out[x] = zeroWhere(active[x] == 0.0f, d * factor);
     }
     if (!vc_.solidFlux.empty()) {  // a moving solid's flux through the closed parts
       const double* solid = vc_.solidFlux.data() + row * nx;
-      for (size_t x = 0; x < nx; ++x) out[x] += active[x] == 0.0f ? 0.0 : solid[x] * factor;
+      for (size_t x = 0; x < nx; ++x) out[x] += zeroWhere(active[x] == 0.0f, solid[x] * factor);
     }
   });
 }
@@ -248,7 +249,7 @@ SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double
       const uint8_t* fr = fixed.data() + base;
       const int x0 = a == 0 ? 1 : 0, x1 = n[0];
       for (int x = x0; x < x1; ++x)
-        if (!fr[x]) gr[x] = float(ppProjectedFace(double(gr[x]), pl[x], ph[x], invH));
+        gr[x] = pick(fr[x], gr[x], float(ppProjectedFace(double(gr[x]), pl[x], ph[x], invH)));
       for (int x : {0, gd[0] - 1})
         if (x < x0 || x >= x1) {
           k[0] = x;

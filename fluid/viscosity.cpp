@@ -1,10 +1,10 @@
 #include "fluid/viscosity.h"
-#include <bit>
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "core/masked_select.h"
 #include "core/parallel.h"
 
 namespace morphoflow {
@@ -168,21 +168,6 @@ static void eachUnknownRow(const IVec<D>& dims, const Grid<float, D>& g, auto&& 
   forEachRow<D>(dims, [&](size_t row, const IVec<D>& k) { fn(row, row * size_t(dims[0]), g.index(k)); });
 }
 
-// v, or +0 where `held` (nonzero): a bit mask rather than a branch, so the
-// row loops below vectorise (the compiler keeps a branch around an IEEE
-// operation that might trap).
-static inline double unlessHeld(uint8_t held, double v) {
-  return std::bit_cast<double>(std::bit_cast<uint64_t>(v) & (uint64_t(held != 0) - 1));
-}
-static inline float unlessHeld(uint8_t held, float v) {
-  return std::bit_cast<float>(std::bit_cast<uint32_t>(v) & (uint32_t(held != 0) - 1));
-}
-// kept where `held`, else v.
-static inline float heldOr(uint8_t held, float kept, float v) {
-  const uint32_t free = uint32_t(held != 0) - 1;
-  return std::bit_cast<float>((std::bit_cast<uint32_t>(v) & free) | (std::bit_cast<uint32_t>(kept) & ~free));
-}
-
 // One row of component a's unknowns as the passes below read it: held[x]
 // is nonzero where unknown i0 + x is held (its face prescribed, or inside
 // a cut obstacle), so the loops over a row have no branches.
@@ -212,7 +197,7 @@ double ViscositySolver<D>::rightHandSide(const MacVelocity<D>& u, int a, double 
     const uint8_t* __restrict f = r.fixed, * __restrict c = r.cut;
     double* __restrict b = b_.data() + r.i0;
     const size_t nx = size_t(C.dims[0]);
-    for (size_t x = 0; x < nx; ++x) b[x] = unlessHeld(f[x] | c[x], double(gr[x]) + s * double(rhs[x]));
+    for (size_t x = 0; x < nx; ++x) b[x] = zeroWhere(f[x] | c[x], double(gr[x]) + s * double(rhs[x]));
   });
   return dot(b_, b_);
 }
@@ -282,7 +267,7 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
       double* __restrict x = x_.data() + r.i0;
       const size_t nx = size_t(C.dims[0]);
       if (history == 0) {
-        for (size_t k = 0; k < nx; ++k) x[k] = unlessHeld(f[k] | c[k], double(gr[k]) + s * 0.0);
+        for (size_t k = 0; k < nx; ++k) x[k] = zeroWhere(f[k] | c[k], double(gr[k]) + s * 0.0);
         return;
       }
       const float* __restrict rate = C.rate.data() + r.i0;
@@ -290,7 +275,7 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
       const double second = history >= 2 ? 1.0 : 0.0;  // the change counts from the second solve on
       for (size_t k = 0; k < nx; ++k) {
         const double v = double(gr[k]) + s * (double(rate[k]) + second * double(fromBfloat16(change[k])));
-        x[k] = unlessHeld(f[k] | c[k], v);
+        x[k] = zeroWhere(f[k] | c[k], v);
       }
     });
     SolverOptions options = options_;
@@ -313,11 +298,11 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
       uint16_t* __restrict change = C.change.data() + r.i0;
       const size_t nx = size_t(C.dims[0]);
       for (size_t k = 0; k < nx; ++k) {
-        const uint8_t held = f[k] | c[k];
-        const float next = unlessHeld(held, float((x[k] - double(gr[k])) * invS));
+        const bool held = f[k] | c[k];
+        const float next = zeroWhere(held, float((x[k] - double(gr[k])) * invS));
         change[k] = toBfloat16(next - rt[k]);
         rt[k] = next;
-        gr[k] = heldOr(held, gr[k], float(x[k]));
+        gr[k] = pick(held, gr[k], float(x[k]));
       }
     });
     C.history = std::min(C.history + 1, 2);
