@@ -114,7 +114,7 @@ void stepRow(const LaplaceSystem<D>& A, size_t row, size_t y, size_t z, const fl
 // Step `First ? 2 : k` on the cells of one colour of one row, in the
 // cyclic layout (each colour's cells of a row in slots x / 2): e = that
 // colour's e_{k-2} (overwritten), g its g, cur the other colour's e_{k-1}
-// (this row's, and the neighbour rows' along y and z in ylo..zhi: the
+// in this row, and lo[a], hi[a] in the neighbour rows along y and z (the
 // other colour's cells there sit at the same x, so in the same slots).
 // s: the colour's first x in this row. The arithmetic is stepRow's, term
 // for term.

@@ -21,7 +21,8 @@
 // step that takes the colour left at e_{k-1} from the other's e_k, which
 // zeroes its residual: the rest is the reduced (Schur complement) system's,
 // on which the even steps are the optimal Chebyshev polynomial in (D^-1 W)^2.
-// About k / 2 sweeps' work for the full iteration's k steps of reduction.
+// About k / 2 sweeps' work for a residual within about 1.25 of the full
+// iteration's after k steps (a round asks for a little more reduction).
 //
 // The steps run on the correction, in single precision, inside a double
 // precision outer loop (r = b - A x; x += e; mixed-precision refinement).
