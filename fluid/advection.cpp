@@ -20,10 +20,10 @@ namespace {
 // Four samples at once (core/simd4.h), or eight in the AVX2 variant and
 // sixteen in the AVX-512 one (core/simd_dispatch.h): the helpers below take
 // the vector type V (vf4, vf8 or vf16) and are always inlined, so inside a
-// wide row kernel they compile for its target too. Used where every axis clamps (walls, inflow, outflow);
-// periodic domains take the scalar path. The arithmetic is the scalar
-// path's, operation for operation, so every path gives bitwise the same
-// fields.
+// wide row kernel they compile for its target too. Used where every axis
+// clamps (walls, inflow, outflow); periodic domains take the scalar path.
+// The arithmetic is the scalar path's, operation for operation, so every
+// path gives bitwise the same fields.
 // vf8 by value is a different psABI with and without AVX; these helpers are
 // internal and always inlined, so no call ever passes one.
 #pragma GCC diagnostic ignored "-Wpsabi"
@@ -129,9 +129,11 @@ MF_INLINE bool allLanes(I m) {
   return all == -1;
 }
 
-// interpolate<D> on a vector of positions; lo/hi receive the stencil's min and max.
+// interpolate<D> on a vector of positions; lo/hi receive the stencil's min
+// and max. `size`: the samples in data.
 template <int D, class V>
-MF_INLINE V vinterpolate(const float* data, const size_t* s, const VTap<V>* tap, V* lo = nullptr, V* hi = nullptr) {
+MF_INLINE V vinterpolate(const float* data, const size_t* s, size_t size, const VTap<V>* tap, V* lo = nullptr,
+                         V* hi = nullptr) {
   constexpr int n = Lanes<V>::n;
   using I = IntLanes<V>;
   I idx = tap[0].lo + tap[1].lo * int(s[1]);
@@ -152,7 +154,10 @@ MF_INLINE V vinterpolate(const float* data, const size_t* s, const VTap<V>* tap,
     return blendCorners<D, V>([d](size_t off) __attribute__((always_inline)) { return vload<V>(d + off); }, sy, sz,
                               t, lo, hi);
   }
-  if (allLanes(inFirst | (run == last))) {
+  // Each run's loads read all n lanes from its start, so both must lie
+  // inside the data for every corner.
+  const long long lowest = std::min(run[0], run[n - 1]), highest = std::max(run[0], run[n - 1]);
+  if (lowest >= 0 && size_t(highest) + sz + sy + 1 + n <= size && allLanes(inFirst | (run == last))) {
     const float *d0 = data + run[0], *d1 = data + run[n - 1];
     return blendCorners<D, V>(
         [ d0, d1, inFirst ](size_t off)
@@ -175,7 +180,8 @@ MF_INLINE void vvelocity(const MacSampler<D>& vel, const V* p, V* v) {
   for (int a = 0; a < D; ++a) {
     VTap<V> t[D];
     for (int b = 0; b < D; ++b) t[b] = b == a ? f[b] : c[b];
-    v[a] = vinterpolate<D, V>(vel.data[a], vel.stride[a], t);
+    const int nz = (a == D - 1 ? vel.face[D - 1] : vel.centre[D - 1]).n;  // samples along the last axis
+    v[a] = vinterpolate<D, V>(vel.data[a], vel.stride[a], vel.stride[a][D - 1] * size_t(nz), t);
   }
 }
 
@@ -265,6 +271,7 @@ MF_INLINE int simdRow(const SimdRow<D>& j, int x) {
   for (int a = 1; a < D; ++a) vp[a] = vsplat<V>(j.p[a]);
   V lane;
   for (int k = 0; k < n; ++k) lane[k] = float(k);
+  const size_t fieldSize = j.field.stride[D - 1] * size_t(j.field.axis[D - 1].n);
   for (; x + n <= j.nx; x += n) {
     vp[0] = (vsplat<V>(float(x)) + lane) + j.field.axis[0].offset;
     const size_t i = j.base + size_t(x);
@@ -286,11 +293,11 @@ MF_INLINE int simdRow(const SimdRow<D>& j, int x) {
     V r;
     if (j.lo) {
       V l, h;
-      r = vinterpolate<D, V>(j.field.data, j.field.stride, t, &l, &h);
+      r = vinterpolate<D, V>(j.field.data, j.field.stride, fieldSize, t, &l, &h);
       vstore(&(*j.lo)[i], l);
       vstore(&(*j.hi)[i], h);
     } else {
-      r = vinterpolate<D, V>(j.field.data, j.field.stride, t);
+      r = vinterpolate<D, V>(j.field.data, j.field.stride, fieldSize, t);
     }
     vstore(&(*j.dst)[i], r);
   }
