@@ -184,6 +184,17 @@ static void eachRowOf(const ViscousSystem<D>& C, const Grid<uint8_t, D>& fixed, 
   });
 }
 
+// One row of b = u* + s (boundary terms), 0 on held unknowns.
+template <int D>
+static void rhsRow(const ViscousSystem<D>& C, const UnknownRow& r, const Grid<float, D>& g, double s, Vector* out) {
+  const float* __restrict rhs = C.boundaryRhs.row(r.row);
+  const float* __restrict gr = g.data() + r.g0;
+  const uint8_t* __restrict f = r.fixed, * __restrict c = r.cut;
+  double* __restrict b = out->data() + r.i0;
+  const size_t nx = size_t(C.dims[0]);
+  for (size_t x = 0; x < nx; ++x) b[x] = zeroWhere(f[x] | c[x], double(gr[x]) + s * double(rhs[x]));
+}
+
 template <int D>
 double ViscositySolver<D>::rightHandSide(const MacVelocity<D>& u, int a, double s) {
   const Component& C = comp_[size_t(a)];
@@ -191,14 +202,7 @@ double ViscositySolver<D>::rightHandSide(const MacVelocity<D>& u, int a, double 
   const Grid<uint8_t, D>& fixed = vc_.fixed[a];
   b_.resize(C.A.size());
   // Row by row: the boundary terms are stored a row at a time.
-  eachRowOf<D>(C, fixed, g, [&](const UnknownRow& r) {
-    const float* __restrict rhs = C.boundaryRhs.row(r.row);
-    const float* __restrict gr = g.data() + r.g0;
-    const uint8_t* __restrict f = r.fixed, * __restrict c = r.cut;
-    double* __restrict b = b_.data() + r.i0;
-    const size_t nx = size_t(C.dims[0]);
-    for (size_t x = 0; x < nx; ++x) b[x] = zeroWhere(f[x] | c[x], double(gr[x]) + s * double(rhs[x]));
-  });
+  eachRowOf<D>(C, fixed, g, [&](const UnknownRow& r) { rhsRow<D>(C, r, g, s, &b_); });
   return dot(b_, b_);
 }
 
@@ -256,16 +260,18 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
     Grid<float, D>& g = (*u)[a];
     const Grid<uint8_t, D>& fixed = vc_.fixed[a];
     const double ba = bb[size_t(a)];
-    if (a > 0) rightHandSide(*u, a, s);  // b_ holds component 0's already
     // Warm start: the increment's rate, linearly extrapolated in steps
-    // (2 r1 - r0 = r1 + (r1 - r0)).
+    // (2 r1 - r0 = r1 + (r1 - r0)). In the same pass, the right-hand side
+    // (b_ holds component 0's already), as rightHandSide forms it.
     const int history = C.history;
     x_.resize(C.A.size());
+    b_.resize(C.A.size());
     eachRowOf<D>(C, fixed, g, [&](const UnknownRow& r) {
       const float* __restrict gr = g.data() + r.g0;
       const uint8_t* __restrict f = r.fixed, * __restrict c = r.cut;
       double* __restrict x = x_.data() + r.i0;
       const size_t nx = size_t(C.dims[0]);
+      if (a > 0) rhsRow<D>(C, r, g, s, &b_);
       if (history == 0) {
         for (size_t k = 0; k < nx; ++k) x[k] = zeroWhere(f[k] | c[k], double(gr[k]) + s * 0.0);
         return;
