@@ -291,22 +291,15 @@ void Chebyshev<D>::colourStep(int level, size_t q, bool jacobi) {
   float* e = work_->e[colour].data();
   const float* g = work_->g.data() + colour * rowsTotal * hx_;
   const float omega = jacobi ? 1.0f : omega_[std::min(size_t(level), omega_.size() - 1)];
-  const size_t ny = size_t(A_.dims[1]);
   rows(q, [&](size_t row, size_t y, size_t z) {
     // The neighbour rows along y and z (the other colour's slots), zeros
-    // across a non-periodic edge, as rowStencil.
-    const float *lo[D] = {}, *hi[D] = {};
-    for (int a = 1; a < D; ++a) {
-      const size_t k = a == 1 ? y : z, n = size_t(A_.dims[a]), stride = a == 1 ? 1 : ny;
-      const bool p = A_.periodic[a];
-      lo[a] = k > 0 ? cur + (row - stride) * hx_ : p ? cur + (row + (n - 1) * stride) * hx_ : zerosOf();
-      hi[a] = k + 1 < n ? cur + (row + stride) * hx_ : p ? cur + (row - (n - 1) * stride) * hx_ : zerosOf();
-    }
+    // across a non-periodic edge.
+    const RowStencil<D, float> n = rowStencil<D, float>(A_, cur, zerosOf(), zerosOf(), row, y, z, hx_);
     const size_t s = (colour + y + z) & 1;  // this colour's first x in the row
     const size_t at = row * hx_;
     if (level == 2 || jacobi)  // e = omega J e_{k-1}
-      colourRow<D, true>(A_, row, s, cur + at, lo, hi, e + at, g + at, packedRow(row), omega);
-    else colourRow<D, false>(A_, row, s, cur + at, lo, hi, e + at, g + at, packedRow(row), omega);
+      colourRow<D, true>(A_, row, s, cur + at, n.xlo, n.xhi, e + at, g + at, packedRow(row), omega);
+    else colourRow<D, false>(A_, row, s, cur + at, n.xlo, n.xhi, e + at, g + at, packedRow(row), omega);
   });
 }
 
@@ -347,7 +340,7 @@ void Chebyshev<D>::residualPlane(const Vector& b, const Vector& x, size_t q) {
     // Each colour's cells to its slots; e_1 = g in both (a round of one
     // step uses both).
     for (size_t colour = 0; colour < 2; ++colour) {
-      const size_t at = splitIndex(row, 0);
+      const size_t at = row * hx_;
       float* __restrict g = work_->g.data() + colour * half + at;
       float* __restrict e = work_->e[colour].data() + at;
       for (size_t i = (colour + y + z) & 1; i < nx; i += 2) g[i / 2] = e[i / 2] = float(v[i]);

@@ -104,9 +104,6 @@ class Chebyshev {
   void step(int level, size_t q, bool jacobi = false);
   // The same on the cells of colour level & 1 (cyclic).
   void colourStep(int level, size_t q, bool jacobi);
-  // Where cell x of a row lives in its colour's vector (cyclic): the
-  // colour of x is (x + y + z) mod 2.
-  size_t splitIndex(size_t row, size_t x) const { return row * hx_ + x / 2; }
   // x += e / rscale on plane q.
   void addCorrection(Vector* x, const float* e0, const float* e1, size_t q) const;
   // r = b - A x on plane q; writes step 1 (e_1 = g = rscale D^-1 r / scale)

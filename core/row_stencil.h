@@ -19,13 +19,15 @@ struct RowStencil {
   const float* wlo[D];  // w[a] of the row below (coupling to this row)
 };
 
-// Row `row` at coordinates y (and z) along axes 1 (and 2).
+// Row `row` at coordinates y (and z) along axes 1 (and 2). `rowLength`:
+// the values x holds a row (0: the grid's; the cyclic Chebyshev iteration's
+// colours hold half a row each).
 template <int D, class T>
 inline RowStencil<D, T> rowStencil(const LaplaceSystem<D>& A, const T* x, const T* zx, const float* zw, size_t row,
-                            size_t y, size_t z) {
+                                   size_t y, size_t z, size_t rowLength = 0) {
   RowStencil<D, T> s{};
   const IVec<D>& dims = A.dims;
-  size_t nx = size_t(dims[0]), ny = size_t(dims[1]);
+  size_t nx = rowLength ? rowLength : size_t(dims[0]), ny = size_t(dims[1]);
   s.base = row * nx;
   for (int a = 1; a < D; ++a) {
     size_t k = a == 1 ? y : z, n = size_t(dims[a]);

@@ -168,9 +168,9 @@ static void eachUnknownRow(const IVec<D>& dims, const Grid<float, D>& g, auto&& 
   forEachRow<D>(dims, [&](size_t row, const IVec<D>& k) { fn(row, row * size_t(dims[0]), g.index(k)); });
 }
 
-// One row of component a's unknowns as the passes below read it: held[x]
-// is nonzero where unknown i0 + x is held (its face prescribed, or inside
-// a cut obstacle), so the loops over a row have no branches.
+// One row of component a's unknowns as the passes below read it: unknown
+// i0 + x is held where fixed[x] | cut[x] (its face prescribed, or inside a
+// cut obstacle), so the loops over a row have no branches.
 struct UnknownRow {
   size_t row, i0, g0;
   const uint8_t* fixed;  // the face's flag
@@ -178,8 +178,9 @@ struct UnknownRow {
 };
 template <int D>
 static void eachRowOf(const ViscousSystem<D>& C, const Grid<uint8_t, D>& fixed, const Grid<float, D>& g, auto&& fn) {
-  static const std::vector<uint8_t> none(size_t(1) << 16, 0);
   eachUnknownRow<D>(C.dims, g, [&](size_t row, size_t i0, size_t g0) {
+    thread_local std::vector<uint8_t> none;  // the cut flags without cut obstacles
+    if (C.insideCut.empty() && none.size() < size_t(C.dims[0])) none.assign(size_t(C.dims[0]), 0);
     fn(UnknownRow{row, i0, g0, fixed.data() + g0, C.insideCut.empty() ? none.data() : C.insideCut.data() + i0});
   });
 }
