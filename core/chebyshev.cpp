@@ -1,6 +1,7 @@
 #include "core/chebyshev.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
@@ -162,22 +163,34 @@ Chebyshev<D>::Chebyshev(const LaplaceSystem<D>& A, const ChebyshevLayout& layout
 template <int D>
 void Chebyshev<D>::refresh() {
   const size_t n = A_.size(), nx = size_t(A_.dims[0]), rows = n / nx;
-  // The largest of f(diag_i, c_i) over the cells (a maximum: any order).
-  auto maxOver = [&](auto&& f) {
-    return deterministicMax(rows, [&](size_t row) {
-      const float *d = A_.diag.row(row), *c = A_.c.row(row);
-      double m = 0.0;
-      for (size_t i = 0; i < nx; ++i) m = std::max(m, f(double(d[i]), double(c[i])));
-      return m;
-    });
-  };
-  // rho = max (diag - c) / diag: diag sums c and the cell's face weights.
-  rho_ = maxOver([](double d, double c) { return d > 0 ? (d - c) / d : 0.0; });
+  // rho = max (diag - c) / diag (diag sums c and the cell's face weights),
+  // and the diagonal's range: maxima, so any order, over the distinct pairs
+  // of stored rows (a box's few, whatever its size; an obstacle's as many
+  // as it has rows).
+  std::vector<std::pair<const float*, const float*>> pairs(rows);
+  for (size_t row = 0; row < rows; ++row) pairs[row] = {A_.diag.row(row), A_.c.row(row)};
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  std::vector<std::array<double, 3>> m(pairs.size());
+  parallelFor(pairs.size(), [&](size_t p) {
+    const auto [d, c] = pairs[p];
+    std::array<double, 3> r{0.0, 0.0, 0.0};  // rho, the largest diagonal, 1 / the smallest
+    for (size_t i = 0; i < nx; ++i) {
+      const double di = d[i];
+      r[0] = std::max(r[0], di > 0 ? (di - double(c[i])) / di : 0.0);
+      r[1] = std::max(r[1], di);
+      r[2] = std::max(r[2], di > 0 ? 1.0 / di : 0.0);
+    }
+    m[p] = r;
+  });
+  std::array<double, 3> most{0.0, 0.0, 0.0};
+  for (const auto& r : m)
+    for (size_t k = 0; k < 3; ++k) most[k] = std::max(most[k], r[k]);
+  rho_ = most[0];
   // The face weights' float sum may round below diag - c: a margin far
   // above it (it costs nothing in the steps' count).
   rho_ = std::min(1.0, rho_ * (1.0 + 1e-5));
-  const double dmax = maxOver([](double d, double) { return d; });
-  const double dminInv = maxOver([](double d, double) { return d > 0 ? 1.0 / d : 0.0; });
+  const double dmax = most[1], dminInv = most[2];
   diagRatio_ = dmax > 0 ? dmax * dminInv : 1.0;
   // Two colours like a chessboard's where every periodic axis is even.
   cyclic_ = layout_.cyclic && nx >= 2;

@@ -38,44 +38,73 @@ bool canCoarsen(const LaplaceSystem<D>& A, int minCells) {
   return true;
 }
 
+// Coarse cell cc of the re-discretisation of F: its identity term (the
+// Galerkin mean, scaled: the coarse scale is the fine one / 4) and its faces'
+// weights (the face between cc and cc + e_a: the mean of the 2^(D-1) fine
+// faces at fine index 2 cc_a + 1).
+template <int D>
+void coarsenCell(const LaplaceSystem<D>& F, const IVec<D>& cc, float* c, float* w) {
+  double csum = 0.0;
+  for (int k = 0; k < (1 << D); ++k) {
+    IVec<D> f;
+    bool inside = true;
+    for (int a = 0; a < D; ++a) {
+      f[a] = 2 * cc[a] + ((k >> a) & 1);
+      inside &= f[a] < F.dims[a];
+    }
+    if (inside) csum += F.c(f);
+  }
+  *c = float(4.0 * csum * (1.0 / double(1 << D)));
+  for (int a = 0; a < D; ++a) {
+    double wsum = 0.0;
+    int count = 0;
+    for (int k = 0; k < (1 << D); ++k) {
+      if ((k >> a) & 1) continue;
+      IVec<D> f;
+      bool inside = true;
+      for (int b = 0; b < D; ++b) {
+        f[b] = b == a ? 2 * cc[a] + 1 : 2 * cc[b] + ((k >> b) & 1);
+        inside &= f[b] < F.dims[b];
+      }
+      ++count;
+      if (inside) wsum += F.w[a](f);
+    }
+    w[a] = float(wsum / count);
+  }
+}
+
 // The coarse re-discretisation of F into C (already shaped (F.dims + 1) / 2).
 template <int D>
 void coarsenInto(const LaplaceSystem<D>& F, LaplaceSystem<D>* Cp) {
   LaplaceSystem<D>& C = *Cp;
   const IVec<D> cd = C.dims;
   C.scale = F.scale / 4.0;
-  const double inv2D = 1.0 / double(1 << D);
   C.c = RowField<D>(cd, 0.0f);
   for (int a = 0; a < D; ++a) C.w[a] = RowField<D>(cd, 0.0f);
   forEachCell<D>(cd, [&](const IVec<D>& cc, size_t ci) {
-    // Identity terms: Galerkin mean (scaled: coarse scale is fine scale / 4).
-    double csum = 0.0;
-    for (int k = 0; k < (1 << D); ++k) {
-      IVec<D> f;
-      bool inside = true;
-      for (int a = 0; a < D; ++a) {
-        f[a] = 2 * cc[a] + ((k >> a) & 1);
-        inside &= f[a] < F.dims[a];
-      }
-      if (inside) csum += F.c(f);
-    }
-    C.c.at(ci) = float(4.0 * csum * inv2D);
-    // Face between cc and cc + e_a: the 2^(D-1) fine faces at fine index 2 cc_a + 1.
-    for (int a = 0; a < D; ++a) {
-      double wsum = 0.0;
-      int count = 0;
-      for (int k = 0; k < (1 << D); ++k) {
-        if ((k >> a) & 1) continue;
-        IVec<D> f;
-        bool inside = true;
-        for (int b = 0; b < D; ++b) {
-          f[b] = b == a ? 2 * cc[a] + 1 : 2 * cc[b] + ((k >> b) & 1);
-          inside &= f[b] < F.dims[b];
-        }
-        ++count;
-        if (inside) wsum += F.w[a](f);
-      }
-      C.w[a].at(ci) = float(wsum / count);
+    float w[D];
+    coarsenCell<D>(F, cc, &C.c.at(ci), w);
+    for (int a = 0; a < D; ++a) C.w[a].at(ci) = w[a];
+  });
+  C.finalize();
+}
+
+// The coarse cells [clo, chi) of C derived again from F (C derived from F
+// before; F's coefficients changed only in the fine cells these cover).
+// The rows stay compact, and the couplings across a non-periodic edge are
+// zeroed here, as finalize() zeroes a dense field's.
+template <int D>
+void coarsenRegion(const LaplaceSystem<D>& F, LaplaceSystem<D>* Cp, const IVec<D>& clo, const IVec<D>& chi) {
+  LaplaceSystem<D>& C = *Cp;
+  std::array<RowField<D>*, D + 1> fields;
+  for (int a = 0; a < D; ++a) fields[size_t(a)] = &C.w[a];
+  fields[D] = &C.c;
+  rewriteRows<D, D + 1>(fields, rowsOf<D>(C.dims, clo, chi), [&](size_t r, const std::array<float*, D + 1>& v) {
+    IVec<D> k = latticeCoord<D>(C.dims, r * size_t(C.dims[0]));
+    for (k[0] = clo[0]; k[0] < chi[0]; ++k[0]) {
+      float w[D];
+      coarsenCell<D>(F, k, &v[D][k[0]], w);
+      for (int a = 0; a < D; ++a) v[size_t(a)][k[0]] = k[a] == C.dims[a] - 1 && !C.periodic[a] ? 0.0f : w[a];
     }
   });
   C.finalize();
@@ -136,6 +165,18 @@ void Multigrid<D>::giveBackFine(WorkPool* pool) {
 template <int D>
 void Multigrid<D>::refresh() {
   for (size_t l = 1; l < levels_.size(); ++l) coarsenInto(level(int(l) - 1), &levels_[l].A);
+}
+
+template <int D>
+void Multigrid<D>::refresh(IVec<D> lo, IVec<D> hi) {
+  for (size_t l = 1; l < levels_.size(); ++l) {
+    const LaplaceSystem<D>& C = levels_[l].A;
+    for (int a = 0; a < D; ++a) {  // coarse cell K covers fine cells 2K and 2K + 1
+      lo[a] = std::clamp(lo[a] / 2, 0, C.dims[a]);
+      hi[a] = std::clamp((hi[a] + 1) / 2, lo[a], C.dims[a]);
+    }
+    coarsenRegion(level(int(l) - 1), &levels_[l].A, lo, hi);
+  }
 }
 
 template <int D>

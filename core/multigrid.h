@@ -49,6 +49,10 @@ class Multigrid final : public Preconditioner {
   // term, say, from a new time step): re-derive the coarse levels in place,
   // as the constructor would, without reallocating anything.
   void refresh();
+  // The same when the fine system changed only in the cells [lo, hi): each
+  // level re-derives the cells over the changed ones (bitwise what refresh()
+  // gives), so a moving obstacle costs the levels what it touches.
+  void refresh(IVec<D> lo, IVec<D> hi);
 
   // The finest level's work vectors (the largest) come from `pool` for one
   // solve and go back to it: a solver lends them only while it solves.

@@ -93,8 +93,7 @@ void RowField<D>::storeRows(const std::vector<size_t>& rows, std::vector<float>*
       if (next != s) std::memmove(pool_.data() + size_t(next) * nx_, pool_.data() + s * nx_, nx_ * sizeof(float));
       to[s] = next++;
     }
-  pool_.resize(size_t(next) * nx_);
-  pool_.shrink_to_fit();
+  pool_.resize(size_t(next) * nx_);  // (its capacity kept for the next rows: an obstacle moves every step)
   for (uint32_t& s : rowOf_) s = to[s];
 }
 

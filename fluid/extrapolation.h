@@ -7,8 +7,10 @@
 // and the GPU (gpu/fluid/gpu_fill.h), with the formula kernels/extrapolation.inc's.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include "core/grid.h"
@@ -32,23 +34,39 @@ struct FillPlan {
   bool empty() const { return covered.empty() && entries.empty(); }
 };
 
-// The plan of a solid that moved from `was` to `now` (flags: 1 = solid, or held).
+// The plan of a solid that moved from `was` to `now` (flags: 1 = solid, or
+// held), which differ only in the box [lo, hi): the elements in it are
+// scanned, and an element outside counts as fluid where `now` says so.
 template <int D>
-FillPlan fillPlan(const Grid<uint8_t, D>& was, const Grid<uint8_t, D>& now) {
+FillPlan fillPlan(const Grid<uint8_t, D>& was, const Grid<uint8_t, D>& now, IVec<D> lo, IVec<D> hi) {
   FillPlan plan;
   plan.stride = 2 + 2 * D;
-  std::vector<size_t> open;  // uncovered, not yet filled
-  std::vector<uint8_t> known(was.size(), 0);
-  for (size_t i = 0; i < was.size(); ++i) {
-    known[i] = !was[i] && !now[i];
-    if (was[i] && !now[i]) open.push_back(i);
+  const IVec<D> dims = was.dims();
+  for (int a = 0; a < D; ++a) lo[a] = std::clamp(lo[a], 0, dims[a]), hi[a] = std::clamp(hi[a], lo[a], dims[a]);
+  const IVec<D> box = hi - lo;
+  auto inBox = [&](const IVec<D>& k) {  // k's index in the box, or SIZE_MAX
+    for (int a = 0; a < D; ++a)
+      if (k[a] < lo[a] || k[a] >= hi[a]) return SIZE_MAX;
+    return latticeIndex<D>(box, k - lo);
+  };
+  std::vector<std::pair<size_t, size_t>> open;  // uncovered, not yet filled: index, index in the box
+  size_t boxCells = 1;
+  for (int a = 0; a < D; ++a) boxCells *= size_t(box[a]);
+  for (size_t b = 0; b < boxCells; ++b) {  // in index order
+    const size_t i = was.index(lo + latticeCoord<D>(box, b));
+    if (was[i] && !now[i]) open.emplace_back(i, b);
     if (!was[i] && now[i]) plan.covered.push_back(uint32_t(i));
   }
-  const IVec<D> dims = was.dims();
+  std::vector<uint8_t> filled(boxCells, 0);  // by an earlier layer
+  auto known = [&](const IVec<D>& k, size_t j) {
+    if (!was[j] && !now[j]) return true;
+    const size_t b = inBox(k);
+    return b != SIZE_MAX && filled[b] != 0;
+  };
   for (int layer = 0; layer < FillPlan::kLayers && !open.empty(); ++layer) {
-    const size_t first = plan.entries.size();
-    std::vector<size_t> rest;
-    for (size_t i : open) {
+    std::vector<std::pair<size_t, size_t>> rest;
+    std::vector<size_t> done;
+    for (const auto& [i, b] : open) {
       const IVec<D> k = was.coord(i);
       uint32_t e[2 + 2 * D] = {uint32_t(i), 0};
       for (int a = 0; a < D; ++a)
@@ -57,17 +75,27 @@ FillPlan fillPlan(const Grid<uint8_t, D>& was, const Grid<uint8_t, D>& now) {
           nb[a] += dir;
           if (nb[a] < 0 || nb[a] >= dims[a]) continue;
           const size_t j = was.index(nb);
-          if (known[j]) e[2 + e[1]++] = uint32_t(j);
+          if (known(nb, j)) e[2 + e[1]++] = uint32_t(j);
         }
-      if (e[1] > 0) plan.entries.insert(plan.entries.end(), e, e + plan.stride);
-      else rest.push_back(i);
+      if (e[1] > 0) {
+        plan.entries.insert(plan.entries.end(), e, e + plan.stride);
+        done.push_back(b);
+      } else {
+        rest.emplace_back(i, b);
+      }
     }
     // A layer at a time: none of its elements reads another of its own.
-    for (size_t q = first; q < plan.entries.size(); q += size_t(plan.stride)) known[plan.entries[q]] = 1;
+    for (size_t b : done) filled[b] = 1;
     plan.layerEnds.push_back(plan.entries.size() / size_t(plan.stride));
     open.swap(rest);
   }
   return plan;
+}
+
+// The same over the whole grid.
+template <int D>
+FillPlan fillPlan(const Grid<uint8_t, D>& was, const Grid<uint8_t, D>& now) {
+  return fillPlan<D>(was, now, IVec<D>(0), was.dims());
 }
 
 // The plan carried out on `values`: the covered elements take `covered`

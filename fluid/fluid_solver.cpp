@@ -76,19 +76,16 @@ FluidSolver<D>::FluidSolver(const FluidSettings& s)
 template <int D>
 void FluidSolver<D>::placeObstacles(double t, bool fill) {
   if (!moves_) return;
-  const Grid<uint8_t, D> wasSolid = constraints_.solid;
-  const std::array<Grid<uint8_t, D>, D> wasFixed = constraints_.fixed;
   IVec<D> lo, hi;
   if (!placement_.moveTo(t, &constraints_, &lo, &hi)) return;
   projection_->rebuild(lo, hi);
   if (settings_.viscosity > 0) viscosity_->rebuild(lo, hi);  // (an inviscid fluid never solves it)
   cutSurfaceMade_ = false;
   if (!fill) return;
-  const FillPlan cells = fillPlan<D>(wasSolid, constraints_.solid);
+  const FillPlan cells = placement_.cellFill(constraints_);
   if (!dye_.empty()) applyFill<float>(cells, dye_.data(), std::nullopt);
   if (!temperature_.empty()) applyFill<float>(cells, temperature_.data(), std::nullopt);
-  for (int a = 0; a < D; ++a)
-    applyFill<float>(fillPlan<D>(wasFixed[a], constraints_.fixed[a]), u_[a].data(), std::nullopt);
+  for (int a = 0; a < D; ++a) applyFill<float>(placement_.faceFill(constraints_, a), u_[a].data(), std::nullopt);
   constraints_.apply(&u_);
 }
 

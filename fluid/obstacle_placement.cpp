@@ -62,10 +62,14 @@ template <int D>
 bool ObstaclePlacement<D>::moveTo(double t, VelocityConstraints<D>* vc, IVec<D>* lo, IVec<D>* hi) {
   std::vector<RigidMotion> motions;
   std::vector<ObstacleSpec> placed = obstaclesAt(t, &motions);
+  wasSolid_ = vc->solid;
+  for (int a = 0; a < D; ++a) wasFixed_[size_t(a)] = vc->fixed[a];
+  movedLo_ = movedHi_ = IVec<D>(0);
   *lo = cells_, *hi = IVec<D>(0);
   if (!movingCells(placed_, lo, hi) || !movingCells(placed, lo, hi)) {
     *vc = constraintsAt(t);  // (which places them itself)
     *lo = IVec<D>(0), *hi = cells_;
+    movedLo_ = *lo, movedHi_ = *hi;
     return true;
   }
   placedAt_ = t;
@@ -74,7 +78,9 @@ bool ObstaclePlacement<D>::moveTo(double t, VelocityConstraints<D>* vc, IVec<D>*
       placed_ = std::move(placed);
       return false;
     }
-  Grid<uint8_t, D> solid = vc->solid;
+  movedLo_ = *lo, movedHi_ = *hi;
+  nowSolid_ = vc->solid;
+  Grid<uint8_t, D>& solid = nowSolid_;
   std::vector<ObstacleSpec> voxel;
   for (const ObstacleSpec& o : placed)
     if (o.boundary == ObstacleBoundary::Voxel) voxel.push_back(o);
@@ -94,6 +100,16 @@ bool ObstaclePlacement<D>::moveTo(double t, VelocityConstraints<D>* vc, IVec<D>*
   vc->move(solid, voxel_, CutSurface(placed, D, size), CutSurface(placed, D, size, motions, true), *lo, *hi);
   placed_ = std::move(placed);
   return true;
+}
+
+template <int D>
+FillPlan ObstaclePlacement<D>::cellFill(const VelocityConstraints<D>& vc) const {
+  return fillPlan<D>(wasSolid_, vc.solid, movedLo_, movedHi_);
+}
+
+template <int D>
+FillPlan ObstaclePlacement<D>::faceFill(const VelocityConstraints<D>& vc, int a) const {
+  return fillPlan<D>(wasFixed_[size_t(a)], vc.fixed[a], movedLo_, movedHi_ + unitVector<D>(a));
 }
 
 template class ObstaclePlacement<2>;

@@ -4,8 +4,10 @@
 // CPU solver and the GPU backend each keep one and place it at every step.
 #pragma once
 
+#include <array>
 #include <vector>
 
+#include "fluid/extrapolation.h"
 #include "fluid/fluid_settings.h"
 #include "fluid/obstacle_motion.h"
 #include "fluid/velocity_constraints.h"
@@ -27,6 +29,10 @@ class ObstaclePlacement {
   // or now: nothing changed.
   bool moveTo(double t, VelocityConstraints<D>* vc, IVec<D>* lo, IVec<D>* hi);
   double time() const { return placedAt_; }  // the time they were placed for
+  // The fill plans of the last moveTo (fluid/extrapolation.h): the cells
+  // and the faces of axis a it uncovered and covered in *vc.
+  FillPlan cellFill(const VelocityConstraints<D>& vc) const;
+  FillPlan faceFill(const VelocityConstraints<D>& vc, int a) const;
 
  private:
   std::vector<ObstacleSpec> obstaclesAt(double t, std::vector<RigidMotion>* motions) const;
@@ -40,6 +46,10 @@ class ObstaclePlacement {
   std::vector<ObstacleSpec> placed_;  // the obstacles where they are now
   Grid<uint8_t, D> voxel_;            // the staircase obstacles' cells (when one moves)
   double placedAt_ = 0.0;
+  // The flags before the last move, and the box it changed (storage kept from step to step).
+  Grid<uint8_t, D> wasSolid_, nowSolid_;
+  std::array<Grid<uint8_t, D>, D> wasFixed_;
+  IVec<D> movedLo_{0}, movedHi_{0};
 };
 
 }  // namespace morphoflow

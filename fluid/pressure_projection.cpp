@@ -64,8 +64,7 @@ template LaplaceSystem<3> pressureSystem<3>(const VelocityConstraints<3>&);
 template <int D>
 void updatePressureSystem(LaplaceSystem<D>* A, const VelocityConstraints<D>& vc, const IVec<D>& lo, const IVec<D>& hi) {
   // A cell's row reads the faces of its own and its neighbours' cells.
-  IVec<D> clo, chi;
-  for (int a = 0; a < D; ++a) clo[a] = std::max(lo[a] - 1, 0), chi[a] = std::min(hi[a] + 1, vc.cells[a]);
+  const IVec<D> clo = pressureRowsChanged(lo, vc.cells, -1), chi = pressureRowsChanged(hi, vc.cells, 1);
   std::array<RowField<D>*, D + 1> fields;
   for (int a = 0; a < D; ++a) fields[size_t(a)] = &A->w[a];
   fields[D] = &A->c;
@@ -95,9 +94,9 @@ PressureProjection<D>::PressureProjection(const VelocityConstraints<D>& vc, Pres
 
 template <int D>
 void PressureProjection<D>::rebuild(const IVec<D>& lo, const IVec<D>& hi) {
-  updatePressureSystem<D>(&A_, vc_, lo, hi);  // (same shape: the multigrid refers to A_ and derives its levels again)
+  updatePressureSystem<D>(&A_, vc_, lo, hi);  // (same shape: the multigrid refers to A_)
   if (solver_ == PressureSolver::ICPCG) mic_ = std::make_unique<MIC0Preconditioner<D>>(A_);
-  else multigrid_->refresh();
+  else multigrid_->refresh(pressureRowsChanged(lo, vc_.cells, -1), pressureRowsChanged(hi, vc_.cells, 1));
   // Cells the solid covers hold no pressure.
   for (size_t i = 0; i < phi_.size(); ++i)
     if (vc_.solid[i] && A_.diag[i] == 0.0f) phi_[i] = 0.0;

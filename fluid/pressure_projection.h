@@ -5,6 +5,7 @@
 // multigrid V-cycles. The previous phi warm-starts the next solve.
 #pragma once
 
+#include <algorithm>
 #include <memory>
 
 #include "core/laplace_system.h"
@@ -27,6 +28,14 @@ LaplaceSystem<D> pressureSystem(const VelocityConstraints<D>& constraints);
 template <int D>
 void updatePressureSystem(LaplaceSystem<D>* A, const VelocityConstraints<D>& constraints, const IVec<D>& lo,
                           const IVec<D>& hi);
+// The box of cells whose rows updatePressureSystem writes for the cells
+// [lo, hi): one cell more on every side (side -1 for lo, +1 for hi).
+template <int D>
+IVec<D> pressureRowsChanged(const IVec<D>& corner, const IVec<D>& cells, int side) {
+  IVec<D> k;
+  for (int a = 0; a < D; ++a) k[a] = std::clamp(corner[a] + side, 0, cells[a]);
+  return k;
+}
 
 template <int D>
 class PressureProjection {

@@ -120,10 +120,7 @@ void updateViscousSystem(ViscousSystem<D>* C, const VelocityConstraints<D>& vc, 
     from[b] = std::max(lo[b] - 1, 0);
     to[b] = std::min(hi[b] + (b == a ? 2 : 1), C->dims[b]);
   }
-  viscousRows<D>(C, vc, a, from, to);
-  C->cBoundary.compact();
-  C->boundaryRhs.compact();
-  C->A.finalize();
+  viscousRows<D>(C, vc, a, from, to);  // (compact rows stay compact; c, the diagonal and the spans follow at setRate)
   if (ulo) *ulo = from;
   if (uhi) *uhi = to;
 }

@@ -52,7 +52,8 @@ template <int D>
 ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& constraints, int axis);
 // Its rows again where changed constraints touch them: the unknowns of the
 // faces of the cells [lo, hi) and one more layer (their neighbours' rows
-// see them), which it returns in [*ulo, *uhi) when asked.
+// see them), which it returns in [*ulo, *uhi) when asked. The system's c,
+// diagonal and uniform spans follow at the next setRate.
 template <int D>
 void updateViscousSystem(ViscousSystem<D>* system, const VelocityConstraints<D>& constraints, int axis,
                          const IVec<D>& lo, const IVec<D>& hi, IVec<D>* ulo = nullptr, IVec<D>* uhi = nullptr);

@@ -166,8 +166,6 @@ void GpuFluid<D>::injectInflowDye() {
 template <int D>
 void GpuFluid<D>::placeObstacles(double t, bool fill) {
   if (!placement_.moves()) return;
-  const Grid<uint8_t, D> wasSolid = vc_.solid;
-  const std::array<Grid<uint8_t, D>, D> wasFixed = vc_.fixed;
   IVec<D> lo, hi;
   if (!placement_.moveTo(t, &vc_, &lo, &hi)) return;
   grid_.refresh(vc_);
@@ -175,11 +173,11 @@ void GpuFluid<D>::placeObstacles(double t, bool fill) {
   if (settings_.viscosity > 0) viscosity_.rebuild(vc_, lo, hi);  // (an inviscid fluid never solves it)
   if (smoke_) smoke_->setSolid(vc_.solid);
   if (!fill) return;
-  const GpuFill cells(fillPlan<D>(wasSolid, vc_.solid));
+  const GpuFill cells(placement_.cellFill(vc_));
   cells.apply(dye_, 0, GpuPrecision::Float);
   if (smoke_) cells.apply(smoke_->temperature(), 0, GpuPrecision::Float);
   for (int a = 0; a < D; ++a)
-    GpuFill(fillPlan<D>(wasFixed[a], vc_.fixed[a])).apply(grid_.vel, grid_.off[size_t(a)], GpuPrecision::Float);
+    GpuFill(placement_.faceFill(vc_, a)).apply(grid_.vel, grid_.off[size_t(a)], GpuPrecision::Float);
   grid_.constrain(grid_.vel, real_);
   speed_cached_ = -1.0;
 }

@@ -48,7 +48,7 @@ GpuProjection<D>::GpuProjection(const VelocityConstraints<D>& vc, GpuMacGrid<D>*
 template <int D>
 void GpuProjection<D>::rebuild(const VelocityConstraints<D>& vc, const IVec<D>& lo, const IVec<D>& hi) {
   updatePressureSystem<D>(&P_, vc, lo, hi);
-  levels_->refresh();
+  levels_->refresh(pressureRowsChanged(lo, vc.cells, -1), pressureRowsChanged(hi, vc.cells, 1));
   // The rows whose weights, c or diagonal can have changed (a margin of two cells), uploaded again.
   IVec<D> clo, chi;
   for (int a = 0; a < D; ++a) clo[a] = std::max(lo[a] - 2, 0), chi[a] = std::min(hi[a] + 2, vc.cells[a]);

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "fluid/extrapolation.h"
 #include "fluid/fluid_solver.h"
 #include "fluid/obstacle_motion.h"
 #include "tests/fluid/towed_body.h"
@@ -237,4 +238,44 @@ TEST(MovingObstacles, TheWindowMeanTakesOutAStepToStepFlickerAndKeepsTheShedding
   const StrouhalEstimate raw = estimateStrouhal(t, y, 0.0, 1.0, 1.0), clean = estimateStrouhal(t, m, 0.0, 1.0, 1.0);
   EXPECT_GT(raw.strouhal, 1.0);  // the flicker's crossings
   EXPECT_NEAR(clean.strouhal, 0.3, 0.01);
+}
+
+// A solid that changed only in a box: the plan made from that box is the
+// plan of the whole grid, element for element (a ball moved inside the box,
+// uncovering cells whose fill reaches several layers out, and a box at the
+// grid's edge).
+TEST(MovingObstacles, TheFillPlanOfTheMovedBoxIsTheWholeGrids) {
+  const IVec<3> dims(24, 20, 18);
+  auto ball = [&](double cx, double cy, double cz, double r) {
+    Grid<uint8_t, 3> g(dims, 0);
+    forEachCell<3>(dims, [&](const IVec<3>& k, size_t i) {
+      const double dx = k[0] - cx, dy = k[1] - cy, dz = k[2] - cz;
+      g[i] = dx * dx + dy * dy + dz * dz < r * r ? 1 : 0;
+    });
+    return g;
+  };
+  struct Move {
+    Grid<uint8_t, 3> was, now;
+    IVec<3> lo, hi;
+  };
+  const std::vector<Move> moves = {
+      {ball(10, 9, 8, 5.5), ball(12.5, 9.5, 8, 4.0), IVec<3>(3, 2, 1), IVec<3>(19, 16, 15)},
+      {ball(2, 9, 8, 4.5), ball(0.5, 10, 9, 5.0), IVec<3>(0, 3, 2), IVec<3>(8, 17, 16)},
+  };
+  for (const Move& m : moves) {
+    forEachCell<3>(dims, [&](const IVec<3>& k, size_t i) {  // the move stays inside its box
+      bool inside = true;
+      for (int a = 0; a < 3; ++a) inside = inside && k[a] >= m.lo[a] && k[a] < m.hi[a];
+      if (!inside) {
+        ASSERT_EQ(m.was[i], m.now[i]);
+      }
+    });
+    const FillPlan whole = fillPlan<3>(m.was, m.now), box = fillPlan<3>(m.was, m.now, m.lo, m.hi);
+    ASSERT_FALSE(whole.entries.empty());
+    ASSERT_FALSE(whole.covered.empty());
+    EXPECT_GT(whole.layerEnds.size(), 1u);  // (the fill reached past the first layer)
+    EXPECT_EQ(box.covered, whole.covered);
+    EXPECT_EQ(box.entries, whole.entries);
+    EXPECT_EQ(box.layerEnds, whole.layerEnds);
+  }
 }
