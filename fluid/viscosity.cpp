@@ -26,8 +26,24 @@ void viscousRows(ViscousSystem<D>* system, const VelocityConstraints<D>& vc, int
   // (outside) elsewhere.
   const bool cut = !vc.cut.empty();
   auto distance = [&](const IVec<D>& k) { return float(vc.cut.distance(vc.facePosition(a, k).data())); };
-  auto phi = [&](const IVec<D>& k) {
+  auto phiAt = [&](const IVec<D>& k) {
     return vc.open[a](k) < 1.0f ? distance(k) : std::numeric_limits<float>::infinity();
+  };
+  // phi over the box and one layer round it, found once (each face's is read
+  // by its 2 D neighbours too); a wrapped neighbour outside it finds its own.
+  IVec<D> plo, pdims;
+  size_t boxSize = 1;
+  for (int b = 0; b < D; ++b) {
+    plo[b] = std::max(lo[b] - 1, 0);
+    pdims[b] = std::max(std::min(hi[b] + 1, C.dims[b]) - plo[b], 0);
+    boxSize *= size_t(pdims[b]);
+  }
+  std::vector<float> phiBox(cut ? boxSize : 0);
+  if (cut) forEachCell<D>(pdims, [&](const IVec<D>& r, size_t i) { phiBox[i] = phiAt(plo + r); });
+  auto phi = [&](const IVec<D>& k) {
+    for (int b = 0; b < D; ++b)
+      if (k[b] < plo[b] || k[b] >= plo[b] + pdims[b]) return phiAt(k);
+    return phiBox[latticeIndex<D>(pdims, k - plo)];
   };
   if (cut && C.insideCut.size() != C.A.size()) C.insideCut.assign(C.A.size(), 0);
   std::array<RowField<D>*, D + 2> fields;
