@@ -287,7 +287,8 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
       const size_t nx = size_t(C.dims[0]);
       if (a > 0) rhsRow<D>(C, r, g, s, &b_);
       if (history == 0) {
-        for (size_t k = 0; k < nx; ++k) x[k] = zeroWhere(f[k] | c[k], double(gr[k]) + s * 0.0);
+        for (size_t k = 0; k < nx; ++k)
+          x[k] = zeroWhere(f[k] | c[k], double(gr[k]) + s * 0.0);  // (a zero rate: -0 -> +0)
         return;
       }
       const float* __restrict rate = C.rate.data() + r.i0;

@@ -41,9 +41,10 @@ struct ViscousSystem {
   // next to walls and prescribed faces):
   RowField<D> cBoundary;    // diagonal terms from walls and prescribed neighbours; -1 on a prescribed face (inactive)
   RowField<D> boundaryRhs;  // their prescribed values, times the coupling
-  // With cut obstacles: 1 on a face inside one, which the viscosity leaves
-  // as the projection made it (held, as a prescribed face is) (its no-slip is at the surface, where the
-  // neighbours' stencils put it); empty without cut obstacles.
+  // With cut obstacles: 1 on a face inside one, which the viscosity holds
+  // as the projection made it, as it holds a prescribed face (the no-slip is
+  // at the surface, where the neighbours' stencils put it); empty without
+  // cut obstacles.
   std::vector<uint8_t> insideCut;
   // A for s = nu dt / h^2: c = 1/s + boundary terms, 0 on prescribed faces.
   void setRate(double s);
