@@ -93,14 +93,19 @@ std::vector<VelocityFrame> findVelocityFrames(const std::string& pattern, double
       throw VelocityFileError(pattern, "no file matches (each '#' stands for one digit of the frame number)");
     std::sort(files.begin(), files.end());
   }
+  std::vector<std::string> paths;
+  for (const auto& file : files) paths.push_back(file.second);
+  std::vector<VdbTime> times;
+  size_t failed = 0;
+  std::string err;
+  const bool read = readVdbTimes(paths, &times, &failed, &err);
   std::vector<VelocityFrame> frames;
-  for (const auto& [number, path] : files) {
+  for (size_t i = 0; i < times.size(); ++i) {  // the files before one that cannot be read first
+    const auto& [number, path] = files[i];
     VelocityFrame f;
     f.path = path;
-    std::string err;
-    bool has = false;
-    if (!readVdbTime(path, &f.time, &has, &err)) throw VelocityFileError(path, err);
-    if (!has) {
+    f.time = times[i].time;
+    if (!times[i].has) {
       if (!(frameTime > 0))
         throw VelocityFileError(
             path, "the file has no 'time' metadata, so the frame's time is unknown; give velocity.frame_time");
@@ -111,6 +116,7 @@ std::vector<VelocityFrame> findVelocityFrames(const std::string& pattern, double
                                         std::to_string(frames.back().time) + ")");
     frames.push_back(f);
   }
+  if (!read) throw VelocityFileError(paths[std::min(failed, paths.size() - 1)], err);
   return frames;
 }
 

@@ -1,5 +1,6 @@
 #include "render/isolated_read.h"
 
+#include <fcntl.h>
 #include <poll.h>
 #include <sys/prctl.h>
 #include <sys/resource.h>
@@ -14,34 +15,12 @@
 #include <cstdint>
 #include <cstring>
 
-// In sanitizer builds, the callback a sanitizer runs before it ends the
-// process (libFuzzer's records the input as a finding); null elsewhere.
-extern "C" void __sanitizer_set_death_callback(void (*callback)(void)) __attribute__((weak));
-
 namespace morphoflow {
 
 namespace {
 
-// The child dies of what kills it: the parent's handlers of fatal signals and
-// its sanitizer death callback are the parent's business (the parent reports
-// the crash as a damaged file).
-void dieAlone() {
-  for (int sig : {SIGSEGV, SIGBUS, SIGABRT, SIGFPE, SIGILL, SIGXCPU}) std::signal(sig, SIG_DFL);
-  if (__sanitizer_set_death_callback) __sanitizer_set_death_callback(nullptr);
-}
-
-bool writeAll(int fd, const char* p, size_t n) {
-  while (n > 0) {
-    const ssize_t w = ::write(fd, p, n);
-    if (w < 0 && errno == EINTR) continue;
-    if (w <= 0) return false;
-    p += w, n -= size_t(w);
-  }
-  return true;
-}
-
-// The child's whole answer from `fd` within `wallSeconds`: false when the
-// time ran out first (the child may be blocked, using no processor time).
+// The reader's whole output from `fd` within `wallSeconds`: false when the
+// time ran out first (the reader may be blocked, using no processor time).
 bool readAll(int fd, double wallSeconds, std::string* got) {
   using Clock = std::chrono::steady_clock;
   const auto deadline =
@@ -61,49 +40,64 @@ bool readAll(int fd, double wallSeconds, std::string* got) {
   }
 }
 
+// In the child, between fork and exec: only async-signal-safe calls.
+[[noreturn]] void execReader(char* const* argv, int out, int null, pid_t parent, double cpuSeconds) {
+  if (::dup2(out, STDOUT_FILENO) < 0 || ::dup2(null, STDIN_FILENO) < 0 || ::dup2(null, STDERR_FILENO) < 0) ::_exit(126);
+  // The reader ends with the process that waits for it (no reader left
+  // behind, blocked, when a run is killed); the setting outlives the exec.
+  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (::getppid() != parent) ::_exit(126);
+  ::close_range(3, ~0u, 0);  // nothing of this process's open files goes with the reader
+  const rlim_t cpu = rlim_t(std::ceil(cpuSeconds));
+  const rlimit limit{cpu, cpu + 1};  // SIGXCPU at the soft limit, SIGKILL at the hard one
+  ::setrlimit(RLIMIT_CPU, &limit);
+  ::execv(argv[0], argv);
+  ::_exit(127);
+}
+
+std::string whyItStopped(int status, const ReaderLimits& limits, const std::string& program) {
+  if (WIFSIGNALED(status) && (WTERMSIG(status) == SIGXCPU || WTERMSIG(status) == SIGKILL))
+    return "the file is damaged: its reader ran for more than " + std::to_string(long(std::ceil(limits.cpuSeconds))) +
+           " s without finishing";
+  if (WIFSIGNALED(status))
+    return "the file is damaged: reading it crashed the reader (" + std::string(strsignal(WTERMSIG(status))) + ")";
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 127)
+    return "the reader " + program + " could not be started: build morphoflow again (scripts/setup)";
+  return "the file is damaged: its reader stopped (status " +
+         std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")";
+}
+
 }  // namespace
 
-bool runIsolated(const std::function<std::string()>& work, const ReaderLimits& limits, std::string* result,
+bool runIsolated(const std::vector<std::string>& argv, const ReaderLimits& limits, std::string* out,
                  std::string* error) {
-  const double cpuSeconds = limits.cpuSeconds;
+  out->clear();
+  if (argv.empty() || ::access(argv[0].c_str(), X_OK) != 0) {
+    *error = "the reader " + (argv.empty() ? std::string("(none)") : argv[0]) +
+             " is missing or cannot run: build morphoflow again (scripts/setup)";
+    return false;
+  }
+  std::vector<char*> args;
+  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
   int fds[2];
-  if (::pipe(fds) != 0) {
+  if (::pipe2(fds, O_CLOEXEC) != 0) {
     *error = std::string("cannot make a pipe for the reader: ") + std::strerror(errno);
     return false;
   }
+  const int null = ::open("/dev/null", O_RDWR | O_CLOEXEC);
   const pid_t parent = ::getpid();
-  const pid_t pid = ::fork();
+  const pid_t pid = null < 0 ? -1 : ::fork();
+  if (pid == 0) execReader(args.data(), fds[1], null, parent, limits.cpuSeconds);
+  const int forkErrno = errno;
+  ::close(fds[1]);
+  if (null >= 0) ::close(null);
   if (pid < 0) {
-    ::close(fds[0]), ::close(fds[1]);
-    *error = std::string("cannot start the reader: ") + std::strerror(errno);
+    ::close(fds[0]);
+    *error = std::string("cannot start the reader: ") + std::strerror(forkErrno);
     return false;
   }
-  if (pid == 0) {  // the child: the work, its length and bytes, and out without running exit handlers
-    ::close(fds[0]);
-    dieAlone();
-    // The reader ends with the process that waits for it (no reader left
-    // behind, blocked, when a run is killed).
-    ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-    if (::getppid() != parent) ::_exit(5);
-    const rlim_t cpu = rlim_t(std::ceil(cpuSeconds));
-    const rlimit limit{cpu, cpu + 1};  // SIGXCPU at the soft limit, SIGKILL at the hard one
-    ::setrlimit(RLIMIT_CPU, &limit);
-    std::string bytes;
-    int status = 0;
-    try {
-      bytes = work();
-    } catch (...) {
-      status = 3;
-    }
-    const uint64_t n = bytes.size();
-    if (status == 0 &&
-        !(writeAll(fds[1], reinterpret_cast<const char*>(&n), sizeof n) && writeAll(fds[1], bytes.data(), n)))
-      status = 4;
-    ::_exit(status);
-  }
-  ::close(fds[1]);
-  std::string got;
-  const bool answered = readAll(fds[0], limits.wallSeconds, &got);
+  const bool answered = readAll(fds[0], limits.wallSeconds, out);
   ::close(fds[0]);
   if (!answered) ::kill(pid, SIGKILL);
   int status = 0;
@@ -114,28 +108,30 @@ bool runIsolated(const std::function<std::string()>& work, const ReaderLimits& l
              " s: the file system did not answer, or the reader is stuck";
     return false;
   }
-  uint64_t n = 0;
-  if (WIFSIGNALED(status) && (WTERMSIG(status) == SIGXCPU || WTERMSIG(status) == SIGKILL)) {
-    *error = "the file is damaged: its reader ran for more than " + std::to_string(long(std::ceil(cpuSeconds))) +
-             " s without finishing";
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    *error = whyItStopped(status, limits, argv[0]);
     return false;
   }
-  if (WIFSIGNALED(status)) {
-    *error = "the file is damaged: reading it crashed the reader (" + std::string(strsignal(WTERMSIG(status))) + ")";
-    return false;
-  }
-  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || got.size() < sizeof n) {
-    *error = "the file is damaged: its reader stopped (status " +
-             std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")";
-    return false;
-  }
-  std::memcpy(&n, got.data(), sizeof n);
-  if (got.size() - sizeof n != n) {
-    *error = "the file is damaged: its reader's result was cut short";
-    return false;
-  }
-  *result = got.substr(sizeof n);
   return true;
+}
+
+void putRecord(std::string* s, const std::string& record) {
+  const uint64_t n = record.size();
+  s->append(reinterpret_cast<const char*>(&n), sizeof n);
+  s->append(record);
+}
+
+std::vector<std::string> takeRecords(const std::string& s) {
+  std::vector<std::string> records;
+  for (size_t at = 0;;) {
+    uint64_t n = 0;
+    if (s.size() - at < sizeof n) break;
+    std::memcpy(&n, s.data() + at, sizeof n);
+    if (s.size() - at - sizeof n < n) break;
+    records.push_back(s.substr(at + sizeof n, n));
+    at += sizeof n + n;
+  }
+  return records;
 }
 
 }  // namespace morphoflow

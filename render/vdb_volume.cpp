@@ -4,7 +4,6 @@
 #include <cstring>
 #include <filesystem>
 #include <mutex>
-#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -18,8 +17,8 @@
 #include <nanovdb/util/OpenToNanoVDB.h>
 #include <xxhash.h>
 
-#include "render/allocation_limit.h"
 #include "render/isolated_read.h"
+#include "render/velocity_answer.h"
 
 namespace morphoflow {
 
@@ -206,251 +205,60 @@ std::string encodeNanoVdb(const std::vector<VolumeGrid>& grids, const VolumeMeta
 
 namespace {
 
-// No buffer of a valid volume's reading is near this: a leaf holds 512 voxels.
-constexpr size_t kMaxReaderAllocation = size_t(64) << 20;
-constexpr const char* kClaimsTooMuch =
-    "the file is damaged: a length stored in it asks for more than 64 MiB at once (a valid volume never does)";
-
-}  // namespace
-
-// In a child process, as readVdbVelocity: opening a damaged file reads its
-// grids' topology, which OpenVDB misreads. The answer: "1" and the time's
-// bytes, "0" (no time), or "E" and the error.
-bool readVdbTime(const std::string& path, double* time, bool* has, std::string* error) {
-  initialiseOnce();
-  std::string answer;
-  if (!runIsolated(
-          [&]() -> std::string {
-            try {
-              AllocationLimit limit(kMaxReaderAllocation);
-              openvdb::io::File file(path);
-              file.open(/*delayLoad=*/true);
-              openvdb::MetaMap::Ptr meta = file.getMetadata();
-              file.close();
-              auto m = meta->getMetadata<openvdb::DoubleMetadata>("time");
-              if (!m) return "0";
-              const double t = m->value();
-              return "1" + std::string(reinterpret_cast<const char*>(&t), sizeof t);
-            } catch (const std::bad_alloc&) {
-              return std::string("E") + kClaimsTooMuch;
-            } catch (const std::exception& e) {
-              return std::string("E") + e.what();
-            }
-          },
-          readerLimits(10.0), &answer, error))
-    return false;
-  if (answer.empty() || answer[0] == 'E') {
-    *error = answer.empty() ? std::string("the file is damaged: its reader gave no answer") : answer.substr(1);
+// The reader's answers for `paths` in `mode` (render/vdb_read_here.h), one
+// process for all of them, allowed `cpuSeconds`. False and *error when it
+// stopped: *answers then holds those it gave, so the file it stopped at is
+// paths[answers->size()].
+bool readerAnswers(const char* mode, const std::vector<std::string>& paths, double cpuSeconds,
+                   std::vector<std::string>* answers, std::string* error) {
+  std::vector<std::string> argv{MORPHOFLOW_VDB_READER, mode};
+  argv.insert(argv.end(), paths.begin(), paths.end());
+  std::string out;
+  const bool ok = runIsolated(argv, readerLimits(cpuSeconds), &out, error);
+  *answers = takeRecords(out);
+  if (ok && answers->size() != paths.size()) {
+    *error = "the file is damaged: its reader's result was cut short";
     return false;
   }
-  *has = answer[0] == '1' && answer.size() == 1 + sizeof(double);
-  if (*has) std::memcpy(time, answer.data() + 1, sizeof(double));
-  return true;
-}
-
-namespace {
-
-bool readVelocityHere(const std::string& path, VelocityVolume* out, std::string* error) {
-  try {
-    std::optional<AllocationLimit> limit(std::in_place, kMaxReaderAllocation);  // (while OpenVDB reads)
-    openvdb::io::File file(path);
-    file.open(/*delayLoad=*/false);
-    const bool mac = file.hasGrid("vel_mac");
-    if (!mac && !file.hasGrid("vel")) {
-      std::string names;
-      for (auto it = file.beginName(); it != file.endName(); ++it) names += (names.empty() ? "" : ", ") + it.gridName();
-      *error = "the file has no velocity grid 'vel' (its grids: " + (names.empty() ? std::string("none") : names) + ")";
-      return false;
-    }
-    openvdb::MetaMap::Ptr meta = file.getMetadata();
-    openvdb::GridBase::Ptr base = file.readGrid(mac ? "vel_mac" : "vel");
-    file.close();
-    limit.reset();
-    auto grid = openvdb::gridPtrCast<openvdb::Vec3SGrid>(base);
-    if (!grid) {
-      *error = "the grid '" + base->getName() + "' is not a Vec3 float grid (it is " + base->valueType() + ")";
-      return false;
-    }
-    const openvdb::math::Transform& t = grid->transform();
-    const openvdb::Vec3d vs = t.voxelSize();
-    if (!t.isLinear() || std::abs(vs[0] - vs[1]) > 1e-9 * vs[0] || std::abs(vs[0] - vs[2]) > 1e-9 * vs[0]) {
-      *error = "the grid '" + grid->getName() + "' does not have cubic voxels on a linear transform";
-      return false;
-    }
-    const openvdb::Vec3d o = t.indexToWorld(openvdb::Vec3d(0.0));
-    if (!(std::isfinite(vs[0]) && vs[0] > 0.0 && vs[0] < 1e30) || !std::isfinite(o[0]) || !std::isfinite(o[1]) ||
-        !std::isfinite(o[2])) {
-      *error = "the grid '" + grid->getName() + "' has a transform that is not finite (voxel size " +
-               std::to_string(vs[0]) + ")";
-      return false;
-    }
-    VelocityVolume v;
-    v.grid = grid->getName();
-    v.staggered = mac || grid->getGridClass() == openvdb::GRID_STAGGERED;
-    v.voxelSize = vs[0];
-    v.indexOrigin = {o[0], o[1], o[2]};
-    if (auto m = meta->getMetadata<openvdb::DoubleMetadata>("time")) v.hasTime = true, v.time = m->value();
-    if (auto m = meta->getMetadata<openvdb::Vec3DMetadata>("domain_size"))
-      v.hasDomain = true, v.domain = {m->value()[0], m->value()[1], m->value()[2]};
-    const openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
-    if (!box.empty()) {
-      const openvdb::Coord d = box.dim();
-      for (int a = 0; a < 3; ++a) v.origin[size_t(a)] = box.min()[a], v.cells[size_t(a)] = d[a];
-      const double cells = double(d[0]) * double(d[1]) * double(d[2]);
-      // The box of the active voxels is read densely: bounded before anything is allocated.
-      if (cells > double(kMaxVelocityCells)) {
-        *error = "the velocity's active voxels span " + std::to_string(d[0]) + " x " + std::to_string(d[1]) + " x " +
-                 std::to_string(d[2]) + " cells (" + std::to_string(grid->activeVoxelCount()) +
-                 " of them active), more than the " + std::to_string(kMaxVelocityCells >> 20) +
-                 " Mi cells a velocity volume may span";
-        return false;
-      }
-      const size_t n = size_t(cells);
-      std::vector<openvdb::Vec3s> dense(n);
-      openvdb::tools::Dense<openvdb::Vec3s, openvdb::tools::LayoutXYZ> dst(box, dense.data());
-      openvdb::tools::copyToDense(*grid, dst, /*serial=*/true);  // (in the reader's child: no threads)
-      for (int a = 0; a < 3; ++a) {
-        v.values[size_t(a)].resize(n);
-        for (size_t i = 0; i < n; ++i) v.values[size_t(a)][i] = dense[i][a];
-      }
-    }
-    *out = std::move(v);
-    return true;
-  } catch (const std::bad_alloc&) {
-    *error = kClaimsTooMuch;
-    return false;
-  } catch (const std::exception& e) {
-    *error = e.what();
-    return false;
-  }
-}
-
-// The child's answer: ok, then the error or the volume, field by field.
-template <class T>
-void put(std::string* s, const T& v) {
-  s->append(reinterpret_cast<const char*>(&v), sizeof v);
-}
-void putText(std::string* s, const std::string& t) {
-  put<uint64_t>(s, t.size());
-  s->append(t);
-}
-template <class T>
-T take(const std::string& s, size_t* at) {
-  if (s.size() - *at < sizeof(T)) throw std::runtime_error("the reader's answer is cut short");
-  T v;
-  std::memcpy(&v, s.data() + *at, sizeof v);
-  *at += sizeof v;
-  return v;
-}
-std::string takeText(const std::string& s, size_t* at) {
-  const uint64_t n = take<uint64_t>(s, at);
-  if (s.size() - *at < n) throw std::runtime_error("the reader's answer is cut short");
-  std::string t = s.substr(*at, n);
-  *at += n;
-  return t;
-}
-
-std::string encodeAnswer(bool ok, const VelocityVolume& v, const std::string& error) {
-  std::string s;
-  put<uint8_t>(&s, ok);
-  if (!ok) {
-    putText(&s, error);
-    return s;
-  }
-  putText(&s, v.grid);
-  put(&s, v.staggered), put(&s, v.origin), put(&s, v.cells), put(&s, v.voxelSize), put(&s, v.indexOrigin);
-  put(&s, v.hasTime), put(&s, v.hasDomain), put(&s, v.time), put(&s, v.domain);
-  for (const std::vector<float>& c : v.values)
-    putText(&s,
-            c.empty() ? std::string() : std::string(reinterpret_cast<const char*>(c.data()), c.size() * sizeof(float)));
-  return s;
-}
-
-bool decodeAnswer(const std::string& s, VelocityVolume* v, std::string* error) {
-  size_t at = 0;
-  if (!take<uint8_t>(s, &at)) {
-    *error = takeText(s, &at);
-    return false;
-  }
-  v->grid = takeText(s, &at);
-  v->staggered = take<bool>(s, &at);
-  v->origin = take<std::array<int, 3>>(s, &at);
-  v->cells = take<std::array<int, 3>>(s, &at);
-  v->voxelSize = take<double>(s, &at);
-  v->indexOrigin = take<std::array<double, 3>>(s, &at);
-  v->hasTime = take<bool>(s, &at);
-  v->hasDomain = take<bool>(s, &at);
-  v->time = take<double>(s, &at);
-  v->domain = take<std::array<double, 3>>(s, &at);
-  for (std::vector<float>& c : v->values) {
-    const std::string b = takeText(s, &at);
-    c.resize(b.size() / sizeof(float));
-    if (!c.empty()) std::memcpy(c.data(), b.data(), c.size() * sizeof(float));
-  }
-  return true;
+  return ok;
 }
 
 }  // namespace
 
-// In a child process (render/isolated_read.h): a damaged file that makes
-// OpenVDB write past a buffer ends the child, not the run.
+bool readVdbTimes(const std::vector<std::string>& paths, std::vector<VdbTime>* out, size_t* failed,
+                  std::string* error) {
+  std::vector<std::string> answers;
+  // 10 s of CPU, and a tenth of a second per file: a valid file's metadata reads in milliseconds.
+  const bool ok = readerAnswers("time", paths, 10.0 + 0.1 * double(paths.size()), &answers, error);
+  out->clear();
+  for (const std::string& a : answers) {
+    if (a.empty() || a[0] == 'E' || (a[0] == '1' && a.size() != 1 + sizeof(double))) {
+      *failed = out->size();
+      *error = a.size() > 1 && a[0] == 'E' ? a.substr(1) : "the file is damaged: its reader gave no answer";
+      return false;
+    }
+    VdbTime t;
+    t.has = a[0] == '1';
+    if (t.has) std::memcpy(&t.time, a.data() + 1, sizeof(double));
+    out->push_back(t);
+  }
+  *failed = out->size();
+  return ok;
+}
+
 bool readVdbVelocity(const std::string& path, VelocityVolume* out, std::string* error) {
-  initialiseOnce();
   // 10 s of CPU and 1 s per 20 MB: a valid volume reads at hundreds of MB/s.
   std::error_code ec;
   const uintmax_t bytes = std::filesystem::file_size(path, ec);
-  const double seconds = 10.0 + (ec ? 0.0 : double(bytes) / 20e6);
-  std::string answer;
-  if (!runIsolated(
-          [&] {
-            VelocityVolume v;
-            std::string err;
-            const bool ok = readVelocityHere(path, &v, &err);
-            return encodeAnswer(ok, v, err);
-          },
-          readerLimits(seconds), &answer, error))
-    return false;
-  try {
-    return decodeAnswer(answer, out, error);
-  } catch (const std::exception& e) {
-    *error = e.what();
-    return false;
-  }
+  std::vector<std::string> answers;
+  if (!readerAnswers("velocity", {path}, 10.0 + (ec ? 0.0 : double(bytes) / 20e6), &answers, error)) return false;
+  return decodeVelocityAnswer(answers[0], out, error);
 }
 
 bool readVdbFrameSummary(const std::string& path, VdbFrameSummary* out, std::string* error) {
-  initialiseOnce();
-  std::string answer;
-  // The names, each ended by a newline, a NUL, then the density's values.
-  const auto work = [&]() -> std::string {
-    try {
-      AllocationLimit limit(size_t(4) << 30);
-      openvdb::io::File file(path);
-      file.open();
-      std::string names, values;
-      openvdb::GridPtrVecPtr grids = file.getGrids();
-      openvdb::MetaMap::Ptr meta = file.getMetadata();
-      file.close();
-      openvdb::Vec3d domain(0.0);
-      if (auto m = meta->getMetadata<openvdb::Vec3DMetadata>("domain_size")) domain = m->value();
-      values.append(reinterpret_cast<const char*>(&domain[0]), 3 * sizeof(double));
-      for (const openvdb::GridBase::Ptr& g : *grids) {
-        names += g->getName() + "\n";
-        auto f = openvdb::gridPtrCast<openvdb::FloatGrid>(g);
-        if (g->getName() != "density" || !f) continue;
-        for (auto v = f->cbeginValueOn(); v; ++v) {
-          const float x = *v;
-          for (openvdb::Index64 k = 0; k < v.getVoxelCount(); ++k) values.append(reinterpret_cast<const char*>(&x), 4);
-        }
-      }
-      return "N" + names + std::string(1, '\0') + values;
-    } catch (const std::bad_alloc&) {
-      return std::string("E") + kClaimsTooMuch;
-    } catch (const std::exception& e) {
-      return std::string("E") + e.what();
-    }
-  };
-  if (!runIsolated(work, readerLimits(60.0), &answer, error)) return false;
+  std::vector<std::string> answers;
+  if (!readerAnswers("summary", {path}, 60.0, &answers, error)) return false;
+  const std::string& answer = answers[0];
   const size_t nul = answer.find('\0');
   if (answer.empty() || answer[0] != 'N' || nul == std::string::npos || answer.size() < nul + 1 + 3 * sizeof(double)) {
     *error =

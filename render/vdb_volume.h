@@ -67,6 +67,9 @@ std::string encodeVdb(const std::vector<VolumeGrid>& grids, const VolumeMetadata
 std::string encodeNanoVdb(const std::vector<VolumeGrid>& grids, const VolumeMetadata& meta,
                           const VolumeOptions& options);
 
+// Reading a .vdb file runs the program morphoflow-vdb-reader (built beside the
+// library) in a process of its own: render/isolated_read.h.
+
 // A velocity read back from a .vdb file: the grid `vel_mac` (staggered, as
 // morphoflow writes it with output.vdb_mac_velocity) if the file has one,
 // else `vel` (any Vec3 float grid, cell-centred), densely over its active
@@ -90,8 +93,14 @@ constexpr long kMaxVelocityCells = 1L << 27;
 // False and a message (what is missing, or what OpenVDB said) when the file
 // cannot be read, has no velocity grid, or spans more than kMaxVelocityCells.
 bool readVdbVelocity(const std::string& path, VelocityVolume* out, std::string* error);
-// The file's `time` metadata (*has false when it has none), without reading its grids.
-bool readVdbTime(const std::string& path, double* time, bool* has, std::string* error);
+// Each file's `time` metadata, without reading its grids, one reader for all
+// of them. False, *error and *failed (the index of the file at fault) when a
+// file cannot be read; *out holds the times of the files before it.
+struct VdbTime {
+  bool has = false;  // false: the file has no `time` metadata
+  double time = 0.0;
+};
+bool readVdbTimes(const std::vector<std::string>& paths, std::vector<VdbTime>* out, size_t* failed, std::string* error);
 
 // A frame's grids by name and the active values of its `density` grid, for
 // the Blender set-up (app's `blender` command) to choose its density scale.

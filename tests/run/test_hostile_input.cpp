@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <atomic>
 #include <chrono>
 #include <fstream>
 #include <limits>
@@ -12,6 +13,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/parallel.h"
 #include "render/allocation_limit.h"
 #include "render/contact_sheet.h"
 #include "render/field_dump.h"
@@ -553,6 +555,49 @@ TEST(HostileInput, AVolumeWhoseLengthsClaimGigabytesIsRefusedAsDamaged) {
     EXPECT_FALSE(morphoflow::readVdbVelocity(file, &v, &error)) << name;
     EXPECT_FALSE(error.empty()) << name;
   }
+}
+
+// A volume read while TBB's workers are busy is read: a run reads its next
+// velocity frame between the parallel loops of its steps, and the reader's
+// child (a fork) must not wait on a lock that a worker held at the fork.
+TEST(HostileInput, AVolumeReadWhileTbbWorkersAreBusyIsRead) {
+  const fs::path dir = tempDir("read_while_busy");
+  morphoflow::VolumeGrid g;
+  g.name = "vel";
+  g.kind = morphoflow::VolumeGrid::Kind::Vector;
+  g.cells = {12, 10, 8};
+  g.values.assign(3, std::vector<float>(12 * 10 * 8));
+  for (size_t a = 0; a < 3; ++a)
+    for (size_t i = 0; i < g.values[a].size(); ++i) g.values[a][i] = 1.0f + float(a) + 1e-3f * float(i);
+  const std::string file = (dir / "vel.vdb").string();
+  std::ofstream(file, std::ios::binary) << morphoflow::encodeVdb({g}, {}, {});
+  std::atomic<bool> stop{false};
+  std::thread busy([&] {
+    while (!stop)
+      morphoflow::parallelFor(
+          64,
+          [](size_t i) {
+            volatile double x = double(i);
+            for (int k = 0; k < 2000; ++k) x = x * 0.5 + 1.0;
+          },
+          1);
+  });
+  for (int i = 0; i < 40; ++i) {
+    morphoflow::VelocityVolume v;
+    morphoflow::VdbFrameSummary summary;
+    std::string error;
+    ASSERT_TRUE(morphoflow::readVdbVelocity(file, &v, &error)) << "read " << i << ": " << error;
+    ASSERT_EQ(v.values[2].size(), g.values[2].size());
+    EXPECT_EQ(v.values[2][7], g.values[2][7]);
+    std::vector<morphoflow::VdbTime> times;
+    size_t failed = 0;
+    ASSERT_TRUE(morphoflow::readVdbTimes({file, file}, &times, &failed, &error)) << "read " << i << ": " << error;
+    ASSERT_EQ(times.size(), 2u);
+    ASSERT_TRUE(morphoflow::readVdbFrameSummary(file, &summary, &error)) << "read " << i << ": " << error;
+  }
+  stop = true;
+  busy.join();
+  fs::remove_all(dir);
 }
 
 // A sweep's contact sheet shows a frame that cannot be read as a grey cell
