@@ -1,5 +1,6 @@
 #include "render/vdb_volume.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -227,23 +228,31 @@ bool readerAnswers(const char* mode, const std::vector<std::string>& paths, doub
 
 bool readVdbTimes(const std::vector<std::string>& paths, std::vector<VdbTime>* out, size_t* failed,
                   std::string* error) {
-  std::vector<std::string> answers;
-  // 10 s of CPU, and a tenth of a second per file: a valid file's metadata reads in milliseconds.
-  const bool ok = readerAnswers("time", paths, 10.0 + 0.1 * double(paths.size()), &answers, error);
   out->clear();
-  for (const std::string& a : answers) {
-    if (a.empty() || a[0] == 'E' || (a[0] == '1' && a.size() != 1 + sizeof(double))) {
+  // A reader for each 256 files, so that the arguments stay far below the
+  // system's limit (ARG_MAX) however long the sequence.
+  constexpr size_t kFilesPerReader = 256;
+  for (size_t first = 0; first < paths.size(); first += kFilesPerReader) {
+    const std::vector<std::string> some(paths.begin() + long(first),
+                                        paths.begin() + long(std::min(paths.size(), first + kFilesPerReader)));
+    std::vector<std::string> answers;
+    // 10 s of CPU, and a tenth of a second per file: a valid file's metadata reads in milliseconds.
+    const bool ok = readerAnswers("time", some, 10.0 + 0.1 * double(some.size()), &answers, error);
+    for (const std::string& a : answers) {
       *failed = out->size();
-      *error = a.size() > 1 && a[0] == 'E' ? a.substr(1) : "the file is damaged: its reader gave no answer";
-      return false;
+      if (a.empty() || a[0] == 'E' || (a[0] == '1' && a.size() != 1 + sizeof(double))) {
+        *error = a.size() > 1 && a[0] == 'E' ? a.substr(1) : "the file is damaged: its reader gave no answer";
+        return false;
+      }
+      VdbTime t;
+      t.has = a[0] == '1';
+      if (t.has) std::memcpy(&t.time, a.data() + 1, sizeof(double));
+      out->push_back(t);
     }
-    VdbTime t;
-    t.has = a[0] == '1';
-    if (t.has) std::memcpy(&t.time, a.data() + 1, sizeof(double));
-    out->push_back(t);
+    *failed = out->size();
+    if (!ok) return false;
   }
-  *failed = out->size();
-  return ok;
+  return true;
 }
 
 bool readVdbVelocity(const std::string& path, VelocityVolume* out, std::string* error) {

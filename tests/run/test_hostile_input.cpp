@@ -600,6 +600,36 @@ TEST(HostileInput, AVolumeReadWhileTbbWorkersAreBusyIsRead) {
   fs::remove_all(dir);
 }
 
+// A long sequence's times are read by a reader for each 256 files, and a
+// damaged file among them is named by its index; the times before it are kept.
+TEST(HostileInput, ALongSequencesTimesAreReadAndItsDamagedFileNamed) {
+  const fs::path dir = tempDir("long_sequence");
+  morphoflow::VolumeGrid g;
+  g.name = "vel";
+  g.kind = morphoflow::VolumeGrid::Kind::Vector;
+  g.cells = {2, 2, 2};
+  g.values.assign(3, std::vector<float>(8, 1.0f));
+  std::vector<std::string> paths;
+  for (int i = 0; i < 300; ++i) {
+    morphoflow::VolumeMetadata meta;
+    meta.time = 0.25 * i;
+    paths.push_back((dir / ("vel." + std::to_string(1000 + i) + ".vdb")).string());
+    std::ofstream(paths.back(), std::ios::binary) << morphoflow::encodeVdb({g}, meta, {});
+  }
+  std::vector<morphoflow::VdbTime> times;
+  size_t failed = 0;
+  std::string error;
+  ASSERT_TRUE(morphoflow::readVdbTimes(paths, &times, &failed, &error)) << error;
+  ASSERT_EQ(times.size(), paths.size());
+  for (size_t i = 0; i < times.size(); ++i) EXPECT_TRUE(times[i].has && times[i].time == 0.25 * double(i)) << i;
+  std::ofstream(paths[280], std::ios::binary) << "not a volume";
+  EXPECT_FALSE(morphoflow::readVdbTimes(paths, &times, &failed, &error));
+  EXPECT_EQ(failed, 280u) << error;
+  EXPECT_EQ(times.size(), 280u);
+  EXPECT_FALSE(error.empty());
+  fs::remove_all(dir);
+}
+
 // A sweep's contact sheet shows a frame that cannot be read as a grey cell
 // and names it; the sheet is still written.
 TEST(HostileInput, AContactSheetShowsADamagedFrameGreyAndNamesIt) {
