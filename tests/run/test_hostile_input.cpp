@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <fstream>
@@ -557,18 +558,29 @@ TEST(HostileInput, AVolumeWhoseLengthsClaimGigabytesIsRefusedAsDamaged) {
   }
 }
 
-// A volume read while TBB's workers are busy is read: a run reads its next
-// velocity frame between the parallel loops of its steps, and the reader's
-// child (a fork) must not wait on a lock that a worker held at the fork.
-TEST(HostileInput, AVolumeReadWhileTbbWorkersAreBusyIsRead) {
-  const fs::path dir = tempDir("read_while_busy");
+namespace {
+
+// A cell-centred velocity grid `vel` of `cells`, component a of cell i being
+// 1 + a + slope i.
+morphoflow::VolumeGrid velocityGrid(const std::array<int, 3>& cells, float slope) {
   morphoflow::VolumeGrid g;
   g.name = "vel";
   g.kind = morphoflow::VolumeGrid::Kind::Vector;
-  g.cells = {12, 10, 8};
-  g.values.assign(3, std::vector<float>(12 * 10 * 8));
+  g.cells = cells;
+  g.values.assign(3, std::vector<float>(size_t(cells[0]) * size_t(cells[1]) * size_t(cells[2])));
   for (size_t a = 0; a < 3; ++a)
-    for (size_t i = 0; i < g.values[a].size(); ++i) g.values[a][i] = 1.0f + float(a) + 1e-3f * float(i);
+    for (size_t i = 0; i < g.values[a].size(); ++i) g.values[a][i] = 1.0f + float(a) + slope * float(i);
+  return g;
+}
+
+}  // namespace
+
+// A volume read while TBB's workers are busy is read: a run reads its next
+// velocity frame between the parallel loops of its steps, and its reader
+// (a program of its own) must not wait on a lock a worker holds.
+TEST(HostileInput, AVolumeReadWhileTbbWorkersAreBusyIsRead) {
+  const fs::path dir = tempDir("read_while_busy");
+  const morphoflow::VolumeGrid g = velocityGrid({12, 10, 8}, 1e-3f);
   const std::string file = (dir / "vel.vdb").string();
   std::ofstream(file, std::ios::binary) << morphoflow::encodeVdb({g}, {}, {});
   std::atomic<bool> stop{false};
@@ -604,11 +616,7 @@ TEST(HostileInput, AVolumeReadWhileTbbWorkersAreBusyIsRead) {
 // damaged file among them is named by its index; the times before it are kept.
 TEST(HostileInput, ALongSequencesTimesAreReadAndItsDamagedFileNamed) {
   const fs::path dir = tempDir("long_sequence");
-  morphoflow::VolumeGrid g;
-  g.name = "vel";
-  g.kind = morphoflow::VolumeGrid::Kind::Vector;
-  g.cells = {2, 2, 2};
-  g.values.assign(3, std::vector<float>(8, 1.0f));
+  const morphoflow::VolumeGrid g = velocityGrid({2, 2, 2}, 0.0f);
   std::vector<std::string> paths;
   for (int i = 0; i < 300; ++i) {
     morphoflow::VolumeMetadata meta;
