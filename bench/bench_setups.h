@@ -23,6 +23,34 @@ FluidSettings benchCavity(int n) {
   return s;
 }
 
+// What the cavity holds: nothing, smoke, or a cut sphere (circle) of
+// radius 0.15 at rest at the centre or circling it at radius 0.2 (a
+// moving obstacle rebuilds its cut cells and the systems every step).
+enum class BenchContent { Plain, Smoke, BodyAtRest, BodyMoving };
+inline const char* contentName(BenchContent c) {
+  const char* names[] = {"-", "smoke", "body at rest", "body moving"};
+  return names[int(c)];
+}
+
+// The cavity with nothing, or with the body at rest or moving (not smoke: fluid_bench.cpp's).
+template <int D>
+FluidSettings benchCavityWith(int n, BenchContent content) {
+  FluidSettings s = benchCavity<D>(n);
+  if (content != BenchContent::BodyAtRest && content != BenchContent::BodyMoving) return s;
+  ObstacleSpec body;
+  body.shape = ObstacleShape::Sphere;
+  body.center = {0.5, 0.5, 0.5};
+  body.radius = 0.15;
+  if (content == BenchContent::BodyMoving) {
+    body.motion = {"0.5 + 0.2 * cos(t)", "0.5 + 0.2 * sin(t)"};
+    if (D == 3) body.motion.push_back("0.5");
+  } else {
+    body.center = {0.7, 0.5, 0.5};  // where the moving one starts
+  }
+  s.obstacles = {body};
+  return s;
+}
+
 // Pearson's Gray-Scott (F = 0.04, k = 0.06) on n^D cells of size `cell`,
 // diffusion rates 0.2 and 0.1 cell^2 per unit time.
 template <int D>

@@ -46,32 +46,10 @@ FluidSettings benchSmokyCavity(int n) {
   return s;
 }
 
-// What the cavity holds: nothing, smoke, or a cut sphere (circle) of
-// radius 0.15 at rest at the centre or circling it at radius 0.2 (a
-// moving obstacle rebuilds its cut cells and the systems every step).
-enum class BenchContent { Plain, Smoke, BodyAtRest, BodyMoving };
-const char* contentName(BenchContent c) {
-  const char* names[] = {"-", "smoke", "body at rest", "body moving"};
-  return names[int(c)];
-}
-
 template <int D>
 FluidSettings benchSettings(int n, BenchContent content) {
   if (content == BenchContent::Smoke) return benchSmokyCavity<D>(n);
-  FluidSettings s = benchCavity<D>(n);
-  if (content == BenchContent::Plain) return s;
-  ObstacleSpec body;
-  body.shape = ObstacleShape::Sphere;
-  body.center = {0.5, 0.5, 0.5};
-  body.radius = 0.15;
-  if (content == BenchContent::BodyMoving) {
-    body.motion = {"0.5 + 0.2 * cos(t)", "0.5 + 0.2 * sin(t)"};
-    if (D == 3) body.motion.push_back("0.5");
-  } else {
-    body.center = {0.7, 0.5, 0.5};  // where the moving one starts
-  }
-  s.obstacles = {body};
-  return s;
+  return benchCavityWith<D>(n, content);
 }
 
 template <int D>

@@ -54,8 +54,8 @@ Timed timeGpu(double minSeconds, Step&& step, After&& after) {
 }
 
 template <int D>
-nlohmann::json benchGpuFluid(int n, double minSeconds, GpuPrecision real) {
-  FluidSolver<D> host(benchCavity<D>(n));  // the constraints; never stepped
+nlohmann::json benchGpuFluid(int n, double minSeconds, GpuPrecision real, BenchContent content = BenchContent::Plain) {
+  FluidSolver<D> host(benchCavityWith<D>(n, content));  // the constraints; never stepped
   GpuFluid<D> gpu(host.settings(), host.constraints(), real);
   const double dt = host.h();
   for (int i = 0; i < kWarmup; ++i) gpu.step(dt);
@@ -74,6 +74,7 @@ nlohmann::json benchGpuFluid(int n, double minSeconds, GpuPrecision real) {
   nlohmann::json j = {{"dim", D},
                       {"n", n},
                       {"backend", "gpu"},
+                      {"content", contentName(content)},
                       {"precision", precisionName(real)},
                       {"steps", steps},
                       {"ms_per_step_median", 1e3 * t.seconds},
@@ -135,18 +136,26 @@ bool runGpuFluidBench(const BenchOptions& o) {
   const GpuPrecision real = benchPrecision(o);
   const GpuBandwidth bw = announceGpu(real);
   std::cout << fmt::format(
-      "{:>4} {:>6} {:>7} {:>12} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>8} {:>7} {:>7} {:>10} {:>7}\n", "dim", "n",
-      "backend", "ms/step(med)", "p-iters", "v-iters", "forces", "advect", "diffuse", "project", "GB/s", "of peak",
+      "{:>4} {:>6} {:>12} {:>12} {:>8} {:>8} {:>9} {:>9} {:>9} {:>9} {:>8} {:>7} {:>7} {:>10} {:>7}\n", "dim", "n",
+      "content", "ms/step(med)", "p-iters", "v-iters", "forces", "advect", "diffuse", "project", "GB/s", "of peak",
       "of copy", "dispatches", "waits");
   nlohmann::json all = nlohmann::json::array();
+  // As the CPU's suite: 3D and 2D 512^2 again with a body at rest and moving (its placement and the host's
+  // rebuild of the systems in the step's time), each right after the plain case.
+  std::vector<std::pair<BenchCase, BenchContent>> runs;
   for (BenchCase c : selectBenchCases(kCases, o.size)) {
-    nlohmann::json j =
-        c.dim == 2 ? benchGpuFluid<2>(c.n, o.minSeconds, real) : benchGpuFluid<3>(c.n, o.minSeconds, real);
+    runs.push_back({c, BenchContent::Plain});
+    if (c.dim == 3 || c.n == 512)
+      for (BenchContent b : {BenchContent::BodyAtRest, BenchContent::BodyMoving}) runs.push_back({c, b});
+  }
+  for (const auto& [c, content] : runs) {
+    nlohmann::json j = c.dim == 2 ? benchGpuFluid<2>(c.n, o.minSeconds, real, content)
+                                  : benchGpuFluid<3>(c.n, o.minSeconds, real, content);
     addBandwidthFractions(&j, bw);
     std::cout << fmt::format(
-                     "{:>4} {:>6} {:>7} {:>12.3f} {:>8.1f} {:>8.1f} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.3f} {:>8.1f} {:>7} "
-                     "{:>7} {:>10.1f} {:>7.1f}{}\n",
-                     c.dim, c.n, "gpu", j["ms_per_step_median"].get<double>(),
+                     "{:>4} {:>6} {:>12} {:>12.3f} {:>8.1f} {:>8.1f} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.3f} {:>8.1f} "
+                     "{:>7} {:>7} {:>10.1f} {:>7.1f}{}\n",
+                     c.dim, c.n, contentName(content), j["ms_per_step_median"].get<double>(),
                      j["pressure_iterations_mean"].get<double>(), j["viscosity_iterations_mean"].get<double>(),
                      j["ms_forces"].get<double>(), j["ms_advect"].get<double>(), j["ms_diffuse"].get<double>(),
                      j["ms_project"].get<double>(), j["gb_per_second"].get<double>(),

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/parallel.h"
+#include "fluid/obstacle_shape.h"
 
 namespace morphoflow {
 
@@ -24,32 +25,7 @@ double sampleField(const ObstacleSpec& o, double s, double t) {
 }  // namespace
 
 double obstacleDistance(const ObstacleSpec& o, const double* x, int dims, const double* size) {
-  // The point in the body's frame: R^T (x - centre).
-  double r[3] = {0, 0, 0}, q[3] = {0, 0, 0};
-  for (int a = 0; a < dims; ++a) {
-    r[a] = x[a] - o.center[size_t(a)];
-    if (o.wrap[size_t(a)]) r[a] -= size[a] * std::round(r[a] / size[a]);  // the nearest image
-  }
-  for (int a = 0; a < 3; ++a)
-    for (int b = 0; b < 3; ++b) q[a] += o.orientation[size_t(3 * b + a)] * r[b];
   switch (o.shape) {
-    case ObstacleShape::Circle:
-    case ObstacleShape::Sphere: {
-      // A circle in 3D is a cylinder along the body's z; a sphere in 2D is a circle.
-      int n = (o.shape == ObstacleShape::Circle) ? 2 : dims;
-      double r2 = 0;
-      for (int a = 0; a < n; ++a) r2 += q[a] * q[a];
-      return std::sqrt(r2) - o.radius;
-    }
-    case ObstacleShape::Box: {
-      double outside = 0, inside = -1e300;
-      for (int a = 0; a < dims; ++a) {
-        double qa = std::abs(q[a]) - o.halfSize[size_t(a)];
-        outside += std::max(qa, 0.0) * std::max(qa, 0.0);
-        inside = std::max(inside, qa);
-      }
-      return std::sqrt(outside) + std::min(inside, 0.0);
-    }
     case ObstacleShape::Image: {
       // Image rows run top to bottom; world y runs bottom to top.
       double v = sampleField(o, x[0] / size[0], 1.0 - x[1] / size[1]);
@@ -58,8 +34,13 @@ double obstacleDistance(const ObstacleSpec& o, const double* x, int dims, const 
     }
     case ObstacleShape::Sdf:
       return sampleField(o, x[0] / size[0], 1.0 - x[1] / size[1]);
+    default: {  // circle, sphere, box: kernels/obstacle_shape.inc, in the body's frame
+      const double wrap[3] = {o.wrap[0] ? 1.0 : 0.0, o.wrap[1] ? 1.0 : 0.0, o.wrap[2] ? 1.0 : 0.0};
+      double q[3];
+      obstacle_shape::osBodyFrame(dims, x, o.center.data(), size, wrap, o.orientation.data(), q);
+      return obstacle_shape::osShapeDistance(int(o.shape), dims, q, o.radius, o.halfSize.data());
+    }
   }
-  return 1.0;
 }
 
 namespace {

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/expression.h"
+#include "fluid/obstacle_shape.h"
 
 namespace morphoflow {
 
@@ -42,10 +43,10 @@ void evaluate(const std::string& text, double t, double* value, double* rate, bo
 }  // namespace
 
 std::array<double, 3> RigidMotion::at(const double* x, int dims) const {
-  double r[3] = {0, 0, 0};
-  for (int a = 0; a < dims; ++a) r[a] = x[a] - center[size_t(a)];
-  return {velocity[0] + omega[1] * r[2] - omega[2] * r[1], velocity[1] + omega[2] * r[0] - omega[0] * r[2],
-          velocity[2] + omega[0] * r[1] - omega[1] * r[0]};
+  std::array<double, 3> u{};
+  for (int a = 0; a < 3; ++a)
+    u[size_t(a)] = obstacle_shape::osRigidVelocity(a, dims, x, center.data(), velocity.data(), omega.data());
+  return u;
 }
 
 bool anyMoves(const std::vector<ObstacleSpec>& obstacles) {

@@ -23,7 +23,7 @@ std::vector<ObstacleSpec> ObstaclePlacement<D>::obstaclesAt(double t, std::vecto
 
 template <int D>
 VelocityConstraints<D> ObstaclePlacement<D>::constraintsAt(double t) {
-  std::vector<RigidMotion> motions;
+  std::vector<RigidMotion>& motions = motions_;
   placed_ = obstaclesAt(t, &motions);
   placedAt_ = t;
   std::vector<ObstacleSpec> voxel;  // the staircase obstacles; the others are cut
@@ -76,6 +76,7 @@ bool ObstaclePlacement<D>::moveTo(double t, VelocityConstraints<D>* vc, IVec<D>*
   for (int a = 0; a < D; ++a)
     if ((*hi)[a] <= (*lo)[a]) {
       placed_ = std::move(placed);
+      motions_ = std::move(motions);
       return false;
     }
   movedLo_ = *lo, movedHi_ = *hi;
@@ -99,6 +100,7 @@ bool ObstaclePlacement<D>::moveTo(double t, VelocityConstraints<D>* vc, IVec<D>*
   });
   vc->move(solid, voxel_, CutSurface(placed, D, size), CutSurface(placed, D, size, motions, true), *lo, *hi);
   placed_ = std::move(placed);
+  motions_ = std::move(motions);
   return true;
 }
 

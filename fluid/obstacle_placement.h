@@ -29,6 +29,9 @@ class ObstaclePlacement {
   // or now: nothing changed.
   bool moveTo(double t, VelocityConstraints<D>* vc, IVec<D>* lo, IVec<D>* hi);
   double time() const { return placedAt_; }  // the time they were placed for
+  // The obstacles where they were last placed, and their motions then (index by index).
+  const std::vector<ObstacleSpec>& placed() const { return placed_; }
+  const std::vector<RigidMotion>& motions() const { return motions_; }
   // The fill plans of the last moveTo (fluid/extrapolation.h): the cells
   // and the faces of axis a it uncovered and covered in *vc.
   FillPlan cellFill(const VelocityConstraints<D>& vc) const;
@@ -44,6 +47,7 @@ class ObstaclePlacement {
   double h_ = 1.0;
   bool moves_ = false;
   std::vector<ObstacleSpec> placed_;  // the obstacles where they are now
+  std::vector<RigidMotion> motions_;  // and their motions
   Grid<uint8_t, D> voxel_;            // the staircase obstacles' cells (when one moves)
   double placedAt_ = 0.0;
   // The flags before the last move, and the box it changed (storage kept from step to step).

@@ -1,0 +1,40 @@
+// Moving obstacles placed on the device: at every step the solid flags, the
+// faces' fixed flags, held velocities and open fractions, and the solid's
+// flux, of the cells a move touched, computed by shaders/cut_geometry.comp
+// with kernels/obstacle_shape.inc's and cut_fraction.inc's formulas (the host's, so they are the
+// CPU's to the bit) into the GpuMacGrid's buffers. Only the obstacles'
+// placements (a few doubles each) go up; nothing comes back. The analytic
+// shapes only (circle, sphere, box): an image or sdf obstacle keeps the
+// host's upload (GpuMacGrid::refresh).
+#pragma once
+
+#include <vector>
+
+#include "fluid/fluid_settings.h"
+#include "fluid/obstacle_motion.h"
+#include "gpu/fluid/gpu_mac_grid.h"
+#include "gpu/gpu_buffer.h"
+
+namespace morphoflow {
+
+template <int D>
+class GpuObstacles {
+ public:
+  // Whether the device can place these obstacles (analytic shapes only).
+  static bool supports(const std::vector<ObstacleSpec>& obstacles);
+  GpuObstacles(const FluidSettings& settings, GpuMacGrid<D>* grid);
+  // The obstacles as `placed`, moving as `motions`, within the cells
+  // [lo, hi): the grid's flags, values, fractions and flux there.
+  void place(const std::vector<ObstacleSpec>& placed, const std::vector<RigidMotion>& motions, const IVec<D>& lo,
+             const IVec<D>& hi);
+
+ private:
+  void run(const char* mode, int axis, const std::array<int, 3>& lo, const std::array<int, 3>& box);
+
+  GpuMacGrid<D>& grid_;
+  DomainBoundaries boundaries_;
+  int count_ = 0, cutCount_ = 0;
+  GpuBuffer bodies_, voxel_;
+};
+
+}  // namespace morphoflow
