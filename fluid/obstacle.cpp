@@ -8,32 +8,12 @@
 
 namespace morphoflow {
 
-namespace {
-// Bilinear sample of the spec's 2D field at normalised (s, t) in [0, 1]^2.
-double sampleField(const ObstacleSpec& o, double s, double t) {
-  double gx = std::clamp(s * o.fieldWidth - 0.5, 0.0, double(o.fieldWidth - 1));
-  double gy = std::clamp(t * o.fieldHeight - 0.5, 0.0, double(o.fieldHeight - 1));
-  int x0 = std::min(int(gx), std::max(o.fieldWidth - 2, 0));
-  int y0 = std::min(int(gy), std::max(o.fieldHeight - 2, 0));
-  int x1 = std::min(x0 + 1, o.fieldWidth - 1), y1 = std::min(y0 + 1, o.fieldHeight - 1);
-  double fx = gx - x0, fy = gy - y0;
-  auto at = [&](int x, int y) { return double(o.field[size_t(y) * size_t(o.fieldWidth) + size_t(x)]); };
-  double a = at(x0, y0) + fx * (at(x1, y0) - at(x0, y0));
-  double b = at(x0, y1) + fx * (at(x1, y1) - at(x0, y1));
-  return a + fy * (b - a);
-}
-}  // namespace
-
 double obstacleDistance(const ObstacleSpec& o, const double* x, int dims, const double* size) {
   switch (o.shape) {
-    case ObstacleShape::Image: {
-      // Image rows run top to bottom; world y runs bottom to top.
-      double v = sampleField(o, x[0] / size[0], 1.0 - x[1] / size[1]);
-      bool solid = o.invert ? v <= o.threshold : v > o.threshold;
-      return solid ? -1.0 : 1.0;
-    }
+    case ObstacleShape::Image:
     case ObstacleShape::Sdf:
-      return sampleField(o, x[0] / size[0], 1.0 - x[1] / size[1]);
+      return obstacle_shape::osFieldDistance(o.field.data(), int(o.shape), o.fieldWidth, o.fieldHeight, o.threshold,
+                                             o.invert, x, size);
     default: {  // circle, sphere, box: kernels/obstacle_shape.inc, in the body's frame
       const double wrap[3] = {o.wrap[0] ? 1.0 : 0.0, o.wrap[1] ? 1.0 : 0.0, o.wrap[2] ? 1.0 : 0.0};
       double q[3];

@@ -1,5 +1,5 @@
-// kernels/obstacle_shape.inc in C++: an analytic obstacle's signed distance
-// in its frame and a rigid body's velocity, written once for the CPU and the
+// kernels/obstacle_shape.inc in C++: an obstacle's signed distance and a
+// rigid body's velocity, written once for the CPU and the
 // GPU (gpu/shaders/cut_geometry.comp; kernels/README.md).
 #pragma once
 
@@ -18,6 +18,9 @@ namespace morphoflow::obstacle_shape {
 #define OS_TRUNC std::trunc
 #define OS_LIT(v) v
 #define OS_PRECISE
+#define OS_TEXEL(i) double(field[i])
+#define OS_FIELD_PARAM const float *field,
+#define OS_FIELD_ARG field,
 #include "kernels/obstacle_shape.inc"
 #undef OS_REAL
 #undef OS_FN
@@ -30,5 +33,8 @@ namespace morphoflow::obstacle_shape {
 #undef OS_TRUNC
 #undef OS_LIT
 #undef OS_PRECISE
+#undef OS_TEXEL
+#undef OS_FIELD_PARAM
+#undef OS_FIELD_ARG
 
 }  // namespace morphoflow::obstacle_shape

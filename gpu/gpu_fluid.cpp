@@ -42,7 +42,7 @@ GpuFluid<D>::GpuFluid(const FluidSettings& s, const VelocityConstraints<D>& vc, 
   if (s.smoke.enabled) smoke_ = std::make_unique<GpuSmoke<D>>(settings_, constraints(vc), &grid_, real);
   speed_ = std::make_unique<GpuReduction>();
   timer_ = std::make_unique<GpuStageTimer>(FluidStepStats::kStages);
-  if (placement_.moves() && GpuObstacles<D>::supports(settings_.obstacles)) {
+  if (placement_.moves()) {
     obstacles_ = std::make_unique<GpuObstacles<D>>(settings_, &grid_);
     obstacles_->place(placement_.placed(), placement_.motions(), IVec<D>(0), vc_.cells);
   }
@@ -172,8 +172,7 @@ void GpuFluid<D>::placeObstacles(double t, bool fill) {
   if (!placement_.moves()) return;
   IVec<D> lo, hi;
   if (!placement_.moveTo(t, &vc_, &lo, &hi)) return;
-  if (obstacles_) obstacles_->place(placement_.placed(), placement_.motions(), lo, hi);
-  else grid_.refresh(vc_);
+  obstacles_->place(placement_.placed(), placement_.motions(), lo, hi);
   projection_.rebuild(vc_, lo, hi);
   if (settings_.viscosity > 0) viscosity_.rebuild(vc_, lo, hi);  // (an inviscid fluid never solves it)
   if (smoke_) smoke_->setSolid(vc_.solid);

@@ -137,14 +137,14 @@ class GpuFluid final : public FluidStepper<D> {
   double time_ = 0.0;
   long steps_ = 0;
   // A moving obstacle's geometry, placed on the host at every step (it
-  // depends on the time alone; the host's systems follow it), the grid's
-  // flags, values, fractions and flux on the device (obstacles_) or, with
-  // an image or sdf obstacle, uploaded: nothing is read back.
+  // depends on the time alone; the host's systems follow it) and the grid's
+  // flags, values, fractions and flux on the device (obstacles_): nothing
+  // is read back.
   ObstaclePlacement<D> placement_;
   VelocityConstraints<D> vc_;
   // the stages, one a CPU file (gpu/fluid/)
   GpuMacGrid<D> grid_;
-  std::unique_ptr<GpuObstacles<D>> obstacles_;  // moving analytic obstacles
+  std::unique_ptr<GpuObstacles<D>> obstacles_;  // with a moving obstacle
   GpuAdvection<D> advection_;
   mutable GpuViscosity<D> viscosity_;
   mutable GpuProjection<D> projection_;

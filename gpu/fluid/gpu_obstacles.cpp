@@ -10,9 +10,10 @@
 namespace morphoflow {
 
 namespace {
-// One obstacle as shaders/cut_geometry.comp reads it (its B_* offsets).
-constexpr size_t kStride = 32;
-void putBody(const ObstacleSpec& o, const RigidMotion& m, double* r) {
+// One obstacle as shaders/cut_geometry.comp reads it (its B_* offsets);
+// fieldAt: an image's or sdf's first texel in the fields buffer.
+constexpr size_t kStride = 40;
+void putBody(const ObstacleSpec& o, const RigidMotion& m, size_t fieldAt, double* r) {
   r[0] = double(int(o.shape));
   r[1] = o.boundary == ObstacleBoundary::Voxel ? 1.0 : 0.0;
   for (size_t a = 0; a < 3; ++a) {
@@ -25,20 +26,25 @@ void putBody(const ObstacleSpec& o, const RigidMotion& m, double* r) {
   }
   r[5] = o.radius;
   std::copy(o.orientation.begin(), o.orientation.end(), r + 9);
+  r[30] = double(fieldAt);
+  r[31] = o.fieldWidth;
+  r[32] = o.fieldHeight;
+  r[33] = o.threshold;
+  r[34] = o.invert ? 1.0 : 0.0;
 }
 }  // namespace
 
 template <int D>
-bool GpuObstacles<D>::supports(const std::vector<ObstacleSpec>& obstacles) {
-  return std::none_of(obstacles.begin(), obstacles.end(), [](const ObstacleSpec& o) {
-    return o.shape == ObstacleShape::Image || o.shape == ObstacleShape::Sdf;
-  });
-}
-
-template <int D>
 GpuObstacles<D>::GpuObstacles(const FluidSettings& s, GpuMacGrid<D>* grid)
     : grid_(*grid), boundaries_(s.boundaries), count_(int(s.obstacles.size())) {
-  for (const ObstacleSpec& o : s.obstacles) cutCount_ += o.boundary == ObstacleBoundary::Cut ? 1 : 0;
+  std::vector<float> fields(1, 0.0f);  // the images' and sdfs' fields (they do not move: uploaded once)
+  for (const ObstacleSpec& o : s.obstacles) {
+    cutCount_ += o.boundary == ObstacleBoundary::Cut ? 1 : 0;
+    exact_ = exact_ && !(o.boundary == ObstacleBoundary::Cut && o.shape == ObstacleShape::Image);
+    fieldAt_.push_back(fields.size());
+    fields.insert(fields.end(), o.field.begin(), o.field.end());
+  }
+  fields_ = GpuBuffer::of(fields);
   bodies_ = GpuBuffer(std::max<size_t>(1, s.obstacles.size()) * kStride * sizeof(double));
   voxel_ = GpuBuffer(grid_.cellCount * sizeof(uint32_t));
   voxel_.zero();
@@ -70,6 +76,7 @@ void GpuObstacles<D>::run(const char* mode, int axis, const std::array<int, 3>& 
   setUniform(p, "cutBodies", cutCount_);
   setUniform(p, "parabolic", boundaries_.profile == InflowProfile::Parabolic ? 1 : 0);
   setUniform(p, "openPerFace", grid_.cut ? 1 : 0);
+  setUniform(p, "exactSurface", exact_ ? 1 : 0);
   setUniform(p, "h", grid_.h);
   setUniform(p, "inflowMean", boundaries_.inflowMeanVelocity);
   setUniformDoubles(p, "domainSize", size, 3);
@@ -80,6 +87,7 @@ void GpuObstacles<D>::run(const char* mode, int axis, const std::array<int, 3>& 
   grid_.value.bind(4);
   grid_.open.bind(5);
   if (grid_.solidFlux.bytes()) grid_.solidFlux.bind(6);
+  fields_.bind(7);
   dispatchFlat(n, 16.0);
   storageBarrier();
 }
@@ -88,7 +96,7 @@ template <int D>
 void GpuObstacles<D>::place(const std::vector<ObstacleSpec>& placed, const std::vector<RigidMotion>& motions,
                             const IVec<D>& lo, const IVec<D>& hi) {
   std::vector<double> table(std::max<size_t>(1, placed.size()) * kStride, 0.0);
-  for (size_t i = 0; i < placed.size(); ++i) putBody(placed[i], motions[i], table.data() + i * kStride);
+  for (size_t i = 0; i < placed.size(); ++i) putBody(placed[i], motions[i], fieldAt_[i], table.data() + i * kStride);
   bodies_.upload(table);
   std::array<int, 3> l{0, 0, 0}, box{1, 1, 1};
   for (int a = 0; a < D; ++a) l[size_t(a)] = lo[a], box[size_t(a)] = hi[a] - lo[a];

@@ -3,9 +3,8 @@
 // flux, of the cells a move touched, computed by shaders/cut_geometry.comp
 // with kernels/obstacle_shape.inc's and cut_fraction.inc's formulas (the host's, so they are the
 // CPU's to the bit) into the GpuMacGrid's buffers. Only the obstacles'
-// placements (a few doubles each) go up; nothing comes back. The analytic
-// shapes only (circle, sphere, box): an image or sdf obstacle keeps the
-// host's upload (GpuMacGrid::refresh).
+// placements (a few doubles each) go up; nothing comes back. Every shape:
+// an image's or sdf's field (which does not move) is uploaded once.
 #pragma once
 
 #include <vector>
@@ -20,8 +19,6 @@ namespace morphoflow {
 template <int D>
 class GpuObstacles {
  public:
-  // Whether the device can place these obstacles (analytic shapes only).
-  static bool supports(const std::vector<ObstacleSpec>& obstacles);
   GpuObstacles(const FluidSettings& settings, GpuMacGrid<D>* grid);
   // The obstacles as `placed`, moving as `motions`, within the cells
   // [lo, hi): the grid's flags, values, fractions and flux there.
@@ -34,7 +31,9 @@ class GpuObstacles {
   GpuMacGrid<D>& grid_;
   DomainBoundaries boundaries_;
   int count_ = 0, cutCount_ = 0;
-  GpuBuffer bodies_, voxel_;
+  bool exact_ = true;            // no cut image: the cut surface's distance is one (an image's is a sign)
+  std::vector<size_t> fieldAt_;  // each obstacle's first texel in fields_
+  GpuBuffer bodies_, voxel_, fields_;
 };
 
 }  // namespace morphoflow

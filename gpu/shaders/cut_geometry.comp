@@ -5,7 +5,8 @@
 // MODE_CELLS  solid: inside any obstacle; voxel: inside a staircase one
 // MODE_FACES  the faces' fixed flags, prescribed values and open fractions
 // MODE_FLUX   the solid's flux through the closed parts of the cells' faces
-// The obstacles are `bodies` records of 32 doubles (gpu/fluid/gpu_obstacles.cpp).
+// The obstacles are `bodies` records of 40 doubles (gpu/fluid/gpu_obstacles.cpp);
+// the images' and sdfs' fields lie in `fields`, one after another.
 layout(std430, binding = 0) readonly buffer Bodies { double body[]; };
 layout(std430, binding = 1) buffer Solid { uint solid[]; };
 layout(std430, binding = 2) buffer Voxel { uint voxel[]; };
@@ -13,11 +14,12 @@ layout(std430, binding = 3) buffer Fixed { uint fixedFace[]; };
 layout(std430, binding = 4) buffer Value { float value[]; };
 layout(std430, binding = 5) buffer Open { float open[]; };
 layout(std430, binding = 6) buffer Flux { double solidFlux[]; };
+layout(std430, binding = 7) readonly buffer Fields { float fields[]; };
 
 uniform ivec3 cells, lo, box, periodic, velOff;
 uniform ivec3 lowKind, highKind;  // the domain's sides: 0 neither, 1 wall, 2 inflow
 uniform int axis, n, bodies, cutBodies;
-uniform bool parabolic, openPerFace;
+uniform bool parabolic, openPerFace, exactSurface;  // exactSurface: no cut image (only a sign)
 uniform double h, inflowMean;
 uniform double domainSize[3];
 
@@ -31,6 +33,12 @@ uniform double domainSize[3];
 #define B_MOTION_CENTRE 21
 #define B_VELOCITY 24
 #define B_OMEGA 27
+#define B_FIELD_AT 30  // an image's or sdf's: its first texel in fields, its size, threshold and invert
+#define B_FIELD_W 31
+#define B_FIELD_H 32
+#define B_THRESHOLD 33
+#define B_INVERT 34
+#define STRIDE 40
 
 #define OS_REAL double
 #define OS_FN double
@@ -43,6 +51,9 @@ uniform double domainSize[3];
 #define OS_TRUNC trunc
 #define OS_LIT(v) v##lf
 #define OS_PRECISE precise
+#define OS_TEXEL(i) double(fields[fieldAt + (i)])
+#define OS_FIELD_PARAM int fieldAt,
+#define OS_FIELD_ARG fieldAt,
 #include "obstacle_shape.inc"
 double cfSurfaceDistance(double x[3]);
 #define CF_REAL double
@@ -58,25 +69,30 @@ double cfSurfaceDistance(double x[3]);
 #include "cut_fraction.inc"
 
 void bodyArray(int o, int at, out double v[3]) {
-  for (int a = 0; a < 3; ++a) v[a] = body[32 * o + at + a];
+  for (int a = 0; a < 3; ++a) v[a] = body[STRIDE * o + at + a];
 }
 
 // Obstacle o's signed distance at world x (obstacleDistance).
 double bodyDistance(int o, double x[3]) {
+  const int shape = int(body[STRIDE * o + B_SHAPE]);
+  if (shape >= 3)
+    return osFieldDistance(int(body[STRIDE * o + B_FIELD_AT]), shape, int(body[STRIDE * o + B_FIELD_W]),
+                           int(body[STRIDE * o + B_FIELD_H]), body[STRIDE * o + B_THRESHOLD],
+                           body[STRIDE * o + B_INVERT] != 0.0lf, x, domainSize);
   double centre[3], wrap[3], halfSize[3], orientation[9], q[3];
   bodyArray(o, B_CENTRE, centre);
   bodyArray(o, B_WRAP, wrap);
   bodyArray(o, B_HALF, halfSize);
-  for (int a = 0; a < 9; ++a) orientation[a] = body[32 * o + B_ORIENTATION + a];
+  for (int a = 0; a < 9; ++a) orientation[a] = body[STRIDE * o + B_ORIENTATION + a];
   osBodyFrame(DIM, x, centre, domainSize, wrap, orientation, q);
-  return osShapeDistance(int(body[32 * o + B_SHAPE]), DIM, q, body[32 * o + B_RADIUS], halfSize);
+  return osShapeDistance(shape, DIM, q, body[STRIDE * o + B_RADIUS], halfSize);
 }
 
 // The cut obstacles' least distance (CutSurface::distance).
 double cfSurfaceDistance(double x[3]) {
   double d = 1e308lf;
   for (int o = 0; o < bodies; ++o)
-    if (body[32 * o + B_VOXEL] == 0.0lf) {
+    if (body[STRIDE * o + B_VOXEL] == 0.0lf) {
       double od = bodyDistance(o, x);
       d = od < d ? od : d;
     }
@@ -136,7 +152,7 @@ void main() {
   for (int o = 0; o < bodies; ++o)
     if (bodyDistance(o, x) < 0.0lf) {
       inside = true;
-      staircase = staircase || body[32 * o + B_VOXEL] != 0.0lf;
+      staircase = staircase || body[STRIDE * o + B_VOXEL] != 0.0lf;
     }
   solid[indexOf(k, cells)] = inside ? 1u : 0u;
   voxel[indexOf(k, cells)] = staircase ? 1u : 0u;
@@ -167,7 +183,7 @@ void main() {
   const bool solidHi = above[axis] < cells[axis] && voxel[indexOf(above, cells)] != 0u;
   float fraction = 1.0;
   if (solidLo || solidHi) fraction = 0.0;
-  else if (cutBodies > 0) fraction = float(cfOpenFraction(DIM, axis, same.x, same.y, same.z, h, true));
+  else if (cutBodies > 0) fraction = float(cfOpenFraction(DIM, axis, same.x, same.y, same.z, h, exactSurface));
   if (fraction == 0.0) {
     held = 1u;
     prescribed = float(bodyVelocity(axis, x));

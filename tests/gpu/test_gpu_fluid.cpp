@@ -458,12 +458,13 @@ std::pair<size_t, size_t> expectDevicePlacementIsTheHosts(const FluidSettings& s
 
 }  // namespace
 
-// The device places moving circles, spheres and boxes itself at every step
+// The device places moving obstacles itself at every step
 // (shaders/cut_geometry.comp, with the host's formulas: kernels/obstacle_shape.inc, cut_fraction.inc):
 // its solid flags, fixed flags, held velocities, open fractions and solid
 // flux are the host's to the bit for a towed circle with a turning paddle
-// (cut and staircase), a towed sphere, a box turning about three axes, and
-// a circle crossing a periodic seam beside an inflow.
+// (cut and staircase), a towed sphere, a box turning about three axes, a
+// circle and a sphere passing an sdf's and an image's disc, and a circle
+// crossing a periodic seam beside an inflow.
 TEST(GpuFluid, TheDevicePlacesMovingObstaclesAsTheHostDoes) {
   if (const std::string why = gpuContextMissing(); !why.empty()) GTEST_SKIP() << why;
   const std::vector<double> times = {0.01, 0.02, 0.1, 0.37};
@@ -485,6 +486,24 @@ TEST(GpuFluid, TheDevicePlacesMovingObstaclesAsTheHostDoes) {
   paddle.rotation = {"2 * t", "3 * t", "5 * t"};
   turning.obstacles = {paddle};
   EXPECT_GT(expectDevicePlacementIsTheHosts<3>(turning, times).first, 100u);
+  // A sphere (a circle in 2D) that passes a disc given as a signed-distance
+  // picture and one given as a grey picture (only a sign: its cut faces found
+  // by bisection in 2D, 8 x 8 samples in 3D); the pictures do not move.
+  for (ObstacleShape shape : {ObstacleShape::Sdf, ObstacleShape::Image}) {
+    ObstacleSpec disc;
+    disc.shape = shape;
+    disc.fieldWidth = disc.fieldHeight = 40;
+    for (int j = 0; j < 40; ++j)
+      for (int i = 0; i < 40; ++i) {
+        const double d = std::hypot((i + 0.5) / 40 - 0.6, 1.0 - (j + 0.5) / 40 - 0.55) - 0.2;
+        disc.field.push_back(float(shape == ObstacleShape::Sdf ? d : std::clamp(0.5 - 40 * d, 0.0, 1.0)));
+      }
+    FluidSettings two = stirred({48, 48}), three = stirred({20, 20, 20});
+    two.obstacles.push_back(disc);
+    three.obstacles.push_back(disc);
+    EXPECT_GT(expectDevicePlacementIsTheHosts<2>(two, times).first, 100u) << int(shape);
+    EXPECT_GT(expectDevicePlacementIsTheHosts<3>(three, times).first, 100u) << int(shape);
+  }
   FluidSettings seam = box({48, 32}, false, true, true);  // inflow at x = 0, periodic in y
   ObstacleSpec body;
   body.radius = 0.1;
