@@ -608,6 +608,45 @@ void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, 
 }
 
 template <int D>
+void LaplaceSystem<D>::relaxBox(const Vector& b, Vector* xp, const IVec<D>& lo, const IVec<D>& hi, int sweeps) const {
+  for (int a = 0; a < D; ++a)
+    if (hi[a] <= lo[a]) return;
+  Vector& x = *xp;
+  const size_t nx = size_t(dims[0]), ny = size_t(dims[1]);
+  const bool px = periodic[0];
+  const double inv = 1.0 / scale;
+  // An odd periodic axis couples cells of one colour across the wrap: then row by row (as gaussSeidel).
+  bool serial = px && nx % 2 == 1;
+  for (int a = 1; a < D; ++a) serial |= periodic[a] && (dims[a] % 2 == 1);
+  const std::vector<size_t> rows = rowsOf<D>(dims, lo, hi);
+  auto sweepRow = [&](size_t row, int colour) {
+    const size_t y = row % ny, z = D == 3 ? row / ny : 0;
+    const RowStencil<D, double> s = rowStencil<D, double>(*this, x.data(), zeros<double>(), zerosW_.data(), row, y, z);
+    const float* wa[D];
+    for (int a = 0; a < D; ++a) wa[a] = w[a].row(row);
+    const float* dr = diag.row(row);
+    const double* br = b.data() + s.base;
+    double* xr = x.data() + s.base;
+    // x_i = (b_i / scale + sum_f w_f x_j) / diag_i on active cells of the colour.
+    for (size_t i = size_t(lo[0]); i < size_t(hi[0]); ++i) {
+      if ((i + y + z) % 2 != size_t(colour) || !(dr[i] > 0.0f)) continue;
+      const size_t il = i == 0 ? nx - 1 : i - 1, ih = i + 1 == nx ? 0 : i + 1;
+      const float wl = (i == 0 && !px) ? 0.0f : wa[0][il];
+      xr[i] = (br[i] * inv + neighbourSum<D, double>(s, wa, xr, i, il, ih, wl)) * double(inverse(dr[i]));
+    }
+  };
+  for (int sweep = 0; sweep < sweeps; ++sweep)
+    for (int colour = 0; colour < 2; ++colour) {
+      if (serial) {
+        for (size_t row : rows) sweepRow(row, colour);
+      } else {
+        parallelFor(
+            rows.size(), [&](size_t k) { sweepRow(rows[k], colour); }, 16);
+      }
+    }
+}
+
+template <int D>
 void LaplaceSystem<D>::removeNullSpace(Vector* xp) const {
   Vector& x = *xp;
   if (active_ == 0) return;

@@ -63,6 +63,9 @@ struct LaplaceSystem {
   // reversed post-smoother makes a symmetric V-cycle).
   template <class T>
   void gaussSeidel(const std::vector<T>& b, std::vector<T>* x, bool reverse) const;
+  // Red-black Gauss-Seidel sweeps on the cells [lo, hi) alone, the others
+  // held: a solve's start made consistent with rows that were rewritten.
+  void relaxBox(const Vector& b, Vector* x, const IVec<D>& lo, const IVec<D>& hi, int sweeps) const;
   // Removes the mean over active cells (for singular systems).
   void removeNullSpace(Vector* x) const;
 

@@ -87,6 +87,7 @@ class ViscositySolver {
     std::vector<float> rate;
     std::vector<uint16_t> change;
     int history = 0;            // how many solves they hold (0, 1, 2)
+    IVec<D> movedLo{0}, movedHi{0};           // the unknowns whose rows the last move rewrote (until the next solve)
     std::unique_ptr<Chebyshev<D>> chebyshev;  // bounds the spectrum; solves while it is quick
     std::unique_ptr<Multigrid<D>> multigrid;  // present while it solves instead
   };
