@@ -1,6 +1,4 @@
 #include "core/chebyshev.h"
-#include <cstdio>
-#include <cstdlib>
 
 #include <algorithm>
 #include <array>
@@ -422,9 +420,6 @@ SolverResult Chebyshev<D>::solve(const Vector& b, Vector* xp, const SolverOption
     // full iteration's, whose bound stepsFor follows.)
     const double factor = std::min(rnorm / budget, kRoundFactor) * (cyclic_ ? kCyclicMargin : 1.0);
     const int steps = std::min(stepsFor(factor), options.maxIterations - result.iterations);
-    if (getenv("MF_CHEB"))
-      fprintf(stderr, "cheb n=%zu rho=%.6f ratio=%.3f r/budget=%.3e steps=%d round=%d\n", n, rho_, diagRatio_,
-              rnorm / budget, steps, rounds);
     // Steps 2.. (step 1 came with the residual), layout_.stepsPerPass per
     // pass; cyclic, then the colour left at e_{k-1} from the other's e_k
     // by a Jacobi half step, so that its residual is 0.

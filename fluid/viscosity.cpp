@@ -309,8 +309,8 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
     // The warm start comes from solves on the rows before a moving obstacle
     // rewrote them, and leaves its largest residuals on them (a face whose
     // cut distance changed, one the solid uncovered): two red-black sweeps
-    // there (at 128^3 the circling sphere's Chebyshev steps fall from 32.6
-    // to about 25, the body at rest's 25.0; docs/performance.md).
+    // there (at 128^3 the circling sphere's Chebyshev steps fall from 32.4
+    // to 22.7-24.2, the body at rest's 22.0-23.5; docs/performance.md).
     C.A.relaxBox(b_, &x_, C.movedLo, C.movedHi, kMovedSweeps);
     C.movedLo = C.movedHi = IVec<D>(0);
     SolverOptions options = options_;

@@ -1,10 +1,11 @@
 // Moving obstacles placed on the device: at every step the solid flags, the
 // faces' fixed flags, held velocities and open fractions, and the solid's
 // flux, of the cells a move touched, computed by shaders/cut_geometry.comp
-// with kernels/obstacle_shape.inc's and cut_fraction.inc's formulas (the host's, so they are the
-// CPU's to the bit) into the GpuMacGrid's buffers. Only the obstacles'
-// placements (a few doubles each) go up; nothing comes back. Every shape:
-// an image's or sdf's field (which does not move) is uploaded once.
+// into the GpuMacGrid's buffers with the host's formulas
+// (kernels/obstacle_shape.inc, cut_fraction.inc), so they are the CPU's to
+// the bit. Only the obstacles' placements (a few doubles each) go up;
+// nothing comes back. Every shape: an image's or sdf's field (which does
+// not move) is uploaded once.
 #pragma once
 
 #include <vector>
