@@ -3,7 +3,10 @@
 #pragma once
 
 #include <cmath>
+#include <utility>
+#include <vector>
 
+#include "bench/bench_timing.h"
 #include "core/parallel.h"
 #include "core/random.h"
 #include "fluid/fluid_settings.h"
@@ -49,6 +52,19 @@ FluidSettings benchCavityWith(int n, BenchContent content) {
   }
   s.obstacles = {body};
   return s;
+}
+
+// The runs of the fluid suites: each case plain, then (3D, with `smoke`)
+// with smoke, and 3D and 2D 512^2 with the body at rest and moving.
+inline std::vector<std::pair<BenchCase, BenchContent>> fluidBenchRuns(const std::vector<BenchCase>& cases, bool smoke) {
+  std::vector<std::pair<BenchCase, BenchContent>> runs;
+  for (BenchCase c : cases) {
+    runs.push_back({c, BenchContent::Plain});
+    if (smoke && c.dim == 3) runs.push_back({c, BenchContent::Smoke});
+    if (c.dim == 3 || c.n == 512)
+      for (BenchContent b : {BenchContent::BodyAtRest, BenchContent::BodyMoving}) runs.push_back({c, b});
+  }
+  return runs;
 }
 
 // Pearson's Gray-Scott (F = 0.04, k = 0.06) on n^D cells of size `cell`,

@@ -108,14 +108,7 @@ bool runFluidBench(const BenchOptions& o) {
   // 3D cases run again with smoke (sources, temperature, buoyancy,
   // confinement), and 3D and 2D 512^2 with a body at rest and moving, each
   // right after the plain one.
-  std::vector<std::pair<BenchCase, BenchContent>> runs;
-  for (BenchCase c : cases) {
-    runs.push_back({c, BenchContent::Plain});
-    if (c.dim == 3) runs.push_back({c, BenchContent::Smoke});
-    if (c.dim == 3 || c.n == 512)
-      for (BenchContent b : {BenchContent::BodyAtRest, BenchContent::BodyMoving}) runs.push_back({c, b});
-  }
-  for (const auto& [c, content] : runs) {
+  for (const auto& [c, content] : fluidBenchRuns(cases, true)) {
     for (int threads : {1, 2}) {
       nlohmann::json j = c.dim == 2 ? benchFluid<2>(c.n, threads, o.minSeconds, triad[size_t(threads)], content)
                                     : benchFluid<3>(c.n, threads, o.minSeconds, triad[size_t(threads)], content);

@@ -140,15 +140,9 @@ bool runGpuFluidBench(const BenchOptions& o) {
       "content", "ms/step(med)", "p-iters", "v-iters", "forces", "advect", "diffuse", "project", "GB/s", "of peak",
       "of copy", "dispatches", "waits");
   nlohmann::json all = nlohmann::json::array();
-  // As the CPU's suite: 3D and 2D 512^2 again with a body at rest and moving (its placement and the host's
-  // rebuild of the systems in the step's time), each right after the plain case.
-  std::vector<std::pair<BenchCase, BenchContent>> runs;
-  for (BenchCase c : selectBenchCases(kCases, o.size)) {
-    runs.push_back({c, BenchContent::Plain});
-    if (c.dim == 3 || c.n == 512)
-      for (BenchContent b : {BenchContent::BodyAtRest, BenchContent::BodyMoving}) runs.push_back({c, b});
-  }
-  for (const auto& [c, content] : runs) {
+  // As the CPU's suite (without its smoke): 3D and 2D 512^2 again with a body at rest and moving (its
+  // placement and the host's rebuild of the systems in the step's time), each right after the plain case.
+  for (const auto& [c, content] : fluidBenchRuns(selectBenchCases(kCases, o.size), false)) {
     nlohmann::json j = c.dim == 2 ? benchGpuFluid<2>(c.n, o.minSeconds, real, content)
                                   : benchGpuFluid<3>(c.n, o.minSeconds, real, content);
     addBandwidthFractions(&j, bw);

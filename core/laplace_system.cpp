@@ -498,10 +498,7 @@ void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, 
   const size_t nx = size_t(dims[0]);
   const bool px = periodic[0];
   const T inv = T(1.0 / scale);
-  // An odd periodic axis couples cells of one colour across the wrap: run
-  // such systems row by row so the sweep stays deterministic and race-free.
-  bool serial = false;
-  for (int a = 1; a < D; ++a) serial |= periodic[a] && (dims[a] % 2 == 1);
+  const bool serial = coloursMeetAcrossRows();
   size_t rows = 1;
   for (int a = 1; a < D; ++a) rows *= size_t(dims[a]);
   [[maybe_unused]] const bool wide = useAvx2();
@@ -608,6 +605,13 @@ void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, 
 }
 
 template <int D>
+bool LaplaceSystem<D>::coloursMeetAcrossRows() const {
+  for (int a = 1; a < D; ++a)
+    if (periodic[a] && dims[a] % 2 == 1) return true;
+  return false;
+}
+
+template <int D>
 void LaplaceSystem<D>::relaxBox(const Vector& b, Vector* xp, const IVec<D>& lo, const IVec<D>& hi, int sweeps) const {
   for (int a = 0; a < D; ++a)
     if (hi[a] <= lo[a]) return;
@@ -615,9 +619,7 @@ void LaplaceSystem<D>::relaxBox(const Vector& b, Vector* xp, const IVec<D>& lo, 
   const size_t nx = size_t(dims[0]), ny = size_t(dims[1]);
   const bool px = periodic[0];
   const double inv = 1.0 / scale;
-  // An odd periodic axis couples cells of one colour across the wrap: then row by row (as gaussSeidel).
-  bool serial = px && nx % 2 == 1;
-  for (int a = 1; a < D; ++a) serial |= periodic[a] && (dims[a] % 2 == 1);
+  const bool serial = coloursMeetAcrossRows();
   const std::vector<size_t> rows = rowsOf<D>(dims, lo, hi);
   auto sweepRow = [&](size_t row, int colour) {
     const size_t y = row % ny, z = D == 3 ? row / ny : 0;

@@ -99,6 +99,9 @@ struct LaplaceSystem {
   double defectRow(size_t row, const T* b, const T* x, T* r) const;
   template <class T>
   const T* zeros() const;
+  // An odd periodic axis beyond x couples rows of one colour across the
+  // wrap: red-black sweeps then take the rows one by one (deterministic, race-free).
+  bool coloursMeetAcrossRows() const;
 
   bool singular_ = false;
   size_t active_ = 0;

@@ -23,8 +23,7 @@ std::vector<ObstacleSpec> ObstaclePlacement<D>::obstaclesAt(double t, std::vecto
 
 template <int D>
 VelocityConstraints<D> ObstaclePlacement<D>::constraintsAt(double t) {
-  std::vector<RigidMotion>& motions = motions_;
-  placed_ = obstaclesAt(t, &motions);
+  placed_ = obstaclesAt(t, &motions_);
   placedAt_ = t;
   std::vector<ObstacleSpec> voxel;  // the staircase obstacles; the others are cut
   for (const ObstacleSpec& o : placed_)
@@ -34,7 +33,7 @@ VelocityConstraints<D> ObstaclePlacement<D>::constraintsAt(double t) {
   if (moves_) voxel_ = solidMask<D>(voxel, cells_, h_);
   return VelocityConstraints<D>(cells_, h_, boundaries_, solidMask<D>(placed_, cells_, h_),
                                 moves_ ? voxel_ : solidMask<D>(voxel, cells_, h_), CutSurface(placed_, D, size),
-                                CutSurface(placed_, D, size, motions, true));
+                                CutSurface(placed_, D, size, motions_, true));
 }
 
 // The cells [lo, hi) that hold the moving obstacles of `placed`, two cells
