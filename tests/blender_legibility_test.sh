@@ -11,7 +11,7 @@ command -v blender >/dev/null || { echo "blender_legibility_test: blender is not
 rm -rf "$WORK"; mkdir -p "$WORK"
 measure() {  # mode -> "median band" of its last frame's render
   "$BIN" run "$SRC/scenes/vfx/plume_gray_scott_3d.toml" --set 'grid.resolution=[48,80,48]' \
-    --set 'rd.resolution=[96,160,96]' --set output.every=150 --set output.images=false \
+    --set 'rd.resolution=[96,160,96]' --set output.every=140 --set output.images=false \
     --set "coupling.mode=\"$1\"" --quiet --out "$WORK/$1"
   "$BIN" blender "$WORK/$1" > /dev/null
   blender -b --factory-startup --python "$WORK/$1/blender_scene.py" -- --render --frame last --resolution 512 \

@@ -189,7 +189,7 @@ TEST(SmokeScenes, ThePatternedPlumeReadsInThePreview) {
     const CommandResult r =
         runMorphoflow("run " + sceneFile("vfx/plume_gray_scott_3d.toml") +
                       " --set grid.resolution=[48,80,48] --set rd.resolution=[96,160,96] --set output.vdb=false"
-                      " --set output.every=300 --set coupling.mode='\"" +
+                      " --set output.every=280 --set coupling.mode='\"" +
                       mode + "\"' --quiet --out " + (dir / mode).string());
     ASSERT_EQ(r.status, 0) << r.output;
     int w = 0, h = 0;
