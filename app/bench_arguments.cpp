@@ -18,6 +18,10 @@ CLI::App* addBenchSubcommand(CLI::App& app, BenchArguments* a, const std::string
   cmd->add_option("--size", bench.size, "only grids of this many cells per axis")->check(CLI::Range(8, 16384));
   cmd->add_option("--json", bench.json, "also write results as JSON");
   cmd->add_option("--seconds", bench.minSeconds, "minimum timed seconds per case")->check(finiteIn(0.0, 3600.0));
+  cmd->add_option("--warm-up", bench.warmUpSteps, "fluid: steps run before the timed ones")
+      ->check(CLI::Range(0, 100000))
+      ->capture_default_str()
+      ->each([a](const std::string&) { a->warmUpGiven = true; });
   cmd->add_option("--backend", bench.backend, "cpu | gpu")->check(CLI::IsMember({"cpu", "gpu"}))->capture_default_str();
   cmd->add_option("--precision", bench.precision, "gpu: float | double (a scene's gpu.precision)")
       ->check(CLI::IsMember({"float", "double"}))
@@ -36,6 +40,9 @@ int runBench(const BenchArguments& a, const std::function<int(const BenchArgumen
   if (a.interpolationGiven && a.suite != "coupling")
     throw UserError({"--interpolation", 0, 0}, "", "only the coupling suite carries chemicals",
                     "drop --interpolation or run `bench coupling`");
+  if (a.warmUpGiven && a.suite != "fluid")
+    throw UserError({"--warm-up", 0, 0}, "", "only the fluid suite takes warm-up steps",
+                    "drop --warm-up or run `bench fluid`");
   if (!bench.trace.empty() && a.suite != "coupling")
     throw UserError({"--trace", 0, 0}, "", "only the coupling suite writes a trace",
                     "drop --trace or run `bench coupling`");

@@ -18,6 +18,7 @@ struct BenchArguments {
   std::string suite;
   BenchOptions bench;
   bool interpolationGiven = false;
+  bool warmUpGiven = false;
   std::string suites;  // the suite names, for errors
 };
 

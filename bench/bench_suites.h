@@ -9,6 +9,7 @@ struct BenchOptions {
   int size = 0;            // 0 = the suite's full list of sizes
   std::string json;        // write results here when not empty
   double minSeconds = 1.0; // time each case for at least this long (after warm-up)
+  int warmUpSteps = 3;     // fluid: steps before the timed ones (the flow starts to develop)
   std::string trace;       // coupling: write a Chrome trace of the stages here
   std::string backend = "cpu";  // cpu | gpu
   std::string precision = "float";       // gpu: the solver vectors' and layer's, float | double (gpu.precision)

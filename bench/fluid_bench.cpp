@@ -53,24 +53,26 @@ FluidSettings benchSettings(int n, BenchContent content) {
 }
 
 template <int D>
-nlohmann::json benchFluid(int n, int threads, double minSeconds, double triad, BenchContent content) {
+nlohmann::json benchFluid(int n, int threads, const BenchOptions& o, double triad, BenchContent content) {
   ThreadLimit limit(threads);
   const bool smoke = content == BenchContent::Smoke;
   FluidSolver<D> f(benchSettings<D>(n, content));
   const double dt = f.h();  // CFL 1 at the lid speed
-  for (int i = 0; i < 3; ++i) f.step(dt);  // warm-up: the flow starts to develop
+  for (int i = 0; i < o.warmUpSteps; ++i) f.step(dt);  // warm-up: the flow starts to develop
   std::vector<double> pit, vit;
   std::array<double, FluidStepStats::kStages> stage{};
   bool converged = true;
   const double cells = cellCount<D>(f.cells());
   double bytes = 0.0;
-  const std::vector<double> times = timeSteps(minSeconds, [&] { f.step(dt); }, [&] {
-    pit.push_back(f.lastStats().pressure.iterations);
-    vit.push_back(f.lastStats().viscosity.iterations);
-    converged &= f.lastStats().pressure.converged;
-    bytes += fluidStepBytes<D>(cells, f.lastStats());
-    for (int k = 0; k < FluidStepStats::kStages; ++k) stage[size_t(k)] += f.lastStats().seconds[size_t(k)];
-  });
+  const std::vector<double> times = timeSteps(
+      o.minSeconds, [&] { f.step(dt); },
+      [&] {
+        pit.push_back(f.lastStats().pressure.iterations);
+        vit.push_back(f.lastStats().viscosity.iterations);
+        converged &= f.lastStats().pressure.converged;
+        bytes += fluidStepBytes<D>(cells, f.lastStats());
+        for (int k = 0; k < FluidStepStats::kStages; ++k) stage[size_t(k)] += f.lastStats().seconds[size_t(k)];
+      });
   double meanIt = 0, meanVit = 0;
   for (double p : pit) meanIt += p;
   for (double v : vit) meanVit += v;
@@ -81,6 +83,7 @@ nlohmann::json benchFluid(int n, int threads, double minSeconds, double triad, B
                       {"smoke", smoke},
                       {"content", contentName(content)},
                       {"threads", threads},
+                      {"warm_up_steps", o.warmUpSteps},
                       {"steps", times.size()},
                       {"ms_per_step_median", 1e3 * median(times)},
                       {"pressure_iterations_mean", meanIt},
@@ -110,8 +113,8 @@ bool runFluidBench(const BenchOptions& o) {
   // right after the plain one.
   for (const auto& [c, content] : fluidBenchRuns(cases, true)) {
     for (int threads : {1, 2}) {
-      nlohmann::json j = c.dim == 2 ? benchFluid<2>(c.n, threads, o.minSeconds, triad[size_t(threads)], content)
-                                    : benchFluid<3>(c.n, threads, o.minSeconds, triad[size_t(threads)], content);
+      nlohmann::json j = c.dim == 2 ? benchFluid<2>(c.n, threads, o, triad[size_t(threads)], content)
+                                    : benchFluid<3>(c.n, threads, o, triad[size_t(threads)], content);
       std::cout << fmt::format(
                        "{:>4} {:>6} {:>12} {:>7} {:>12.2f} {:>8.1f} {:>8.1f} {:>9.2f} {:>9.2f} {:>9.2f} {:>9.2f} "
                        "{:>9.2f}{}\n",

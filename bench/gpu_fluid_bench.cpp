@@ -31,7 +31,7 @@ namespace morphoflow {
 
 namespace {
 
-constexpr int kWarmup = 3;
+constexpr int kWarmup = 3;  // the coupling suite's steps before the timed ones
 
 // The cases of both suites: the CPU's sizes and the GPU targets' (1024^2, 256^3).
 const std::vector<BenchCase> kCases = {{2, 256}, {2, 512}, {2, 1024}, {2, 2048}, {3, 64}, {3, 128}, {3, 256}};
@@ -54,11 +54,12 @@ Timed timeGpu(double minSeconds, Step&& step, After&& after) {
 }
 
 template <int D>
-nlohmann::json benchGpuFluid(int n, double minSeconds, GpuPrecision real, BenchContent content = BenchContent::Plain) {
+nlohmann::json benchGpuFluid(int n, double minSeconds, GpuPrecision real, BenchContent content = BenchContent::Plain,
+                             int warmUpSteps = 3) {
   FluidSolver<D> host(benchCavityWith<D>(n, content));  // the constraints; never stepped
   GpuFluid<D> gpu(host.settings(), host.constraints(), real);
   const double dt = host.h();
-  for (int i = 0; i < kWarmup; ++i) gpu.step(dt);
+  for (int i = 0; i < warmUpSteps; ++i) gpu.step(dt);
   double pit = 0, vit = 0;
   std::array<double, FluidStepStats::kStages> stage{};
   bool converged = true;
@@ -76,6 +77,7 @@ nlohmann::json benchGpuFluid(int n, double minSeconds, GpuPrecision real, BenchC
                       {"backend", "gpu"},
                       {"content", contentName(content)},
                       {"precision", precisionName(real)},
+                      {"warm_up_steps", warmUpSteps},
                       {"steps", steps},
                       {"ms_per_step_median", 1e3 * t.seconds},
                       {"steps_per_second", 1.0 / t.seconds},
@@ -143,8 +145,8 @@ bool runGpuFluidBench(const BenchOptions& o) {
   // As the CPU's suite (without its smoke): 3D and 2D 512^2 again with a body at rest and moving (its
   // placement and the host's rebuild of the systems in the step's time), each right after the plain case.
   for (const auto& [c, content] : fluidBenchRuns(selectBenchCases(kCases, o.size), false)) {
-    nlohmann::json j = c.dim == 2 ? benchGpuFluid<2>(c.n, o.minSeconds, real, content)
-                                  : benchGpuFluid<3>(c.n, o.minSeconds, real, content);
+    nlohmann::json j = c.dim == 2 ? benchGpuFluid<2>(c.n, o.minSeconds, real, content, o.warmUpSteps)
+                                  : benchGpuFluid<3>(c.n, o.minSeconds, real, content, o.warmUpSteps);
     addBandwidthFractions(&j, bw);
     std::cout << fmt::format(
                      "{:>4} {:>6} {:>12} {:>12.3f} {:>8.1f} {:>8.1f} {:>9.3f} {:>9.3f} {:>9.3f} {:>9.3f} {:>8.1f} "

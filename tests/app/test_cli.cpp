@@ -754,6 +754,26 @@ TEST(Cli, CouplingBenchWritesAChromeTrace) {
   fs::remove_all(dir);
 }
 
+// `bench fluid --warm-up N` runs N steps before the timed ones and records
+// them in its JSON; the other suites refuse the option (exit 2, naming it).
+TEST(Cli, FluidBenchTakesWarmUpSteps) {
+  auto dir = tempDir("bench_warm_up");
+  const CommandResult warm =
+      runMorphoflow("bench fluid --size 32 --seconds 0 --warm-up 7 --json " + (dir / "fluid.json").string());
+  ASSERT_EQ(warm.status, 0) << warm.output;
+  std::ifstream in(dir / "fluid.json");
+  const nlohmann::json rows = nlohmann::json::parse(in);
+  ASSERT_FALSE(rows.empty());
+  for (const nlohmann::json& c : rows) {
+    EXPECT_EQ(c["warm_up_steps"].get<int>(), 7) << c;
+    EXPECT_GE(c["steps"].get<int>(), 1) << c;
+  }
+  const CommandResult rd = runMorphoflow("bench rd --size 32 --seconds 0 --warm-up 7");
+  EXPECT_EQ(rd.status, 2) << rd.output;
+  EXPECT_NE(rd.output.find("only the fluid suite"), std::string::npos) << rd.output;
+  fs::remove_all(dir);
+}
+
 // `bench roofline`: the triad's bandwidth with 1 and 2 threads, and every
 // kernel's bytes, rate and fraction of it (consistent with each other).
 TEST(Cli, RooflineBenchRelatesEveryKernelToTheTriad) {

@@ -291,6 +291,8 @@ TEST(HostileInput, CommandLineNumbersOutsideTheirRangeAreRefused) {
   }
   for (const char* v : {"inf", "nan", "1e9", "-1"})
     cases.push_back({std::string("bench roofline --seconds ") + v, "--seconds"});
+  for (const char* v : {"inf", "nan", "1e9", "-1", "2.5"})
+    cases.push_back({std::string("bench fluid --warm-up ") + v, "--warm-up"});
   for (const char* v : {"inf", "nan", "1e300", "-1"}) {
     cases.push_back({std::string("texton --lifetime ") + v + png, "--lifetime"});
     cases.push_back({std::string("texton --radius ") + v + png, "--radius"});
