@@ -55,7 +55,7 @@ Timed timeGpu(double minSeconds, Step&& step, After&& after) {
 
 template <int D>
 nlohmann::json benchGpuFluid(int n, double minSeconds, GpuPrecision real, BenchContent content = BenchContent::Plain,
-                             int warmUpSteps = 3) {
+                             int warmUpSteps = BenchOptions{}.warmUpSteps) {
   FluidSolver<D> host(benchCavityWith<D>(n, content));  // the constraints; never stepped
   GpuFluid<D> gpu(host.settings(), host.constraints(), real);
   const double dt = host.h();
