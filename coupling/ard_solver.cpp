@@ -13,7 +13,13 @@ ARDSolver<D>::ARDSolver(RDSolver<D>* rd, ChemicalAdvector<D> advector, CouplingM
   if (!(rdTimeScale > 0)) throw std::invalid_argument("coupling: the reaction-diffusion time scale must be > 0");
   if (advector_.domain().cells != rd->cells()) throw std::invalid_argument("coupling: advection and RD grids differ");
   if (mode_ != CouplingMode::RDOnly) advector_.emptySolids(species());
-  rd_->setWorkPool(pool_.get());
+  rd_->setWorkPool(pool_);
+}
+
+template <int D>
+void ARDSolver<D>::shareWorkPool(WorkPool* pool) {
+  pool_ = pool;
+  rd_->setWorkPool(pool);
 }
 
 template <int D>
@@ -30,7 +36,7 @@ struct ARDSolver<D>::Stages {
   const MacVelocity<D>* u = nullptr;
   void reactDiffuse(double dt) { s.rd_->step(dt); }
   void emptySolids() { s.advector_.emptySolids(s.species()); }
-  void advect(double dt) { s.advector_.advect(*u, dt, s.species(), s.pool_.get()); }
+  void advect(double dt) { s.advector_.advect(*u, dt, s.species(), s.pool_); }
 };
 
 template <int D>

@@ -32,6 +32,9 @@ class ARDSolver {
 
   RDSolver<D>& rd() { return *rd_; }
   ChemicalAdvector<D>& advector() { return advector_; }
+  // Lends the stages' work vectors from `pool` (a caller's that is idle
+  // while this layer steps) instead of this layer's own.
+  void shareWorkPool(WorkPool* pool);
   const RDSolver<D>& rd() const { return *rd_; }
   CouplingMode mode() const { return mode_; }
   double time() const { return time_; }
@@ -49,7 +52,8 @@ class ARDSolver {
   ChemicalAdvector<D> advector_;
   // The advection's and the RD solves' work vectors, lent to each in turn
   // (owned here, so the RD solver's pointer to it survives a move).
-  std::unique_ptr<WorkPool> pool_ = std::make_unique<WorkPool>();
+  std::unique_ptr<WorkPool> own_ = std::make_unique<WorkPool>();
+  WorkPool* pool_ = own_.get();
   CouplingMode mode_;
   double rdTimeScale_;
   double time_ = 0.0;

@@ -15,12 +15,13 @@ namespace morphoflow {
 
 namespace {
 
-// Records stages that ran back to back from `begin` on the calling thread.
+// Records stages [first, first + count) that ran back to back from `begin`
+// on the calling thread.
 template <size_t N>
 void recordStages(StageTrace* trace, const char* category, const char* const (&names)[N],
-                  const std::array<double, N>& seconds, double begin) {
+                  const std::array<double, N>& seconds, double begin, size_t first = 0, size_t count = N) {
   if (!trace) return;
-  for (size_t k = 0; k < N; ++k) {
+  for (size_t k = first; k < first + count; ++k) {
     trace->record(names[k], category, begin, begin + seconds[k]);
     begin += seconds[k];
   }
@@ -30,7 +31,9 @@ void recordStages(StageTrace* trace, const char* category, const char* const (&n
 
 template <int D>
 CpuCoupledStepper<D>::CpuCoupledStepper(FluidSolver<D>* fluid, ARDSolver<D>* ard, Backend backend)
-    : fluid_(fluid), fluidStepper_(fluid), ard_(ard), backend_(backend) {}
+    : fluid_(fluid), fluidStepper_(fluid), ard_(ard), overlap_(D == 2 && backend != Backend::Serial) {
+  if (!overlap_) ard_->shareWorkPool(fluid_->workPool());
+}
 
 // A moving obstacle: the fluid's solid where this step ends, and the
 // chemicals' solid cells with it (coupling/solid_on_layer.h).
@@ -50,12 +53,6 @@ template <int D>
 void CpuCoupledStepper<D>::step(double dt) {
   const double t0 = traceClock();
   if (fluid_->movesObstacles()) moveSolids(dt);
-  auto fluidStep = [&](const std::function<void()>& afterAdvection) {
-    const double b = traceClock();
-    fluid_->step(dt, afterAdvection);
-    fluidSeconds_ = traceClock() - b;
-    recordStages(trace_, "fluid", FluidStepStats::kStageNames, fluid_->lastStats().seconds, b);
-  };
   // The ARD's stages, each recorded on the thread that ran it.
   auto ardStage = [&](int k, auto&& run) {
     const double b = traceClock();
@@ -65,11 +62,28 @@ void CpuCoupledStepper<D>::step(double dt) {
   auto reactDiffuse = [&] { ardStage(0, [&] { ard_->reactDiffuse(dt); }); };
   // The fluid's step keeps the velocity it advected through until the next step.
   auto advect = [&] { ardStage(1, [&] { ard_->advect(dt, fluid_->advectedVelocity()); }); };
-  if (backend_ == Backend::Serial) {
-    fluidStep({});
-    reactDiffuse();
-    advect();
+  const auto& fluidStages = FluidStepStats::kStageNames;
+  if (!overlap_) {
+    // The ARD's step inside the fluid's, once its advection is done: the
+    // fluid's stages leave their work vectors in the pool the ARD borrows.
+    const double b = traceClock();
+    double resumed = b;
+    fluid_->step(dt, [&] {
+      reactDiffuse();
+      advect();
+      resumed = traceClock();
+    });
+    const auto& seconds = fluid_->lastStats().seconds;  // (the ARD's time not among them)
+    fluidSeconds_ = seconds[0] + seconds[1] + seconds[2] + seconds[3];
+    recordStages(trace_, "fluid", fluidStages, seconds, b, 0, 2);
+    recordStages(trace_, "fluid", fluidStages, seconds, resumed, 2, 2);
   } else {
+    auto fluidStep = [&](const std::function<void()>& afterAdvection) {
+      const double b = traceClock();
+      fluid_->step(dt, afterAdvection);
+      fluidSeconds_ = traceClock() - b;
+      recordStages(trace_, "fluid", fluidStages, fluid_->lastStats().seconds, b);
+    };
     // The chemicals' advection waits for two things, the reaction-diffusion
     // stage and the fluid's advection: whichever is done second starts it.
     std::atomic<int> done{0};

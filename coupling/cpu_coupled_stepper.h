@@ -1,14 +1,23 @@
 // CpuCoupledStepper<D>: advances a fluid and its ARD layer together.
 //
-//   serial: fluid step n + 1, then the ARD step n: reaction-diffusion, then
-//           the chemicals advected through the velocity the fluid's step
-//           advected through (velocity n with step n + 1's forces, which the
-//           fluid keeps until its next step: no copy of it is made).
-//   tbb:    the same two steps run concurrently (seed 001 sec. 7): the ARD's
-//           reaction-diffusion beside the fluid's step from its start, its
-//           advection once the fluid's advection is done too, and both steps
-//           split into TBB tasks, so RD work fills the cores while the
-//           pressure solve waits on memory.
+//   nested:     the ARD step n inside the fluid's step n + 1, once the
+//               fluid's advection is done: reaction-diffusion, then the
+//               chemicals advected through the velocity the fluid's step
+//               advected through (velocity n with step n + 1's forces, which
+//               the fluid keeps until its next step: no copy of it is made).
+//               The ARD borrows its work vectors from the fluid's pool, which
+//               its stages have then given back: one set for both steps.
+//   overlapped: the same two steps run concurrently (seed 001 sec. 7): the
+//               ARD's reaction-diffusion beside the fluid's step from its
+//               start, its advection once the fluid's advection is done too,
+//               and both steps split into TBB tasks, so RD work fills the
+//               cores while the pressure solve waits on memory; each step
+//               keeps its own work vectors.
+//
+// The serial backend nests, and so does tbb in 3D, whose stages are bound by
+// memory on both sides, so that overlapping them gains nothing measurable
+// while the second set of work vectors costs 20 bytes a cell
+// (docs/performance.md); tbb in 2D overlaps.
 //
 // Both orders compute exactly the same numbers: neither step reads what the
 // other writes, and every parallel loop has a fixed decomposition, so the
@@ -26,14 +35,14 @@ namespace morphoflow {
 template <int D>
 class CpuCoupledStepper final : public CoupledStepper<D> {
  public:
-  // backend: Serial (one order, one thread) or TBB (the two overlapped).
+  // backend: Serial (nested, one thread) or TBB (nested in 3D, else overlapped).
   CpuCoupledStepper(FluidSolver<D>* fluid, ARDSolver<D>* ard, Backend backend);
 
   void step(double dt) override;
   const FluidStepper<D>& fluid() const override { return fluidStepper_; }
   const RDStepStats& layerStats() const override { return ard_->rd().lastStats(); }
   std::array<double, 3> seconds() const override { return {fluidSeconds_, ardSeconds_, stepSeconds_}; }
-  bool overlapped() const override { return backend_ != Backend::Serial; }
+  bool overlapped() const override { return overlap_; }
   // (the hosts are the solvers stepped)
   void toHost(FluidSolver<D>*, RDSolver<D>*) const override {}
   void fromHost(const FluidSolver<D>&, const RDSolver<D>&) override {}
@@ -60,7 +69,7 @@ class CpuCoupledStepper final : public CoupledStepper<D> {
   FluidSolver<D>* fluid_;
   CpuFluidStepper<D> fluidStepper_;
   ARDSolver<D>* ard_;
-  Backend backend_;
+  bool overlap_;
   double fluidSeconds_ = 0, ardSeconds_ = 0, stepSeconds_ = 0;
   StageTrace* trace_ = nullptr;
 };

@@ -101,6 +101,7 @@ struct FluidSolver<D>::Stages {
     if (stage > 0) f.stats_.seconds[size_t(stage - 1)] = std::chrono::duration<double>(t1 - t0).count();
     t0 = t1;
   }
+  void resumeClock() { t0 = Clock::now(); }
   bool smoke() const { return f.settings_.smoke.enabled; }
   void emitSmoke(double dt) {
     morphoflow::emitSmoke<D>(f.settings_.smoke, f.sourceCoverage_, f.constraints_.solid, f.time_, dt, &f.dye(),

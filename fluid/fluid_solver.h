@@ -60,6 +60,7 @@ class FluidSolver {
   // The velocity the last step's advection traced through (the step's start
   // velocity with its forces applied), kept until the next step's advection.
   const MacVelocity<D>& advectedVelocity() const { return scratch_; }
+  WorkPool* workPool() { return &pool_; }
   // The dye (zeros until something puts dye in: a scene without dye keeps no
   // grid for it until asked for one).
   Grid<float, D>& dye() { return materialisedDye(); }

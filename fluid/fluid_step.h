@@ -4,6 +4,8 @@
 // gpu/gpu_fluid.cpp) supply the stages; the order is this file's alone.
 // A backend's Stages has:
 //   mark(k)           stage k of FluidStepStats begins (k = 4: the step ends)
+//   resumeClock()     the stage goes on after a caller's work, whose time is
+//                     not the stage's
 //   smoke()           whether the scene has [smoke]
 //   emitSmoke(dt)     the sources' smoke and heat
 //   forces(dt)        the scene's forces (gravity, the dye's buoyancy)
@@ -37,7 +39,10 @@ void stepFluid(Stages& s, double dt, const std::function<void()>& afterAdvection
   s.injectInflowDye();
   if (s.smoke()) s.decaySmoke(dt);
   s.mark(2);
-  if (afterAdvection) afterAdvection();  // (the coupled step's chemicals may start)
+  if (afterAdvection) {  // (the coupled step's chemicals may start, or run)
+    afterAdvection();
+    s.resumeClock();
+  }
   // 3. diffuse
   s.diffuse(dt);
   s.mark(3);

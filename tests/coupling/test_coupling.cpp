@@ -219,10 +219,11 @@ TEST(ARDSolver, ObstaclesHoldNoChemicalExceptInRDOnly) {
 
 namespace {
 
+template <int D>
 FluidSettings cavity(int n, double re) {
   FluidSettings f;
-  f.resolution = {n, n};
-  f.size = {1.0, 1.0};
+  f.resolution = std::vector<int>(size_t(D), n);
+  f.size = std::vector<double>(size_t(D), 1.0);
   f.viscosity = 1.0 / re;
   f.boundaries.sides[3].wallVelocity = {1.0, 0.0, 0.0};  // the lid: y_max moves along +x
   return f;
@@ -233,58 +234,79 @@ struct CoupledRun {
   std::vector<float> velocity;
 };
 
-// A Gray-Scott layer in a lid-driven cavity, run with one backend.
-CoupledRun runCavity(Backend backend, int threads, int steps, double dt, int rdCells,
-                      StageTrace* trace = nullptr) {
+// A Gray-Scott layer in a lid-driven cavity (fluid 24^D, chemicals
+// rdCells^D), run with one backend; by hand: the fluid's step, then the ARD's
+// through the velocity it advected through, each with its own work vectors.
+template <int D>
+CoupledRun runCavity(Backend backend, int threads, int steps, double dt, int rdCells, StageTrace* trace = nullptr,
+                     bool byHand = false) {
   ThreadLimit limit(threads);
-  FluidSolver<2> fluid(cavity(24, 400));
+  FluidSolver<D> fluid(cavity<D>(24, 400));
   RDSettings s;
   s.model = "gray-scott";
-  s.resolution = {rdCells, rdCells};
-  s.size = {1.0, 1.0};
+  s.resolution = std::vector<int>(size_t(D), rdCells);
+  s.size = std::vector<double>(size_t(D), 1.0);
   s.boundary = RDBoundary::Neumann;
   s.diffusion = {2e-5 * 4, 1e-5 * 4};
   s.parameters = {0.04, 0.06};
-  RDSolver<2> rd(s, *findModel("gray-scott"));
-  forEachCell<2>(rd.cells(), [&](const IVec<2>& k, size_t i) {
-    bool inside = std::abs(k[0] - rdCells / 2) < rdCells / 5 && std::abs(k[1] - rdCells / 2) < rdCells / 5;
+  RDSolver<D> rd(s, *findModel("gray-scott"));
+  forEachCell<D>(rd.cells(), [&](const IVec<D>& k, size_t i) {
+    bool inside = true;
+    for (int a = 0; a < D; ++a) inside = inside && std::abs(k[a] - rdCells / 2) < rdCells / 5;
     rd.field(0)[i] = (inside ? 0.5 : 1.0) + 0.02 * (uniform01(3, 0, i) - 0.5);
     rd.field(1)[i] = (inside ? 0.25 : 0.0) + 0.02 * uniform01(3, 1, i);
   });
-  ChemicalDomain<2> d;
+  ChemicalDomain<D> d;
   d.cells = rd.cells();
   d.h = rd.h();
-  ARDSolver<2> ard(&rd, ChemicalAdvector<2>(d, ChemicalInterpolation::Cubic), CouplingMode::ARD, 50.0);
-  CpuCoupledStepper<2> stepper(&fluid, &ard, backend);
-  stepper.setTrace(trace);
-  for (int i = 0; i < steps; ++i) stepper.step(dt);
+  ARDSolver<D> ard(&rd, ChemicalAdvector<D>(d, ChemicalInterpolation::Cubic), CouplingMode::ARD, 50.0);
+  if (byHand) {
+    for (int i = 0; i < steps; ++i) {
+      fluid.step(dt);
+      ard.step(dt, fluid.advectedVelocity());
+    }
+  } else {
+    CpuCoupledStepper<D> stepper(&fluid, &ard, backend);
+    stepper.setTrace(trace);
+    for (int i = 0; i < steps; ++i) stepper.step(dt);
+  }
   CoupledRun r;
   for (int sp = 0; sp < 2; ++sp) r.species.push_back(rd.field(sp).values());
-  for (int a = 0; a < 2; ++a)
+  for (int a = 0; a < D; ++a)
     r.velocity.insert(r.velocity.end(), fluid.velocity()[a].values().begin(), fluid.velocity()[a].values().end());
   return r;
 }
 
-}  // namespace
-
-// Serial and tbb (overlapped) give the same bits, for 1 and 2 threads.
-TEST(CpuCoupledStepper, SerialAndTbbAreBitwiseIdentical) {
-  const CoupledRun a = runCavity(Backend::Serial, 1, 30, 0.02, 40);
-  const CoupledRun b = runCavity(Backend::TBB, 2, 30, 0.02, 40);
-  const CoupledRun c = runCavity(Backend::TBB, 1, 30, 0.02, 40);
-  for (const CoupledRun* o : {&b, &c}) {
-    EXPECT_EQ(a.velocity, o->velocity);
-    for (int sp = 0; sp < 2; ++sp) EXPECT_EQ(a.species[size_t(sp)], o->species[size_t(sp)]) << "species " << sp;
-  }
+void expectSameRuns(const CoupledRun& a, const CoupledRun& b) {
+  EXPECT_EQ(a.velocity, b.velocity);
+  for (int sp = 0; sp < 2; ++sp) EXPECT_EQ(a.species[size_t(sp)], b.species[size_t(sp)]) << "species " << sp;
   double spread = 0;  // the chemicals did move and react
   for (size_t i = 0; i < a.species[1].size(); ++i) spread += std::abs(a.species[1][i] - a.species[1][0]);
   EXPECT_GT(spread, 1.0);
 }
 
+}  // namespace
+
+// Serial (nested) and tbb (overlapped in 2D) give the same bits, for 1 and
+// 2 threads.
+TEST(CpuCoupledStepper, SerialAndTbbAreBitwiseIdentical) {
+  const CoupledRun a = runCavity<2>(Backend::Serial, 1, 30, 0.02, 40);
+  expectSameRuns(a, runCavity<2>(Backend::TBB, 2, 30, 0.02, 40));
+  expectSameRuns(a, runCavity<2>(Backend::TBB, 1, 30, 0.02, 40));
+}
+
+// In 3D the ARD step runs nested in the fluid's on the fluid's work vectors:
+// the same bits as the two steps one after the other, each with its own.
+TEST(CpuCoupledStepper, TheNestedStepIsBitwiseTheTwoStepsInTurn) {
+  const CoupledRun a = runCavity<3>(Backend::TBB, 2, 6, 0.02, 32);
+  expectSameRuns(a, runCavity<3>(Backend::TBB, 1, 6, 0.02, 32, nullptr, true));
+  expectSameRuns(a, runCavity<3>(Backend::Serial, 1, 6, 0.02, 32));
+}
+
 // At a time step far beyond the advective CFL limit (lid speed 1, h = 1/24:
 // CFL 6) and 50x the RD clock, the coupled layer stays bounded and finite.
 TEST(CpuCoupledStepper, LargeTimeStepStaysBounded) {
-  const CoupledRun r = runCavity(Backend::TBB, 2, 300, 0.25, 48);
+  const CoupledRun r = runCavity<2>(Backend::TBB, 2, 300, 0.25, 48);
   for (int sp = 0; sp < 2; ++sp)
     for (double v : r.species[size_t(sp)]) {
       ASSERT_TRUE(std::isfinite(v));
@@ -297,37 +319,53 @@ TEST(CpuCoupledStepper, LargeTimeStepStaysBounded) {
   }
 }
 
-// The trace shows the schedule: with tbb the ARD step of step n runs on
-// another thread while the fluid computes step n + 1; serial never overlaps.
+// The trace shows the schedule: with tbb (2D) the ARD step of step n runs
+// on another thread while the fluid computes step n + 1; serial nests it
+// between the fluid's advection and its diffusion, on one thread.
 // 160^2 keeps each stage long (a few ms) against scheduling jitter: at 96^2
 // the faster solvers left too short a window on a loaded machine (ctest -j2),
 // where 3 to 6 of 12 steps overlapped.
 TEST(CpuCoupledStepper, TraceShowsTheOverlap) {
-  auto overlaps = [](Backend backend, int* threads) {
+  // Each step's 6 events (4 fluid stages, 2 ARD stages) in the order they began.
+  auto steps = [](Backend backend, int* threads) {
     StageTrace trace;
-    runCavity(backend, 2, 12, 0.02, 160, &trace);
-    const std::vector<StageTrace::Event> events = trace.events();
+    runCavity<2>(backend, 2, 12, 0.02, 160, &trace);
+    std::vector<StageTrace::Event> events = trace.events();
     std::set<int> used;
     for (const auto& e : events) used.insert(e.thread);
     *threads = int(used.size());
-    EXPECT_EQ(events.size(), 12u * 6u);  // 4 fluid stages, 2 ARD stages per step
-    int steps = 0;
-    for (size_t i = 0; i < events.size(); i += 6) {  // one step's events
-      double fluid[2] = {1e300, -1e300}, ard[2] = {1e300, -1e300};
-      for (size_t k = i; k < i + 6; ++k) {
-        double* span = events[k].category == "fluid" ? fluid : ard;
-        span[0] = std::min(span[0], events[k].begin);
-        span[1] = std::max(span[1], events[k].end);
-      }
-      steps += std::max(fluid[0], ard[0]) < std::min(fluid[1], ard[1]) ? 1 : 0;
+    EXPECT_EQ(events.size(), 12u * 6u);
+    std::vector<std::vector<StageTrace::Event>> byStep;
+    for (size_t i = 0; i + 6 <= events.size(); i += 6) {
+      byStep.emplace_back(events.begin() + long(i), events.begin() + long(i + 6));
+      std::stable_sort(byStep.back().begin(), byStep.back().end(),
+                       [](const auto& x, const auto& y) { return x.begin < y.begin; });
     }
-    return steps;
+    return byStep;
   };
   int serialThreads = 0, tbbThreads = 0;
-  EXPECT_EQ(overlaps(Backend::Serial, &serialThreads), 0);
+  for (const auto& step : steps(Backend::Serial, &serialThreads)) {
+    const char* order[6] = {"fluid", "fluid", "ard", "ard", "fluid", "fluid"};
+    for (size_t k = 0; k < 6; ++k) {
+      EXPECT_EQ(step[k].category, order[k]) << k;
+      if (k > 0) {
+        EXPECT_GE(step[k].begin, step[k - 1].end) << k;  // one after the other
+      }
+    }
+  }
   EXPECT_EQ(serialThreads, 1);
   if (std::thread::hardware_concurrency() >= 2) {
-    EXPECT_GT(overlaps(Backend::TBB, &tbbThreads), 6);
+    int overlapped = 0;
+    for (const auto& step : steps(Backend::TBB, &tbbThreads)) {
+      double fluid[2] = {1e300, -1e300}, ard[2] = {1e300, -1e300};
+      for (const auto& e : step) {
+        double* span = e.category == "fluid" ? fluid : ard;
+        span[0] = std::min(span[0], e.begin);
+        span[1] = std::max(span[1], e.end);
+      }
+      overlapped += std::max(fluid[0], ard[0]) < std::min(fluid[1], ard[1]) ? 1 : 0;
+    }
+    EXPECT_GT(overlapped, 6);
     EXPECT_EQ(tbbThreads, 2);
   }
 }
