@@ -282,7 +282,8 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
     const Grid<uint8_t, D>& fixed = vc_.fixed[a];
     const double ba = bb[size_t(a)];
     // Warm start: the increment's rate, linearly extrapolated in steps
-    // (2 r1 - r0 = r1 + (r1 - r0)). In the same pass, the right-hand side
+    // (2 r1 - r0 = r1 + (r1 - r0)) where kExtrapolates, else the last
+    // rate. In the same pass, the right-hand side
     // (b_ holds component 0's already), as rightHandSide forms it.
     const int history = C.history;
     x_.resize(C.A.size());
@@ -299,11 +300,15 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
         return;
       }
       const float* __restrict rate = C.rate.data() + r.i0;
-      const uint16_t* __restrict change = C.change.data() + r.i0;
-      const double second = history >= 2 ? 1.0 : 0.0;  // the change counts from the second solve on
-      for (size_t k = 0; k < nx; ++k) {
-        const double v = double(gr[k]) + s * (double(rate[k]) + second * double(fromBfloat16(change[k])));
-        x[k] = zeroWhere(f[k] | c[k], v);
+      if constexpr (!kExtrapolates) {
+        for (size_t k = 0; k < nx; ++k) x[k] = zeroWhere(f[k] | c[k], double(gr[k]) + s * double(rate[k]));
+      } else {
+        const uint16_t* __restrict change = C.change.data() + r.i0;
+        const double second = history >= 2 ? 1.0 : 0.0;  // the change counts from the second solve on
+        for (size_t k = 0; k < nx; ++k) {
+          const double v = double(gr[k]) + s * (double(rate[k]) + second * double(fromBfloat16(change[k])));
+          x[k] = zeroWhere(f[k] | c[k], v);
+        }
       }
     });
     // The warm start comes from solves on the rows before a moving obstacle
@@ -323,24 +328,24 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
     usedCG_ = usedCG_ || C.multigrid != nullptr;
     std::vector<float>& rate = C.rate;
     rate.resize(C.A.size(), 0.0f);  // zeros before the first solve: change = the first rate, unused
-    C.change.resize(C.A.size());
+    if (kExtrapolates) C.change.resize(C.A.size());
     const double invS = 1.0 / s;
     eachRowOf<D>(C, fixed, g, [&](const UnknownRow& r) {
       float* __restrict gr = g.data() + r.g0;
       const uint8_t* __restrict f = r.fixed, * __restrict c = r.cut;
       const double* __restrict x = x_.data() + r.i0;
       float* __restrict rt = rate.data() + r.i0;
-      uint16_t* __restrict change = C.change.data() + r.i0;
+      uint16_t* __restrict change = kExtrapolates ? C.change.data() + r.i0 : nullptr;
       const size_t nx = size_t(C.dims[0]);
       for (size_t k = 0; k < nx; ++k) {
         const bool held = f[k] | c[k];
         const float next = zeroWhere(held, float((x[k] - double(gr[k])) * invS));
-        change[k] = toBfloat16(next - rt[k]);
+        if (kExtrapolates) change[k] = toBfloat16(next - rt[k]);
         rt[k] = next;
         gr[k] = pick(held, gr[k], float(x[k]));
       }
     });
-    C.history = std::min(C.history + 1, 2);
+    C.history = std::min(C.history + 1, kExtrapolates ? 2 : 1);
   }
   result.residual = bAll > 0.0 ? std::sqrt(rAll / bAll) : 0.0;
   result.converged = result.residual <= options_.tolerance * 1.0001;
@@ -356,7 +361,7 @@ void ViscositySolver<D>::save(StateWriter* out) const {
     const Component& C = comp_[size_t(a)];
     out->put(p + "history", C.history);
     if (C.history >= 1) out->putVector(p + "rate", C.rate);
-    if (C.history >= 2) out->putVector(p + "change", C.change);
+    if (kExtrapolates && C.history >= 2) out->putVector(p + "change", C.change);
   }
 }
 
@@ -367,9 +372,10 @@ void ViscositySolver<D>::load(const StateReader& in) {
     const std::string p = "viscosity." + std::to_string(a) + ".";
     in.get(p + "history", &C.history);
     C.rate.assign(C.A.size(), 0.0f);
-    C.change.resize(C.A.size());
+    C.history = std::min(C.history, kExtrapolates ? 2 : 1);  // (a change the checkpoint holds beyond: not read)
+    if (kExtrapolates) C.change.resize(C.A.size());
     if (C.history >= 1) in.getVector(p + "rate", &C.rate);
-    if (C.history >= 2) in.getVector(p + "change", &C.change);
+    if (kExtrapolates && C.history >= 2) in.getVector(p + "change", &C.change);
   }
 }
 

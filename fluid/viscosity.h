@@ -7,8 +7,9 @@
 // iteration count does not grow with nu dt. The systems are built
 // once; a new nu dt (a CFL-limited step) only rescales their diagonal and
 // re-derives the multigrid levels in place. Each solve starts from u* plus
-// the viscous increment extrapolated from the last two steps (per unit
-// nu dt / h^2, so a changing dt keeps it), which changes slowly. The
+// the viscous increment (per unit nu dt / h^2, so a changing dt keeps it),
+// which changes slowly: in 2D extrapolated from the last two steps, in 3D
+// the last step's alone (kExtrapolates). The
 // tolerance is a relative residual of the whole velocity system, not of
 // each component: sum_a ||r_a||^2 <= tol^2 sum_a ||b_a||^2.
 #pragma once
@@ -81,9 +82,10 @@ class ViscositySolver {
 
  private:
   struct Component : ViscousSystem<D> {
-    // The last solve's (x - u*) / s and its change from the one before: the
-    // next warm start, rate + change (a guess only: the rate in single
-    // precision, its change, a small correction, in bfloat16).
+    // The last solve's (x - u*) / s and, where kExtrapolates, its change
+    // from the one before: the next warm start, rate + change (a guess
+    // only: the rate in single precision, its change, a small correction,
+    // in bfloat16).
     std::vector<float> rate;
     std::vector<uint16_t> change;
     int history = 0;            // how many solves they hold (0, 1, 2)
@@ -91,6 +93,11 @@ class ViscositySolver {
     std::unique_ptr<Chebyshev<D>> chebyshev;  // bounds the spectrum; solves while it is quick
     std::unique_ptr<Multigrid<D>> multigrid;  // present while it solves instead
   };
+  // Whether the warm start extrapolates the rate over the last two steps.
+  // In 2D that saves 5-12% of the Chebyshev steps; in 3D it saves none
+  // (bench fluid at 64^3 and 128^3, 3 and 60 steps of warm-up) and would
+  // keep 6 bytes a cell more (docs/performance.md).
+  static constexpr bool kExtrapolates = D == 2;
   SolverResult solveComponents(MacVelocity<D>* u, double s);
   // Component a's right-hand side into b_ (its unknowns' count); returns ||b||^2.
   double rightHandSide(const MacVelocity<D>& u, int a, double s);
