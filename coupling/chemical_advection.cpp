@@ -200,7 +200,16 @@ ChemicalAdvector<D>::ChemicalAdvector(ChemicalDomain<D> domain, ChemicalInterpol
   for (int a = 0; a < D; ++a) n *= size_t(domain_.cells[a]);
   if (!domain_.solid.empty() && domain_.solid.size() != n)
     throw std::invalid_argument("coupling: solid mask has the wrong size");
-  if (!domain_.inflowValues.empty()) fromInflow_.assign(n, 0);
+  if (weighsInflow()) fromInflow_.assign(n, 0);
+}
+
+// Without an inflow side every foot's inflow weight is 0: no weights are
+// kept, and the passes blend with none (the same values, bit for bit).
+template <int D>
+bool ChemicalAdvector<D>::weighsInflow() const {
+  bool side = false;
+  for (const auto& s : domain_.inflow) side = side || s[0] || s[1];
+  return side && !domain_.inflowValues.empty();
 }
 
 template <int D>
@@ -262,7 +271,7 @@ template <int D>
 void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::vector<Grid<double, D>*>& species,
                                  WorkPool* pool) {
   const ChemicalDomain<D>& d = domain_;
-  const bool inflow = !d.inflowValues.empty();
+  const bool inflow = !d.inflowValues.empty(), weighed = weighsInflow();
   const bool bfecc = interpolation_ == ChemicalInterpolation::BFECC;
   const size_t ns = species.size();
   if (pool) {
@@ -274,11 +283,11 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
   for (int a = 0; a < D; ++a) n *= size_t(d.cells[a]);
   for (auto& f : feet_) f.resize(n);
   cellFeet<D>(d, u, dt, &feet_);
-  if (inflow) inflowWeights<D>(d, feet_, &fromInflow_);
+  if (weighed) inflowWeights<D>(d, feet_, &fromInflow_);
   if (bfecc) {  // the forward trace of BFECC's backward step: the feet over -dt
     for (auto& f : backFeet_) f.resize(n);
     cellFeet<D>(d, u, -dt, &backFeet_);
-    if (inflow) backFromInflow_.resize(n), inflowWeights<D>(d, backFeet_, &backFromInflow_);
+    if (weighed) backFromInflow_.resize(n), inflowWeights<D>(d, backFeet_, &backFromInflow_);
   }
   const bool spline = interpolation_ == ChemicalInterpolation::BSpline;
   const bool linear = interpolation_ == ChemicalInterpolation::Linear || bfecc;
@@ -321,7 +330,7 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
       return i;
     });
   };
-  const double* inflowWeight = inflow ? fromInflow_.data() : nullptr;
+  const double* inflowWeight = weighed ? fromInflow_.data() : nullptr;
   // Species s into scratch_ by the cubic or the spline (16 or 64 loads a cell).
   auto cubicPass = [&](size_t s) {
     pass(feet_, inflowWeight, inflow ? d.inflowValues[s] : 0.0, scratch_.data(), [&](const Vec<D>& c) {
@@ -338,7 +347,7 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
     coefficients_.reshape(d.cells);
     auto forward = [&] { linearPass(feet_, inflowWeight, in, phi, scratch_.data()); };
     auto backward = [&] {
-      linearPass(backFeet_, inflow ? backFromInflow_.data() : nullptr, in, scratch_.data(), coefficients_.data());
+      linearPass(backFeet_, weighed ? backFromInflow_.data() : nullptr, in, scratch_.data(), coefficients_.data());
     };
     const double* back = coefficients_.data();
     auto compensated = [&] {

@@ -56,13 +56,14 @@ class ChemicalAdvector {
   const ChemicalDomain<D>& domain() const { return domain_; }
 
  private:
+  bool weighsInflow() const;  // whether a side lets chemicals in (their values given)
   ChemicalDomain<D> domain_;
   ChemicalInterpolation interpolation_;
   // Foot of every cell (grid coordinates, per axis; single precision, as
   // the fluid's own traces: 1e-7 of the domain, far below a cell).
   std::array<std::vector<float>, D> feet_;
-  std::vector<double>
-      fromInflow_;  // weight of the inflow value (1: the foot left through an inflow side); empty without inflow
+  std::vector<double> fromInflow_;  // weight of the inflow value (1: the foot left through an inflow side); empty
+                                    // without an inflow side
   std::array<std::vector<float>, D> backFeet_;  // bfecc: the feet over -dt
   std::vector<double> backFromInflow_;          // bfecc: their inflow weights
   Grid<double, D> scratch_;  // one species' advected values (borrowed, with a pool)
