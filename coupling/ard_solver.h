@@ -50,8 +50,9 @@ class ARDSolver {
 
   RDSolver<D>* rd_;
   ChemicalAdvector<D> advector_;
-  // The advection's and the RD solves' work vectors, lent to each in turn
-  // (owned here, so the RD solver's pointer to it survives a move).
+  // The advection's and the RD solves' work vectors, lent to each in turn:
+  // this layer's own pool (on the heap, so the RD solver's pointer to it
+  // survives a move) or the one shareWorkPool gave.
   std::unique_ptr<WorkPool> own_ = std::make_unique<WorkPool>();
   WorkPool* pool_ = own_.get();
   CouplingMode mode_;

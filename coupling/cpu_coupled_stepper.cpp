@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <functional>
+#include <numeric>
 
 #include "coupling/solid_on_layer.h"
 
@@ -74,7 +75,7 @@ void CpuCoupledStepper<D>::step(double dt) {
       resumed = traceClock();
     });
     const auto& seconds = fluid_->lastStats().seconds;  // (the ARD's time not among them)
-    fluidSeconds_ = seconds[0] + seconds[1] + seconds[2] + seconds[3];
+    fluidSeconds_ = std::accumulate(seconds.begin(), seconds.end(), 0.0);
     recordStages(trace_, "fluid", fluidStages, seconds, b, 0, 2);
     recordStages(trace_, "fluid", fluidStages, seconds, resumed, 2, 2);
   } else {
