@@ -8,6 +8,7 @@
 #include "core/parallel.h"
 #include "core/row_stencil.h"
 #include "core/simd_dispatch.h"
+#include "core/work_pool.h"
 
 namespace morphoflow {
 
@@ -391,7 +392,7 @@ SolverResult Chebyshev<D>::solve(const Vector& b, Vector* xp, const SolverOption
   if (!applicable()) return solvePCG<D>(A_, b, xp, nullptr, options);  // no bound: plain CG
   Vector& x = *xp;
   const size_t n = A_.size(), nx = size_t(A_.dims[0]);
-  x.resize(n, 0.0);
+  resizeExactly(&x, n, 0.0);
   SolverResult result;
   if (bnorm < 0.0) bnorm = norm2(b);
   if (bnorm == 0.0) {
@@ -400,8 +401,8 @@ SolverResult Chebyshev<D>::solve(const Vector& b, Vector* xp, const SolverOption
     return result;
   }
   const size_t slots = cyclic_ ? n / nx * hx_ : n;  // per colour where cyclic
-  for (auto& v : work_->e) v.resize(slots);
-  work_->g.resize(cyclic_ ? 2 * slots : n);
+  for (auto& v : work_->e) resizeExactly(&v, slots);
+  resizeExactly(&work_->g, cyclic_ ? 2 * slots : n);
   planeSquares_.assign(size_t(A_.dims[D - 1]), 0.0);
   // g of order 1 in float for any residual from 1e-30 ||b|| up.
   rscale_ = std::sqrt(double(n)) / bnorm;

@@ -88,6 +88,7 @@ class Grid {
     size_t n = 1;
     for (int a = 0; a < D; ++a) n *= size_t(dims[a]);
     dims_ = dims;
+    if (data_.capacity() < n) data_.reserve(n);  // (exactly: a lent vector's storage may be another shape's)
     data_.resize(n);
   }
 

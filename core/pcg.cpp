@@ -4,6 +4,7 @@
 
 #include "core/anisotropic_system.h"
 #include "core/parallel.h"
+#include "core/work_pool.h"
 
 namespace morphoflow {
 
@@ -15,7 +16,7 @@ SolverResult pcg(const Op& A, const Vector& bIn, Vector* xp, Preconditioner* M, 
                  PcgWorkspace* workspace) {
   Vector& x = *xp;
   const size_t n = A.size();
-  x.resize(n, 0.0);
+  resizeExactly(&x, n, 0.0);
   SolverResult result;
   PcgWorkspace local;
   PcgWorkspace& ws = workspace ? *workspace : local;
@@ -24,7 +25,7 @@ SolverResult pcg(const Op& A, const Vector& bIn, Vector* xp, Preconditioner* M, 
   bool consume = false;
   if constexpr (requires { A.residualInPlace(&ws.b, x); }) consume = ws.regenerate && &bIn == &ws.b;
   for (Vector* v : {&ws.r, &ws.p, &ws.q})
-    if (!(consume && v == &ws.r)) v->resize(n);
+    if (!(consume && v == &ws.r)) resizeExactly(v, n);
   const Vector* bp = &bIn;
   if (A.singular()) {  // keep the system consistent (in place when b is ws.b)
     if (&bIn != &ws.b) ws.b = bIn;

@@ -36,7 +36,10 @@ struct ARDSolver<D>::Stages {
   const MacVelocity<D>* u = nullptr;
   void reactDiffuse(double dt) { s.rd_->step(dt); }
   void emptySolids() { s.advector_.emptySolids(s.species()); }
-  void advect(double dt) { s.advector_.advect(*u, dt, s.species(), s.pool_); }
+  void advect(double dt) {
+    if (u) s.advector_.advect(*u, dt, s.species(), s.pool_);
+    else s.advector_.carry(s.species(), s.pool_);
+  }
 };
 
 template <int D>
@@ -55,10 +58,31 @@ void ARDSolver<D>::reactDiffuse(double dt) {
 
 template <int D>
 void ARDSolver<D>::advect(double dt, const MacVelocity<D>& u) {
+  if (tracedAhead_) throw std::logic_error("ARDSolver: the feet were traced ahead; advect(dt) carries to them");
   const double t0 = traceClock();
   Stages stages{*this, &u};
   advectChemicals(stages, mode_, dt);
   stageSeconds_[1] = traceClock() - t0;
+  time_ += dt;
+  ++steps_;
+}
+
+template <int D>
+void ARDSolver<D>::traceAhead(double dt, const MacVelocity<D>& u) {
+  const double t0 = traceClock();
+  if (mode_ != CouplingMode::RDOnly) advector_.trace(u, dt, pool_);  // (advectChemicals' condition)
+  tracedAhead_ = true;
+  traceSeconds_ = traceClock() - t0;
+}
+
+template <int D>
+void ARDSolver<D>::advect(double dt) {
+  if (!tracedAhead_) throw std::logic_error("ARDSolver: advect(dt) needs traceAhead first");
+  const double t0 = traceClock();
+  Stages stages{*this};
+  advectChemicals(stages, mode_, dt);
+  tracedAhead_ = false;
+  stageSeconds_[1] = traceSeconds_ + (traceClock() - t0);
   time_ += dt;
   ++steps_;
 }

@@ -29,6 +29,11 @@ class ARDSolver {
   // need not exist before advect): react and diffuse, then advect.
   void reactDiffuse(double dt);
   void advect(double dt, const MacVelocity<D>& u);
+  // advect's trace of the feet through u, taken ahead (before reactDiffuse:
+  // the feet do not depend on the species), so that u may go before the
+  // step ends; advect(dt) then carries the species to those feet.
+  void traceAhead(double dt, const MacVelocity<D>& u);
+  void advect(double dt);
 
   RDSolver<D>& rd() { return *rd_; }
   ChemicalAdvector<D>& advector() { return advector_; }
@@ -46,6 +51,8 @@ class ARDSolver {
 
  private:
   struct Stages;  // the step's stages (coupling/ard_step.h)
+  bool tracedAhead_ = false;
+  double traceSeconds_ = 0.0;  // traceAhead's, counted in the advection stage's
   std::vector<Grid<double, D>*> species();
 
   RDSolver<D>* rd_;

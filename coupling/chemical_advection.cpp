@@ -228,7 +228,7 @@ namespace {
 // side): beyond the outermost cell centre of an inflow side the value blends
 // into the inflow concentration, reached at the wall itself.
 template <int D>
-void inflowWeights(const ChemicalDomain<D>& d, const std::array<std::vector<float>, D>& feet, std::vector<double>* w) {
+void inflowWeights(const ChemicalDomain<D>& d, const std::array<float*, D>& feet, std::vector<double>* w) {
   parallelFor(w->size(), [&](size_t i) {
     double in = 0.0;
     for (int a = 0; a < D; ++a) {
@@ -243,12 +243,12 @@ void inflowWeights(const ChemicalDomain<D>& d, const std::array<std::vector<floa
 // Feet of every cell over dt (seed 001 eq. 19: x* = x - dt u), with the
 // fluid's vector kernels; periodic domains trace cell by cell.
 template <int D>
-void cellFeet(const ChemicalDomain<D>& d, const MacVelocity<D>& u, double dt, std::array<std::vector<float>, D>* feet) {
+void cellFeet(const ChemicalDomain<D>& d, const MacVelocity<D>& u, double dt, const std::array<float*, D>& feet) {
   if (traceCellFeet<D>(u, dt, d.cells, d.h, feet)) return;
   forEachCell<D>(d.cells, [&](const IVec<D>& k, size_t i) {
     const Vec<D> x = (Vec<D>(k) + 0.5) * d.h;
     const Vec<D> c = traceBack<D>(u, x, dt) / d.h - Vec<D>(0.5);
-    for (int a = 0; a < D; ++a) (*feet)[size_t(a)][i] = float(c[a]);
+    for (int a = 0; a < D; ++a) feet[size_t(a)][i] = float(c[a]);
   });
 }
 
@@ -268,27 +268,35 @@ void forChunks(size_t cells, const Cell& cell, const Run& run) {
 }  // namespace
 
 template <int D>
-void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::vector<Grid<double, D>*>& species,
-                                 WorkPool* pool) {
+void ChemicalAdvector<D>::trace(const MacVelocity<D>& u, double dt, WorkPool* pool) {
+  const ChemicalDomain<D>& d = domain_;
+  const bool weighed = weighsInflow();
+  const bool bfecc = interpolation_ == ChemicalInterpolation::BFECC;
+  size_t n = 1;
+  for (int a = 0; a < D; ++a) n *= size_t(d.cells[a]);
+  // (floats first: the species' scratch that follows is a double vector)
+  feet_.lend(pool ? pool : &own_, bfecc ? 2 * D : D, n, FloatArrays::First::Floats);
+  cellFeet<D>(d, u, dt, feet(0));
+  if (weighed) fromInflow_.resize(n), inflowWeights<D>(d, feet(0), &fromInflow_);
+  if (bfecc) {  // the forward trace of BFECC's backward step: the feet over -dt
+    cellFeet<D>(d, u, -dt, feet(1));
+    if (weighed) backFromInflow_.resize(n), inflowWeights<D>(d, feet(1), &backFromInflow_);
+  }
+}
+
+template <int D>
+void ChemicalAdvector<D>::carry(const std::vector<Grid<double, D>*>& species, WorkPool* pool) {
   const ChemicalDomain<D>& d = domain_;
   const bool inflow = !d.inflowValues.empty(), weighed = weighsInflow();
   const bool bfecc = interpolation_ == ChemicalInterpolation::BFECC;
   const size_t ns = species.size();
-  if (pool) {
-    for (auto& f : feet_) pool->lend(&f);
-    if (bfecc)
-      for (auto& f : backFeet_) pool->lend(&f);
+  std::array<const float*, D> fwdFeet{}, backFeet{};
+  for (int a = 0; a < D; ++a) {
+    fwdFeet[size_t(a)] = feet(0)[size_t(a)];
+    if (bfecc) backFeet[size_t(a)] = feet(1)[size_t(a)];
   }
   size_t n = 1;
   for (int a = 0; a < D; ++a) n *= size_t(d.cells[a]);
-  for (auto& f : feet_) f.resize(n);
-  cellFeet<D>(d, u, dt, &feet_);
-  if (weighed) inflowWeights<D>(d, feet_, &fromInflow_);
-  if (bfecc) {  // the forward trace of BFECC's backward step: the feet over -dt
-    for (auto& f : backFeet_) f.resize(n);
-    cellFeet<D>(d, u, -dt, &backFeet_);
-    if (weighed) backFromInflow_.resize(n), inflowWeights<D>(d, backFeet_, &backFromInflow_);
-  }
   const bool spline = interpolation_ == ChemicalInterpolation::BSpline;
   const bool linear = interpolation_ == ChemicalInterpolation::Linear || bfecc;
   const size_t cells = n;
@@ -297,7 +305,7 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
   [[maybe_unused]] const bool wide = walls && cells < (size_t(1) << 31) && useAvx2();
   // dst[i] = the sample at cell i's foot, blended into the inflow value `in`
   // by the weights w (null: none); `run` may do a chunk's leading cells first.
-  auto pass = [&](const std::array<std::vector<float>, D>& feet, const double* w, double in, double* dst,
+  auto pass = [&](const std::array<const float*, D>& feet, const double* w, double in, double* dst,
                   const auto& sampleAt, const auto& run) {
     forChunks(cells, [&](size_t i) {
       const double wi = w ? w[i] : 0.0;
@@ -312,10 +320,9 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
   };
   auto scalar = [](size_t i, size_t) { return i; };
   // src sampled linearly at `feet` into dst (2^D loads a cell).
-  auto linearPass = [&](const std::array<std::vector<float>, D>& feet, const double* w, double in, const double* src,
+  auto linearPass = [&](const std::array<const float*, D>& feet, const double* w, double in, const double* src,
                         double* dst) {
-    [[maybe_unused]] LinearRun<D> run{d.cells, {}, w, &in, &src, &dst, 1};
-    for (int a = 0; a < D; ++a) run.feet[size_t(a)] = feet[size_t(a)].data();
+    [[maybe_unused]] LinearRun<D> run{d.cells, feet, w, &in, &src, &dst, 1};
     pass(feet, w, in, dst, [&](const Vec<D>& c) {
       size_t index[1 << D];
       double weight[1 << D];
@@ -333,10 +340,13 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
   const double* inflowWeight = weighed ? fromInflow_.data() : nullptr;
   // Species s into scratch_ by the cubic or the spline (16 or 64 loads a cell).
   auto cubicPass = [&](size_t s) {
-    pass(feet_, inflowWeight, inflow ? d.inflowValues[s] : 0.0, scratch_.data(), [&](const Vec<D>& c) {
-      return spline ? sampleBSpline<D>(coefficients_, *species[s], d.periodic, c)
-                    : sampleChemical<D>(*species[s], d.periodic, c, interpolation_);
-    }, scalar);
+    pass(
+        fwdFeet, inflowWeight, inflow ? d.inflowValues[s] : 0.0, scratch_.data(),
+        [&](const Vec<D>& c) {
+          return spline ? sampleBSpline<D>(coefficients_, *species[s], d.periodic, c)
+                        : sampleChemical<D>(*species[s], d.periodic, c, interpolation_);
+        },
+        scalar);
   };
   // BFECC (Kim, Liu, Llamas & Rossignac 2005): forward phi^ = A(phi) into scratch_,
   // backward phi_b = A^-1(phi^) into coefficients_, then A(phi + (phi - phi_b) / 2),
@@ -345,14 +355,14 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
     const double in = inflow ? d.inflowValues[s] : 0.0;
     const double* phi = species[s]->data();
     coefficients_.reshape(d.cells);
-    auto forward = [&] { linearPass(feet_, inflowWeight, in, phi, scratch_.data()); };
+    auto forward = [&] { linearPass(fwdFeet, inflowWeight, in, phi, scratch_.data()); };
     auto backward = [&] {
-      linearPass(backFeet_, weighed ? backFromInflow_.data() : nullptr, in, scratch_.data(), coefficients_.data());
+      linearPass(backFeet, weighed ? backFromInflow_.data() : nullptr, in, scratch_.data(), coefficients_.data());
     };
     const double* back = coefficients_.data();
     auto compensated = [&] {
       pass(
-          feet_, inflowWeight, in, scratch_.data(),
+          fwdFeet, inflowWeight, in, scratch_.data(),
           [&](const Vec<D>& c) {
             size_t index[1 << D];
             double weight[1 << D];
@@ -379,7 +389,7 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
       bfeccPass(s);
       if (pool) pool->give(&coefficients_.values());
     } else if (linear) {
-      linearPass(feet_, inflowWeight, inflow ? d.inflowValues[s] : 0.0, species[s]->data(), scratch_.data());
+      linearPass(fwdFeet, inflowWeight, inflow ? d.inflowValues[s] : 0.0, species[s]->data(), scratch_.data());
     } else {
       if (spline) bsplineCoefficients<D>(*species[s], d.periodic, &coefficients_);
       cubicPass(s);
@@ -387,11 +397,7 @@ void ChemicalAdvector<D>::advect(const MacVelocity<D>& u, double dt, const std::
     std::swap(species[s]->values(), scratch_.values());
     if (pool) pool->give(&scratch_.values());
   }
-  if (pool) {
-    for (auto& f : feet_) pool->give(&f);
-    if (bfecc)
-      for (auto& f : backFeet_) pool->give(&f);
-  }
+  feet_.give(pool ? pool : &own_);
   emptySolids(species);
 }
 

@@ -47,7 +47,14 @@ class ChemicalAdvector {
   // The feet and the species' scratch are borrowed from `pool` (if given)
   // for the call; the species go through the scratch one at a time.
   void advect(const MacVelocity<D>& u, double dt, const std::vector<Grid<double, D>*>& species,
-              WorkPool* pool = nullptr);
+              WorkPool* pool = nullptr) {
+    trace(u, dt, pool);
+    carry(species, pool);
+  }
+  // advect in two halves: the feet through u (after which u is not read),
+  // then the species carried to them (the feet go back to the pool).
+  void trace(const MacVelocity<D>& u, double dt, WorkPool* pool = nullptr);
+  void carry(const std::vector<Grid<double, D>*>& species, WorkPool* pool = nullptr);
   // New solid cells (a moving obstacle; per RD cell, empty: none).
   void setSolid(std::vector<uint8_t> solid) { domain_.solid = std::move(solid); }
   // Sets the solid cells of every species to the solid values.
@@ -60,12 +67,19 @@ class ChemicalAdvector {
   ChemicalDomain<D> domain_;
   ChemicalInterpolation interpolation_;
   // Foot of every cell (grid coordinates, per axis; single precision, as
-  // the fluid's own traces: 1e-7 of the domain, far below a cell).
-  std::array<std::vector<float>, D> feet_;
+  // the fluid's own traces: 1e-7 of the domain, far below a cell), then
+  // (bfecc) the feet over -dt: float arrays in the pool's double vectors,
+  // from trace to carry.
+  FloatArrays feet_;
+  std::array<float*, D> feet(int set) const {
+    std::array<float*, D> f;
+    for (int a = 0; a < D; ++a) f[size_t(a)] = feet_[size_t(set * D + a)];
+    return f;
+  }
   std::vector<double> fromInflow_;  // weight of the inflow value (1: the foot left through an inflow side); empty
                                     // without an inflow side
-  std::array<std::vector<float>, D> backFeet_;  // bfecc: the feet over -dt
-  std::vector<double> backFromInflow_;          // bfecc: their inflow weights
+  std::vector<double> backFromInflow_;  // bfecc: the weights of the feet over -dt
+  WorkPool own_;                        // what a call without a pool borrows from
   Grid<double, D> scratch_;  // one species' advected values (borrowed, with a pool)
   Grid<double, D> coefficients_;  // bspline: one species' spline coefficients; bfecc: its backward step
 };

@@ -34,6 +34,10 @@ template <int D>
 CpuCoupledStepper<D>::CpuCoupledStepper(FluidSolver<D>* fluid, ARDSolver<D>* ard, Backend backend)
     : fluid_(fluid), fluidStepper_(fluid), ard_(ard), overlap_(D == 2 && backend != Backend::Serial) {
   if (!overlap_) ard_->shareWorkPool(fluid_->workPool());
+  fluid_->keepAdvectedVelocity(overlap_);  // (overlapped, the ARD reads it beside the fluid's later stages)
+  size_t fluidCells = 1, layerCells = 1;
+  for (int a = 0; a < D; ++a) fluidCells *= size_t(fluid_->cells()[a]), layerCells *= size_t(ard_->rd().cells()[a]);
+  traceAhead_ = layerCells <= fluidCells;
 }
 
 // A moving obstacle: the fluid's solid where this step ends, and the
@@ -70,8 +74,20 @@ void CpuCoupledStepper<D>::step(double dt) {
     const double b = traceClock();
     double resumed = b;
     fluid_->step(dt, [&] {
-      reactDiffuse();
-      advect();
+      // Chemicals on a grid no finer than the fluid's: their feet first
+      // (counted in their advection's seconds), whose bytes are no more
+      // than the velocity's, which then goes back to the pool before the
+      // reaction-diffusion solves borrow from it. Finer chemicals keep the
+      // velocity instead, and trace after those solves.
+      if (traceAhead_) {
+        ard_->traceAhead(dt, fluid_->advectedVelocity());
+        fluid_->releaseAdvectedVelocity();
+        reactDiffuse();
+        ardStage(1, [&] { ard_->advect(dt); });
+      } else {
+        reactDiffuse();
+        advect();
+      }
       resumed = traceClock();
     });
     const auto& seconds = fluid_->lastStats().seconds;  // (the ARD's time not among them)

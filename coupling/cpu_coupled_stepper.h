@@ -70,6 +70,7 @@ class CpuCoupledStepper final : public CoupledStepper<D> {
   CpuFluidStepper<D> fluidStepper_;
   ARDSolver<D>* ard_;
   bool overlap_;
+  bool traceAhead_;  // nested: the chemicals' feet before the velocity goes back to the pool
   double fluidSeconds_ = 0, ardSeconds_ = 0, stepSeconds_ = 0;
   StageTrace* trace_ = nullptr;
 };

@@ -261,7 +261,7 @@ struct SimdRow {
   int nx;
   size_t base;     // index of the row's first sample
   StartVelocity<D> start;
-  Grid<float, D>*dst, *lo, *hi;
+  float *dst, *lo, *hi;  // the pass's samples and (if lo) its stencils' bounds
 };
 
 template <int D, class V>
@@ -294,12 +294,12 @@ MF_INLINE int simdRow(const SimdRow<D>& j, int x) {
     if (j.lo) {
       V l, h;
       r = vinterpolate<D, V>(j.field.data, j.field.stride, fieldSize, t, &l, &h);
-      vstore(&(*j.lo)[i], l);
-      vstore(&(*j.hi)[i], h);
+      vstore(j.lo + i, l);
+      vstore(j.hi + i, h);
     } else {
       r = vinterpolate<D, V>(j.field.data, j.field.stride, fieldSize, t);
     }
-    vstore(&(*j.dst)[i], r);
+    vstore(j.dst + i, r);
   }
   return x;
 }
@@ -443,9 +443,9 @@ std::optional<UniformRows> uniformRows(const IVec<D>& dims, const UniformRows& b
 // One semi-Lagrangian pass; optionally records the min/max of each stencil.
 // Works in cell units: p = k + offset, foot = p - (dt/h) u(p - (dt/2h) u(p)).
 template <int D>
-size_t semiLagrangian(const Grid<float, D>& src, const Layout<D>& layout, const MacVelocity<D>& u,
-                    double dt, Grid<float, D>* dst, Grid<float, D>* lo, Grid<float, D>* hi,
-                    StartVelocity<D> start = {}, const UniformRows* uniform = nullptr) {
+size_t semiLagrangian(const Grid<float, D>& src, const Layout<D>& layout, const MacVelocity<D>& u, double dt,
+                      float* dst, float* lo, float* hi, StartVelocity<D> start = {},
+                      const UniformRows* uniform = nullptr) {
   const LinearSampler<D> field(src, layout);
   const MacSampler<D> vel(u);
   const float c = float(dt / u.h());
@@ -456,10 +456,10 @@ size_t semiLagrangian(const Grid<float, D>& src, const Layout<D>& layout, const 
     const size_t base = row * size_t(dims[0]);
     if (uniform && uniform->skip[row]) {
       const float c = uniform->value[row];
-      std::fill_n(dst->data() + base, dims[0], c + 0.0f);
+      std::fill_n(dst + base, dims[0], c + 0.0f);
       if (lo && uniform->bounds) {
-        std::fill_n(lo->data() + base, dims[0], c);
-        std::fill_n(hi->data() + base, dims[0], c);
+        std::fill_n(lo + base, dims[0], c);
+        std::fill_n(hi + base, dims[0], c);
       }
       return;
     }
@@ -492,10 +492,7 @@ size_t semiLagrangian(const Grid<float, D>& src, const Layout<D>& layout, const 
       for (int a = 0; a < D; ++a) m[a] = p[a] - 0.5f * c * v[a];
       vel(m, v);
       for (int a = 0; a < D; ++a) f[a] = p[a] - c * v[a];
-      if (lo)
-        (*dst)[i] = field(f, &(*lo)[i], &(*hi)[i]);
-      else
-        (*dst)[i] = field(f);
+      dst[i] = lo ? field(f, lo + i, hi + i) : field(f);
     }
   });
   size_t rows = src.size() / size_t(dims[0]);
@@ -516,19 +513,21 @@ size_t advectField(const Grid<float, D>& src, const Layout<D>& layout, const Mac
     return map ? &*map : nullptr;
   };
   if (scheme == AdvectionScheme::SemiLagrangian) {
-    return semiLagrangian<D>(src, layout, u, dt, dst, nullptr, nullptr, {}, uniform(src));
+    return semiLagrangian<D>(src, layout, u, dt, dst->data(), nullptr, nullptr, {}, uniform(src));
   }
+  WorkPool own;
   AdvectionScratch<D> local;
-  typename AdvectionScratch<D>::Set& s = (scratch ? *scratch : local).forShape(src.dims());
-  Grid<float, D>&lo = s.lo, &hi = s.hi, &back = s.back;
+  if (!scratch) local.borrow(&own, scheme, src.size());
+  AdvectionScratch<D>& s = scratch ? *scratch : local;
+  float *lo = s.lo(), *hi = s.hi(), *back = s.back();
   if (scheme == AdvectionScheme::MacCormack) {
     // phi^ = A(phi); phi~ = A^-1(phi^); phi = phi^ + (phi - phi~) / 2, limited.
     Grid<float, D>& fwd = *dst;
     std::optional<UniformRows> first = reach ? uniformRows<D>(src, *reach) : std::nullopt, second;
     if (first) first->bounds = false;  // lo = hi = the row's value there
-    size_t traced = semiLagrangian<D>(src, layout, u, dt, &fwd, &lo, &hi, {}, first ? &*first : nullptr);
+    size_t traced = semiLagrangian<D>(src, layout, u, dt, fwd.data(), lo, hi, {}, first ? &*first : nullptr);
     if (first) second = uniformRows<D>(src.dims(), *first, *reach);
-    traced += semiLagrangian<D>(fwd, layout, u, -dt, &back, nullptr, nullptr, {}, second ? &*second : nullptr);
+    traced += semiLagrangian<D>(fwd, layout, u, -dt, back, nullptr, nullptr, {}, second ? &*second : nullptr);
     const size_t nx = size_t(src.dims()[0]);
     parallelForRows<D>(src.dims(), [&](size_t row) {
       const bool flat = first && first->skip[row];
@@ -546,12 +545,12 @@ size_t advectField(const Grid<float, D>& src, const Layout<D>& layout, const Mac
   // BFECC: phi_bar = phi + (phi - A^-1 A phi) / 2, then A(phi_bar), limited.
   Grid<float, D>& fwd = s.fwd;
   fwd.reshape(src.dims());
-  size_t traced = semiLagrangian<D>(src, layout, u, dt, &fwd, nullptr, nullptr, {}, uniform(src));
-  traced += semiLagrangian<D>(fwd, layout, u, -dt, &back, nullptr, nullptr, {}, uniform(fwd));
+  size_t traced = semiLagrangian<D>(src, layout, u, dt, fwd.data(), nullptr, nullptr, {}, uniform(src));
+  traced += semiLagrangian<D>(fwd, layout, u, -dt, back, nullptr, nullptr, {}, uniform(fwd));
   Grid<float, D>& corrected = fwd;  // fwd is no longer needed
   parallelFor(src.size(), [&](size_t i) { corrected[i] = src[i] + 0.5f * (src[i] - back[i]); }, 4096);
-  traced += semiLagrangian<D>(corrected, layout, u, dt, dst, nullptr, nullptr, {}, uniform(corrected));
-  traced += semiLagrangian<D>(src, layout, u, dt, &back, &lo, &hi, {}, uniform(src));  // first-order fallback
+  traced += semiLagrangian<D>(corrected, layout, u, dt, dst->data(), nullptr, nullptr, {}, uniform(corrected));
+  traced += semiLagrangian<D>(src, layout, u, dt, back, lo, hi, {}, uniform(src));  // first-order fallback
   parallelFor(src.size(), [&](size_t i) {
     if ((*dst)[i] < lo[i] || (*dst)[i] > hi[i]) (*dst)[i] = back[i];
   }, 4096);
@@ -593,14 +592,11 @@ template void advectVelocity<3>(const MacVelocity<3>&, double, AdvectionScheme, 
 
 template <int D>
 bool traceCellFeet(const MacVelocity<D>& u, double dt, const IVec<D>& cells, double h,
-                   std::array<std::vector<float>, D>* feet) {
+                   const std::array<float*, D>& feet) {
   const MacSampler<D> vel(u);
   for (int a = 0; a < D; ++a)
     if (vel.face[a].periodic || vel.centre[a].n < 2) return false;
   const float r = float(h / u.h()), c = float(dt / u.h());
-  size_t n = 1;
-  for (int a = 0; a < D; ++a) n *= size_t(cells[a]);
-  for (auto& f : *feet) f.resize(n);
   // On the velocity's own cells the first velocity needs no gathers.
   bool same = true;
   for (int a = 0; a < D; ++a) same = same && cells[a] == u.cells()[a];
@@ -616,7 +612,7 @@ bool traceCellFeet(const MacVelocity<D>& u, double dt, const IVec<D>& cells, dou
     std::optional<RowVelocity<D>> rv;
     if (same) rv.emplace(vel, p, 0.5f, cells[0]);
     FeetRow<D> job{vel, rv ? &*rv : nullptr, p, r, c, cells[0], base, {}};
-    for (int a = 0; a < D; ++a) job.out[a] = (*feet)[size_t(a)].data();
+    for (int a = 0; a < D; ++a) job.out[a] = feet[size_t(a)];
     int x = 0;
 #if MORPHOFLOW_AVX2_KERNELS
     if (wider) x = feetRow16<D>(job, x);
@@ -628,15 +624,13 @@ bool traceCellFeet(const MacVelocity<D>& u, double dt, const IVec<D>& cells, dou
       vel(p, v);
       for (int a = 0; a < D; ++a) m[a] = p[a] - 0.5f * c * v[a];
       vel(m, v);
-      for (int a = 0; a < D; ++a) (*feet)[size_t(a)][base + size_t(x)] = (p[a] - c * v[a]) * (1.0f / r) - 0.5f;
+      for (int a = 0; a < D; ++a) feet[size_t(a)][base + size_t(x)] = (p[a] - c * v[a]) * (1.0f / r) - 0.5f;
     }
   });
   return true;
 }
 
-template bool traceCellFeet<2>(const MacVelocity<2>&, double, const IVec<2>&, double,
-                               std::array<std::vector<float>, 2>*);
-template bool traceCellFeet<3>(const MacVelocity<3>&, double, const IVec<3>&, double,
-                               std::array<std::vector<float>, 3>*);
+template bool traceCellFeet<2>(const MacVelocity<2>&, double, const IVec<2>&, double, const std::array<float*, 2>&);
+template bool traceCellFeet<3>(const MacVelocity<3>&, double, const IVec<3>&, double, const std::array<float*, 3>&);
 
 }  // namespace morphoflow

@@ -14,36 +14,29 @@
 
 namespace morphoflow {
 
-// Scratch grids of the second-order schemes: one set, reshaped for each
-// field advected (the fields are advected one after another), so it costs
-// one grid shape's worth, not one per shape; a solver lends it storage from
-// its WorkPool for the advection stage only.
+// Scratch of the second-order schemes: the forward pass's stencil bounds
+// (lo, hi) and the backward pass (back), float arrays in the bytes of the
+// pool's idle double vectors, sized for the largest field advected (the
+// fields are advected one after another, through the same arrays); BFECC's
+// corrected field, traced again, is a grid. A solver lends them from its
+// WorkPool for the advection stage only.
 template <int D>
 struct AdvectionScratch {
-  struct Set {
-    Grid<float, D> lo, hi, back, fwd;  // fwd: BFECC's only (reshaped there)
-  };
-  Set set;
-  // Borrows the grids' storage from a pool for one advection stage, and
-  // gives it back.
-  void borrow(WorkPool* pool, AdvectionScheme scheme) {
+  FloatArrays arrays;  // lo, hi, back
+  Grid<float, D> fwd;  // BFECC's (reshaped there)
+  // Borrows for fields of at most n samples, and gives back.
+  void borrow(WorkPool* pool, AdvectionScheme scheme, size_t n) {
     if (scheme == AdvectionScheme::SemiLagrangian) return;  // it uses none
-    each([&](std::vector<float>& v) { pool->lend(&v); }, scheme == AdvectionScheme::Bfecc);
+    arrays.lend(pool, 3, n);
+    if (scheme == AdvectionScheme::Bfecc) pool->lend(&fwd.values());
   }
   void giveBack(WorkPool* pool) {
-    each([&](std::vector<float>& v) { pool->give(&v); }, true);
+    arrays.give(pool);
+    pool->give(&fwd.values());
   }
-  Set& forShape(const IVec<D>& dims) {
-    for (Grid<float, D>* g : {&set.lo, &set.hi, &set.back}) g->reshape(dims);
-    return set;
-  }
-
- private:
-  template <class F>
-  void each(F&& f, bool withFwd) {
-    for (Grid<float, D>* g : {&set.lo, &set.hi, &set.back}) f(g->values());
-    if (withFwd) f(set.fwd.values());
-  }
+  float* lo() const { return arrays[0]; }
+  float* hi() const { return arrays[1]; }
+  float* back() const { return arrays[2]; }
 };
 
 // How many rows along each axis a trace through u over +-dt can move a
@@ -74,10 +67,10 @@ void advectVelocity(const MacVelocity<D>& u, double dt, AdvectionScheme scheme, 
 // the semi-Lagrangian row kernels) from the cell centres of a grid of
 // `cells` cells of size h over u's domain, in that grid's cell coordinates
 // (centre k at k). Returns false, leaving feet alone, when u has a periodic
-// axis (which these kernels do not take).
+// axis (which these kernels do not take). feet[a] holds a value per cell.
 template <int D>
 bool traceCellFeet(const MacVelocity<D>& u, double dt, const IVec<D>& cells, double h,
-                   std::array<std::vector<float>, D>* feet);
+                   const std::array<float*, D>& feet);
 
 // Foot of the characteristic through x over a step dt (midpoint rule).
 template <int D>

@@ -55,7 +55,8 @@ FluidSolver<D>::FluidSolver(const FluidSettings& s)
   projection_ = std::make_unique<PressureProjection<D>>(constraints_, s.pressureSolver, p);
   viscosity_ = std::make_unique<ViscositySolver<D>>(constraints_, SolverOptions{s.viscosityTolerance, 500});
   u_ = MacVelocity<D>(cells_, h_, constraints_.periodic());
-  scratch_ = u_;
+  scratch_ = u_;  // (its storage to the pool: the advection lends it, releaseAdvectedVelocity takes it back)
+  for (int a = 0; a < D; ++a) pool_.give(&scratch_[a].values());
   constraints_.apply(&u_);
   if (s.smoke.enabled) {
     temperature_ = Grid<float, D>(cells_, float(s.smoke.ambient));
@@ -113,7 +114,13 @@ struct FluidSolver<D>::Stages {
   }
   void constrain() { f.constraints_.apply(&f.u_); }
   void advect(double dt) {
-    f.advectionScratch_.borrow(&f.pool_, f.settings_.advection);
+    size_t largest = 0;  // (a face grid: the scalars' cell grids are smaller)
+    for (int a = 0; a < D; ++a) {
+      f.pool_.lend(&f.scratch_[a].values(), f.u_[a].size());  // (kept where keepAdvectedVelocity asked)
+      f.scratch_[a].reshape(f.u_[a].dims());
+      largest = std::max(largest, f.u_[a].size());
+    }
+    f.advectionScratch_.borrow(&f.pool_, f.settings_.advection, largest);
     advectVelocity<D>(f.u_, dt, f.settings_.advection, &f.scratch_, &f.advectionScratch_);
     // An all-zero dye (no dye in the scene yet) advects to zero: skip the work.
     const Grid<float, D>& dye = f.dye_;
@@ -128,6 +135,7 @@ struct FluidSolver<D>::Stages {
     f.advectionScratch_.giveBack(&f.pool_);
     std::swap(f.u_, f.scratch_);  // scratch_ keeps the velocity advected through (advectedVelocity())
   }
+  void releaseAdvected() { f.releaseAdvectedVelocity(); }
   void injectInflowDye() { f.injectInflowDye(); }
   void decaySmoke(double dt) { morphoflow::decaySmoke<D>(f.settings_.smoke, dt, &f.dye(), &f.temperature_); }
   void diffuse(double dt) {
@@ -148,6 +156,12 @@ void FluidSolver<D>::step(double dt, const std::function<void()>& afterAdvection
   if (moves_ && placement_.time() != time_ + dt) placeObstacles(time_ + dt, true);
   Stages stages{*this};
   stepFluid(stages, dt, afterAdvection);
+}
+
+template <int D>
+void FluidSolver<D>::releaseAdvectedVelocity() {
+  if (keepsAdvected_) return;
+  for (int a = 0; a < D; ++a) pool_.give(&scratch_[a].values());
 }
 
 // A cell-centred scalar carried through u_ (before the swap) with the

@@ -57,9 +57,16 @@ class FluidSolver {
   long steps() const { return steps_; }
   const MacVelocity<D>& velocity() const { return u_; }
   MacVelocity<D>& velocity() { return u_; }
-  // The velocity the last step's advection traced through (the step's start
-  // velocity with its forces applied), kept until the next step's advection.
+  // The velocity the step's advection traced through (the step's start
+  // velocity with its forces applied), from the advection until the step
+  // releases it, right after afterAdvection (its storage goes back to the
+  // pool the later stages borrow from; afterAdvection may release it
+  // sooner), or until the next step's advection after
+  // keepAdvectedVelocity(true) (a caller reading it beside the later
+  // stages or after the step).
   const MacVelocity<D>& advectedVelocity() const { return scratch_; }
+  void releaseAdvectedVelocity();
+  void keepAdvectedVelocity(bool keep) { keepsAdvected_ = keep; }
   WorkPool* workPool() { return &pool_; }
   // The dye (zeros until something puts dye in: a scene without dye keeps no
   // grid for it until asked for one).
@@ -115,6 +122,7 @@ class FluidSolver {
   mutable bool cutSurfaceMade_ = false;
   AdvectionScratch<D> advectionScratch_;
   WorkPool pool_;  // the stages' work vectors, lent to each in turn
+  bool keepsAdvected_ = false;  // scratch_ kept between steps (keepAdvectedVelocity)
   double time_ = 0.0;
   long steps_ = 0;
   ObstaclePlacement<D> placement_;

@@ -13,6 +13,7 @@
 //   constrain()       prescribed faces, periodic copies
 //   advect(dt)        the velocity through itself, the dye and the
 //                     temperature through the same field
+//   releaseAdvected() the velocity advected through is no longer needed
 //   injectInflowDye() dye stripes on the inflow side
 //   decaySmoke(dt)    the smoke's dissipation and cooling
 //   diffuse(dt)       the implicit viscosity
@@ -43,6 +44,7 @@ void stepFluid(Stages& s, double dt, const std::function<void()>& afterAdvection
     afterAdvection();
     s.resumeClock();
   }
+  s.releaseAdvected();
   // 3. diffuse
   s.diffuse(dt);
   s.mark(3);

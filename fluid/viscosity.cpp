@@ -6,6 +6,7 @@
 
 #include "core/masked_select.h"
 #include "core/parallel.h"
+#include "core/work_pool.h"
 
 namespace morphoflow {
 
@@ -221,7 +222,7 @@ double ViscositySolver<D>::rightHandSide(const MacVelocity<D>& u, int a, double 
   const Component& C = comp_[size_t(a)];
   const Grid<float, D>& g = u[a];
   const Grid<uint8_t, D>& fixed = vc_.fixed[a];
-  b_.resize(C.A.size());
+  resizeExactly(&b_, C.A.size());
   // Row by row: the boundary terms are stored a row at a time.
   eachRowOf<D>(C, fixed, g, [&](const UnknownRow& r) { rhsRow<D>(C, r, g, s, &b_); });
   return dot(b_, b_);
@@ -286,8 +287,8 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
     // rate. In the same pass, the right-hand side
     // (b_ holds component 0's already), as rightHandSide forms it.
     const int history = C.history;
-    x_.resize(C.A.size());
-    b_.resize(C.A.size());
+    resizeExactly(&x_, C.A.size());
+    resizeExactly(&b_, C.A.size());
     eachRowOf<D>(C, fixed, g, [&](const UnknownRow& r) {
       const float* __restrict gr = g.data() + r.g0;
       const uint8_t* __restrict f = r.fixed, * __restrict c = r.cut;

@@ -197,6 +197,7 @@ struct GpuFluid<D>::Stages {
     for (int k = 0; k < FluidStepStats::kStages; ++k) f.stats_.seconds[size_t(k)] = seconds[size_t(k)];
   }
   void resumeClock() {}  // (the device's step is given no caller's work)
+  void releaseAdvected() {}  // (the device keeps its velScratch)
   bool smoke() const { return bool(f.smoke_); }
   void emitSmoke(double dt) { f.smoke_->emit(f.time_, dt, &f.dye_); }
   void forces(double dt) { f.forces(dt); }

@@ -10,6 +10,7 @@
 #include "core/mic0.h"
 #include "core/multigrid.h"
 #include "core/parallel.h"
+#include "core/work_pool.h"
 #include "rd/rd_step.h"
 
 namespace morphoflow {
@@ -303,7 +304,7 @@ SolverResult RDSolver<D>::solveDiffusion(int s, double thetaDt, Vector* rhs) {
   // the fluid's viscosity does. The same pass forms ||b|| for the Chebyshev
   // iteration (norm2's sum, so bitwise its value).
   Vector& x = solveX_;  // shared: the species are solved one after another
-  x.resize(b.size());
+  resizeExactly(&x, b.size());
   double bnorm = -1.0;  // not known: the solver computes it
   if (df.increment.size() == b.size()) {
     const double ratio = thetaDt / df.incrementThetaDt;

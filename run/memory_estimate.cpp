@@ -17,15 +17,14 @@ namespace {
 // (double state, its implicit system and warm start, a share of the solves'
 // vectors; in a coupled run also its advection scratch and feet; float
 // state for the fused explicit step).
-constexpr double kFluidBytesPerCell[2] = {156.0, 97.0};  // 2D, 3D
+constexpr double kFluidBytesPerCell[2] = {144.0, 81.0};  // 2D, 3D
 // A coupled run's fluid and species, each from two runs (the same grid for
 // both, and chemicals twice as fine: 2D 512^2 / 1024^2, 3D the shipped
-// 128^3 / 256^3 cavity) solved for the two unknowns; in 2D the species' share
-// then less the inflow weights a run without inflow sides keeps no more (8
-// bytes a cell of the layer, as measured in 3D).
-constexpr double kCoupledFluidBytesPerCell[2] = {79.1, 72.7};
+// 128^3 / 256^3 cavity) solved for the two unknowns (in 3D the fluid's work
+// vectors are the finer layer's, borrowed from one pool).
+constexpr double kCoupledFluidBytesPerCell[2] = {83.7, 53.8};
 constexpr double kSpeciesBytesPerCell[2] = {26.0, 27.3};         // reaction-diffusion only
-constexpr double kCoupledSpeciesBytesPerCell[2] = {25.4, 23.2};  // carried by a fluid
+constexpr double kCoupledSpeciesBytesPerCell[2] = {23.0, 24.4};  // carried by a fluid
 constexpr double kFusedSpeciesBytesPerCell = 16.0;               // the fused explicit step
 // A frame's OpenVDB volumes: each grid is built densely, then as a tree,
 // before the file is written, on top of the solvers' work vectors when the

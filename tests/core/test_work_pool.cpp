@@ -46,6 +46,68 @@ TEST(WorkPool, LendsTheLargestVectorAndKeepsItsStorage) {
   EXPECT_EQ(none.capacity(), 0u);  // the pool is empty now
 }
 
+// Float arrays live in the pool's double vectors, two to a vector where they
+// fit, and go back to it unchanged: a float stage costs the pool nothing.
+TEST(WorkPool, FloatArraysLiveInTheDoubleVectors) {
+  WorkPool pool;
+  std::vector<double> a(1000), b(1000);
+  const double *sa = a.data(), *sb = b.data();
+  pool.give(&a);
+  pool.give(&b);
+  const size_t held = pool.bytes();
+  {
+    FloatArrays f;
+    f.lend(&pool, 3, 1000);  // 500 doubles' bytes each
+    ASSERT_EQ(f.size(), 3u);
+    EXPECT_EQ(static_cast<void*>(f[0]), static_cast<const void*>(sa));  // two in the larger vector
+    EXPECT_EQ(f[1], f[0] + 1000);
+    EXPECT_EQ(static_cast<void*>(f[2]), static_cast<const void*>(sb));  // one in the other
+    EXPECT_EQ(pool.bytes(), 0u);
+    for (size_t k = 0; k < 3; ++k)
+      for (size_t i = 0; i < 1000; ++i) f[k][i] = float(k * 1000 + i);
+    for (size_t k = 0; k < 3; ++k) EXPECT_EQ(f[k][999], float(k * 1000 + 999));  // no overlap
+    f.give(&pool);
+    EXPECT_EQ(pool.bytes(), held);
+    // Floats first: a float vector large enough serves whole.
+    std::vector<float> g(1000);
+    const float* sg = g.data();
+    pool.give(&g);
+    f.lend(&pool, 2, 1000, FloatArrays::First::Floats);
+    EXPECT_EQ(f[0], sg);
+    EXPECT_EQ(static_cast<void*>(f[1]), static_cast<const void*>(sa));
+  }  // (given back to nobody: freed)
+  // An empty pool makes new double vectors, kept by the pool once given.
+  WorkPool empty;
+  FloatArrays f;
+  f.lend(&empty, 3, 100);
+  EXPECT_EQ(f.size(), 3u);
+  f.give(&empty);
+  EXPECT_GE(empty.bytes(), 3u * 100u * sizeof(float));
+  EXPECT_LE(empty.bytes(), 4u * 100u * sizeof(float));
+}
+
+// No pooled vector holds more than the largest size given back: a resize
+// past the capacity (which doubles it) is trimmed when given back;
+// resizeExactly grows to the size.
+TEST(WorkPool, VectorsHoldTheLargestSizeNotADoubledOne) {
+  WorkPool pool;
+  std::vector<double> v(100);
+  v.resize(150);  // (doubled)
+  EXPECT_GE(v.capacity(), 200u);
+  pool.give(&v);
+  EXPECT_EQ(pool.bytes(), 150u * sizeof(double));
+  std::vector<double> a;
+  pool.lend(&a);
+  EXPECT_EQ(a.capacity(), 150u);
+  a.resize(100);
+  pool.give(&a);  // (a stage that needed less)
+  EXPECT_EQ(pool.bytes(), 150u * sizeof(double));
+  std::vector<float> w(10);
+  resizeExactly(&w, 11, 1.0f);
+  EXPECT_EQ(w.capacity(), 11u);
+  EXPECT_EQ(w[10], 1.0f);
+}
+
 TEST(AtomicFile, WritesPiecesAndLeavesNothingWithoutCommit) {
   const fs::path dir = fs::temp_directory_path() / ("mf_atomic_" + std::to_string(::getpid()));
   fs::create_directories(dir);

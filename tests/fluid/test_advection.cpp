@@ -184,7 +184,12 @@ void checkCellFeet(int n, int gridCells) {
     setUseAvx512(widest && lanes == 16);
     setUseAvx2(wide && lanes >= 8);
     std::array<std::vector<float>, D> feet;
-    const bool done = traceCellFeet<D>(u, dt, cells, gh, &feet);
+    std::array<float*, D> out;
+    for (int a = 0; a < D; ++a) {
+      feet[size_t(a)].resize(size_t(std::pow(gridCells, D)));
+      out[size_t(a)] = feet[size_t(a)].data();
+    }
+    const bool done = traceCellFeet<D>(u, dt, cells, gh, out);
     setUseAvx2(wide);
     setUseAvx512(widest);
     ASSERT_TRUE(done);
@@ -221,8 +226,8 @@ TEST(Advection, CellFeetMatchTheDoubleTrace) {
 // A periodic axis is left to the caller's own trace.
 TEST(Advection, CellFeetDeclinePeriodicAxes) {
   MacVelocity<2> u(IVec<2>(16), 1.0 / 16, {true, false});
-  std::array<std::vector<float>, 2> feet;
-  EXPECT_FALSE(traceCellFeet<2>(u, 0.01, IVec<2>(16), 1.0 / 16, &feet));
+  std::vector<float> x(256), y(256);
+  EXPECT_FALSE(traceCellFeet<2>(u, 0.01, IVec<2>(16), 1.0 / 16, {x.data(), y.data()}));
 }
 
 namespace {
