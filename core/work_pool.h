@@ -61,7 +61,10 @@ class WorkPool {
     if (v->capacity() > 0) {
       size_t& most = mostOf<T>();
       most = std::max(most, v->size());
-      if (v->capacity() > most) *v = std::vector<T>(), *v = reserved<T>(most);  // (freed first)
+      if (v->capacity() > most) {
+        *v = std::vector<T>();  // (freed before the smaller one is made)
+        *v = reserved<T>(most);
+      }
       heldOf<T>().push_back(std::move(*v));
     }
     *v = std::vector<T>();
