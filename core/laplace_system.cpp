@@ -455,9 +455,9 @@ double LaplaceSystem<D>::defectRow(size_t row, const T* b, const T* x, T* r) con
 
 template <int D>
 template <class T>
-void LaplaceSystem<D>::defect(const std::vector<T>& b, const std::vector<T>& x, std::vector<T>* r) const {
+void LaplaceSystem<D>::defect(const T* b, const T* x, T* r) const {
   const size_t nx = size_t(dims[0]);
-  parallelForRows<D>(dims, [&](size_t row) { defectRow<T, false>(row, b.data(), x.data(), r->data() + row * nx); });
+  parallelForRows<D>(dims, [&](size_t row) { defectRow<T, false>(row, b, x, r + row * nx); });
 }
 
 template <int D>
@@ -493,8 +493,7 @@ constexpr size_t kSlabCells = 16384;  // and cells
 
 template <int D>
 template <class T>
-void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, bool reverse) const {
-  std::vector<T>& x = *xp;
+void LaplaceSystem<D>::gaussSeidel(const T* b, T* x, bool reverse) const {
   const size_t nx = size_t(dims[0]);
   const bool px = periodic[0];
   const T inv = T(1.0 / scale);
@@ -503,14 +502,14 @@ void LaplaceSystem<D>::gaussSeidel(const std::vector<T>& b, std::vector<T>* xp, 
   for (int a = 1; a < D; ++a) rows *= size_t(dims[a]);
   [[maybe_unused]] const bool wide = useAvx2();
   auto sweepRow = [&](size_t row, size_t y, size_t z, int colour, bool shared) {
-    RowStencil<D, T> s = rowStencil<D, T>(*this, x.data(), zeros<T>(), zerosW_.data(), row, y, z);
+    RowStencil<D, T> s = rowStencil<D, T>(*this, x, zeros<T>(), zerosW_.data(), row, y, z);
     const size_t parity = y + z;
     const float* wa[D];
     for (int a = 0; a < D; ++a) wa[a] = w[a].row(row);
     const float* dr = diag.row(row);
     auto rd = [&](size_t i) { return inverse(dr[i]); };
-    const T* br = b.data() + s.base;
-    T* xr = x.data() + s.base;
+    const T* br = b + s.base;
+    T* xr = x + s.base;
     // x_i = (b_i / scale + sum_f w_f x_j) / diag_i; invDiag is 0 on inactive cells.
     auto edge = [&](size_t i) {
       size_t il = i == 0 ? nx - 1 : i - 1, ih = i + 1 == nx ? 0 : i + 1;
@@ -687,11 +686,10 @@ void axpy(double alpha, const Vector& x, Vector* y) {
 
 template struct LaplaceSystem<2>;
 template struct LaplaceSystem<3>;
-#define MORPHOFLOW_LAPLACE_KERNELS(D, T)                                                        \
-  template void LaplaceSystem<D>::apply<T>(const std::vector<T>&, std::vector<T>*) const;       \
-  template void LaplaceSystem<D>::defect<T>(const std::vector<T>&, const std::vector<T>&,        \
-                                            std::vector<T>*) const;                             \
-  template void LaplaceSystem<D>::gaussSeidel<T>(const std::vector<T>&, std::vector<T>*, bool) const;
+#define MORPHOFLOW_LAPLACE_KERNELS(D, T)                                                  \
+  template void LaplaceSystem<D>::apply<T>(const std::vector<T>&, std::vector<T>*) const; \
+  template void LaplaceSystem<D>::defect<T>(const T*, const T*, T*) const;                \
+  template void LaplaceSystem<D>::gaussSeidel<T>(const T*, T*, bool) const;
 MORPHOFLOW_LAPLACE_KERNELS(2, double)
 MORPHOFLOW_LAPLACE_KERNELS(3, double)
 MORPHOFLOW_LAPLACE_KERNELS(2, float)

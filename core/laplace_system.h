@@ -52,7 +52,11 @@ struct LaplaceSystem {
   double applyDot(const Vector& x, Vector* y) const;
   // r = b - A x (0 on inactive cells).
   template <class T>
-  void defect(const std::vector<T>& b, const std::vector<T>& x, std::vector<T>* r) const;
+  void defect(const T* b, const T* x, T* r) const;
+  template <class T>
+  void defect(const std::vector<T>& b, const std::vector<T>& x, std::vector<T>* r) const {
+    defect(b.data(), x.data(), r->data());
+  }
   // r = b - A x; returns ||r||_2.
   double residual(const Vector& b, const Vector& x, Vector* r) const;
   // The same with r in b's place (bitwise residual()'s values and norm).
@@ -62,7 +66,11 @@ struct LaplaceSystem {
   // One red-black Gauss-Seidel sweep; `reverse` runs black first (so a
   // reversed post-smoother makes a symmetric V-cycle).
   template <class T>
-  void gaussSeidel(const std::vector<T>& b, std::vector<T>* x, bool reverse) const;
+  void gaussSeidel(const T* b, T* x, bool reverse) const;
+  template <class T>
+  void gaussSeidel(const std::vector<T>& b, std::vector<T>* x, bool reverse) const {
+    gaussSeidel(b.data(), x->data(), reverse);
+  }
   // Red-black Gauss-Seidel sweeps on the cells [lo, hi) alone, the others
   // held: a solve's start made consistent with rows that were rewritten.
   void relaxBox(const Vector& b, Vector* x, const IVec<D>& lo, const IVec<D>& hi, int sweeps) const;

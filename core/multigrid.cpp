@@ -133,33 +133,67 @@ Multigrid<D>::Multigrid(const LaplaceSystem<D>& fine, const MultigridOptions& op
     cur = &levels_.back().A;
   }
   for (size_t l = 0; l + 1 < levels_.size(); ++l) buildTransfer(int(l));
-  for (size_t l = 1; l < levels_.size(); ++l) {  // level 0's: at the first cycle (ensureFine)
-    size_t n = level(int(l)).size();
-    levels_[l].x.assign(n, 0.0f);
-    levels_[l].b.assign(n, 0.0f);
-    levels_[l].r.assign(n, 0.0f);
-  }
+  // The levels' vectors: level 0's at the first cycle (ensureFine), the
+  // coarse levels' placed for each (placeCoarse).
 }
 
 template <int D>
 void Multigrid<D>::ensureFine() {
   const size_t n = fine_.size();
-  for (FVector* v : {&levels_[0].x, &levels_[0].b, &levels_[0].r})
+  for (FVector* v : {&fineX_, &fineB_, &fineR_})
     if (v->size() != n) v->assign(n, 0.0f);
+  Level& L0 = levels_[0];
+  L0.x = fineX_.data(), L0.b = fineB_.data(), L0.r = fineR_.data();
 }
 
 template <int D>
 void Multigrid<D>::borrowFine(WorkPool* pool) {
-  Level& L0 = levels_[0];
-  pool->lend({&L0.x, &L0.b, &L0.r});
-  for (FVector* v : {&L0.x, &L0.b, &L0.r}) v->clear();  // ensureFine() zeroes them, as on first use
+  pool->lend({&fineX_, &fineB_, &fineR_});
+  for (FVector* v : {&fineX_, &fineB_, &fineR_}) v->clear();  // ensureFine() zeroes them, as on first use
   ensureFine();
 }
 
 template <int D>
 void Multigrid<D>::giveBackFine(WorkPool* pool) {
-  Level& L0 = levels_[0];
-  pool->give({&L0.x, &L0.b, &L0.r});
+  pool->give({&fineX_, &fineB_, &fineR_});
+}
+
+namespace {
+constexpr size_t padded(size_t n) { return (n + 15) / 16 * 16; }  // floats, to 64 bytes
+}  // namespace
+
+template <int D>
+size_t Multigrid<D>::coarseFloats() const {
+  size_t n = 0;
+  for (int l = 1; l < levels(); ++l) n += 3 * padded(level(l).size());
+  return n;
+}
+
+template <int D>
+void Multigrid<D>::placeCoarse() {
+  const size_t need = coarseFloats();
+  inScratch_ = need > 0 && need <= 2 * scratch_.size();
+  float* f = nullptr;
+  if (inScratch_) {
+    // The lent doubles' bytes hold floats now: their lifetime begins here,
+    // the doubles' ends (both trivial: no code); releaseCoarse() restores them.
+    f = ::new (static_cast<void*>(scratch_.data())) float[2 * scratch_.size()];
+  } else {
+    if (coarse_.size() != need) coarse_.assign(need, 0.0f);
+    f = coarse_.data();
+  }
+  for (int l = 1; l < levels(); ++l) {
+    const size_t n = padded(level(l).size());
+    Level& L = levels_[size_t(l)];
+    L.x = f, L.b = f + n, L.r = f + 2 * n;
+    f += 3 * n;
+  }
+}
+
+template <int D>
+void Multigrid<D>::releaseCoarse() {
+  if (inScratch_) ::new (static_cast<void*>(scratch_.data())) double[scratch_.size()];
+  inScratch_ = false;
 }
 
 template <int D>
@@ -251,8 +285,8 @@ void Multigrid<D>::restrict(int l) {
   const LaplaceSystem<D>& F = level(l);
   const LaplaceSystem<D>& C = level(l + 1);
   const std::array<AxisTransfer, D>& T = levels_[size_t(l)].transfer;
-  const FVector& r = levels_[size_t(l)].r;
-  FVector& b = levels_[size_t(l) + 1].b;
+  const float* r = levels_[size_t(l)].r;
+  float* b = levels_[size_t(l) + 1].b;
   const float inv2D = 1.0f / float(1 << D);
   const size_t ncx = size_t(C.dims[0]), nfx = size_t(F.dims[0]);
   const size_t nfy = size_t(F.dims[1]);
@@ -277,7 +311,7 @@ void Multigrid<D>::restrict(int l) {
       for (int my = 0; my < 4; ++my) {
         const float wy = wz * T[1].fineWeight[size_t(cc[1])][size_t(my)];
         if (wy == 0.0f) continue;
-        const float* __restrict fr = r.data() + (fz * nfy + size_t(T[1].fine[size_t(cc[1])][size_t(my)])) * nfx;
+        const float* __restrict fr = r + (fz * nfy + size_t(T[1].fine[size_t(cc[1])][size_t(my)])) * nfx;
         if (any)
           for (size_t i = 0; i < nfx; ++i) cy[i] += wy * fr[i];
         else
@@ -286,7 +320,7 @@ void Multigrid<D>::restrict(int l) {
       }
     }
     if (!any) std::fill_n(cy, nfx, 0.0f);
-    float* __restrict br = b.data() + row * ncx;
+    float* __restrict br = b + row * ncx;
     auto table = [&](size_t X) {
       const std::array<int, 4>& fx = T[0].fine[X];
       const std::array<float, 4>& wx = T[0].fineWeight[X];
@@ -307,8 +341,8 @@ void Multigrid<D>::prolongAdd(int l) {
   const LaplaceSystem<D>& F = level(l);
   const LaplaceSystem<D>& C = level(l + 1);
   const std::array<AxisTransfer, D>& T = levels_[size_t(l)].transfer;
-  const FVector& xc = levels_[size_t(l) + 1].x;
-  FVector& x = levels_[size_t(l)].x;
+  const float* xc = levels_[size_t(l) + 1].x;
+  float* x = levels_[size_t(l)].x;
   const size_t ncx = size_t(C.dims[0]), nfx = size_t(F.dims[0]);
   const size_t ncy = size_t(C.dims[1]);
   parallelForRows<D>(F.dims, [&](size_t row) {
@@ -332,7 +366,7 @@ void Multigrid<D>::prolongAdd(int l) {
         float wy = wz * (ky ? 1.0f - T[1].w[fy] : T[1].w[fy]);
         if (wy == 0.0f) continue;
         size_t y = size_t(ky ? T[1].hi[fy] : T[1].lo[fy]);
-        crow[nrows] = xc.data() + (z * ncy + y) * ncx;
+        crow[nrows] = xc + (z * ncy + y) * ncx;
         cw[nrows++] = wy;
       }
     }
@@ -345,7 +379,7 @@ void Multigrid<D>::prolongAdd(int l) {
     for (int k = 1; k < nrows; ++k)
       for (size_t X = 0; X < ncx; ++X) cy[X] += cw[k] * crow[k][X];
     const float* fd = F.diag.row(row);
-    float* xr = x.data() + row * nfx;
+    float* xr = x + row * nfx;
     const int* lo = T[0].lo.data();
     const int* hi = T[0].hi.data();
     const float* wx = T[0].w.data();
@@ -382,23 +416,22 @@ void Multigrid<D>::cycle(int l) {
   const LaplaceSystem<D>& A = level(l);
   if (l + 1 == levels()) {
     // Coarsest level: solve accurately with CG (in double) so the cycle stays linear.
-    coarseB_.assign(L.b.begin(), L.b.end());
+    coarseB_.assign(L.b, L.b + A.size());
     coarseX_.assign(A.size(), 0.0);
     SolverOptions o;
     o.tolerance = 1e-10;
     o.maxIterations = 20 * int(A.size()) + 50;
     solvePCG<D>(A, coarseB_, &coarseX_, nullptr, o, &coarseWork_);
-    for (size_t i = 0; i < L.x.size(); ++i) L.x[i] = float(coarseX_[i]);
+    for (size_t i = 0; i < A.size(); ++i) L.x[i] = float(coarseX_[i]);
     return;
   }
-  for (int s = 0; s < options_.preSmooth; ++s) A.gaussSeidel(L.b, &L.x, false);
-  A.defect(L.b, L.x, &L.r);
+  for (int s = 0; s < options_.preSmooth; ++s) A.gaussSeidel(L.b, L.x, false);
+  A.defect(L.b, L.x, L.r);
   restrict(l);
-  FVector& xc = levels_[size_t(l) + 1].x;
-  std::fill(xc.begin(), xc.end(), 0.0f);
+  std::fill_n(levels_[size_t(l) + 1].x, level(l + 1).size(), 0.0f);
   cycle(l + 1);
   prolongAdd(l);
-  for (int s = 0; s < options_.postSmooth; ++s) A.gaussSeidel(L.b, &L.x, true);
+  for (int s = 0; s < options_.postSmooth; ++s) A.gaussSeidel(L.b, L.x, true);
 }
 
 template <int D>
@@ -406,20 +439,22 @@ double Multigrid<D>::scaledCycle(const Vector& r, double rscale, Vector* z, bool
   ensureFine();
   Level& L0 = levels_[0];
   if (rscale == 0.0 || !std::isfinite(rscale)) {  // zero in, zero out; an overflow stays visible
-    std::fill(L0.x.begin(), L0.x.end(), 0.0f);
+    std::fill(fineX_.begin(), fineX_.end(), 0.0f);
     zScale_ = rscale == 0.0 ? 0.0 : std::numeric_limits<double>::quiet_NaN();  // z = 0 x: 0 or NaN
   } else {
     const double inv = 1.0 / rscale;
     // Raw pointers here and below: through the vectors, each store would
     // reload their data pointers and the loops would stay scalar.
     const double* __restrict rd = r.data();
-    float* __restrict b = L0.b.data();
-    float* __restrict x = L0.x.data();
+    float* __restrict b = L0.b;
+    float* __restrict x = L0.x;
     parallelFor(r.size(), [&](size_t i) {
       b[i] = float(rd[i] * inv);
       x[i] = 0.0f;
     }, 4096);
+    placeCoarse();
     cycle(0);
+    releaseCoarse();
     zScale_ = rscale;
   }
   const double* __restrict rd = r.data();

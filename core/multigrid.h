@@ -15,6 +15,7 @@
 
 #include <array>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "core/pcg.h"
@@ -44,6 +45,12 @@ class Multigrid final : public Preconditioner {
   // z is the fine level's x times the last cycle's scale.
   bool recomputesZ() const override { return true; }
   void direction(double beta, bool first, Vector* p) override;
+  // The coarse levels' vectors (about 3/7 of a float a fine cell) live in
+  // the storage lent, where it has room, else in the hierarchy's own.
+  void scratch(std::span<double> s) override { scratch_ = s; }
+  // The bytes the coarse levels' own vectors hold (none while every cycle
+  // found a scratch with room).
+  size_t coarseBytes() const { return coarse_.capacity() * sizeof(float); }
 
   // The fine system's coefficients changed, not its shape (a new identity
   // term, say, from a new time step): re-derive the coarse levels in place,
@@ -80,11 +87,18 @@ class Multigrid final : public Preconditioner {
   };
   struct Level {
     LaplaceSystem<D> A;  // unused on level 0 (fine_ is used)
-    FVector x, b, r;
+    // The level's vectors, A's size each: level 0's in fine_x_ etc., the
+    // coarse levels' in a scratch or coarse_ (placed for each cycle).
+    float *x = nullptr, *b = nullptr, *r = nullptr;
     std::array<AxisTransfer, D> transfer;  // to level + 1 (absent on the coarsest)
   };
   void buildTransfer(int l);
   void ensureFine();  // level 0's vectors, sized (allocated on first use)
+  // Places the coarse levels' vectors for a cycle: in scratch_ where it has
+  // room (its bytes then hold floats until releaseCoarse()), else in coarse_.
+  void placeCoarse();
+  void releaseCoarse();
+  size_t coarseFloats() const;  // the coarse levels' vectors, each padded to 64 bytes
   void cycle(int l);
   // The cycle on r / rscale (single precision must neither underflow nor
   // overflow), z = rscale * result (unless z is null); returns r . z when
@@ -93,7 +107,7 @@ class Multigrid final : public Preconditioner {
   // z_i = zScale_ x_i on level 0, through a raw pointer (so the loops that
   // use it vectorise; stores through the vectors would reload their data).
   auto zOf() const {
-    const float* x = levels_[0].x.data();
+    const float* x = fineX_.data();
     const double scale = zScale_;
     return [x, scale](size_t i) { return double(x[i]) * scale; };
   }
@@ -103,6 +117,10 @@ class Multigrid final : public Preconditioner {
   const LaplaceSystem<D>& fine_;
   MultigridOptions options_;
   std::vector<Level> levels_;
+  FVector fineX_, fineB_, fineR_;  // level 0's vectors (from a pool while borrowed)
+  FVector coarse_;                 // the coarse levels' vectors where no scratch is lent
+  std::span<double> scratch_;
+  bool inScratch_ = false;            // the coarse levels' vectors are in scratch_
   Vector coarseB_, coarseX_, r_, z_;  // the coarsest solve in double; solve()'s vectors
   PcgWorkspace coarseWork_;
   double zScale_ = 0.0;  // the last cycle's rscale (z = zScale_ x on level 0)

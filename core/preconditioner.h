@@ -1,6 +1,8 @@
 // A symmetric positive definite preconditioner: z = M^{-1} r.
 #pragma once
 
+#include <span>
+
 #include "core/laplace_system.h"
 #include "core/parallel.h"
 
@@ -26,6 +28,10 @@ class Preconditioner {
   virtual void direction(double beta, bool first, Vector* p) {
     (void)beta, (void)first, (void)p;
   }
+  // The caller's storage that no one reads while applyDot runs (PCG's q,
+  // whose z is recomputed), lent until scratch({}): a preconditioner may
+  // keep its work there in place of vectors of its own.
+  virtual void scratch(std::span<double> s) { (void)s; }
 
  protected:
   // direction() for a preconditioner that forms z_i as zAt(i).

@@ -11,20 +11,20 @@ namespace {
 
 // Peak bytes per cell beyond the fixed overhead, measured by `bench memory`
 // (2D 1024^2, 3D 128^3, four steps and the final checkpoint;
-// docs/performance.md "Memory"): the fluid (velocity and its advected copy,
-// pressure and viscosity systems, their warm starts, and the work vectors
-// its stages borrow in turn) and each species of a reaction-diffusion layer
+// docs/performance.md "Memory"): the fluid (velocity, pressure and viscosity
+// systems, their warm starts, and the work vectors its stages borrow in
+// turn, the advection's destination among them) and each species of a reaction-diffusion layer
 // (double state, its implicit system and warm start, a share of the solves'
 // vectors; in a coupled run also its advection scratch and feet; float
 // state for the fused explicit step).
-constexpr double kFluidBytesPerCell[2] = {144.0, 81.0};  // 2D, 3D
+constexpr double kFluidBytesPerCell[2] = {132.0, 79.0};  // 2D, 3D
 // A coupled run's fluid and species, each from two runs (the same grid for
 // both, and chemicals twice as fine: 2D 512^2 / 1024^2, 3D the shipped
 // 128^3 / 256^3 cavity) solved for the two unknowns (in 3D the fluid's work
 // vectors are the finer layer's, borrowed from one pool).
-constexpr double kCoupledFluidBytesPerCell[2] = {83.7, 53.8};
+constexpr double kCoupledFluidBytesPerCell[2] = {79.9, 52.4};
 constexpr double kSpeciesBytesPerCell[2] = {26.0, 27.3};         // reaction-diffusion only
-constexpr double kCoupledSpeciesBytesPerCell[2] = {23.0, 24.4};  // carried by a fluid
+constexpr double kCoupledSpeciesBytesPerCell[2] = {23.2, 24.4};  // carried by a fluid
 constexpr double kFusedSpeciesBytesPerCell = 16.0;               // the fused explicit step
 // A frame's OpenVDB volumes: each grid is built densely, then as a tree,
 // before the file is written, on top of the solvers' work vectors when the

@@ -186,6 +186,47 @@ TEST(LinearSolvers, MultigridPreconditionerIsSymmetric) {
   EXPECT_NEAR(ab, ba, 1e-5 * std::abs(ab));
 }
 
+// MGPCG keeps the coarse levels' vectors in PCG's q while it preconditions
+// (q is dead then): the hierarchy allocates none of its own, and the solve
+// is bitwise the one with the levels in vectors of their own.
+template <int D>
+void expectCoarseLevelsInTheScratch(int n) {
+  LaplaceSystem<D> A = dirichletSystem<D>(n);
+  A.w[0].densify();
+  A.w[0].at(size_t(n) / 2) = 0.25f;  // a partial face, as an obstacle's
+  A.finalize();
+  Vector b(A.size());
+  for (size_t i = 0; i < b.size(); ++i) b[i] = std::sin(0.37 * double(i)) + 0.1;
+  const SolverOptions o{1e-8, 200};
+  Multigrid<D> lent(A);
+  Vector x1(A.size(), 0.0);
+  const SolverResult r1 = solvePCG<D>(A, b, &x1, &lent, o);
+  EXPECT_EQ(lent.coarseBytes(), 0u);
+  // The same cycle through a preconditioner that takes no scratch.
+  struct OwnVectors final : Preconditioner {
+    explicit OwnVectors(Multigrid<D>* m) : mg(m) {}
+    void apply(const Vector& r, Vector* z) override { mg->apply(r, z); }
+    double applyDot(const Vector& r, double rnorm, Vector* z) override { return mg->applyDot(r, rnorm, z); }
+    bool recomputesZ() const override { return true; }
+    void direction(double beta, bool first, Vector* p) override { mg->direction(beta, first, p); }
+    Multigrid<D>* mg;
+  };
+  Multigrid<D> own(A);
+  OwnVectors wrapped(&own);
+  Vector x2(A.size(), 0.0);
+  const SolverResult r2 = solvePCG<D>(A, b, &x2, &wrapped, o);
+  EXPECT_GT(own.coarseBytes(), 0u);
+  EXPECT_TRUE(r1.converged);
+  EXPECT_EQ(r1.iterations, r2.iterations);
+  EXPECT_EQ(r1.residual, r2.residual);
+  EXPECT_EQ(x1, x2);
+}
+
+TEST(LinearSolvers, MultigridCoarseLevelsLiveInTheSolversScratch) {
+  expectCoarseLevelsInTheScratch<2>(96);
+  expectCoarseLevelsInTheScratch<3>(32);
+}
+
 // A new identity term (a new time step of an implicit diffusion) with the
 // levels re-derived in place must give bitwise the cycle of a hierarchy built
 // from scratch, in 2D and 3D, with an obstacle-like partial face.
