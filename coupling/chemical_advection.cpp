@@ -196,11 +196,15 @@ double sampleChemical(const Grid<double, D>& g, const std::array<bool, D>& perio
 template <int D>
 ChemicalAdvector<D>::ChemicalAdvector(ChemicalDomain<D> domain, ChemicalInterpolation interpolation)
     : domain_(std::move(domain)), interpolation_(interpolation) {
+  if (!domain_.solid.empty() && domain_.solid.size() != cells())
+    throw std::invalid_argument("coupling: solid mask has the wrong size");
+}
+
+template <int D>
+size_t ChemicalAdvector<D>::cells() const {
   size_t n = 1;
   for (int a = 0; a < D; ++a) n *= size_t(domain_.cells[a]);
-  if (!domain_.solid.empty() && domain_.solid.size() != n)
-    throw std::invalid_argument("coupling: solid mask has the wrong size");
-  if (weighsInflow()) fromInflow_.assign(n, 0);
+  return n;
 }
 
 // Without an inflow side every foot's inflow weight is 0: no weights are
@@ -272,8 +276,7 @@ void ChemicalAdvector<D>::trace(const MacVelocity<D>& u, double dt, WorkPool* po
   const ChemicalDomain<D>& d = domain_;
   const bool weighed = weighsInflow();
   const bool bfecc = interpolation_ == ChemicalInterpolation::BFECC;
-  size_t n = 1;
-  for (int a = 0; a < D; ++a) n *= size_t(d.cells[a]);
+  const size_t n = cells();
   // (floats first: the species' scratch that follows is a double vector)
   feet_.lend(pool ? pool : &own_, bfecc ? 2 * D : D, n, FloatArrays::First::Floats);
   cellFeet<D>(d, u, dt, feet(0));
@@ -295,11 +298,9 @@ void ChemicalAdvector<D>::carry(const std::vector<Grid<double, D>*>& species, Wo
     fwdFeet[size_t(a)] = feet(0)[size_t(a)];
     if (bfecc) backFeet[size_t(a)] = feet(1)[size_t(a)];
   }
-  size_t n = 1;
-  for (int a = 0; a < D; ++a) n *= size_t(d.cells[a]);
   const bool spline = interpolation_ == ChemicalInterpolation::BSpline;
   const bool linear = interpolation_ == ChemicalInterpolation::Linear || bfecc;
-  const size_t cells = n;
+  const size_t cells = this->cells();
   bool walls = true;
   for (int a = 0; a < D; ++a) walls = walls && !d.periodic[size_t(a)];
   [[maybe_unused]] const bool wide = walls && cells < (size_t(1) << 31) && useAvx2();

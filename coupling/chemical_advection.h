@@ -63,6 +63,7 @@ class ChemicalAdvector {
   const ChemicalDomain<D>& domain() const { return domain_; }
 
  private:
+  size_t cells() const;       // the domain's
   bool weighsInflow() const;  // whether a side lets chemicals in (their values given)
   ChemicalDomain<D> domain_;
   ChemicalInterpolation interpolation_;
