@@ -87,7 +87,7 @@ class Multigrid final : public Preconditioner {
   };
   struct Level {
     LaplaceSystem<D> A;  // unused on level 0 (fine_ is used)
-    // The level's vectors, A's size each: level 0's in fine_x_ etc., the
+    // The level's vectors, A's size each: level 0's in fineX_, fineB_, fineR_, the
     // coarse levels' in a scratch or coarse_ (placed for each cycle).
     float *x = nullptr, *b = nullptr, *r = nullptr;
     std::array<AxisTransfer, D> transfer;  // to level + 1 (absent on the coarsest)

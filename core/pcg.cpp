@@ -78,7 +78,14 @@ SolverResult pcg(const Op& A, const Vector& bIn, Vector* xp, Preconditioner* M, 
     // the same; x's resulting drift is removed at the end.
     return M->applyDot(r, rnorm, recompute ? nullptr : &z);
   };
-  // q is dead while a z that is recomputed is formed: the preconditioner's work.
+  // q is dead while a z that is recomputed is formed: the preconditioner's
+  // work, lent until the solve ends (however it ends).
+  struct Lent {
+    Preconditioner* M;
+    ~Lent() {
+      if (M) M->scratch({});
+    }
+  } lent{recompute ? M : nullptr};
   if (recompute) M->scratch(q);
   double rz = precondition();
   if (recompute)
@@ -118,7 +125,6 @@ SolverResult pcg(const Op& A, const Vector& bIn, Vector* xp, Preconditioner* M, 
     else
       parallelFor(n, [&](size_t i) { p[i] = z[i] + beta * p[i]; }, 4096);
   }
-  if (recompute) M->scratch({});
   // Report the true residual, not the recursively updated one.
   if (consume) {  // b again, as it was solved for, in p (no longer needed)
     ws.regenerate(&p);
