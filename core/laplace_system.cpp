@@ -611,7 +611,8 @@ bool LaplaceSystem<D>::coloursMeetAcrossRows() const {
 }
 
 template <int D>
-void LaplaceSystem<D>::relaxBox(const Vector& b, Vector* xp, const IVec<D>& lo, const IVec<D>& hi, int sweeps) const {
+void LaplaceSystem<D>::relaxBox(const Vector& b, Vector* xp, const IVec<D>& lo, const IVec<D>& hi, int sweeps,
+                                double omega) const {
   for (int a = 0; a < D; ++a)
     if (hi[a] <= lo[a]) return;
   Vector& x = *xp;
@@ -633,7 +634,8 @@ void LaplaceSystem<D>::relaxBox(const Vector& b, Vector* xp, const IVec<D>& lo, 
       if ((i + y + z) % 2 != size_t(colour) || !(dr[i] > 0.0f)) continue;
       const size_t il = i == 0 ? nx - 1 : i - 1, ih = i + 1 == nx ? 0 : i + 1;
       const float wl = (i == 0 && !px) ? 0.0f : wa[0][il];
-      xr[i] = (br[i] * inv + neighbourSum<D, double>(s, wa, xr, i, il, ih, wl)) * double(inverse(dr[i]));
+      const double gs = (br[i] * inv + neighbourSum<D, double>(s, wa, xr, i, il, ih, wl)) * double(inverse(dr[i]));
+      xr[i] = omega == 1.0 ? gs : xr[i] + omega * (gs - xr[i]);
     }
   };
   for (int sweep = 0; sweep < sweeps; ++sweep)

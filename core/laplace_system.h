@@ -73,7 +73,8 @@ struct LaplaceSystem {
   }
   // Red-black Gauss-Seidel sweeps on the cells [lo, hi) alone, the others
   // held: a solve's start made consistent with rows that were rewritten.
-  void relaxBox(const Vector& b, Vector* x, const IVec<D>& lo, const IVec<D>& hi, int sweeps) const;
+  // With omega != 1, over-relaxed (SOR: x_i += omega (the sweep's x_i - x_i)).
+  void relaxBox(const Vector& b, Vector* x, const IVec<D>& lo, const IVec<D>& hi, int sweeps, double omega = 1.0) const;
   // Removes the mean over active cells (for singular systems).
   void removeNullSpace(Vector* x) const;
 

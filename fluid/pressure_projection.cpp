@@ -97,9 +97,20 @@ void PressureProjection<D>::rebuild(const IVec<D>& lo, const IVec<D>& hi) {
   updatePressureSystem<D>(&A_, vc_, lo, hi);  // (same shape: the multigrid refers to A_)
   if (solver_ == PressureSolver::ICPCG) mic_ = std::make_unique<MIC0Preconditioner<D>>(A_);
   else multigrid_->refresh(pressureRowsChanged(lo, vc_.cells, -1), pressureRowsChanged(hi, vc_.cells, 1));
-  // Cells the solid covers hold no pressure.
-  for (size_t i = 0; i < phi_.size(); ++i)
-    if (vc_.solid[i] && A_.diag[i] == 0.0f) phi_[i] = 0.0;
+  // Cells the solid covers hold no pressure (those it covered before hold none already).
+  if (!phi_.empty())
+    for (size_t row : rowsOf<D>(vc_.cells, lo, hi))
+      for (int x = lo[0]; x < hi[0]; ++x) {
+        const size_t i = row * size_t(vc_.cells[0]) + size_t(x);
+        if (vc_.solid[i] && A_.diag[i] == 0.0f) phi_[i] = 0.0;
+      }
+  // The next warm start is relaxed over the rewritten rows (project()).
+  const IVec<D> rlo = pressureRowsChanged(lo, vc_.cells, -1), rhi = pressureRowsChanged(hi, vc_.cells, 1);
+  const bool none = movedHi_[0] <= movedLo_[0];
+  for (int a = 0; a < D; ++a) {
+    movedLo_[a] = none ? rlo[a] : std::min(movedLo_[a], rlo[a]);
+    movedHi_[a] = none ? rhi[a] : std::max(movedHi_[a], rhi[a]);
+  }
 }
 
 template <int D>
@@ -175,6 +186,12 @@ SolverResult PressureProjection<D>::project(MacVelocity<D>* u, double dt, double
       ratePrev_[i] = float(rate);
     }, 4096);
   }
+  // The warm start comes from solves before a moving obstacle rewrote the
+  // rows [movedLo_, movedHi_), and its error there is the larger part of
+  // the solve's (the body's cut cells hold nearly all of its residual):
+  // red-black SOR sweeps over those rows first (docs/performance.md).
+  if (solves_ >= 1) A_.relaxBox(workspace_.b, &phi_, movedLo_, movedHi_, relaxation_.sweeps, relaxation_.omega);
+  movedLo_ = movedHi_ = IVec<D>(0);
   w.regenerate = [&](Vector* b) { divergenceTimes(*u, -1.0 / vc_.h, b); };
   SolverResult r;
   if (solver_ == PressureSolver::Multigrid)
@@ -296,6 +313,9 @@ void PressureProjection<D>::load(const StateReader& in) {
   in.get("pressure.last_dt", &lastDt_);
   in.get("pressure.last_density", &lastDensity_);
   in.get("pressure.solves", &solves_);
+  // The checkpoint's run relaxed its rows at its last projection: the
+  // obstacles placed again for the load rewrote none of its next step's.
+  movedLo_ = movedHi_ = IVec<D>(0);
 }
 
 template class PressureProjection<2>;

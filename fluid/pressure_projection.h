@@ -37,6 +37,13 @@ IVec<D> pressureRowsChanged(const IVec<D>& corner, const IVec<D>& cells, int sid
   return k;
 }
 
+// The warm start relaxed over the rows a moving obstacle rewrote, before
+// the solve: red-black SOR sweeps there (0 sweeps: none).
+struct MovedRowsRelaxation {
+  int sweeps = 40;
+  double omega = 1.6;
+};
+
 template <int D>
 class PressureProjection {
  public:
@@ -48,6 +55,7 @@ class PressureProjection {
   // The system again from the constraints (a moving obstacle changed them
   // in the cells [lo, hi)); the warm start stays.
   void rebuild(const IVec<D>& lo, const IVec<D>& hi);
+  void setMovedRowsRelaxation(const MovedRowsRelaxation& r) { relaxation_ = r; }
   // Cell divergence of u (0 on solid cells).
   void divergence(const MacVelocity<D>& u, Vector* div) const;
   // Takes phi of a projection computed elsewhere (the GPU backend) as the
@@ -76,6 +84,8 @@ class PressureProjection {
   PcgWorkspace workspace_;  // its b holds the right-hand side
   double lastDt_ = 0.0, lastDensity_ = 1.0;
   int solves_ = 0;  // projections with dt > 0 since the start, capped at 2
+  IVec<D> movedLo_{0}, movedHi_{0};  // the rows rebuild() rewrote since the last projection
+  MovedRowsRelaxation relaxation_;
 };
 
 }  // namespace morphoflow
