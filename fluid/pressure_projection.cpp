@@ -95,8 +95,11 @@ PressureProjection<D>::PressureProjection(const VelocityConstraints<D>& vc, Pres
 template <int D>
 void PressureProjection<D>::rebuild(const IVec<D>& lo, const IVec<D>& hi) {
   updatePressureSystem<D>(&A_, vc_, lo, hi);  // (same shape: the multigrid refers to A_)
+  // The rows written; the next warm start is relaxed over them (project()), as the viscosity's.
+  movedLo_ = pressureRowsChanged(lo, vc_.cells, -1);
+  movedHi_ = pressureRowsChanged(hi, vc_.cells, 1);
   if (solver_ == PressureSolver::ICPCG) mic_ = std::make_unique<MIC0Preconditioner<D>>(A_);
-  else multigrid_->refresh(pressureRowsChanged(lo, vc_.cells, -1), pressureRowsChanged(hi, vc_.cells, 1));
+  else multigrid_->refresh(movedLo_, movedHi_);
   // Cells the solid covers hold no pressure (those it covered before hold none already).
   if (!phi_.empty())
     for (size_t row : rowsOf<D>(vc_.cells, lo, hi))
@@ -104,13 +107,6 @@ void PressureProjection<D>::rebuild(const IVec<D>& lo, const IVec<D>& hi) {
         const size_t i = row * size_t(vc_.cells[0]) + size_t(x);
         if (vc_.solid[i] && A_.diag[i] == 0.0f) phi_[i] = 0.0;
       }
-  // The next warm start is relaxed over the rewritten rows (project()).
-  const IVec<D> rlo = pressureRowsChanged(lo, vc_.cells, -1), rhi = pressureRowsChanged(hi, vc_.cells, 1);
-  const bool none = movedHi_[0] <= movedLo_[0];
-  for (int a = 0; a < D; ++a) {
-    movedLo_[a] = none ? rlo[a] : std::min(movedLo_[a], rlo[a]);
-    movedHi_[a] = none ? rhi[a] : std::max(movedHi_[a], rhi[a]);
-  }
 }
 
 template <int D>

@@ -84,7 +84,7 @@ class PressureProjection {
   PcgWorkspace workspace_;  // its b holds the right-hand side
   double lastDt_ = 0.0, lastDensity_ = 1.0;
   int solves_ = 0;  // projections with dt > 0 since the start, capped at 2
-  IVec<D> movedLo_{0}, movedHi_{0};  // the rows rebuild() rewrote since the last projection
+  IVec<D> movedLo_{0}, movedHi_{0};  // the rows the last move rewrote, until the next projection
   MovedRowsRelaxation relaxation_;
 };
 
