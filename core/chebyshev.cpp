@@ -164,17 +164,52 @@ Chebyshev<D>::Chebyshev(const LaplaceSystem<D>& A, const ChebyshevLayout& layout
 template <int D>
 void Chebyshev<D>::refresh() {
   const size_t n = A_.size(), nx = size_t(A_.dims[0]), rows = n / nx;
+  // Rows alike in their stored rows (diagonal, c, the weights of their
+  // faces) and domain edges have the same bounds, span and packed
+  // coefficients: each kind is visited once (a box's few, whatever its
+  // size; an obstacle's as many as it has rows).
+  using Key = std::array<uintptr_t, 2 * D + 2>;
+  auto at = [](const float* p) { return reinterpret_cast<uintptr_t>(p); };
+  std::vector<std::pair<Key, size_t>> kinds(rows);
+  parallelFor(
+      rows,
+      [&](size_t row) {
+        const RowStencil<D, float> s = rowStencil<D, float>(A_, zerosOf(), zerosOf(), zerosOf(), row);
+        Key key{at(A_.diag.row(row)), at(A_.c.row(row)), at(A_.w[0].row(row))};
+        uintptr_t edges = 0;
+        size_t rest = row;
+        for (int a = 1; a < D; ++a) {
+          const int k = int(rest % size_t(A_.dims[a]));
+          rest /= size_t(A_.dims[a]);
+          key[size_t(2 * a + 1)] = at(A_.w[a].row(row));
+          key[size_t(2 * a + 2)] = at(s.wlo[a]);
+          edges |= uintptr_t(k == 0) << (2 * a) | uintptr_t(k == A_.dims[a] - 1) << (2 * a + 1);
+        }
+        key[size_t(2 * D + 1)] = edges;
+        kinds[row] = {key, row};
+      },
+      256);
+  std::sort(kinds.begin(), kinds.end());
+  std::vector<size_t> first;  // where each kind's rows begin in `kinds`
+  for (size_t j = 0; j < rows; ++j)
+    if (j == 0 || kinds[j].first != kinds[j - 1].first) first.push_back(j);
+  first.push_back(rows);
+  const size_t count = first.size() - 1;
+  // The coefficients of the cells outside each kind's uniform span, packed.
+  std::vector<size_t> start(count + 1, 0);
+  for (size_t g = 0; g < count; ++g) {
+    const auto& span = A_.sweepSpan(kinds[first[g]].second);
+    start[g + 1] = start[g] + (nx - (span.hi - span.lo)) * kPacked<D>;
+  }
+  packed_.resize(start[count]);
+  if (packed_.capacity() > 2 * packed_.size()) packed_.shrink_to_fit();
+  packedStart_.resize(rows);
   // rho = max (diag - c) / diag (diag sums c and the cell's face weights),
-  // and the diagonal's range: maxima, so any order, over the distinct pairs
-  // of stored rows (a box's few, whatever its size; an obstacle's as many
-  // as it has rows).
-  std::vector<std::pair<const float*, const float*>> pairs(rows);
-  for (size_t row = 0; row < rows; ++row) pairs[row] = {A_.diag.row(row), A_.c.row(row)};
-  std::sort(pairs.begin(), pairs.end());
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-  std::vector<std::array<double, 3>> m(pairs.size());
-  parallelFor(pairs.size(), [&](size_t p) {
-    const auto [d, c] = pairs[p];
+  // and the diagonal's range: maxima, so any order.
+  std::vector<std::array<double, 3>> m(count);
+  parallelFor(count, [&](size_t g) {
+    const size_t row = kinds[first[g]].second;
+    const float *d = A_.diag.row(row), *c = A_.c.row(row);
     std::array<double, 3> r{0.0, 0.0, 0.0};  // rho, the largest diagonal, 1 / the smallest
     for (size_t i = 0; i < nx; ++i) {
       const double di = d[i];
@@ -182,7 +217,9 @@ void Chebyshev<D>::refresh() {
       r[1] = std::max(r[1], di);
       r[2] = std::max(r[2], di > 0 ? 1.0 / di : 0.0);
     }
-    m[p] = r;
+    m[g] = r;
+    packRow(row, packed_.data() + start[g]);
+    for (size_t j = first[g]; j < first[g + 1]; ++j) packedStart_[kinds[j].second] = start[g];
   });
   std::array<double, 3> most{0.0, 0.0, 0.0};
   for (const auto& r : m)
@@ -197,31 +234,6 @@ void Chebyshev<D>::refresh() {
   cyclic_ = layout_.cyclic && nx >= 2;
   for (int a = 0; a < D; ++a) cyclic_ = cyclic_ && !(A_.periodic[a] && A_.dims[a] % 2);
   hx_ = (nx + 1) / 2;
-  // The coefficients of the cells outside each row's uniform span, packed.
-  packedStart_.assign(rows + 1, 0);
-  for (size_t row = 0; row < rows; ++row) {
-    const auto& span = A_.sweepSpan(row);
-    packedStart_[row + 1] = packedStart_[row] + (nx - (span.hi - span.lo)) * kPacked<D>;
-  }
-  packed_.resize(packedStart_[rows]);
-  parallelForRows<D>(A_.dims, [&](size_t row) {
-    const RowStencil<D, float> s = rowStencil<D, float>(A_, zerosOf(), zerosOf(), zerosOf(), row);
-    const auto& span = A_.sweepSpan(row);
-    float* out = packed_.data() + packedStart_[row];
-    const float *dr = A_.diag.row(row), *w0 = A_.w[0].row(row);
-    for (size_t i = 0; i < nx; ++i) {
-      if (i >= span.lo && i < span.hi) continue;
-      const size_t il = i == 0 ? nx - 1 : i - 1;
-      *out++ = LaplaceSystem<D>::inverse(dr[i]);
-      *out++ = w0[i];
-      *out++ = (i == 0 && !A_.periodic[0]) ? 0.0f : w0[il];
-      for (int a = 1; a < D; ++a) {
-        *out++ = A_.w[a].row(row)[i];
-        *out++ = s.wlo[a][i];
-      }
-    }
-  });
-  keepDistinctSegments(&packed_, &packedStart_);  // rows alike (a box's) share their coefficients
   // w_1 = 1, w_2 = 1 / (1 - rho^2 / 2), w_k = 1 / (1 - rho^2 w_{k-1} / 4).
   omega_.assign(2, 1.0f);
   double w = 1.0;
@@ -229,6 +241,27 @@ void Chebyshev<D>::refresh() {
     w = k == 2 ? 1.0 / (1.0 - rho_ * rho_ / 2.0) : 1.0 / (1.0 - rho_ * rho_ * w / 4.0);
     omega_.push_back(float(w));
     if (k > 64 && float(w) == omega_[size_t(k) - 1]) break;  // converged to its limit
+  }
+}
+
+// Row `row`'s coefficients outside its uniform span: per cell 1 / diag and
+// the face weights in neighbourSum's order.
+template <int D>
+void Chebyshev<D>::packRow(size_t row, float* out) const {
+  const size_t nx = size_t(A_.dims[0]);
+  const RowStencil<D, float> s = rowStencil<D, float>(A_, zerosOf(), zerosOf(), zerosOf(), row);
+  const auto& span = A_.sweepSpan(row);
+  const float *dr = A_.diag.row(row), *w0 = A_.w[0].row(row);
+  for (size_t i = 0; i < nx; ++i) {
+    if (i >= span.lo && i < span.hi) continue;
+    const size_t il = i == 0 ? nx - 1 : i - 1;
+    *out++ = LaplaceSystem<D>::inverse(dr[i]);
+    *out++ = w0[i];
+    *out++ = (i == 0 && !A_.periodic[0]) ? 0.0f : w0[il];
+    for (int a = 1; a < D; ++a) {
+      *out++ = A_.w[a].row(row)[i];
+      *out++ = s.wlo[a][i];
+    }
   }
 }
 

@@ -123,10 +123,11 @@ class Chebyshev {
   const float* zerosOf() const { return zeros_.data(); }
   // Per row, from packedStart_[row]: the coefficients of its cells outside
   // the uniform span (1 / diag, then the face weights), 2D + 1 floats each;
-  // rows with the same coefficients share them.
+  // rows with the same stored rows share them.
   std::vector<size_t> packedStart_;
   std::vector<float> packed_;
   const float* packedRow(size_t row) const { return packed_.data() + packedStart_[row]; }
+  void packRow(size_t row, float* out) const;
   std::vector<float> omega_;  // omega_[k] of step k
   std::vector<double> planeSquares_;
   double rscale_ = 1.0;

@@ -225,16 +225,10 @@ void LaplaceSystem<D>::finalize() {
       if (last && !periodic[a] && w[a].dense()) std::fill_n(w[a].mutableRow(row), nx, 0.0f);
     }
   });
-  // diag_i = c_i + sum over the 2D faces of w (the low faces' weights are the
-  // row's own for x, the neighbour rows' for y and z; wrapped, or 0 beyond a
-  // non-periodic edge: finalize zeroed those).
   // Rows alike in c and their weights (a box's, whatever its size) share one
   // computed row.
   c.compact();
   for (int a = 0; a < D; ++a) w[a].compact();
-  auto stencil = [&](size_t row) {
-    return rowStencil<D>(*this, zerosX_.data(), zerosX_.data(), zerosW_.data(), row);
-  };
   diag = RowField<D>::template fromSources<2 * D>(
       dims,
       [&](size_t row) {
@@ -243,105 +237,177 @@ void LaplaceSystem<D>::finalize() {
         for (int a = 1; a < D; ++a) src[size_t(2 * a)] = w[a].row(row), src[size_t(2 * a + 1)] = s.wlo[a];
         return src;
       },
-      [&](size_t row, float* d) {
-        const RowStencil<D, double> s = stencil(row);
-        const float* cr = c.row(row);
-        const float* w0 = w[0].row(row);
-        for (size_t i = 0; i < nx; ++i) {
-          float v = cr[i];
-          v += w0[i] + w0[i == 0 ? nx - 1 : i - 1];
-          for (int a = 1; a < D; ++a) v += w[a].row(row)[i] + s.wlo[a][i];
-          d[i] = v;
-        }
-      });
-  // The longest run of interior cells per row that are uniform among
-  // themselves (one weight wu > 0 on every face, one c, hence one diagonal).
+      [&](size_t row, float* d) { diagRow(row, d); });
   // Rows alike in their stored rows and domain edges (a box's, whatever its
   // size) share one computed span.
-  std::map<std::array<uintptr_t, 2 * D + 1>, uint32_t> ids;
-  std::vector<size_t> first;
-  std::vector<uint32_t> idOf(rows);
-  for (size_t row = 0; row < rows; ++row) {
-    const RowStencil<D, double> s = stencil(row);
-    std::array<uintptr_t, 2 * D + 1> key{reinterpret_cast<uintptr_t>(c.row(row)),
-                                         reinterpret_cast<uintptr_t>(w[0].row(row))};
-    uintptr_t edges = 0;
-    const int k[3] = {0, int(row % size_t(dims[1])), D == 3 ? int(row / size_t(dims[1])) : 0};
-    for (int a = 1; a < D; ++a) {
-      key[size_t(2 * a)] = reinterpret_cast<uintptr_t>(w[a].row(row));
-      key[size_t(2 * a + 1)] = reinterpret_cast<uintptr_t>(s.wlo[a]);
-      edges |= uintptr_t(k[a] == 0 && !periodic[a]) << (2 * a);
-      edges |= uintptr_t(k[a] == dims[a] - 1 && !periodic[a]) << (2 * a + 1);
-    }
-    key[size_t(2 * D)] = edges;
-    const auto [it, added] = ids.emplace(key, uint32_t(first.size()));
-    if (added) first.push_back(row);
-    idOf[row] = it->second;
-  }
-  std::vector<Span> uniformOf(first.size()), sweepOf(first.size());
-  parallelFor(first.size(), [&](size_t id) {
-    const size_t row = first[id];
-    if (nx < 3) return;
-    const RowStencil<D, double> s = stencil(row);
-    const float* cr = c.row(row);
-    const float* w0 = w[0].row(row);
-    // The smoother also takes a face across a non-periodic domain edge:
-    // there the general sum adds 0 * 0 from the row of zeros, and the
-    // uniform one wu times that row's 0 (bitwise the same; not so A x, whose
-    // face sum would add 0 (x_i - 0) against wu (x_i - 0)).
-    bool edgeLo[D] = {}, edgeHi[D] = {};
-    const int k[3] = {0, int(row % size_t(dims[1])), D == 3 ? int(row / size_t(dims[1])) : 0};
-    for (int a = 1; a < D; ++a) {
-      edgeLo[a] = k[a] == 0 && !periodic[a];
-      edgeHi[a] = k[a] == dims[a] - 1 && !periodic[a];
-    }
-    // Every face of cell i weighs wu (with `edges`, a face across a
-    // non-periodic domain edge may weigh 0 instead).
-    auto uniform = [&](size_t i, float wu, bool edges) {
-      if (w0[i] != wu || w0[i - 1] != wu) return false;
-      for (int a = 1; a < D; ++a) {
-        const float hi = w[a].row(row)[i];
-        if (!(hi == wu || (edges && edgeHi[a] && hi == 0.0f)) || !(s.wlo[a][i] == wu || (edges && edgeLo[a])))
-          return false;
-      }
-      return true;
-    };
-    auto longest = [&](bool edges) -> Span {
-      Span best;
-      for (size_t i = 1; i + 1 < nx;) {
-        const float wu = w0[i];
-        if (!(wu > 0.0f) || !uniform(i, wu, edges)) {
-          ++i;
-          continue;
-        }
-        size_t e = i + 1;
-        while (e + 1 < nx && uniform(e, wu, edges) && cr[e] == cr[i]) ++e;
-        if (e - i > best.hi - best.lo) best = {uint32_t(i), uint32_t(e), wu};
-        i = e;
-      }
-      return best;
-    };
-    uniformOf[id] = longest(false);
-    sweepOf[id] = longest(true);
-  });
+  std::vector<size_t> all(rows);
+  for (size_t row = 0; row < rows; ++row) all[row] = row;
   uniformSpan_.resize(rows);
   sweepSpan_.resize(rows);
-  for (size_t row = 0; row < rows; ++row)
-    uniformSpan_[row] = uniformOf[idOf[row]], sweepSpan_[row] = sweepOf[idOf[row]];
-  // The active cells and whether any c is positive, counted once per stored row.
-  auto positives = [&](const RowField<D>& f) {
-    std::map<const float*, size_t> counted;
-    size_t total = 0;
+  findSpans(all);
+  // The active cells and the positive c, counted once per stored row.
+  auto positives = [&](const RowField<D>& f, std::vector<uint32_t>* perRow) {
+    std::map<const float*, uint32_t> counted;
+    perRow->resize(rows);
     for (size_t row = 0; row < rows; ++row) {
       const float* r = f.row(row);
       auto [it, added] = counted.emplace(r, 0);
-      if (added) it->second = size_t(std::count_if(r, r + nx, [](float v) { return v > 0; }));
-      total += it->second;
+      if (added) it->second = positiveCount(r);
+      (*perRow)[row] = it->second;
     }
-    return total;
   };
-  active_ = positives(diag);
-  singular_ = positives(c) == 0;
+  positives(diag, &activeOf_);
+  positives(c, &positiveCOf_);
+  countActive();
+}
+
+template <int D>
+void LaplaceSystem<D>::finalizeRows(const IVec<D>& lo, const IVec<D>& hi) {
+  bool compact = !c.dense() && !diag.dense() && !activeOf_.empty();
+  for (int a = 0; a < D; ++a) compact = compact && !w[a].dense();
+  if (!compact) return finalize();  // (written in place: the edges' zeros and the compaction are finalize's)
+  const std::vector<size_t> rows = rowsReading(lo, hi);
+  rewriteRows<D, 1>({&diag}, rows, [&](size_t row, const std::array<float*, 1>& d) { diagRow(row, d[0]); });
+  findSpans(rows);
+  parallelFor(rows.size(), [&](size_t k) {
+    activeOf_[rows[k]] = positiveCount(diag.row(rows[k]));
+    positiveCOf_[rows[k]] = positiveCount(c.row(rows[k]));
+  });
+  countActive();
+}
+
+template <int D>
+std::vector<size_t> LaplaceSystem<D>::rowsReading(const IVec<D>& lo, const IVec<D>& hi) const {
+  std::vector<size_t> rows = rowsOf<D>(dims, lo, hi);
+  const size_t own = rows.size();
+  size_t stride = 1;  // rows between neighbours along axis a
+  for (int a = 1; a < D; ++a) {
+    for (size_t k = 0; k < own; ++k) {
+      const int at = int((rows[k] / stride) % size_t(dims[a]));
+      if (at + 1 < dims[a]) rows.push_back(rows[k] + stride);
+      else if (periodic[a]) rows.push_back(rows[k] - size_t(dims[a] - 1) * stride);
+    }
+    stride *= size_t(dims[a]);
+  }
+  std::sort(rows.begin(), rows.end());
+  rows.erase(std::unique(rows.begin(), rows.end()), rows.end());
+  return rows;
+}
+
+template <int D>
+RowStencil<D, double> LaplaceSystem<D>::stencil(size_t row) const {
+  return rowStencil<D>(*this, zerosX_.data(), zerosX_.data(), zerosW_.data(), row);
+}
+
+// diag_i = c_i + sum over the 2D faces of w (the low faces' weights are the
+// row's own for x, the neighbour rows' for y and z; wrapped, or 0 beyond a
+// non-periodic edge: finalize zeroed those).
+template <int D>
+void LaplaceSystem<D>::diagRow(size_t row, float* d) const {
+  const size_t nx = size_t(dims[0]);
+  const RowStencil<D, double> s = stencil(row);
+  const float* cr = c.row(row);
+  const float* w0 = w[0].row(row);
+  for (size_t i = 0; i < nx; ++i) {
+    float v = cr[i];
+    v += w0[i] + w0[i == 0 ? nx - 1 : i - 1];
+    for (int a = 1; a < D; ++a) v += w[a].row(row)[i] + s.wlo[a][i];
+    d[i] = v;
+  }
+}
+
+// The longest run of interior cells of a row that are uniform among
+// themselves (one weight wu > 0 on every face, one c, hence one diagonal).
+template <int D>
+typename LaplaceSystem<D>::Span LaplaceSystem<D>::longestSpan(size_t row, bool edges) const {
+  const size_t nx = size_t(dims[0]);
+  if (nx < 3) return Span{};
+  const RowStencil<D, double> s = stencil(row);
+  const float* cr = c.row(row);
+  const float* w0 = w[0].row(row);
+  // The smoother also takes a face across a non-periodic domain edge:
+  // there the general sum adds 0 * 0 from the row of zeros, and the
+  // uniform one wu times that row's 0 (bitwise the same; not so A x, whose
+  // face sum would add 0 (x_i - 0) against wu (x_i - 0)).
+  bool edgeLo[D] = {}, edgeHi[D] = {};
+  const int k[3] = {0, int(row % size_t(dims[1])), D == 3 ? int(row / size_t(dims[1])) : 0};
+  for (int a = 1; a < D; ++a) {
+    edgeLo[a] = k[a] == 0 && !periodic[a];
+    edgeHi[a] = k[a] == dims[a] - 1 && !periodic[a];
+  }
+  // Every face of cell i weighs wu (with `edges`, a face across a
+  // non-periodic domain edge may weigh 0 instead).
+  auto uniform = [&](size_t i, float wu) {
+    if (w0[i] != wu || w0[i - 1] != wu) return false;
+    for (int a = 1; a < D; ++a) {
+      const float hi = w[a].row(row)[i];
+      if (!(hi == wu || (edges && edgeHi[a] && hi == 0.0f)) || !(s.wlo[a][i] == wu || (edges && edgeLo[a])))
+        return false;
+    }
+    return true;
+  };
+  Span best;
+  for (size_t i = 1; i + 1 < nx;) {
+    const float wu = w0[i];
+    if (!(wu > 0.0f) || !uniform(i, wu)) {
+      ++i;
+      continue;
+    }
+    size_t e = i + 1;
+    while (e + 1 < nx && uniform(e, wu) && cr[e] == cr[i]) ++e;
+    if (e - i > best.hi - best.lo) best = {uint32_t(i), uint32_t(e), wu};
+    i = e;
+  }
+  return best;
+}
+
+// The spans of `rows` (ascending): once per set of rows alike in their
+// stored rows and domain edges.
+template <int D>
+void LaplaceSystem<D>::findSpans(const std::vector<size_t>& rows) {
+  using Key = std::array<uintptr_t, 2 * D + 1>;
+  std::vector<std::pair<Key, size_t>> keys(rows.size());
+  parallelFor(
+      rows.size(),
+      [&](size_t j) {
+        const size_t row = rows[j];
+        const RowStencil<D, double> s = stencil(row);
+        Key key{reinterpret_cast<uintptr_t>(c.row(row)), reinterpret_cast<uintptr_t>(w[0].row(row))};
+        uintptr_t edges = 0;
+        const int k[3] = {0, int(row % size_t(dims[1])), D == 3 ? int(row / size_t(dims[1])) : 0};
+        for (int a = 1; a < D; ++a) {
+          key[size_t(2 * a)] = reinterpret_cast<uintptr_t>(w[a].row(row));
+          key[size_t(2 * a + 1)] = reinterpret_cast<uintptr_t>(s.wlo[a]);
+          edges |= uintptr_t(k[a] == 0 && !periodic[a]) << (2 * a);
+          edges |= uintptr_t(k[a] == dims[a] - 1 && !periodic[a]) << (2 * a + 1);
+        }
+        key[size_t(2 * D)] = edges;
+        keys[j] = {key, row};
+      },
+      256);
+  std::sort(keys.begin(), keys.end());
+  std::vector<size_t> first;  // the first of each run of equal keys
+  for (size_t j = 0; j < keys.size(); ++j)
+    if (j == 0 || keys[j].first != keys[j - 1].first) first.push_back(j);
+  parallelFor(first.size(), [&](size_t g) {
+    const size_t row = keys[first[g]].second;
+    const Span uniform = longestSpan(row, false), sweep = longestSpan(row, true);
+    const size_t end = g + 1 < first.size() ? first[g + 1] : keys.size();
+    for (size_t j = first[g]; j < end; ++j) uniformSpan_[keys[j].second] = uniform, sweepSpan_[keys[j].second] = sweep;
+  });
+}
+
+template <int D>
+uint32_t LaplaceSystem<D>::positiveCount(const float* row) const {
+  return uint32_t(std::count_if(row, row + dims[0], [](float v) { return v > 0; }));
+}
+
+template <int D>
+void LaplaceSystem<D>::countActive() {
+  active_ = 0;
+  size_t positiveC = 0;
+  for (size_t row = 0; row < activeOf_.size(); ++row) active_ += activeOf_[row], positiveC += positiveCOf_[row];
+  singular_ = positiveC == 0;
 }
 
 template <int D>

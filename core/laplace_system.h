@@ -21,6 +21,9 @@ namespace morphoflow {
 
 using Vector = std::vector<double>;
 
+template <int D, class T>
+struct RowStencil;  // core/row_stencil.h
+
 template <int D>
 struct LaplaceSystem {
   IVec<D> dims{0};
@@ -40,6 +43,14 @@ struct LaplaceSystem {
   // compacts the fields. Call after filling c and w (a field already
   // compacted by an earlier finalize() may stay so).
   void finalize();
+  // finalize() on the rows of the cells [lo, hi), whose c and w were written
+  // again in place (compact: rewriteRows), and on the rows whose diagonal
+  // reads their weights: the diagonal, spans and counts a whole finalize()
+  // gives, without a pass over the other rows.
+  void finalizeRows(const IVec<D>& lo, const IVec<D>& hi);
+  // The rows of the cells [lo, hi) and the next along each axis beyond x
+  // (a cell's diagonal reads the weights of the faces below it), ascending.
+  std::vector<size_t> rowsReading(const IVec<D>& lo, const IVec<D>& hi) const;
   // True when no c_i > 0: constants are then in the null space, and solvers
   // work on mean-free vectors.
   bool singular() const { return singular_; }
@@ -111,9 +122,16 @@ struct LaplaceSystem {
   // An odd periodic axis beyond x couples rows of one colour across the
   // wrap: red-black sweeps then take the rows one by one (deterministic, race-free).
   bool coloursMeetAcrossRows() const;
+  RowStencil<D, double> stencil(size_t row) const;  // x and the weights beyond an edge: zeros
+  void diagRow(size_t row, float* d) const;
+  Span longestSpan(size_t row, bool edges) const;
+  void findSpans(const std::vector<size_t>& rows);
+  uint32_t positiveCount(const float* row) const;
+  void countActive();  // active_ and singular_ from the rows' counts
 
   bool singular_ = false;
   size_t active_ = 0;
+  std::vector<uint32_t> activeOf_, positiveCOf_;  // per row: active cells, and cells with c > 0
   Vector zerosX_;               // a row of zeros: the neighbour beyond a wall
   std::vector<float> zerosW_;   // (also the float row of zeros)
   std::vector<Span> uniformSpan_;

@@ -107,7 +107,7 @@ void coarsenRegion(const LaplaceSystem<D>& F, LaplaceSystem<D>* Cp, const IVec<D
       for (int a = 0; a < D; ++a) v[size_t(a)][k[0]] = k[a] == C.dims[a] - 1 && !C.periodic[a] ? 0.0f : w[a];
     }
   });
-  C.finalize();
+  C.finalizeRows(clo, chi);
 }
 
 template <int D>

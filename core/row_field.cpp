@@ -5,46 +5,73 @@
 #include <cstring>
 #include <functional>
 #include <string_view>
-#include <unordered_map>
 
 #include "core/parallel.h"
 
 namespace morphoflow {
 
-bool keepDistinctSegments(std::vector<float>* values, std::vector<size_t>* offset) {
-  std::vector<float>& v = *values;
+size_t keepDistinctSegments(float* v, std::vector<size_t>* offset) {
   std::vector<size_t>& off = *offset;
   const size_t rows = off.size() - 1;
   auto bytes = [&](size_t r) { return (off[r + 1] - off[r]) * sizeof(float); };
-  std::vector<size_t> hash(rows);
-  parallelFor(rows, [&](size_t r) {
-    hash[r] = std::hash<std::string_view>{}({reinterpret_cast<const char*>(v.data() + off[r]), bytes(r)});
-  }, 64);
-  // Serial, in order: which segment each repeats is the same for any thread count.
-  std::unordered_map<size_t, std::vector<size_t>> kept;  // hash -> segments kept
-  std::vector<size_t> to(rows + 1), keep;
+  // Segments grouped by their hash (in order within a group): each takes the
+  // first earlier one of its group that it equals, the same for any thread count.
+  std::vector<std::pair<size_t, size_t>> byHash(rows);  // (hash, segment)
+  parallelFor(
+      rows,
+      [&](size_t r) {
+        byHash[r] = {std::hash<std::string_view>{}({reinterpret_cast<const char*>(v + off[r]), bytes(r)}), r};
+      },
+      64);
+  std::sort(byHash.begin(), byHash.end());
+  std::vector<size_t> same(rows);  // the segment each repeats (itself where none)
+  for (size_t g = 0; g < rows;) {
+    size_t e = g + 1;
+    while (e < rows && byHash[e].first == byHash[g].first) ++e;
+    for (size_t j = g; j < e; ++j) {
+      const size_t r = byHash[j].second;
+      same[r] = r;
+      for (size_t m = g; m < j; ++m) {
+        const size_t k = byHash[m].second;
+        if (same[k] == k && bytes(k) == bytes(r) && std::memcmp(v + off[k], v + off[r], bytes(r)) == 0) {
+          same[r] = k;
+          break;
+        }
+      }
+    }
+    g = e;
+  }
+  std::vector<size_t> to(rows + 1);
   size_t end = 0;
+  bool repeated = false;
   for (size_t r = 0; r < rows; ++r) {
-    std::vector<size_t>& same = kept[hash[r]];
-    auto match = std::find_if(same.begin(), same.end(), [&](size_t k) {
-      return bytes(k) == bytes(r) && std::memcmp(v.data() + off[k], v.data() + off[r], bytes(r)) == 0;
-    });
-    if (match != same.end()) {
-      to[r] = to[*match];
+    if (same[r] != r) {
+      to[r] = to[same[r]];
+      repeated = true;
       continue;
     }
-    same.push_back(r);
-    keep.push_back(r);
     to[r] = end;
+    // Kept segments move down (never up), in order: in place.
+    if (end != off[r]) std::memmove(v + end, v + off[r], bytes(r));
     end += off[r + 1] - off[r];
   }
   to[rows] = end;
-  if (keep.size() == rows) return false;
-  // Kept segments move down (never up), in order: in place.
-  for (size_t r : keep) std::memmove(v.data() + to[r], v.data() + off[r], bytes(r));
-  v.resize(end);
-  v.shrink_to_fit();
-  off.swap(to);
+  if (repeated) off.swap(to);
+  return end;
+}
+
+float* rowScratch(size_t n) {
+  static thread_local std::vector<float> scratch;
+  if (scratch.size() < n) scratch.resize(n);
+  return scratch.data();
+}
+
+bool keepDistinctSegments(std::vector<float>* values, std::vector<size_t>* offset) {
+  const size_t before = values->size();
+  const size_t end = keepDistinctSegments(values->data(), offset);
+  if (end == before) return false;
+  values->resize(end);
+  values->shrink_to_fit();
   return true;
 }
 
@@ -66,21 +93,21 @@ void RowField<D>::densify() {
 }
 
 template <int D>
-void RowField<D>::storeRows(const std::vector<size_t>& rows, std::vector<float>* fresh) {
+void RowField<D>::storeRows(const std::vector<size_t>& rows, float* fresh) {
   requireCompact();
-  std::vector<float>& f = *fresh;
-  // The rows that changed, their new values gathered and kept once each.
+  // The rows that changed, moved to the front of fresh and kept once each.
   std::vector<size_t> changed;
-  for (size_t k = 0; k < rows.size(); ++k)
-    if (std::memcmp(f.data() + k * nx_, row(rows[k]), nx_ * sizeof(float)) != 0) changed.push_back(k);
+  for (size_t k = 0; k < rows.size(); ++k) {
+    if (std::memcmp(fresh + k * nx_, row(rows[k]), nx_ * sizeof(float)) == 0) continue;
+    if (changed.size() != k) std::memcpy(fresh + changed.size() * nx_, fresh + k * nx_, nx_ * sizeof(float));
+    changed.push_back(k);
+  }
   if (changed.empty()) return;
-  std::vector<float> block(changed.size() * nx_);
-  for (size_t j = 0; j < changed.size(); ++j) std::copy_n(f.data() + changed[j] * nx_, nx_, block.data() + j * nx_);
   std::vector<size_t> off(changed.size() + 1);
   for (size_t j = 0; j < off.size(); ++j) off[j] = j * nx_;
-  keepDistinctSegments(&block, &off);
+  const size_t end = keepDistinctSegments(fresh, &off);
   const size_t base = pool_.size();
-  pool_.insert(pool_.end(), block.begin(), block.end());
+  pool_.insert(pool_.end(), fresh, fresh + end);
   for (size_t j = 0; j < changed.size(); ++j) rowOf_[rows[changed[j]]] = uint32_t((base + off[j]) / nx_);
   // Stored rows no row uses: dropped once they are most of the pool.
   std::vector<uint32_t> to(storedRows(), UINT32_MAX);

@@ -27,6 +27,8 @@ namespace morphoflow {
 // shortened *values (compared bitwise; the first of equal segments is kept,
 // independent of the thread count). Returns whether anything repeated.
 bool keepDistinctSegments(std::vector<float>* values, std::vector<size_t>* offset);
+// The same in place on the segments at `values`; returns where the kept ones end.
+size_t keepDistinctSegments(float* values, std::vector<size_t>* offset);
 
 template <int D>
 class RowField {
@@ -96,11 +98,12 @@ class RowField {
   // Back to one row per row, writable.
   void densify();
   // Rows `rows` of a compact field take new values, fresh[k nx ..] for rows[k]
-  // (rewriteRows() below): a row that comes out as it was keeps its stored
-  // row, equal new rows share one; stored rows no row uses any more are
-  // dropped once they are most of them. The values read are the dense
-  // field's after the same writes, whatever rows end up shared.
-  void storeRows(const std::vector<size_t>& rows, std::vector<float>* fresh);
+  // (rewriteRows() below; fresh is scratch, overwritten): a row that comes
+  // out as it was keeps its stored row, equal new rows share one; stored
+  // rows no row uses any more are dropped once they are most of them. The
+  // values read are the dense field's after the same writes, whatever rows
+  // end up shared.
+  void storeRows(const std::vector<size_t>& rows, float* fresh);
   // v -> f(v) on every value, applied to the stored rows only.
   template <class F>
   void transform(F&& f) {
@@ -157,6 +160,11 @@ inline std::pair<size_t, size_t> rowSpan(const std::vector<size_t>& rows) {
   return rows.empty() ? std::pair<size_t, size_t>{0, 0} : std::pair<size_t, size_t>{rows.front(), rows.back() + 1};
 }
 
+// At least n floats of the calling thread's scratch for rewriteRows, kept
+// from call to call (a moving obstacle's rows, every step): no allocation,
+// no zeros written first. Valid until the thread's next call.
+float* rowScratch(size_t n);
+
 // Rows `rows` of fields of one shape written again: write(r, v) changes
 // row r's values of field q in v[q] (given as they are). A dense field is
 // written in place; a compact one stays compact (RowField::storeRows), so
@@ -164,24 +172,27 @@ inline std::pair<size_t, size_t> rowSpan(const std::vector<size_t>& rows) {
 // written in parallel, each once.
 template <int D, size_t K, class Write>
 void rewriteRows(const std::array<RowField<D>*, K>& fields, const std::vector<size_t>& rows, Write&& write) {
-  const size_t nx = size_t(fields[0]->dim(0));
-  std::array<std::vector<float>, K> fresh;
-  for (size_t q = 0; q < K; ++q)
-    if (!fields[q]->dense()) fresh[q].resize(rows.size() * nx);
+  const size_t nx = size_t(fields[0]->dim(0)), block = rows.size() * nx;
+  size_t compact = 0;  // (dense fields are written in place)
+  for (size_t q = 0; q < K; ++q) compact += fields[q]->dense() ? 0 : 1;
+  float* const scratch = rowScratch(compact * block);
+  std::array<float*, K> at{};  // each compact field's block of scratch
+  for (size_t q = 0, j = 0; q < K; ++q)
+    if (!fields[q]->dense()) at[q] = scratch + block * j++;
   parallelFor(rows.size(), [&](size_t k) {
     std::array<float*, K> v;
     for (size_t q = 0; q < K; ++q) {
       if (fields[q]->dense()) {
         v[q] = fields[q]->mutableRow(rows[k]);
       } else {
-        v[q] = fresh[q].data() + k * nx;
+        v[q] = at[q] + k * nx;
         std::copy_n(fields[q]->row(rows[k]), nx, v[q]);
       }
     }
     write(rows[k], v);
   });
   for (size_t q = 0; q < K; ++q)
-    if (!fields[q]->dense()) fields[q]->storeRows(rows, &fresh[q]);
+    if (!fields[q]->dense()) fields[q]->storeRows(rows, at[q]);
 }
 
 }  // namespace morphoflow

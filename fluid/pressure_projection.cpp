@@ -76,7 +76,7 @@ void updatePressureSystem(LaplaceSystem<D>* A, const VelocityConstraints<D>& vc,
       for (int a = 0; a < D; ++a) v[size_t(a)][k[0]] = w[a];
     }
   });
-  A->finalize();
+  A->finalizeRows(clo, chi);
 }
 template void updatePressureSystem<2>(LaplaceSystem<2>*, const VelocityConstraints<2>&, const IVec<2>&, const IVec<2>&);
 template void updatePressureSystem<3>(LaplaceSystem<3>*, const VelocityConstraints<3>&, const IVec<3>&, const IVec<3>&);

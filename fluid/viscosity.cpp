@@ -144,22 +144,41 @@ void updateViscousSystem(ViscousSystem<D>* C, const VelocityConstraints<D>& vc, 
 
 template <int D>
 void ViscositySolver<D>::rebuild(const IVec<D>& lo, const IVec<D>& hi) {
-  // (the solvers refer to C.A, whose coefficients change, not its shape: they refresh at the next solve)
+  // (the solvers refer to C.A, whose coefficients change, not its shape)
   for (int a = 0; a < D; ++a) {
     Component& C = comp_[size_t(a)];
     // (the last move's rows: a resumed run places its obstacles at its
     // time before the step, and relaxes what an uninterrupted one does)
     updateViscousSystem<D>(&C, vc_, a, lo, hi, &C.movedLo, &C.movedHi);
+    if (s_ < 0.0) continue;  // (no rate yet: the whole system follows at the first solve)
+    C.setRateRows(C.movedLo, C.movedHi);
+    refreshSolvers(C, &C.movedLo, &C.movedHi);
   }
-  s_ = -1.0;
 }
+
+namespace {
+// c of an unknown at rate s from its boundary terms (-1: prescribed, inactive).
+inline float rateTerm(double s, float cBoundary) {
+  return cBoundary < 0.0f ? 0.0f : float(1.0 / s + double(cBoundary));
+}
+}  // namespace
 
 template <int D>
 void ViscousSystem<D>::setRate(double s) {
   A.scale = s;
   A.c = cBoundary;  // its rows, mapped: no full-size field
-  A.c.transform([s](float cb) { return cb < 0.0f ? 0.0f : float(1.0 / s + double(cb)); });
+  A.c.transform([s](float cb) { return rateTerm(s, cb); });
   A.finalize();
+}
+
+template <int D>
+void ViscousSystem<D>::setRateRows(const IVec<D>& lo, const IVec<D>& hi) {
+  const double s = A.scale;
+  rewriteRows<D, 1>({&A.c}, rowsOf<D>(dims, lo, hi), [&](size_t row, const std::array<float*, 1>& c) {
+    const float* cb = cBoundary.row(row);
+    for (int x = 0; x < dims[0]; ++x) c[0][x] = rateTerm(s, cb[x]);
+  });
+  A.finalizeRows(lo, hi);
 }
 
 template <int D>
@@ -244,6 +263,16 @@ SolverResult ViscositySolver<D>::diffuse(MacVelocity<D>* u, double nu, double dt
 }
 
 template <int D>
+void ViscositySolver<D>::refreshSolvers(Component& C, const IVec<D>* lo, const IVec<D>* hi) {
+  if (!C.chebyshev) C.chebyshev = std::make_unique<Chebyshev<D>>(C.A, ChebyshevLayout{}, &chebyshevWork_);
+  else C.chebyshev->refresh();
+  if (C.chebyshev->quick()) C.multigrid.reset();
+  else if (!C.multigrid) C.multigrid = std::make_unique<Multigrid<D>>(C.A, kViscosityCycle);
+  else if (lo) C.multigrid->refresh(*lo, *hi);
+  else C.multigrid->refresh();
+}
+
+template <int D>
 SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
   SolverResult result;
   result.converged = true;
@@ -254,16 +283,7 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
     Component& C = comp_[size_t(a)];
     if (s != s_) {  // A = s (c + sum w (x_i - x_j)), c = 1/s + boundary terms
       C.setRate(s);
-      if (C.chebyshev)
-        C.chebyshev->refresh();
-      else
-        C.chebyshev = std::make_unique<Chebyshev<D>>(C.A, ChebyshevLayout{}, &chebyshevWork_);
-      if (C.chebyshev->quick())
-        C.multigrid.reset();
-      else if (C.multigrid)
-        C.multigrid->refresh();
-      else
-        C.multigrid = std::make_unique<Multigrid<D>>(C.A, kViscosityCycle);
+      refreshSolvers(C);
     }
     bb[size_t(a)] = rightHandSide(*u, a, s);
   }

@@ -49,13 +49,17 @@ struct ViscousSystem {
   std::vector<uint8_t> insideCut;
   // A for s = nu dt / h^2: c = 1/s + boundary terms, 0 on prescribed faces.
   void setRate(double s);
+  // The same at the rate set (A.scale) on the unknowns [lo, hi) alone, whose
+  // rows were written again (updateViscousSystem), and the diagonal and
+  // spans that read them.
+  void setRateRows(const IVec<D>& lo, const IVec<D>& hi);
 };
 template <int D>
 ViscousSystem<D> viscousSystem(const VelocityConstraints<D>& constraints, int axis);
 // Its rows again where changed constraints touch them: the unknowns of the
 // faces of the cells [lo, hi) and one more layer (their neighbours' rows
 // see them), which it returns in [*ulo, *uhi) when asked. The system's c,
-// diagonal and uniform spans follow at the next setRate.
+// diagonal and uniform spans follow at the next setRate or setRateRows.
 template <int D>
 void updateViscousSystem(ViscousSystem<D>* system, const VelocityConstraints<D>& constraints, int axis,
                          const IVec<D>& lo, const IVec<D>& hi, IVec<D>* ulo = nullptr, IVec<D>* uhi = nullptr);
@@ -99,6 +103,9 @@ class ViscositySolver {
   // keep 6 bytes a cell more (docs/performance.md).
   static constexpr bool kExtrapolates = D == 2;
   SolverResult solveComponents(MacVelocity<D>* u, double s);
+  // C's Chebyshev bounds and multigrid (whichever solves) after its
+  // coefficients changed: on the unknowns [*lo, *hi) alone where given.
+  void refreshSolvers(Component& C, const IVec<D>* lo = nullptr, const IVec<D>* hi = nullptr);
   // Component a's right-hand side into b_ (its unknowns' count); returns ||b||^2.
   double rightHandSide(const MacVelocity<D>& u, int a, double s);
   const VelocityConstraints<D>& vc_;

@@ -82,7 +82,7 @@ void GpuViscosity<D>::rebuild(const VelocityConstraints<D>& vc, const IVec<D>& l
     const std::vector<float> rhs = c.host.boundaryRhs.expandedRows(r0, r1);  // (the shader reads reals)
     uploadReals(&c.boundaryRhs, std::vector<double>(rhs.begin(), rhs.end()), real_, r0 * size_t(c.host.dims[0]));
     if (s_ > 0.0) {
-      c.host.setRate(s_);
+      c.host.setRateRows(ulo, uhi);
       c.A->update(c.host.A, r0, r1);
     }
     if (held_.bytes()) {

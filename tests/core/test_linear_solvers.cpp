@@ -310,6 +310,66 @@ TEST(LinearSolvers, MultigridRegionalRefreshMatchesARebuild) {
   expectRegionalRefreshMatchesRebuild<3>(IVec<3>(20, 16, 12), {true, false, true});
 }
 
+// Rows of a compact system written again in a box (an obstacle that
+// moved), finalized over those rows alone: the diagonal, the spans, the
+// singularity and every kernel bitwise those of a whole finalize(), with
+// the box inside, at the low edges, at the high ones (across a periodic
+// seam) and over everything, and with c > 0 coming and going (a singular
+// system and not).
+template <int D>
+void expectRowFinalizeMatchesAWholeOne(const IVec<D>& dims, std::array<bool, D> periodic) {
+  LaplaceSystem<D> A = makeNeumannLaplacian<D>(dims, periodic, 1.0 / dims[0]);
+  for (int corner = 0; corner < 4; ++corner) {
+    IVec<D> lo, hi;
+    for (int a = 0; a < D; ++a) {  // inside; touching the low edges; touching the high ones; everything
+      lo[a] = corner == 1 || corner == 3 ? 0 : 3 + a;
+      hi[a] = corner == 2 || corner == 3 ? dims[a] : lo[a] + 5 + a;
+    }
+    std::array<RowField<D>*, D + 1> fields{&A.c};
+    for (int a = 0; a < D; ++a) fields[size_t(a) + 1] = &A.w[a];
+    rewriteRows<D, D + 1>(fields, rowsOf<D>(dims, lo, hi), [&](size_t row, const std::array<float*, D + 1>& v) {
+      IVec<D> k = latticeCoord<D>(dims, row * size_t(dims[0]));
+      for (k[0] = lo[0]; k[0] < hi[0]; ++k[0]) {
+        const size_t i = latticeIndex<D>(dims, k);
+        v[0][k[0]] = corner == 3 ? 0.0f : float(0.25 * corner * double(i % 3));  // the last box: none left
+        for (int a = 0; a < D; ++a)
+          v[size_t(a) + 1][k[0]] =
+              k[a] == dims[a] - 1 && !periodic[a] ? 0.0f : float(0.125 * double((i + size_t(a) + corner) % 9));
+      }
+    });
+    A.finalizeRows(lo, hi);
+    LaplaceSystem<D> whole = A;
+    whole.c.densify();
+    for (int a = 0; a < D; ++a) whole.w[a].densify();
+    whole.finalize();
+    EXPECT_EQ(A.diag.expanded(), whole.diag.expanded()) << "box " << corner;
+    EXPECT_EQ(A.singular(), whole.singular()) << "box " << corner;
+    for (size_t row = 0; row < A.size() / size_t(dims[0]); ++row) {
+      EXPECT_EQ(A.sweepSpan(row).lo, whole.sweepSpan(row).lo) << "row " << row << ", box " << corner;
+      EXPECT_EQ(A.sweepSpan(row).hi, whole.sweepSpan(row).hi) << "row " << row << ", box " << corner;
+    }
+    Vector x(A.size()), y1(A.size()), y2(A.size()), b(A.size());
+    for (size_t i = 0; i < x.size(); ++i) x[i] = std::sin(0.37 * double(i)) + 0.1, b[i] = std::cos(0.11 * double(i));
+    EXPECT_EQ(A.applyDot(x, &y1), whole.applyDot(x, &y2)) << "box " << corner;
+    EXPECT_EQ(y1, y2) << "box " << corner;
+    Vector x1 = x, x2 = x;
+    A.gaussSeidel(b, &x1, false);
+    whole.gaussSeidel(b, &x2, false);
+    EXPECT_EQ(x1, x2) << "box " << corner;
+    A.removeNullSpace(&x1);
+    whole.removeNullSpace(&x2);
+    EXPECT_EQ(x1, x2) << "box " << corner;
+  }
+  EXPECT_TRUE(A.singular());  // the last box took every c > 0 away
+}
+
+TEST(LinearSolvers, RowFinalizeMatchesAWholeOne) {
+  expectRowFinalizeMatchesAWholeOne<2>(IVec<2>(40, 33), {false, false});
+  expectRowFinalizeMatchesAWholeOne<2>(IVec<2>(40, 32), {true, true});
+  expectRowFinalizeMatchesAWholeOne<3>(IVec<3>(20, 17, 12), {false, false, false});
+  expectRowFinalizeMatchesAWholeOne<3>(IVec<3>(20, 16, 12), {true, true, true});
+}
+
 TEST(LinearSolvers, ResultsIndependentOfThreadCount) {
   IVec<2> dims(128, 128);
   LaplaceSystem<2> A = makeNeumannLaplacian<2>(dims, {}, 1.0 / 128);
