@@ -313,6 +313,40 @@ void checkExtremalModes(const IVec<D>& dims, double s) {
 
 }  // namespace
 
+// Refreshed after its system's coefficients changed (another rate, another
+// obstacle's rows), the iteration is bitwise one built on the new system:
+// its bounds and its coefficients outside the uniform spans, found once per
+// kind of row, are every row's own.
+template <int D>
+void checkRefresh(const IVec<D>& dims, bool periodicLast) {
+  LaplaceSystem<D> A = viscousSystem<D>(dims, 1.28, periodicLast);
+  Chebyshev<D> kept(A);
+  const SolverOptions fixed{1e-300, 17};
+  for (double s : {4.0, 0.3}) {
+    A = viscousSystem<D>(dims, s, periodicLast);
+    A.w[D - 1].densify();
+    forEachCell<D>(dims, [&](const IVec<D>& k, size_t i) {  // partial faces: rows alike but for the faces below
+      if (k[D - 1] == 2 && k[0] % 5 == 1 && k[0] > 10) A.w[D - 1].at(i) = float(0.25 * s);
+    });
+    A.finalize();
+    kept.refresh();
+    Chebyshev<D> fresh(A);
+    EXPECT_EQ(kept.rho(), fresh.rho()) << name<D>(dims) << " s = " << s;
+    const Vector b = wavyVector<D>(A, 0.9);
+    Vector x1(A.size(), 0.0), x2(A.size(), 0.0);
+    kept.solve(b, &x1, fixed);
+    fresh.solve(b, &x2, fixed);
+    EXPECT_EQ(0, std::memcmp(x1.data(), x2.data(), x1.size() * sizeof(double))) << name<D>(dims) << " s = " << s;
+  }
+}
+
+TEST(Chebyshev, RefreshIsAFreshIteration) {
+  checkRefresh<2>(IVec<2>(40, 33), false);
+  checkRefresh<2>(IVec<2>(40, 34), true);
+  checkRefresh<3>(IVec<3>(19, 14, 23), false);
+  checkRefresh<3>(IVec<3>(19, 14, 22), true);
+}
+
 TEST(Chebyshev, ResidualIsTheChebyshevPolynomialAtTheSpectrumsEnds) {
   checkExtremalModes<2>(IVec<2>(32, 24), 1.28);
   checkExtremalModes<2>(IVec<2>(16, 40), 8.0);
