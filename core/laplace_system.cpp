@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <map>
+#include <stdexcept>
 #include <type_traits>
 
 #include "core/parallel.h"
@@ -216,6 +217,7 @@ void LaplaceSystem<D>::finalize() {
   // cell of every row along x, the whole last rows along y (and z).
   const size_t nx = size_t(dims[0]);
   const size_t rows = size() / nx;
+  if (nx > UINT16_MAX) throw std::length_error("LaplaceSystem: a row of more than 65535 cells (its counts are 16-bit)");
   parallelForRows<D>(dims, [&](size_t row) {
     if (!periodic[0] && w[0].dense()) w[0].at(row * nx + nx - 1) = 0.0f;
     size_t rest = row;
@@ -246,8 +248,8 @@ void LaplaceSystem<D>::finalize() {
   sweepSpan_.resize(rows);
   findSpans(all);
   // The active cells and the positive c, counted once per stored row.
-  auto positives = [&](const RowField<D>& f, std::vector<uint32_t>* perRow) {
-    std::map<const float*, uint32_t> counted;
+  auto positives = [&](const RowField<D>& f, std::vector<uint16_t>* perRow) {
+    std::map<const float*, uint16_t> counted;
     perRow->resize(rows);
     for (size_t row = 0; row < rows; ++row) {
       const float* r = f.row(row);
@@ -398,8 +400,8 @@ void LaplaceSystem<D>::findSpans(const std::vector<size_t>& rows) {
 }
 
 template <int D>
-uint32_t LaplaceSystem<D>::positiveCount(const float* row) const {
-  return uint32_t(std::count_if(row, row + dims[0], [](float v) { return v > 0; }));
+uint16_t LaplaceSystem<D>::positiveCount(const float* row) const {
+  return uint16_t(std::count_if(row, row + dims[0], [](float v) { return v > 0; }));
 }
 
 template <int D>

@@ -126,12 +126,12 @@ struct LaplaceSystem {
   void diagRow(size_t row, float* d) const;
   Span longestSpan(size_t row, bool edges) const;
   void findSpans(const std::vector<size_t>& rows);
-  uint32_t positiveCount(const float* row) const;
+  uint16_t positiveCount(const float* row) const;
   void countActive();  // active_ and singular_ from the rows' counts
 
   bool singular_ = false;
   size_t active_ = 0;
-  std::vector<uint32_t> activeOf_, positiveCOf_;  // per row: active cells, and cells with c > 0
+  std::vector<uint16_t> activeOf_, positiveCOf_;  // per row: active cells, and cells with c > 0
   Vector zerosX_;               // a row of zeros: the neighbour beyond a wall
   std::vector<float> zerosW_;   // (also the float row of zeros)
   std::vector<Span> uniformSpan_;
