@@ -28,6 +28,13 @@ IVec<D> latticeCoord(const IVec<D>& dims, size_t i) {
   }
   return c;
 }
+// Whether the box of cells [lo, hi) holds none.
+template <int D>
+bool boxEmpty(const IVec<D>& lo, const IVec<D>& hi) {
+  for (int a = 0; a < D; ++a)
+    if (hi[a] <= lo[a]) return true;
+  return false;
+}
 // Distance in the flat array between neighbours along `axis`.
 template <int D>
 size_t latticeStride(const IVec<D>& dims, int axis) {

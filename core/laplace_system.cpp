@@ -681,8 +681,7 @@ bool LaplaceSystem<D>::coloursMeetAcrossRows() const {
 template <int D>
 void LaplaceSystem<D>::relaxBox(const Vector& b, Vector* xp, const IVec<D>& lo, const IVec<D>& hi, int sweeps,
                                 double omega) const {
-  for (int a = 0; a < D; ++a)
-    if (hi[a] <= lo[a]) return;
+  if (boxEmpty<D>(lo, hi)) return;
   Vector& x = *xp;
   const size_t nx = size_t(dims[0]), ny = size_t(dims[1]);
   const bool px = periodic[0];

@@ -108,17 +108,24 @@ double orderedSum(size_t begin, size_t end, Fn& f) {
   return (s0 + s1) + (s2 + s3);
 }
 
-// Deterministic sum of f(i), i in [0, n): fixed chunks, partials summed in order.
-template <typename Fn>
-double deterministicSum(size_t n, Fn&& f) {
+// The sum of chunkSum(begin, end) over fixed chunks [begin, end) of [0, n),
+// in parallel, the partials summed in order.
+template <typename ChunkSum>
+double deterministicChunkSum(size_t n, ChunkSum&& chunkSum) {
   constexpr size_t kChunk = 8192;
   size_t chunks = (n + kChunk - 1) / kChunk;
-  if (chunks <= 1) return orderedSum(0, n, f);
+  if (chunks <= 1) return chunkSum(size_t(0), n);
   std::vector<double> partial(chunks, 0.0);
-  parallelFor(chunks, [&](size_t k) { partial[k] = orderedSum(k * kChunk, std::min(n, (k + 1) * kChunk), f); });
+  parallelFor(chunks, [&](size_t k) { partial[k] = chunkSum(k * kChunk, std::min(n, (k + 1) * kChunk)); });
   double s = 0;
   for (double p : partial) s += p;
   return s;
+}
+
+// Deterministic sum of f(i), i in [0, n): fixed chunks, partials summed in order.
+template <typename Fn>
+double deterministicSum(size_t n, Fn&& f) {
+  return deterministicChunkSum(n, [&](size_t begin, size_t end) { return orderedSum(begin, end, f); });
 }
 
 // Deterministic sum of fn(row) over the rows of a lattice: the rows are cut

@@ -147,8 +147,7 @@ class RowField {
 template <int D>
 std::vector<size_t> rowsOf(const IVec<D>& dims, const IVec<D>& lo, const IVec<D>& hi) {
   std::vector<size_t> rows;
-  for (int a = 0; a < D; ++a)
-    if (hi[a] <= lo[a]) return rows;
+  if (boxEmpty<D>(lo, hi)) return rows;
   const int zlo = D == 3 ? lo[D - 1] : 0, zhi = D == 3 ? hi[D - 1] : 1;
   for (int z = zlo; z < zhi; ++z)
     for (int y = lo[1]; y < hi[1]; ++y) rows.push_back(size_t(y) + (D == 3 ? size_t(z) * size_t(dims[1]) : 0));

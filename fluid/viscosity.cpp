@@ -200,51 +200,63 @@ const MultigridOptions kViscosityCycle{3, 3, 4};
 constexpr int kMovedSweeps = 2;
 }  // namespace
 
-// Unknown i of component a's system is face gi of its grid: the same index
-// unless a periodic axis drops the duplicate face layer. Row by row:
-// fn(row, i0, g0) with the row's first unknown and its face in g.
-template <int D>
-static void eachUnknownRow(const IVec<D>& dims, const Grid<float, D>& g, auto&& fn) {
-  forEachRow<D>(dims, [&](size_t row, const IVec<D>& k) { fn(row, row * size_t(dims[0]), g.index(k)); });
-}
-
 // One row of component a's unknowns as the passes below read it: unknown
-// i0 + x is held where fixed[x] | cut[x] (its face prescribed, or inside a
-// cut obstacle), so the loops over a row have no branches.
+// i0 + x is face g0 + x of its grid (the same index unless a periodic axis
+// drops the duplicate face layer), held where fixed[x] | cut[x] (its face
+// prescribed, or inside a cut obstacle), so the loops over a row have no
+// branches.
 struct UnknownRow {
   size_t row, i0, g0;
   const uint8_t* fixed;  // the face's flag
   const uint8_t* cut;    // inside a cut obstacle (a row of zeros without one)
 };
 template <int D>
+static UnknownRow unknownRow(const ViscousSystem<D>& C, const Grid<uint8_t, D>& fixed, const Grid<float, D>& g,
+                             size_t row) {
+  thread_local std::vector<uint8_t> none;  // the cut flags without cut obstacles
+  if (C.insideCut.empty() && none.size() < size_t(C.dims[0])) none.assign(size_t(C.dims[0]), 0);
+  const size_t i0 = row * size_t(C.dims[0]), g0 = g.index(latticeCoord<D>(C.dims, i0));
+  return UnknownRow{row, i0, g0, fixed.data() + g0, C.insideCut.empty() ? none.data() : C.insideCut.data() + i0};
+}
+// fn(UnknownRow) on every row, in parallel; on the rows of plane q (along the last axis).
+template <int D>
 static void eachRowOf(const ViscousSystem<D>& C, const Grid<uint8_t, D>& fixed, const Grid<float, D>& g, auto&& fn) {
-  eachUnknownRow<D>(C.dims, g, [&](size_t row, size_t i0, size_t g0) {
-    thread_local std::vector<uint8_t> none;  // the cut flags without cut obstacles
-    if (C.insideCut.empty() && none.size() < size_t(C.dims[0])) none.assign(size_t(C.dims[0]), 0);
-    fn(UnknownRow{row, i0, g0, fixed.data() + g0, C.insideCut.empty() ? none.data() : C.insideCut.data() + i0});
-  });
+  forEachRow<D>(C.dims, [&](size_t row, const IVec<D>&) { fn(unknownRow<D>(C, fixed, g, row)); });
+}
+template <int D>
+static void eachRowOfPlane(const ViscousSystem<D>& C, const Grid<uint8_t, D>& fixed, const Grid<float, D>& g, size_t q,
+                           auto&& fn) {
+  const size_t perPlane = D == 3 ? size_t(C.dims[1]) : 1;
+  for (size_t row = q * perPlane; row < (q + 1) * perPlane; ++row) fn(unknownRow<D>(C, fixed, g, row));
 }
 
-// One row of b = u* + s (boundary terms), 0 on held unknowns.
+// One row of b = u* + s (boundary terms), 0 on held unknowns, to b.
 template <int D>
-static void rhsRow(const ViscousSystem<D>& C, const UnknownRow& r, const Grid<float, D>& g, double s, Vector* out) {
+static void rhsRow(const ViscousSystem<D>& C, const UnknownRow& r, const Grid<float, D>& g, double s,
+                   double* __restrict b) {
   const float* __restrict rhs = C.boundaryRhs.row(r.row);
   const float* __restrict gr = g.data() + r.g0;
   const uint8_t* __restrict f = r.fixed, * __restrict c = r.cut;
-  double* __restrict b = out->data() + r.i0;
   const size_t nx = size_t(C.dims[0]);
   for (size_t x = 0; x < nx; ++x) b[x] = zeroWhere(f[x] | c[x], double(gr[x]) + s * double(rhs[x]));
 }
 
 template <int D>
-double ViscositySolver<D>::rightHandSide(const MacVelocity<D>& u, int a, double s) {
+double ViscositySolver<D>::rightHandSideSquared(const MacVelocity<D>& u, int a, double s) const {
   const Component& C = comp_[size_t(a)];
   const Grid<float, D>& g = u[a];
   const Grid<uint8_t, D>& fixed = vc_.fixed[a];
-  resizeExactly(&b_, C.A.size());
-  // Row by row: the boundary terms are stored a row at a time.
-  eachRowOf<D>(C, fixed, g, [&](const UnknownRow& r) { rhsRow<D>(C, r, g, s, &b_); });
-  return dot(b_, b_);
+  const size_t nx = size_t(C.dims[0]);
+  // dot(b, b)'s chunks and order, each chunk's rows formed in a buffer.
+  return deterministicChunkSum(C.A.size(), [&](size_t begin, size_t end) {
+    thread_local std::vector<double> rows;
+    const size_t r0 = begin / nx, r1 = (end + nx - 1) / nx;
+    rows.resize((r1 - r0) * nx);
+    for (size_t row = r0; row < r1; ++row) rhsRow<D>(C, unknownRow<D>(C, fixed, g, row), g, s, &rows[(row - r0) * nx]);
+    const double* b = rows.data() + (begin - r0 * nx);
+    auto square = [b](size_t i) { return b[i] * b[i]; };
+    return orderedSum(size_t(0), end - begin, square);
+  });
 }
 
 template <int D>
@@ -285,7 +297,7 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
       C.setRate(s);
       refreshSolvers(C);
     }
-    bb[size_t(a)] = rightHandSide(*u, a, s);
+    bb[size_t(a)] = rightHandSideSquared(*u, a, s);
   }
   // The D systems are blocks of one linear system, (I - nu dt lap) u = u*
   // on the MAC velocity, solved to a relative residual of that system:
@@ -304,17 +316,16 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
     const double ba = bb[size_t(a)];
     // Warm start: the increment's rate, linearly extrapolated in steps
     // (2 r1 - r0 = r1 + (r1 - r0)) where kExtrapolates, else the last
-    // rate. In the same pass, the right-hand side
-    // (b_ holds component 0's already), as rightHandSide forms it.
+    // rate; in the same pass, the right-hand side.
     const int history = C.history;
     resizeExactly(&x_, C.A.size());
     resizeExactly(&b_, C.A.size());
-    eachRowOf<D>(C, fixed, g, [&](const UnknownRow& r) {
+    auto warmStart = [&](const UnknownRow& r) {
       const float* __restrict gr = g.data() + r.g0;
       const uint8_t* __restrict f = r.fixed, * __restrict c = r.cut;
       double* __restrict x = x_.data() + r.i0;
       const size_t nx = size_t(C.dims[0]);
-      if (a > 0) rhsRow<D>(C, r, g, s, &b_);
+      rhsRow<D>(C, r, g, s, b_.data() + r.i0);
       if (history == 0) {
         for (size_t k = 0; k < nx; ++k)
           x[k] = zeroWhere(f[k] | c[k], double(gr[k]) + s * 0.0);  // (a zero rate: -0 -> +0)
@@ -331,18 +342,26 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
           x[k] = zeroWhere(f[k] | c[k], v);
         }
       }
-    });
-    // The warm start comes from solves on the rows before a moving obstacle
-    // rewrote them, and leaves its largest residuals on them (a face whose
-    // cut distance changed, one the solid uncovered): two red-black sweeps
-    // there (at 128^3 the circling sphere's Chebyshev steps fall from 32.4
-    // to 22.7-24.2, the body at rest's 22.0-23.5; docs/performance.md).
-    C.A.relaxBox(b_, &x_, C.movedLo, C.movedHi, kMovedSweeps);
-    C.movedLo = C.movedHi = IVec<D>(0);
+    };
     SolverOptions options = options_;
     if (ba > 0.0) options.tolerance = options_.tolerance * std::sqrt(0.5 * (ba + bAll / D) / ba);
-    const SolverResult r = C.multigrid ? solvePCG<D>(C.A, b_, &x_, C.multigrid.get(), options, &pcgWork_)
-                                       : C.chebyshev->solve(b_, &x_, options, std::sqrt(ba));
+    SolverResult r;
+    if (C.multigrid || !boxEmpty<D>(C.movedLo, C.movedHi)) {
+      eachRowOf<D>(C, fixed, g, warmStart);
+      // The warm start comes from solves on the rows before a moving
+      // obstacle rewrote them, and leaves its largest residuals on them (a
+      // face whose cut distance changed, one the solid uncovered): two
+      // red-black sweeps there (at 128^3 the circling sphere's Chebyshev
+      // steps fall from 32.4 to 22.7-24.2, the body at rest's 22.0-23.5;
+      // docs/performance.md).
+      C.A.relaxBox(b_, &x_, C.movedLo, C.movedHi, kMovedSweeps);
+      C.movedLo = C.movedHi = IVec<D>(0);
+      r = C.multigrid ? solvePCG<D>(C.A, b_, &x_, C.multigrid.get(), options, &pcgWork_)
+                      : C.chebyshev->solve(b_, &x_, options, std::sqrt(ba));
+    } else {  // the warm start written plane by plane in the first residual's pass
+      r = C.chebyshev->solve(b_, &x_, options, std::sqrt(ba),
+                             [&](size_t q) { eachRowOfPlane<D>(C, fixed, g, q, warmStart); });
+    }
     rAll += r.residual * r.residual * ba;
     result.iterations = std::max(result.iterations, r.iterations);
     cellUpdates_ += double(r.iterations) * (C.multigrid ? double(C.A.size()) : C.chebyshev->cellsPerStep());

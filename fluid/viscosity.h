@@ -106,8 +106,8 @@ class ViscositySolver {
   // C's Chebyshev bounds and multigrid (whichever solves) after its
   // coefficients changed: on the unknowns [*lo, *hi) alone where given.
   void refreshSolvers(Component& C, const IVec<D>* lo = nullptr, const IVec<D>* hi = nullptr);
-  // Component a's right-hand side into b_ (its unknowns' count); returns ||b||^2.
-  double rightHandSide(const MacVelocity<D>& u, int a, double s);
+  // ||b||^2 of component a's right-hand side (none stored).
+  double rightHandSideSquared(const MacVelocity<D>& u, int a, double s) const;
   const VelocityConstraints<D>& vc_;
   SolverOptions options_;
   std::array<Component, D> comp_;
