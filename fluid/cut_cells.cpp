@@ -18,6 +18,7 @@ CutSurface::CutSurface(const std::vector<ObstacleSpec>& obstacles, int dims, con
       motions_.push_back(i < motions.size() ? motions[i] : RigidMotion{});
       moves = moves || (i < motions.size() && movesAtAll(obstacles[i]));
       exact_ = exact_ && obstacles[i].shape != ObstacleShape::Image;
+      lipschitz_ = lipschitz_ && obstacles[i].shape != ObstacleShape::Image && obstacles[i].shape != ObstacleShape::Sdf;
     }
   if (!moves) motions_.clear();
   for (int a = 0; a < dims; ++a) size_[a] = domainSize[a];
@@ -25,9 +26,9 @@ CutSurface::CutSurface(const std::vector<ObstacleSpec>& obstacles, int dims, con
 
 std::array<double, 3> CutSurface::velocity(const double* x) const {
   if (motions_.empty()) return {0, 0, 0};
-  size_t nearest = 0;
+  size_t nearest = 0;  // (one obstacle: the nearest, at any distance)
   double d = std::numeric_limits<double>::infinity();
-  for (size_t i = 0; i < obstacles_.size(); ++i) {
+  for (size_t i = 0; i < obstacles_.size() && obstacles_.size() > 1; ++i) {
     const double di = obstacleDistance(obstacles_[i], x, dims_, size_);
     if (di < d) d = di, nearest = i;
   }
@@ -61,11 +62,20 @@ namespace {
 }  // namespace
 
 template <int D>
-float openFraction(const CutSurface& surface, int axis, const IVec<D>& k, double h) {
-  return float(cfOpenFraction(surface, D, axis, k[0], k[1], D == 3 ? k[2] : 0, h, surface.exact()));
+double faceCentreDistance(const CutSurface& surface, int axis, const IVec<D>& k, double h) {
+  return cfFaceCentreDistance(surface, D, axis, k[0], k[1], D == 3 ? k[2] : 0, h);
 }
 
-template float openFraction<2>(const CutSurface&, int, const IVec<2>&, double);
-template float openFraction<3>(const CutSurface&, int, const IVec<3>&, double);
+template <int D>
+float openFractionFrom(const CutSurface& surface, int axis, const IVec<D>& k, double h, double centre) {
+  return float(cfOpenFractionFrom(surface, D, axis, k[0], k[1], D == 3 ? k[2] : 0, h, surface.exact(), centre));
+}
+
+double faceReach(int dims, double h) { return cfFaceReach(dims, h); }
+
+template double faceCentreDistance<2>(const CutSurface&, int, const IVec<2>&, double);
+template double faceCentreDistance<3>(const CutSurface&, int, const IVec<3>&, double);
+template float openFractionFrom<2>(const CutSurface&, int, const IVec<2>&, double, double);
+template float openFractionFrom<3>(const CutSurface&, int, const IVec<3>&, double, double);
 
 }  // namespace morphoflow

@@ -36,12 +36,16 @@ class CutSurface {
   std::array<double, 3> velocity(const double* x) const;
   // Whether distance() is one (an image shape only has a sign: -1 inside, 1 outside).
   bool exact() const { return exact_; }
+  // Whether it changes by at most the distance moved (circles, spheres and
+  // boxes: exact distances, a union's least; not a sampled field).
+  bool lipschitz() const { return lipschitz_; }
   static constexpr double kMinTheta = 0.01;
 
  private:
   std::vector<ObstacleSpec> obstacles_;
   std::vector<RigidMotion> motions_;  // empty unless one moves
   bool exact_ = true;
+  bool lipschitz_ = true;
   int dims_ = 2;
   double size_[3] = {0, 0, 0};
 };
@@ -58,11 +62,16 @@ inline double cutTheta(double from, double to) {
 
 // The open fraction of face k of grid `axis` (a cell face of size h; face k
 // lies at x_axis = k h), in [0, 1]: the part where the distance is positive
-// (a face on the surface is closed). From the distances at its corners
-// (2D: the segment's fluid part, linearly interpolated; 3D: the bilinear
-// interpolant of 4 x 4 sub-squares' corners, sampled 4 x 4 each); with only
-// a sign (an image), by bisection for the crossing (2D) or 8 x 8 samples (3D).
+// (a face on the surface is closed), given the distance at its centre
+// (faceCentreDistance). From the distances at its corners (2D: the
+// segment's fluid part, linearly interpolated; 3D: the bilinear interpolant
+// of 4 x 4 sub-squares' corners, sampled 4 x 4 each); with only a sign (an
+// image), by bisection for the crossing (2D) or 8 x 8 samples (3D). Farther
+// than faceReach from an exact surface the face lies wholly on one side.
 template <int D>
-float openFraction(const CutSurface& surface, int axis, const IVec<D>& k, double h);
+double faceCentreDistance(const CutSurface& surface, int axis, const IVec<D>& k, double h);
+template <int D>
+float openFractionFrom(const CutSurface& surface, int axis, const IVec<D>& k, double h, double centre);
+double faceReach(int dims, double h);
 
 }  // namespace morphoflow

@@ -1,7 +1,9 @@
 #include "fluid/velocity_constraints.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "core/parallel.h"
 
@@ -46,11 +48,12 @@ void VelocityConstraints<D>::move(const Grid<uint8_t, D>& s, const Grid<uint8_t,
     rewriteRows<D, 1>({&open[a]}, rows, [&](size_t r, const std::array<float*, 1>& o) {
       const size_t k = size_t(std::lower_bound(rows.begin(), rows.end(), r) - rows.begin());
       IVec<D> c = fixed[a].coord(r * size_t(fd[0]));
+      RowReach along{flo[0], 0.0};
       for (c[0] = flo[0]; c[0] < fhi[0]; ++c[0]) {
         const size_t i = fixed[a].index(c);
         float value = 0.0f;
         fixed[a][i] = 0;
-        o[0][c[0]] = constrainFace(a, c, i, voxel, &value);
+        o[0][c[0]] = constrainFace(a, c, i, voxel, &value, &along);
         if (fixed[a][i]) held[k].emplace_back(i, value);
       }
     });
@@ -94,8 +97,23 @@ void VelocityConstraints<D>::relistFixed(int a, const std::vector<size_t>& rows,
 // Face k (index i) of grid a: held by a wall, an inflow or a solid, and
 // its open fraction.
 template <int D>
+double VelocityConstraints<D>::centreDistance(int a, const IVec<D>& k, RowReach* along) const {
+  if (along && k[0] < along->until) return along->side;
+  const double d = faceCentreDistance<D>(cut, a, k, h);
+  if (!along || !cut.lipschitz()) return d;
+  // The faces j further along lie at least |d| - j h from the surface:
+  // beyond their reach (and a margin for rounding) while j h < far.
+  const double far = std::abs(d) - faceReach(D, h) - 1e-9 * h;
+  if (far > h) {
+    along->until = k[0] + int(std::ceil(std::min(far / h, 1e6)));  // (faces k + 1 .. until - 1)
+    along->side = std::copysign(std::numeric_limits<double>::infinity(), d);
+  }
+  return d;
+}
+
+template <int D>
 float VelocityConstraints<D>::constrainFace(int a, const IVec<D>& k, size_t i, const Grid<uint8_t, D>& voxel,
-                                            float* value) {
+                                            float* value, RowReach* along) {
   bool boundary = !boundaries.periodic(a) && (k[a] == 0 || k[a] == cells[a]);
   if (boundary) {
     bool high = k[a] == cells[a];
@@ -117,7 +135,10 @@ float VelocityConstraints<D>::constrainFace(int a, const IVec<D>& k, size_t i, c
   bool solidLo = lo[a] >= 0 && voxel(lo), solidHi = hi[a] < cells[a] && voxel(hi);
   IVec<D> same = k;  // on a periodic axis face n is face 0
   if (boundaries.periodic(a) && same[a] == cells[a]) same[a] = 0;
-  float o = solidLo || solidHi ? 0.0f : cut.empty() ? 1.0f : openFraction<D>(cut, a, same, h);
+  // (the row's faces follow one another but for face n on a periodic x)
+  float o = solidLo || solidHi ? 0.0f
+            : cut.empty()      ? 1.0f
+                          : openFractionFrom<D>(cut, a, same, h, centreDistance(a, same, same == k ? along : nullptr));
   if (o == 0.0f) {
     fixed[a][i] = 1;
     *value = bodies.moving() ? float(bodies.velocity(facePosition(a, k).data())[size_t(a)]) : 0.0f;

@@ -69,8 +69,22 @@ struct VelocityConstraints {
             const CutSurface& bodies, const IVec<D>& lo, const IVec<D>& hi);
 
  private:
-  // Face k (index i) of grid a: its fixed flag and *value set, its open fraction returned.
-  float constrainFace(int a, const IVec<D>& k, size_t i, const Grid<uint8_t, D>& voxel, float* value);
+  // Along a row of faces (rising x), what the last cut distance found
+  // tells of the next faces: those before `until` lie farther than their
+  // reach from a Lipschitz surface (CutSurface::lipschitz()), on the side
+  // of `side` (an infinity of that sign, which their open fraction reads
+  // as their centre's distance).
+  struct RowReach {
+    int until = 0;
+    double side = 0.0;
+  };
+  // Face k (index i) of grid a: its fixed flag and *value set, its open
+  // fraction returned; `along`, when given, the row's faces so far.
+  float constrainFace(int a, const IVec<D>& k, size_t i, const Grid<uint8_t, D>& voxel, float* value,
+                      RowReach* along = nullptr);
+  // The cut distance at the centre of face k of grid a, or where `along`
+  // knows the face wholly on one side, its side (and `along` updated).
+  double centreDistance(int a, const IVec<D>& k, RowReach* along) const;
   void listFixed(int a, const std::vector<float>& value);
   void relistFixed(int a, const std::vector<size_t>& rows, int xlo, int xhi,
                    const std::vector<std::vector<std::pair<size_t, float>>>& held);
