@@ -421,13 +421,7 @@ double Chebyshev<D>::residualNorm() const {
 }
 
 template <int D>
-SolverResult Chebyshev<D>::solve(const Vector& b, Vector* xp, const SolverOptions& options, double bnorm,
-                                 const std::function<void(size_t)>& prepare) {
-  const size_t planes = size_t(A_.dims[D - 1]);
-  if (prepare && (!applicable() || bnorm < 0.0)) {  // b and x whole first
-    parallelFor(planes, [&](size_t q) { prepare(q); });
-    return solve(b, xp, options, bnorm);
-  }
+SolverResult Chebyshev<D>::solve(const Vector& b, Vector* xp, const SolverOptions& options, double bnorm) {
   if (!applicable()) return solvePCG<D>(A_, b, xp, nullptr, options);  // no bound: plain CG
   Vector& x = *xp;
   const size_t n = A_.size(), nx = size_t(A_.dims[0]);
@@ -442,17 +436,11 @@ SolverResult Chebyshev<D>::solve(const Vector& b, Vector* xp, const SolverOption
   const size_t slots = cyclic_ ? n / nx * hx_ : n;  // per colour where cyclic
   for (auto& v : work_->e) resizeExactly(&v, slots);
   resizeExactly(&work_->g, cyclic_ ? 2 * slots : n);
-  planeSquares_.assign(planes, 0.0);
+  planeSquares_.assign(size_t(A_.dims[D - 1]), 0.0);
   // g of order 1 in float for any residual from 1e-30 ||b|| up.
   rscale_ = std::sqrt(double(n)) / bnorm;
   const double budget = options.tolerance * bnorm;
-  // (the residual of plane q reads x on its neighbours: prepared first)
-  if (prepare) {
-    pipeline(2, [&](int t, size_t q) {
-      if (t == 1) return prepare(q);
-      residualPlane(b, x, q);
-    });
-  } else pipeline(1, [&](int, size_t q) { residualPlane(b, x, q); });
+  pipeline(1, [&](int, size_t q) { residualPlane(b, x, q); });
   double rnorm = residualNorm();
   // Rounds of at most 1e5 each: the float steps resolve that much of the
   // correction. A well conditioned operator (a 1e6 reduction in at most 48

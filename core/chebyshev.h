@@ -35,7 +35,6 @@
 // cut and ordered: the result is bitwise independent of the thread count.
 #pragma once
 
-#include <functional>
 #include <vector>
 
 #include "core/laplace_system.h"
@@ -89,11 +88,8 @@ class Chebyshev {
 
   // Solves A x = b from *x to the relative residual options.tolerance;
   // iterations counts the Chebyshev steps (plain CG where not applicable).
-  // bnorm, when known (>= 0), saves a pass: ||b||_2. prepare(q), when
-  // given, writes plane q (along the last axis) of b and *x first, in the
-  // pass of the first residual, which then reads them from cache.
-  SolverResult solve(const Vector& b, Vector* x, const SolverOptions& options, double bnorm = -1.0,
-                     const std::function<void(size_t)>& prepare = {});
+  // bnorm, when known (>= 0), saves a pass: ||b||_2.
+  SolverResult solve(const Vector& b, Vector* x, const SolverOptions& options, double bnorm = -1.0);
 
  private:
   // Runs op(t, q), t = 1..m, on every plane q along the last axis, step t

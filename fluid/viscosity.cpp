@@ -218,16 +218,10 @@ static UnknownRow unknownRow(const ViscousSystem<D>& C, const Grid<uint8_t, D>& 
   const size_t i0 = row * size_t(C.dims[0]), g0 = g.index(latticeCoord<D>(C.dims, i0));
   return UnknownRow{row, i0, g0, fixed.data() + g0, C.insideCut.empty() ? none.data() : C.insideCut.data() + i0};
 }
-// fn(UnknownRow) on every row, in parallel; on the rows of plane q (along the last axis).
+// fn(UnknownRow) on every row, in parallel.
 template <int D>
 static void eachRowOf(const ViscousSystem<D>& C, const Grid<uint8_t, D>& fixed, const Grid<float, D>& g, auto&& fn) {
   forEachRow<D>(C.dims, [&](size_t row, const IVec<D>&) { fn(unknownRow<D>(C, fixed, g, row)); });
-}
-template <int D>
-static void eachRowOfPlane(const ViscousSystem<D>& C, const Grid<uint8_t, D>& fixed, const Grid<float, D>& g, size_t q,
-                           auto&& fn) {
-  const size_t perPlane = D == 3 ? size_t(C.dims[1]) : 1;
-  for (size_t row = q * perPlane; row < (q + 1) * perPlane; ++row) fn(unknownRow<D>(C, fixed, g, row));
 }
 
 // One row of b = u* + s (boundary terms), 0 on held unknowns, to b.
@@ -320,7 +314,7 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
     const int history = C.history;
     resizeExactly(&x_, C.A.size());
     resizeExactly(&b_, C.A.size());
-    auto warmStart = [&](const UnknownRow& r) {
+    eachRowOf<D>(C, fixed, g, [&](const UnknownRow& r) {
       const float* __restrict gr = g.data() + r.g0;
       const uint8_t* __restrict f = r.fixed, * __restrict c = r.cut;
       double* __restrict x = x_.data() + r.i0;
@@ -342,26 +336,18 @@ SolverResult ViscositySolver<D>::solveComponents(MacVelocity<D>* u, double s) {
           x[k] = zeroWhere(f[k] | c[k], v);
         }
       }
-    };
+    });
+    // The warm start comes from solves on the rows before a moving obstacle
+    // rewrote them, and leaves its largest residuals on them (a face whose
+    // cut distance changed, one the solid uncovered): two red-black sweeps
+    // there (at 128^3 the circling sphere's Chebyshev steps fall from 32.4
+    // to 22.7-24.2, the body at rest's 22.0-23.5; docs/performance.md).
+    C.A.relaxBox(b_, &x_, C.movedLo, C.movedHi, kMovedSweeps);
+    C.movedLo = C.movedHi = IVec<D>(0);
     SolverOptions options = options_;
     if (ba > 0.0) options.tolerance = options_.tolerance * std::sqrt(0.5 * (ba + bAll / D) / ba);
-    SolverResult r;
-    if (C.multigrid || !boxEmpty<D>(C.movedLo, C.movedHi)) {
-      eachRowOf<D>(C, fixed, g, warmStart);
-      // The warm start comes from solves on the rows before a moving
-      // obstacle rewrote them, and leaves its largest residuals on them (a
-      // face whose cut distance changed, one the solid uncovered): two
-      // red-black sweeps there (at 128^3 the circling sphere's Chebyshev
-      // steps fall from 32.4 to 22.7-24.2, the body at rest's 22.0-23.5;
-      // docs/performance.md).
-      C.A.relaxBox(b_, &x_, C.movedLo, C.movedHi, kMovedSweeps);
-      C.movedLo = C.movedHi = IVec<D>(0);
-      r = C.multigrid ? solvePCG<D>(C.A, b_, &x_, C.multigrid.get(), options, &pcgWork_)
-                      : C.chebyshev->solve(b_, &x_, options, std::sqrt(ba));
-    } else {  // the warm start written plane by plane in the first residual's pass
-      r = C.chebyshev->solve(b_, &x_, options, std::sqrt(ba),
-                             [&](size_t q) { eachRowOfPlane<D>(C, fixed, g, q, warmStart); });
-    }
+    const SolverResult r = C.multigrid ? solvePCG<D>(C.A, b_, &x_, C.multigrid.get(), options, &pcgWork_)
+                                       : C.chebyshev->solve(b_, &x_, options, std::sqrt(ba));
     rAll += r.residual * r.residual * ba;
     result.iterations = std::max(result.iterations, r.iterations);
     cellUpdates_ += double(r.iterations) * (C.multigrid ? double(C.A.size()) : C.chebyshev->cellsPerStep());

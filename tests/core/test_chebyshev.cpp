@@ -5,11 +5,9 @@
 // blocked, sliced and vectorised layouts all give bitwise the plain sweeps.
 #include <gtest/gtest.h>
 
-#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <string>
-#include <vector>
 
 #include "core/chebyshev.h"
 #include "core/parallel.h"
@@ -347,48 +345,6 @@ TEST(Chebyshev, RefreshIsAFreshIteration) {
   checkRefresh<2>(IVec<2>(40, 34), true);
   checkRefresh<3>(IVec<3>(19, 14, 23), false);
   checkRefresh<3>(IVec<3>(19, 14, 22), true);
-}
-
-namespace {
-
-// A start written plane by plane in the first residual's pass (prepare)
-// gives bitwise the solve from the same start written whole: every plane
-// prepared once, before any residual reads it.
-template <int D>
-void checkPrepared(const IVec<D>& dims, bool periodicLast, const ChebyshevLayout& layout, bool bnormKnown) {
-  const LaplaceSystem<D> A = viscousSystem<D>(dims, 1.28, periodicLast);
-  const Vector b = wavyVector<D>(A, 0.4), start = wavyVector<D>(A, 2.1);
-  const SolverOptions options{1e-9, 200};
-  const double bnorm = bnormKnown ? norm2(b) : -1.0;
-  Vector ref = start;
-  const SolverResult r0 = Chebyshev<D>(A, layout).solve(b, &ref, options, bnorm);
-  const size_t planes = size_t(dims[D - 1]), perPlane = A.size() / planes;
-  Vector b2(A.size(), std::nan("")), x(A.size(), std::nan(""));
-  std::vector<int> calls(planes, 0);
-  const SolverResult r = Chebyshev<D>(A, layout).solve(b2, &x, options, bnorm, [&](size_t q) {
-    ++calls[q];
-    std::copy_n(b.begin() + std::ptrdiff_t(q * perPlane), perPlane, b2.begin() + std::ptrdiff_t(q * perPlane));
-    std::copy_n(start.begin() + std::ptrdiff_t(q * perPlane), perPlane, x.begin() + std::ptrdiff_t(q * perPlane));
-  });
-  const std::string what = name<D>(dims) + " steps/pass " + std::to_string(layout.stepsPerPass) + " bnorm " +
-                           (bnormKnown ? "given" : "not given");
-  EXPECT_EQ(std::vector<int>(planes, 1), calls) << what;
-  EXPECT_TRUE(r0.converged) << what;
-  EXPECT_EQ(r0.iterations, r.iterations) << what;
-  EXPECT_EQ(0, std::memcmp(x.data(), ref.data(), x.size() * sizeof(double))) << what;
-}
-
-}  // namespace
-
-TEST(Chebyshev, PreparedPlanesAreTheWholeStart) {
-  for (bool bnormKnown : {true, false})
-    for (ChebyshevLayout layout : {ChebyshevLayout{}, ChebyshevLayout{1, 0}, ChebyshevLayout{3, 5, false}}) {
-      checkPrepared<2>(IVec<2>(41, 90), false, layout, bnormKnown);
-      checkPrepared<2>(IVec<2>(41, 90), true, layout, bnormKnown);
-      checkPrepared<3>(IVec<3>(37, 9, 40), false, layout, bnormKnown);
-      checkPrepared<3>(IVec<3>(37, 9, 40), true, layout, bnormKnown);
-      checkPrepared<3>(IVec<3>(20, 8, 7), true, layout, bnormKnown);  // too thin to cut
-    }
 }
 
 TEST(Chebyshev, ResidualIsTheChebyshevPolynomialAtTheSpectrumsEnds) {
