@@ -98,6 +98,35 @@ nlohmann::json benchFluid(int n, int threads, const BenchOptions& o, double tria
   return j;
 }
 
+// The body moving against the body at rest, their steps taken in turn
+// (one of each, and so on): on a shared host the load drifts over seconds,
+// and two cases timed one after the other see different loads, where a
+// pair of steps sees the same. The median of the pairs' ratios.
+template <int D>
+nlohmann::json benchMovingOverRest(int n, int threads, const BenchOptions& o) {
+  ThreadLimit limit(threads);
+  FluidSolver<D> rest(benchSettings<D>(n, BenchContent::BodyAtRest));
+  FluidSolver<D> moving(benchSettings<D>(n, BenchContent::BodyMoving));
+  const double dt = rest.h();
+  for (int i = 0; i < o.warmUpSteps; ++i) rest.step(dt), moving.step(dt);
+  std::vector<double> atRest, ratio;
+  const std::vector<double> pairs = timeSteps(
+      2.0 * o.minSeconds,
+      [&] {
+        atRest.push_back(timeOnce([&] { rest.step(dt); }));
+        ratio.push_back(timeOnce([&] { moving.step(dt); }) / atRest.back());
+      },
+      [] {});
+  return {{"dim", D},
+          {"n", n},
+          {"content", "moving over rest"},
+          {"threads", threads},
+          {"warm_up_steps", o.warmUpSteps},
+          {"steps", pairs.size()},
+          {"ms_at_rest_median", 1e3 * median(atRest)},
+          {"moving_over_rest_median", median(ratio)}};
+}
+
 }  // namespace
 
 bool runFluidBench(const BenchOptions& o) {
@@ -123,6 +152,17 @@ bool runFluidBench(const BenchOptions& o) {
                        j["ms_forces"].get<double>(), j["ms_advect"].get<double>(), j["ms_diffuse"].get<double>(),
                        j["ms_project"].get<double>(), j["of_triad"].get<double>(),
                        j["pressure_converged"].get<bool>() ? "" : "  (unconverged)")
+                << std::flush;
+      all.push_back(j);
+    }
+    if (content != BenchContent::BodyMoving) continue;
+    for (int threads : {1, 2}) {
+      nlohmann::json j = c.dim == 2 ? benchMovingOverRest<2>(c.n, threads, o) : benchMovingOverRest<3>(c.n, threads, o);
+      std::cout << fmt::format(
+                       "{:>4} {:>6} {:>12} {:>7}   moving adds {:+.1f}% to the step at rest (median of {} pairs "
+                       "of steps taken in turn)\n",
+                       c.dim, c.n, "pair", threads, 100.0 * (j["moving_over_rest_median"].get<double>() - 1.0),
+                       j["steps"].get<size_t>())
                 << std::flush;
       all.push_back(j);
     }
