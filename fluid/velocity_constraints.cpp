@@ -94,8 +94,6 @@ void VelocityConstraints<D>::relistFixed(int a, const std::vector<size_t>& rows,
   fixedValues[a].swap(values);
 }
 
-// Face k (index i) of grid a: held by a wall, an inflow or a solid, and
-// its open fraction.
 template <int D>
 double VelocityConstraints<D>::centreDistance(int a, const IVec<D>& k, RowReach* along) const {
   if (along && k[0] < along->until) return along->side;
@@ -111,6 +109,8 @@ double VelocityConstraints<D>::centreDistance(int a, const IVec<D>& k, RowReach*
   return d;
 }
 
+// Face k (index i) of grid a: held by a wall, an inflow or a solid, and
+// its open fraction.
 template <int D>
 float VelocityConstraints<D>::constrainFace(int a, const IVec<D>& k, size_t i, const Grid<uint8_t, D>& voxel,
                                             float* value, RowReach* along) {
@@ -135,10 +135,12 @@ float VelocityConstraints<D>::constrainFace(int a, const IVec<D>& k, size_t i, c
   bool solidLo = lo[a] >= 0 && voxel(lo), solidHi = hi[a] < cells[a] && voxel(hi);
   IVec<D> same = k;  // on a periodic axis face n is face 0
   if (boundaries.periodic(a) && same[a] == cells[a]) same[a] = 0;
-  // (the row's faces follow one another but for face n on a periodic x)
-  float o = solidLo || solidHi ? 0.0f
-            : cut.empty()      ? 1.0f
-                          : openFractionFrom<D>(cut, a, same, h, centreDistance(a, same, same == k ? along : nullptr));
+  float o = 1.0f;
+  if (solidLo || solidHi) {
+    o = 0.0f;
+  } else if (!cut.empty()) {  // (the row's faces follow one another but for face n on a periodic x)
+    o = openFractionFrom<D>(cut, a, same, h, centreDistance(a, same, same == k ? along : nullptr));
+  }
   if (o == 0.0f) {
     fixed[a][i] = 1;
     *value = bodies.moving() ? float(bodies.velocity(facePosition(a, k).data())[size_t(a)]) : 0.0f;
