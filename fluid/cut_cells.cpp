@@ -26,12 +26,13 @@ CutSurface::CutSurface(const std::vector<ObstacleSpec>& obstacles, int dims, con
 
 std::array<double, 3> CutSurface::velocity(const double* x) const {
   if (motions_.empty()) return {0, 0, 0};
-  size_t nearest = 0;  // (one obstacle: the nearest, at any distance)
+  size_t nearest = 0;
   double d = std::numeric_limits<double>::infinity();
-  for (size_t i = 0; i < obstacles_.size() && obstacles_.size() > 1; ++i) {
-    const double di = obstacleDistance(obstacles_[i], x, dims_, size_);
-    if (di < d) d = di, nearest = i;
-  }
+  if (obstacles_.size() > 1)  // (one obstacle is the nearest, at any distance)
+    for (size_t i = 0; i < obstacles_.size(); ++i) {
+      const double di = obstacleDistance(obstacles_[i], x, dims_, size_);
+      if (di < d) d = di, nearest = i;
+    }
   // Where the obstacle wraps, the point's image nearest its centre.
   const ObstacleSpec& o = obstacles_[nearest];
   double image[3] = {x[0], x[1], dims_ == 3 ? x[2] : 0.0};
