@@ -133,6 +133,7 @@ Multigrid<D>::Multigrid(const LaplaceSystem<D>& fine, const MultigridOptions& op
     cur = &levels_.back().A;
   }
   for (size_t l = 0; l + 1 < levels_.size(); ++l) buildTransfer(int(l));
+  findBands();
   // The levels' vectors: level 0's at the first cycle (ensureFine), the
   // coarse levels' placed for each (placeCoarse).
 }
@@ -199,6 +200,16 @@ void Multigrid<D>::releaseCoarse() {
 template <int D>
 void Multigrid<D>::refresh() {
   for (size_t l = 1; l < levels_.size(); ++l) coarsenInto(level(int(l) - 1), &levels_[l].A);
+  findBands();
+}
+
+template <int D>
+void Multigrid<D>::findBands() {
+  for (size_t l = 0; l < levels_.size(); ++l) {
+    const LaplaceSystem<D>& A = level(int(l));
+    const bool smoothed = options_.bandSweeps > 0 && l + 1 < levels_.size() && A.size() > options_.bandMinCells;
+    levels_[l].band = smoothed ? boundaryBand<D>(A, options_.bandWidth) : BoundaryBand<D>{};
+  }
 }
 
 template <int D>
@@ -211,6 +222,7 @@ void Multigrid<D>::refresh(IVec<D> lo, IVec<D> hi) {
     }
     coarsenRegion(level(int(l) - 1), &levels_[l].A, lo, hi);
   }
+  findBands();
 }
 
 template <int D>
@@ -426,11 +438,13 @@ void Multigrid<D>::cycle(int l) {
     return;
   }
   for (int s = 0; s < options_.preSmooth; ++s) A.gaussSeidel(L.b, L.x, false);
+  for (int s = 0; s < options_.bandSweeps && !L.band.empty(); ++s) sweepBand<D, float>(A, L.band, L.b, L.x, false);
   A.defect(L.b, L.x, L.r);
   restrict(l);
   std::fill_n(levels_[size_t(l) + 1].x, level(l + 1).size(), 0.0f);
   cycle(l + 1);
   prolongAdd(l);
+  for (int s = 0; s < options_.bandSweeps && !L.band.empty(); ++s) sweepBand<D, float>(A, L.band, L.b, L.x, true);
   for (int s = 0; s < options_.postSmooth; ++s) A.gaussSeidel(L.b, L.x, true);
 }
 

@@ -18,6 +18,7 @@
 #include <span>
 #include <vector>
 
+#include "core/boundary_band.h"
 #include "core/pcg.h"
 #include "core/preconditioner.h"
 #include "core/solver_result.h"
@@ -29,6 +30,13 @@ struct MultigridOptions {
   int preSmooth = 2;
   int postSmooth = 2;
   int minCoarseCells = 4;  // stop coarsening when an axis would drop below this
+  // Boundary smoothing (core/boundary_band.h), for systems whose weights
+  // are open fractions: this many red-black sweeps on a level's band after
+  // its pre-smoothing, and their adjoints before its post-smoothing, on the
+  // levels of more than bandMinCells cells (0 sweeps: none).
+  int bandSweeps = 0;
+  int bandWidth = 1;
+  size_t bandMinCells = 4096;
 };
 
 template <int D>
@@ -68,6 +76,9 @@ class Multigrid final : public Preconditioner {
 
   int levels() const { return int(levels_.size()); }
   const LaplaceSystem<D>& level(int l) const { return l == 0 ? fine_ : levels_[size_t(l)].A; }
+  // Level l's boundary band (empty where it has none to smooth).
+  const BoundaryBand<D>& band(int l) const { return levels_[size_t(l)].band; }
+  const MultigridOptions& options() const { return options_; }
 
  private:
   using FVector = std::vector<float>;
@@ -91,8 +102,10 @@ class Multigrid final : public Preconditioner {
     // coarse levels' in a scratch or coarse_ (placed for each cycle).
     float *x = nullptr, *b = nullptr, *r = nullptr;
     std::array<AxisTransfer, D> transfer;  // to level + 1 (absent on the coarsest)
+    BoundaryBand<D> band;
   };
   void buildTransfer(int l);
+  void findBands();   // the levels' bands from their systems
   void ensureFine();  // level 0's vectors, sized (allocated on first use)
   // Places the coarse levels' vectors for a cycle: in scratch_ where it has
   // room (its bytes then hold floats until releaseCoarse()), else in coarse_.

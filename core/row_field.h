@@ -114,6 +114,9 @@ class RowField {
   std::vector<float> expandedRows(size_t begin, size_t end) const;
   // Rows stored (the footprint is storedRows() * nx floats plus 4 bytes a row).
   size_t storedRows() const { return pool_.size() / (nx_ ? nx_ : 1); }
+  // The stored row that row r reads (< storedRows()).
+  uint32_t storedRow(size_t r) const { return rowOf_[r]; }
+  const float* stored(uint32_t k) const { return pool_.data() + size_t(k) * nx_; }
 
  private:
   explicit RowField(const IVec<D>& dims) : dims_(dims) {  // shaped, no rows yet

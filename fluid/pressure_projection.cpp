@@ -87,8 +87,7 @@ PressureProjection<D>::PressureProjection(const VelocityConstraints<D>& vc, Pres
     : vc_(vc), solver_(solver), options_(options), A_(pressureSystem(vc)) {
   if (solver_ == PressureSolver::ICPCG)
     mic_ = std::make_unique<MIC0Preconditioner<D>>(A_);
-  else
-    multigrid_ = std::make_unique<Multigrid<D>>(A_);
+  else multigrid_ = std::make_unique<Multigrid<D>>(A_, kPressureCycle);
   phi_.assign(A_.size(), 0.0);
 }
 

@@ -44,6 +44,10 @@ struct MovedRowsRelaxation {
   double omega = 1.6;
 };
 
+// The pressure's V-cycle: its weights are open fractions, and the band of
+// a cut body's cells takes four more sweeps a level (docs/performance.md).
+inline constexpr MultigridOptions kPressureCycle{.bandSweeps = 4};
+
 template <int D>
 class PressureProjection {
  public:

@@ -199,6 +199,28 @@ void GpuLaplace::smooth(const GpuBuffer& b, GpuBuffer* x, int colour) const {
   run(LaplaceMode::Smooth, true, *x, nullptr, &b, colour, 0.0f);
 }
 
+void GpuLaplace::smoothCells(const GpuBuffer& b, GpuBuffer* x, const GpuBuffer& cells, int first, int count) const {
+  if (count == 0) return;
+  const ComputeProgram& p = useProgram(
+      "laplace.comp", fmt::format("#define DIM {}\n#define {}\n#define CELL_LIST", dim_, define(LaplaceMode::Smooth)),
+      GpuPrecision::Float, GpuPrecision::Float);
+  setUniform(p, "dims", dims_);
+  setUniform(p, "scale", scale_);
+  setUniform(p, "colour", -1);  // (the list's cells are of one colour)
+  setUniform(p, "listFirst", first);
+  setUniform(p, "listCount", count);
+  x->bind(0);
+  x->bind(1);
+  b.bind(2);
+  for (int a = 0; a < 3; ++a) w_[size_t(a < dim_ ? a : 0)].bind(3 + a);
+  diag_.bind(6);
+  c_.bind(7);
+  cells.bind(8);
+  // a cell's index, x, b, its neighbours' x and its coefficients
+  dispatchFlat(size_t(count), 4.0 * (3 + 2 * dim_ + dim_ + 2));
+  storageBarrier();
+}
+
 void GpuLaplace::jacobi(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* y, float omega) const {
   run(LaplaceMode::Jacobi, true, x, y, &b, 0, omega);
 }

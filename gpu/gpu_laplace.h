@@ -111,6 +111,9 @@ class GpuLaplace {
   bool hasCross() const { return hasCross_; }
   // One colour of a red-black Gauss-Seidel sweep on float vectors.
   void smooth(const GpuBuffer& b, GpuBuffer* x, int colour) const;
+  // The same update on the `count` cells cells[first ..] alone (one colour
+  // of a boundary band: core/boundary_band.h).
+  void smoothCells(const GpuBuffer& b, GpuBuffer* x, const GpuBuffer& cells, int first, int count) const;
   // y = x + omega (D^-1 (b / scale + N x) - x) on float vectors.
   void jacobi(const GpuBuffer& b, const GpuBuffer& x, GpuBuffer* y, float omega) const;
 

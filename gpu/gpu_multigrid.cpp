@@ -121,6 +121,23 @@ GpuMultigrid::GpuMultigrid(const Multigrid<D>& levels, const GpuLaplace& fine, c
   }
   invertCoarsest(levels.level(levels.levels() - 1));
   chooseTail(tailCells);
+  uploadBands(levels);
+}
+
+template <int D>
+void GpuMultigrid::uploadBands(const Multigrid<D>& levels) {
+  for (int l = 0; l < levels.levels(); ++l) {
+    const BoundaryBand<D>& band = levels.band(l);
+    Level& L = levels_[size_t(l)];
+    L.bandCount = {int(band.colour[0].size()), int(band.colour[1].size())};
+    if (band.empty()) {
+      L.band = GpuBuffer();
+      continue;
+    }
+    std::vector<uint32_t> cells = band.colour[0];
+    cells.insert(cells.end(), band.colour[1].begin(), band.colour[1].end());
+    L.band = GpuBuffer::of(cells);
+  }
 }
 
 template <int D>
@@ -128,6 +145,7 @@ void GpuMultigrid::update(const Multigrid<D>& levels) {
   for (int l = 1; l < levels.levels(); ++l) levels_[size_t(l)].own->update(levels.level(l));
   invertCoarsest(levels.level(levels.levels() - 1));
   packTail();
+  uploadBands(levels);
 }
 
 template <int D>
@@ -224,6 +242,15 @@ void GpuMultigrid::smooth(Level& L, bool reverse, int sweeps, bool skipFirst, bo
   }
 }
 
+void GpuMultigrid::sweepBand(Level& L, bool reverse) {
+  if (!L.band.id()) return;
+  for (int s = 0; s < options_.bandSweeps; ++s)
+    for (int q = 0; q < 2; ++q) {
+      const int colour = reverse ? 1 - q : q;
+      L.A->smoothCells(L.b, &L.x, L.band, colour == 0 ? 0 : L.bandCount[0], L.bandCount[size_t(colour)]);
+    }
+}
+
 bool GpuMultigrid::sweepsFused() const {
   const GpuLaplace& A = *levels_[0].A;
   return levels_.size() > 1 && tail_ > 0 && !A.mixesColours() && options_.preSmooth > 0 && options_.postSmooth > 0;
@@ -256,6 +283,7 @@ void GpuMultigrid::cycle(size_t l) {
   const bool fused = l == 0 && sweepsFused();
   if (!fused) L.x.zero();
   smooth(L, false, options_.preSmooth, fused, false);
+  sweepBand(L, false);
   auto transfer = [&](TransferMode mode, const GpuBuffer& fine, const GpuBuffer& coarse, const GpuBuffer& fineX,
                       const GpuBuffer& diag, size_t samples) {
     const ComputeProgram& p =
@@ -284,6 +312,7 @@ void GpuMultigrid::cycle(size_t l) {
   transfer(TransferMode::Restrict, L.b, C.b, L.x, C.A->diag(), C.A->size());
   cycle(l + 1);
   transfer(TransferMode::Prolong, L.b, C.x, L.x, L.A->diag(), L.A->size());  // (fine unread)
+  sweepBand(L, true);
   smooth(L, true, options_.postSmooth, false, fused);
 }
 

@@ -5,9 +5,12 @@
 // coarsest level is solved exactly by its dense (pseudo-)inverse, computed
 // once on the host, so the cycle is a fixed symmetric linear operator. The
 // levels of at most kTailCells cells run in one work group and one dispatch
-// (shaders/vcycle_tail.comp), their vectors and coefficients packed.
+// (shaders/vcycle_tail.comp), their vectors and coefficients packed. A
+// level's boundary band (core/boundary_band.h) is the CPU level's, swept
+// as the CPU sweeps it.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -43,7 +46,12 @@ class GpuMultigrid {
     const GpuLaplace* A = nullptr;
     std::unique_ptr<GpuLaplace> own;  // levels >= 1
     GpuBuffer x, b, r;
+    GpuBuffer band;                  // the band's cells, colour 0's then colour 1's
+    std::array<int, 2> bandCount{};  // the cells of each colour
   };
+  template <int D>
+  void uploadBands(const Multigrid<D>& levels);
+  void sweepBand(Level& L, bool reverse);  // options_.bandSweeps sweeps (their adjoints when reverse)
   void cycle(size_t l);
   // skipFirst, skipLast: without the first sweep's first colour or the last sweep's last
   void smooth(Level& L, bool reverse, int sweeps, bool skipFirst = false, bool skipLast = false);

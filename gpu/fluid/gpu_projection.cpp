@@ -34,8 +34,8 @@ GpuProjection<D>::GpuProjection(const VelocityConstraints<D>& vc, GpuMacGrid<D>*
   inactive_ = GpuBuffer::of(inactiveCells<D>(P_, vc, 0, P_.size() / size_t(P_.dims[0])));
   A_ = std::make_unique<GpuLaplace>(P_);
   A_->setPrecision(real_, kPhiPrecision);
-  levels_ = std::make_unique<Multigrid<D>>(P_);
-  multigrid_ = std::make_unique<GpuMultigrid>(*levels_, *A_, MultigridOptions{});
+  levels_ = std::make_unique<Multigrid<D>>(P_, kPressureCycle);
+  multigrid_ = std::make_unique<GpuMultigrid>(*levels_, *A_, kPressureCycle);
   if (!vc.bodies.moving()) levels_.reset(), P_ = LaplaceSystem<D>();  // (at rest: uploaded once)
   pcg_ = std::make_unique<GpuPcg>(*A_, std::move(work));
   rhs_ = realBuffer(grid_.cellCount, real_);

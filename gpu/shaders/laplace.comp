@@ -34,7 +34,13 @@ layout(std430, binding = 7) readonly buffer C { float cTerm[]; };
 uniform ivec3 dims;
 uniform double scale;
 #define CELLS (dims.x * dims.y * dims.z)
-uniform int colour;    // MODE_SMOOTH: the cells with (x + y + z) % 2 == colour
+uniform int colour;    // MODE_SMOOTH: the cells with (x + y + z) % 2 == colour (-1: every cell)
+#if defined(CELL_LIST)
+// MODE_SMOOTH on the cells cellList[listFirst ..] alone (listCount of them)
+layout(std430, binding = 8) readonly buffer Cells { uint cellList[]; };
+uniform int listFirst;
+uniform int listCount;
+#endif
 uniform float omega;   // MODE_JACOBI
 
 #if defined(CROSS)
@@ -226,14 +232,20 @@ void main() {
 }
 #else
 void main() {
+#if defined(CELL_LIST)
+  const int k = flatIndex();
+  if (k >= listCount) return;
+  const int i = int(cellList[listFirst + k]);
+#else
   const int i = flatIndex();
   if (i >= CELLS) return;
+#endif
 #if defined(MODE_APPLY)
   y[i] = operatorAt(i, REAL(0));
 #else
   const ivec3 c = coordsOf(i, dims);
 #if defined(MODE_SMOOTH)
-  if (((c.x + c.y + c.z) & 1) != colour) return;
+  if (colour >= 0 && ((c.x + c.y + c.z) & 1) != colour) return;
 #endif
   const float d = diag[i];
   if (d <= 0.0) {

@@ -2,10 +2,11 @@
 // solution to the discretisation error, which falls at second order.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
-#include <string>
 #include <cstring>
 #include <functional>
+#include <string>
 
 #include "core/laplace_system.h"
 #include "core/mic0.h"
@@ -625,4 +626,197 @@ TEST(LinearSolvers, SmootherMatchesAPlainRedBlackSweep) {
   checkSmoother<2>(IVec<2>(64, 600));
   checkSmoother<3>(IVec<3>(64, 16, 40));
   checkSmoother<3>(IVec<3>(64, 16, 40), 0.3f, true);
+}
+
+namespace {
+
+// A body cut from a Neumann box: a ball of radius 0.3 n_y about the
+// centre (periodic along x when asked, the ball then across the seam),
+// each face open by its centre's distance outside it (clamped to [0, 1]),
+// as cut cells give.
+template <int D>
+LaplaceSystem<D> cutBallSystem(const IVec<D>& dims, bool periodicX) {
+  std::array<bool, D> periodic{};
+  periodic[0] = periodicX;
+  LaplaceSystem<D> A(dims, periodic, 1.0);
+  for (int a = 0; a < D; ++a) A.w[a].fill(1.0f);
+  const double radius = 0.3 * dims[1];
+  auto open = [&](const IVec<D>& k, int a) {
+    double d2 = 0.0;
+    for (int b = 0; b < D; ++b) {
+      double x = k[b] + (b == a ? 1.0 : 0.5) - 0.5 * dims[b];
+      if (b == 0 && periodicX) x = std::remainder(x + 0.5 * dims[0], double(dims[0]));
+      d2 += x * x;
+    }
+    return float(std::clamp(std::sqrt(d2) - radius + 0.5, 0.0, 1.0));
+  };
+  forEachCell<D>(dims, [&](const IVec<D>& k, size_t i) {
+    for (int a = 0; a < D; ++a) A.w[a].at(i) = open(k, a);
+  });
+  A.finalize();
+  return A;
+}
+
+// The band by its definition, plainly: the active cells either side of a
+// face inside the domain that weighs less than 1, grown `width` times by
+// the active face neighbours.
+template <int D>
+std::vector<uint8_t> referenceBand(const LaplaceSystem<D>& A, int width) {
+  std::vector<uint8_t> in(A.size(), 0);
+  for (size_t i = 0; i < A.size(); ++i) {
+    const IVec<D> k = A.c.coord(i);
+    for (int a = 0; a < D; ++a) {
+      IVec<D> up = k;
+      up[a] += 1;
+      if (A.periodic[size_t(a)]) up[a] %= A.dims[a];
+      if (up[a] >= A.dims[a] || !(A.w[a][i] < 1.0f)) continue;
+      for (size_t c : {i, A.c.index(up)}) in[c] = A.diag[c] > 0;
+    }
+  }
+  for (int step = 0; step < width; ++step) {
+    std::vector<uint8_t> grown = in;
+    for (size_t i = 0; i < A.size(); ++i)
+      if (in[i]) eachNeighbour<D>(A, A.c.coord(i), i, [&](size_t j, double) { grown[j] = A.diag[j] > 0; });
+    in.swap(grown);
+  }
+  return in;
+}
+
+template <int D>
+void expectBandMatches(const LaplaceSystem<D>& A) {
+  for (int width : {0, 1, 2}) {
+    const BoundaryBand<D> band = boundaryBand<D>(A, width);
+    const std::vector<uint8_t> ref = referenceBand<D>(A, width);
+    std::vector<uint8_t> got(A.size(), 0);
+    for (int colour = 0; colour < 2; ++colour) {
+      const std::vector<uint32_t>& cells = band.colour[size_t(colour)];
+      EXPECT_TRUE(std::is_sorted(cells.begin(), cells.end()));
+      for (uint32_t i : cells) {
+        const IVec<D> k = A.c.coord(i);
+        int parity = 0;
+        for (int a = 0; a < D; ++a) parity += k[a];
+        EXPECT_EQ(parity & 1, colour);
+        EXPECT_EQ(got[i], 0) << "twice: " << i;
+        got[i] = 1;
+      }
+    }
+    EXPECT_EQ(got, ref) << "width " << width;
+    EXPECT_GT(band.size(), 0u);
+    EXPECT_LT(band.size(), A.size() / 2);
+  }
+}
+
+template <int D>
+void expectBandIsItsDefinition(const IVec<D>& dims, bool periodicX) {
+  expectBandMatches<D>(cutBallSystem<D>(dims, periodicX));
+}
+
+// One band sweep: the plain red-black sweep on the band's cells (as the
+// smoother's reference computes it), every other cell bit for bit as it was.
+template <int D>
+void expectBandSweepIsARedBlackSweepOnItsCells(const IVec<D>& dims, bool periodicX) {
+  const LaplaceSystem<D> A = cutBallSystem<D>(dims, periodicX);
+  const BoundaryBand<D> band = boundaryBand<D>(A, 1);
+  std::vector<uint8_t> in(A.size(), 0);
+  for (const auto& cells : band.colour)
+    for (uint32_t i : cells) in[i] = 1;
+  std::vector<float> b(A.size()), x(A.size());
+  for (size_t i = 0; i < b.size(); ++i) {
+    b[i] = float(std::sin(0.37 * double(i)));
+    x[i] = A.diag[i] > 0 ? float(std::cos(0.11 * double(i))) : 0.0f;
+  }
+  for (bool reverse : {false, true}) {
+    std::vector<float> y = x;
+    sweepBand<D, float>(A, band, b.data(), y.data(), reverse);
+    // The reference sweep everywhere, then the cells outside the band put back.
+    const std::vector<double> ref = referenceSweep<D>(A, b, x, reverse);
+    std::vector<double> xd(x.begin(), x.end());
+    for (int pass = 0; pass < 2; ++pass) {
+      const int colour = reverse ? 1 - pass : pass;
+      for (size_t i = 0; i < A.size(); ++i) {
+        const IVec<D> k = A.c.coord(i);
+        int parity = 0;
+        for (int a = 0; a < D; ++a) parity += k[a];
+        if ((parity & 1) != colour || !in[i]) continue;
+        double sum = 0.0;
+        eachNeighbour<D>(A, k, i, [&](size_t j, double w) { sum += w * xd[j]; });
+        xd[i] = (double(b[i]) / A.scale + sum) / double(A.diag[i]);
+      }
+    }
+    double worst = 0.0, scale = 0.0;
+    size_t moved = 0;
+    for (size_t i = 0; i < A.size(); ++i) {
+      if (!in[i]) {
+        EXPECT_EQ(std::memcmp(&y[i], &x[i], sizeof(float)), 0) << "outside the band: " << i;
+        continue;
+      }
+      worst = std::max(worst, std::abs(double(y[i]) - xd[i]));
+      scale = std::max(scale, std::abs(xd[i]));
+      moved += xd[i] != double(x[i]);
+      // A band cell whose neighbours all lie in the band takes the whole sweep's value.
+      bool inner = true;
+      eachNeighbour<D>(A, A.c.coord(i), i, [&](size_t j, double) { inner = inner && (in[j] || !(A.diag[j] > 0)); });
+      if (inner) {
+        EXPECT_NEAR(xd[i], ref[i], 1e-12 * (1.0 + std::abs(ref[i])));
+      }
+    }
+    EXPECT_LT(worst, 1e-5 * scale) << "reverse " << reverse;
+    EXPECT_GT(moved, band.size() / 2);
+  }
+}
+
+}  // namespace
+
+// The band of a cut ball: the active cells beside its partial and closed
+// faces, grown face by face (0, 1, 2), as found cell by cell; across a
+// periodic seam too.
+TEST(BoundaryBand, IsTheActiveCellsBesideCutFacesGrownFaceByFace) {
+  // One partial face, across the periodic seam: its two cells, then their neighbours.
+  LaplaceSystem<2> seam = makeNeumannLaplacian<2>(IVec<2>(8, 6), {true, false}, 1.0);
+  seam.w[0].densify();
+  seam.w[0].at(seam.c.index(IVec<2>(7, 3))) = 0.5f;
+  seam.finalize();
+  const BoundaryBand<2> two = boundaryBand<2>(seam, 0);
+  EXPECT_EQ(two.colour[0], std::vector<uint32_t>{uint32_t(seam.c.index(IVec<2>(7, 3)))});
+  EXPECT_EQ(two.colour[1], std::vector<uint32_t>{uint32_t(seam.c.index(IVec<2>(0, 3)))});
+  EXPECT_EQ(boundaryBand<2>(seam, 1).size(), 2u + 6u);
+  expectBandMatches<2>(seam);
+  expectBandIsItsDefinition<2>(IVec<2>(40, 30), false);
+  expectBandIsItsDefinition<2>(IVec<2>(30, 30), true);
+  expectBandIsItsDefinition<3>(IVec<3>(20, 16, 12), false);
+  expectBandIsItsDefinition<3>(IVec<3>(16, 16, 12), true);
+}
+
+TEST(BoundaryBand, SweepIsARedBlackSweepOnItsCells) {
+  expectBandSweepIsARedBlackSweepOnItsCells<2>(IVec<2>(40, 30), false);
+  expectBandSweepIsARedBlackSweepOnItsCells<3>(IVec<3>(20, 16, 12), true);
+}
+
+// With boundary smoothing the V-cycle stays a symmetric operator (PCG
+// needs one): the band's sweeps after the pre-smoothing, their adjoints
+// before the post-smoothing.
+TEST(BoundaryBand, TheCycleStaysSymmetric) {
+  for (bool periodicX : {false, true}) {
+    const LaplaceSystem<3> A = cutBallSystem<3>(IVec<3>(32, 24, 20), periodicX);
+    MultigridOptions o;
+    o.bandSweeps = 4;
+    o.bandMinCells = 0;  // every level but the coarsest
+    Multigrid<3> mg(A, o);
+    ASSERT_FALSE(mg.band(0).empty());
+    ASSERT_FALSE(mg.band(1).empty());
+    EXPECT_TRUE(mg.band(mg.levels() - 1).empty());
+    Vector a(A.size()), b(A.size()), ma, mb;
+    for (size_t i = 0; i < a.size(); ++i) {
+      a[i] = A.diag[i] > 0 ? std::sin(1.3 * double(i)) : 0.0;
+      b[i] = A.diag[i] > 0 ? std::cos(0.7 * double(i) + 0.2) : 0.0;
+    }
+    mg.apply(a, &ma);
+    mg.apply(b, &mb);
+    const double ab = dot(ma, b), ba = dot(a, mb);
+    EXPECT_NEAR(ab, ba, 1e-5 * std::abs(ab));
+    Multigrid<3> plain(A);
+    Vector pa;
+    plain.apply(a, &pa);
+    EXPECT_NE(pa, ma);  // (the band's sweeps do something)
+  }
 }
