@@ -94,6 +94,27 @@ BoundaryBand<D> boundaryBand(const LaplaceSystem<D>& A, int width) {
     for (int a = 0; a < D; ++a) parity += k[a];
     band.colour[size_t(parity & 1)].push_back(i);
   }
+  for (size_t c = 0; c < 2; ++c) {
+    const std::vector<uint32_t>& of = band.colour[c];
+    band.stencil[c].resize(of.size());
+    parallelFor(
+        of.size(),
+        [&](size_t n) {
+          const size_t i = of[n];
+          const IVec<D> k = A.diag.coord(i);
+          BandStencil<D>& s = band.stencil[c][n];
+          for (int a = 0; a < D; ++a) {
+            size_t lo = i, hi = i;
+            const bool hasLo = neighbour<D>(A, k, i, a, -1, &lo), hasHi = neighbour<D>(A, k, i, a, 1, &hi);
+            s.j[size_t(2 * a)] = uint32_t(lo);
+            s.w[size_t(2 * a)] = hasLo ? A.w[a][lo] : 0.0f;
+            s.j[size_t(2 * a + 1)] = uint32_t(hi);
+            s.w[size_t(2 * a + 1)] = hasHi ? A.w[a][i] : 0.0f;
+          }
+          s.inv = A.invDiag(i);
+        },
+        1024);
+  }
   return band;
 }
 
@@ -101,20 +122,18 @@ template <int D, class T>
 void sweepBand(const LaplaceSystem<D>& A, const BoundaryBand<D>& band, const T* b, T* x, bool reverse) {
   const T inv = T(1.0 / A.scale);
   for (int q = 0; q < 2; ++q) {
-    const std::vector<uint32_t>& cells = band.colour[size_t(reverse ? 1 - q : q)];
+    const size_t c = size_t(reverse ? 1 - q : q);
+    const uint32_t* cells = band.colour[c].data();
+    const BandStencil<D>* stencil = band.stencil[c].data();
     // (a colour's cells read the other colour only: in any order, in parallel)
     parallelFor(
-        cells.size(),
+        band.colour[c].size(),
         [&](size_t n) {
+          const BandStencil<D>& s = stencil[n];
           const size_t i = cells[n];
-          const IVec<D> k = A.diag.coord(i);
           T sum = b[i] * inv;
-          for (int a = 0; a < D; ++a) {
-            size_t j = 0;
-            if (neighbour<D>(A, k, i, a, -1, &j)) sum += T(A.w[a][j]) * x[j];
-            if (neighbour<D>(A, k, i, a, 1, &j)) sum += T(A.w[a][i]) * x[j];
-          }
-          x[i] = sum * T(A.invDiag(i));
+          for (size_t k = 0; k < 2 * D; ++k) sum += T(s.w[k]) * x[s.j[k]];
+          x[i] = sum * T(s.inv);
         },
         1024);
   }
