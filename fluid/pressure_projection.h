@@ -40,7 +40,7 @@ IVec<D> pressureRowsChanged(const IVec<D>& corner, const IVec<D>& cells, int sid
 // The warm start relaxed over the rows a moving obstacle rewrote, before
 // the solve: red-black SOR sweeps there (0 sweeps: none).
 struct MovedRowsRelaxation {
-  int sweeps = 40;
+  int sweeps = 10;
   double omega = 1.6;
 };
 
