@@ -4,9 +4,25 @@
 #include <cmath>
 
 #include "core/parallel.h"
+#include "core/row_field.h"
 #include "fluid/obstacle.h"
 
 namespace morphoflow {
+
+namespace {
+// from's cells [lo, hi) written into *to (all of from where *to has another shape).
+template <int D>
+void copyBox(const Grid<uint8_t, D>& from, Grid<uint8_t, D>* to, const IVec<D>& lo, const IVec<D>& hi) {
+  if (to->dims() != from.dims()) {
+    *to = from;
+    return;
+  }
+  const size_t nx = size_t(from.dims()[0]);
+  for (size_t row : rowsOf<D>(from.dims(), lo, hi))
+    std::copy(from.data() + row * nx + size_t(lo[0]), from.data() + row * nx + size_t(hi[0]),
+              to->data() + row * nx + size_t(lo[0]));
+}
+}  // namespace
 
 template <int D>
 ObstaclePlacement<D>::ObstaclePlacement(const FluidSettings& s, const IVec<D>& cells, double h)
@@ -61,11 +77,11 @@ template <int D>
 bool ObstaclePlacement<D>::moveTo(double t, VelocityConstraints<D>* vc, IVec<D>* lo, IVec<D>* hi) {
   std::vector<RigidMotion> motions;
   std::vector<ObstacleSpec> placed = obstaclesAt(t, &motions);
-  wasSolid_ = vc->solid;
-  for (int a = 0; a < D; ++a) wasFixed_[size_t(a)] = vc->fixed[a];
   movedLo_ = movedHi_ = IVec<D>(0);
   *lo = cells_, *hi = IVec<D>(0);
   if (!movingCells(placed_, lo, hi) || !movingCells(placed, lo, hi)) {
+    wasSolid_ = vc->solid;
+    for (int a = 0; a < D; ++a) wasFixed_[size_t(a)] = vc->fixed[a];
     *vc = constraintsAt(t);  // (which places them itself)
     *lo = IVec<D>(0), *hi = cells_;
     movedLo_ = *lo, movedHi_ = *hi;
@@ -79,6 +95,9 @@ bool ObstaclePlacement<D>::moveTo(double t, VelocityConstraints<D>* vc, IVec<D>*
       return false;
     }
   movedLo_ = *lo, movedHi_ = *hi;
+  // The fill plans read what was there in the moved box alone.
+  copyBox<D>(vc->solid, &wasSolid_, *lo, *hi);
+  for (int a = 0; a < D; ++a) copyBox<D>(vc->fixed[a], &wasFixed_[size_t(a)], *lo, *hi + unitVector<D>(a));
   nowSolid_ = vc->solid;
   Grid<uint8_t, D>& solid = nowSolid_;
   std::vector<ObstacleSpec> voxel;
