@@ -78,7 +78,6 @@ class Multigrid final : public Preconditioner {
   const LaplaceSystem<D>& level(int l) const { return l == 0 ? fine_ : levels_[size_t(l)].A; }
   // Level l's boundary band (empty where it has none to smooth).
   const BoundaryBand<D>& band(int l) const { return levels_[size_t(l)].band; }
-  const MultigridOptions& options() const { return options_; }
 
  private:
   using FVector = std::vector<float>;
