@@ -9,24 +9,6 @@ namespace morphoflow {
 
 namespace {
 
-// A cell shifted by an offset in {-1, 0, 1}^D, wrapped on every axis; `inside`
-// is false when the shift crosses a non-periodic wall.
-template <int D>
-size_t shiftedIndex(const IVec<D>& dims, const std::array<bool, D>& periodic, IVec<D> c, const IVec<D>& o,
-                    bool* inside) {
-  size_t idx = 0, stride = 1;
-  for (int a = 0; a < D; ++a) {
-    int v = c[a] + o[a];
-    if (v < 0 || v >= dims[a]) {
-      if (!periodic[size_t(a)]) *inside = false;
-      v = (v + dims[a]) % dims[a];
-    }
-    idx += size_t(v) * stride;
-    stride *= size_t(dims[a]);
-  }
-  return idx;
-}
-
 template <int D>
 IVec<D> unit(int a, int sign = 1) {
   IVec<D> e(0);

@@ -9,19 +9,13 @@ namespace morphoflow {
 
 namespace {
 
-// Cell i's neighbour one step along axis a (side -1 or +1), wrapped across a
+// Cell k's neighbour one step along axis a (side -1 or +1), wrapped across a
 // periodic axis; false beyond a wall.
 template <int D>
-bool neighbour(const LaplaceSystem<D>& A, const IVec<D>& k, size_t i, int a, int side, size_t* j) {
-  const size_t stride = A.diag.stride(a), n = size_t(A.dims[a]);
-  const int to = k[a] + side;
-  if (to >= 0 && to < A.dims[a]) {
-    *j = side > 0 ? i + stride : i - stride;
-    return true;
-  }
-  if (!A.periodic[a]) return false;
-  *j = side > 0 ? i - stride * (n - 1) : i + stride * (n - 1);
-  return true;
+bool neighbour(const LaplaceSystem<D>& A, const IVec<D>& k, int a, int side, size_t* j) {
+  bool inside = true;
+  *j = shiftedIndex<D>(A.dims, A.periodic, k, side * unitVector<D>(a), &inside);
+  return inside;
 }
 
 // The active cells either side of the faces of axis a with a weight below 1
@@ -52,7 +46,7 @@ void cutFaceCells(const LaplaceSystem<D>& A, int a, std::vector<uint32_t>* cells
           k[0] = int(x);
           const size_t i = r * nx + x;
           size_t j = 0;
-          neighbour<D>(A, k, i, a, 1, &j);
+          neighbour<D>(A, k, a, 1, &j);
           for (size_t c : {i, j})
             if (A.diag[c] > 0.0f) found[r].push_back(uint32_t(c));
         }
@@ -82,7 +76,7 @@ BoundaryBand<D> boundaryBand(const LaplaceSystem<D>& A, int width) {
       for (int a = 0; a < D; ++a)
         for (int side : {-1, 1}) {
           size_t j = 0;
-          if (neighbour<D>(A, k, i, a, side, &j) && A.diag[j] > 0.0f) grown.push_back(uint32_t(j));
+          if (neighbour<D>(A, k, a, side, &j) && A.diag[j] > 0.0f) grown.push_back(uint32_t(j));
         }
     }
     sortUnique(&grown);
@@ -104,11 +98,11 @@ BoundaryBand<D> boundaryBand(const LaplaceSystem<D>& A, int width) {
           const IVec<D> k = A.diag.coord(i);
           BandStencil<D>& s = band.stencil[c][n];
           for (int a = 0; a < D; ++a) {
-            size_t lo = i, hi = i;
-            const bool hasLo = neighbour<D>(A, k, i, a, -1, &lo), hasHi = neighbour<D>(A, k, i, a, 1, &hi);
-            s.j[size_t(2 * a)] = uint32_t(lo);
+            size_t lo = 0, hi = 0;
+            const bool hasLo = neighbour<D>(A, k, a, -1, &lo), hasHi = neighbour<D>(A, k, a, 1, &hi);
+            s.j[size_t(2 * a)] = uint32_t(hasLo ? lo : i);  // (beyond a wall: itself, weight 0)
             s.w[size_t(2 * a)] = hasLo ? A.w[a][lo] : 0.0f;
-            s.j[size_t(2 * a + 1)] = uint32_t(hi);
+            s.j[size_t(2 * a + 1)] = uint32_t(hasHi ? hi : i);
             s.w[size_t(2 * a + 1)] = hasHi ? A.w[a][i] : 0.0f;
           }
           s.inv = A.invDiag(i);

@@ -3,6 +3,7 @@
 // unchanged to a GL image or SSBO.
 #pragma once
 
+#include <array>
 #include <cassert>
 #include <cstddef>
 #include <cstdint>
@@ -35,6 +36,24 @@ bool boxEmpty(const IVec<D>& lo, const IVec<D>& hi) {
     if (hi[a] <= lo[a]) return true;
   return false;
 }
+// A cell shifted by an offset in {-1, 0, 1}^D, wrapped on every axis; `inside`
+// is false when the shift crosses a non-periodic wall.
+template <int D>
+size_t shiftedIndex(const IVec<D>& dims, const std::array<bool, D>& periodic, IVec<D> c, const IVec<D>& o,
+                    bool* inside) {
+  size_t idx = 0, stride = 1;
+  for (int a = 0; a < D; ++a) {
+    int v = c[a] + o[a];
+    if (v < 0 || v >= dims[a]) {
+      if (!periodic[size_t(a)]) *inside = false;
+      v = (v + dims[a]) % dims[a];
+    }
+    idx += size_t(v) * stride;
+    stride *= size_t(dims[a]);
+  }
+  return idx;
+}
+
 // Distance in the flat array between neighbours along `axis`.
 template <int D>
 size_t latticeStride(const IVec<D>& dims, int axis) {
