@@ -35,9 +35,17 @@ struct BoundaryBand {
   size_t size() const { return colour[0].size() + colour[1].size(); }
 };
 
-// A's band (none on a system of 2^32 cells or more).
+// Marks a band is found with, a byte a cell and a byte a row: all zero
+// between calls, so a caller that finds bands often (a moving obstacle's
+// multigrid, every step) keeps them and skips their clearing.
+struct BandMarks {
+  std::vector<uint8_t> cell, row;
+};
+
+// A's band (none on a system of 2^32 cells or more); marks: kept for the
+// next call, or none.
 template <int D>
-BoundaryBand<D> boundaryBand(const LaplaceSystem<D>& A, int width);
+BoundaryBand<D> boundaryBand(const LaplaceSystem<D>& A, int width, BandMarks* marks = nullptr);
 
 // One red-black Gauss-Seidel sweep of A on the band's cells alone, colour 0
 // first (1 first when `reverse`, the first's adjoint): x_i = (b_i / scale +

@@ -697,8 +697,9 @@ void LaplaceSystem<D>::relaxBox(const Vector& b, Vector* xp, const IVec<D>& lo, 
     const double* br = b.data() + s.base;
     double* xr = x.data() + s.base;
     // x_i = (b_i / scale + sum_f w_f x_j) / diag_i on active cells of the colour.
-    for (size_t i = size_t(lo[0]); i < size_t(hi[0]); ++i) {
-      if ((i + y + z) % 2 != size_t(colour) || !(dr[i] > 0.0f)) continue;
+    // (the colour's cells: every other one from the first of the colour)
+    for (size_t i = size_t(lo[0]) + (size_t(lo[0]) + y + z + size_t(colour)) % 2; i < size_t(hi[0]); i += 2) {
+      if (!(dr[i] > 0.0f)) continue;
       const size_t il = i == 0 ? nx - 1 : i - 1, ih = i + 1 == nx ? 0 : i + 1;
       const float wl = (i == 0 && !px) ? 0.0f : wa[0][il];
       const double gs = (br[i] * inv + neighbourSum<D, double>(s, wa, xr, i, il, ih, wl)) * double(inverse(dr[i]));

@@ -208,7 +208,7 @@ void Multigrid<D>::findBands() {
   for (size_t l = 0; l < levels_.size(); ++l) {
     const LaplaceSystem<D>& A = level(int(l));
     const bool smoothed = options_.bandSweeps > 0 && l + 1 < levels_.size() && A.size() > options_.bandMinCells;
-    levels_[l].band = smoothed ? boundaryBand<D>(A, options_.bandWidth) : BoundaryBand<D>{};
+    levels_[l].band = smoothed ? boundaryBand<D>(A, options_.bandWidth, &bandMarks_) : BoundaryBand<D>{};
   }
 }
 

@@ -105,6 +105,7 @@ class Multigrid final : public Preconditioner {
   };
   void buildTransfer(int l);
   void findBands();   // the levels' bands from their systems
+  BandMarks bandMarks_;  // (kept zero between findBands calls)
   void ensureFine();  // level 0's vectors, sized (allocated on first use)
   // Places the coarse levels' vectors for a cycle: in scratch_ where it has
   // room (its bytes then hold floats until releaseCoarse()), else in coarse_.

@@ -25,7 +25,11 @@ CutSurface::CutSurface(const std::vector<ObstacleSpec>& obstacles, int dims, con
 }
 
 std::array<double, 3> CutSurface::velocity(const double* x) const {
-  if (motions_.empty()) return {0, 0, 0};
+  return {velocity(x, 0), velocity(x, 1), velocity(x, 2)};
+}
+
+double CutSurface::velocity(const double* x, int axis) const {
+  if (motions_.empty()) return 0.0;
   size_t nearest = 0;
   double d = std::numeric_limits<double>::infinity();
   if (obstacles_.size() > 1)  // (one obstacle is the nearest, at any distance)
@@ -38,7 +42,7 @@ std::array<double, 3> CutSurface::velocity(const double* x) const {
   double image[3] = {x[0], x[1], dims_ == 3 ? x[2] : 0.0};
   for (int a = 0; a < dims_; ++a)
     if (o.wrap[size_t(a)]) image[a] -= size_[a] * obstacle_shape::osRound((x[a] - o.center[size_t(a)]) / size_[a]);
-  return motions_[nearest].at(image, dims_);
+  return motions_[nearest].at(image, dims_, axis);
 }
 
 double CutSurface::distance(const double* x) const {

@@ -34,6 +34,8 @@ class CutSurface {
   bool moving() const { return !motions_.empty(); }
   // The velocity of the solid nearest x (0 when none moves).
   std::array<double, 3> velocity(const double* x) const;
+  // Its component along axis a alone.
+  double velocity(const double* x, int a) const;
   // Whether distance() is one (an image shape only has a sign: -1 inside, 1 outside).
   bool exact() const { return exact_; }
   // Whether it changes by at most the distance moved (circles, spheres and

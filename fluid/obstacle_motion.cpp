@@ -43,10 +43,11 @@ void evaluate(const std::string& text, double t, double* value, double* rate, bo
 }  // namespace
 
 std::array<double, 3> RigidMotion::at(const double* x, int dims) const {
-  std::array<double, 3> u{};
-  for (int a = 0; a < 3; ++a)
-    u[size_t(a)] = obstacle_shape::osRigidVelocity(a, dims, x, center.data(), velocity.data(), omega.data());
-  return u;
+  return {at(x, dims, 0), at(x, dims, 1), at(x, dims, 2)};
+}
+
+double RigidMotion::at(const double* x, int dims, int axis) const {
+  return obstacle_shape::osRigidVelocity(axis, dims, x, center.data(), velocity.data(), omega.data());
 }
 
 bool anyMoves(const std::vector<ObstacleSpec>& obstacles) {

@@ -20,6 +20,7 @@ struct RigidMotion {
   std::array<double, 3> omega{0, 0, 0};  // 2D: only omega_z
   // The velocity at world point x: v + omega x (x - centre).
   std::array<double, 3> at(const double* x, int dims) const;
+  double at(const double* x, int dims, int axis) const;  // its component along axis
 };
 
 // Whether the obstacle has a motion or a rotation.

@@ -143,7 +143,7 @@ float VelocityConstraints<D>::constrainFace(int a, const IVec<D>& k, size_t i, c
   }
   if (o == 0.0f) {
     fixed[a][i] = 1;
-    *value = bodies.moving() ? float(bodies.velocity(facePosition(a, k).data())[size_t(a)]) : 0.0f;
+    *value = bodies.moving() ? float(bodies.velocity(facePosition(a, k).data(), a)) : 0.0f;
   }
   return o;
 }
@@ -159,20 +159,35 @@ void VelocityConstraints<D>::listFixed(int a, const std::vector<float>& value) {
     }
 }
 
-// The moving solid's flux through the closed parts of the faces of the cells [lo, hi).
+// The moving solid's flux through the closed parts of the faces of the cells [lo, hi)
+// (0 in a cell closed on every side), row by row as the divergence reads the faces.
 template <int D>
 void VelocityConstraints<D>::computeSolidFlux(const IVec<D>& lo, const IVec<D>& hi) {
   if (solidFlux.empty()) solidFlux.assign(solid.size(), 0.0);
-  forEachCell<D>(hi - lo, [&](const IVec<D>& r, size_t) {
-    const IVec<D> k = lo + r;
-    double flux = 0.0;
-    for (int a = 0; a < D; ++a)
-      for (int side = 0; side < 2; ++side) {
-        const IVec<D> f = k + (side ? unitVector<D>(a) : IVec<D>(0));
-        const double closed = 1.0 - double(open[a](f));
-        if (closed > 0.0) flux += (side ? closed : -closed) * bodies.velocity(facePosition(a, f).data())[size_t(a)];
-      }
-    solidFlux[solid.index(k)] = flux;
+  const std::vector<size_t> rows = rowsOf<D>(cells, lo, hi);
+  const size_t nx = size_t(cells[0]);
+  parallelFor(rows.size(), [&](size_t q) {
+    IVec<D> k = latticeCoord<D>(cells, rows[q] * nx);
+    std::array<const float*, D> below, above;  // grid a's faces k_a and k_a + 1 of the row's cells
+    for (int a = 0; a < D; ++a) {
+      const size_t fnx = size_t(fixed[a].dims()[0]);
+      below[size_t(a)] = open[a].row(fixed[a].index(k) / fnx);
+      above[size_t(a)] = a == 0 ? below[0] + 1 : open[a].row(fixed[a].index(k + unitVector<D>(a)) / fnx);
+    }
+    for (k[0] = lo[0]; k[0] < hi[0]; ++k[0]) {
+      const size_t x = size_t(k[0]);
+      bool fluid = false;  // (a cell whose faces are all closed holds no fluid, and no pressure: no flux)
+      for (int a = 0; a < D; ++a) fluid = fluid || below[size_t(a)][x] > 0.0f || above[size_t(a)][x] > 0.0f;
+      double flux = 0.0;
+      for (int a = 0; a < D && fluid; ++a)
+        for (int side = 0; side < 2; ++side) {
+          const double closed = 1.0 - double((side ? above : below)[size_t(a)][x]);
+          if (closed > 0.0)
+            flux += (side ? closed : -closed) *
+                    bodies.velocity(facePosition(a, k + (side ? unitVector<D>(a) : IVec<D>(0))).data(), a);
+        }
+      solidFlux[solid.index(k)] = flux;
+    }
   });
 }
 
@@ -199,9 +214,8 @@ double VelocityConstraints<D>::inflowSpeed(int axis, const Vec<D>& x) const {
 
 template <int D>
 std::array<double, 3> VelocityConstraints<D>::facePosition(int a, const IVec<D>& k) const {
-  const Vec<D> p = Layout<D>::face(a, h, cells, periodic()).toWorld(k);
-  std::array<double, 3> x{0, 0, 0};
-  for (int b = 0; b < D; ++b) x[size_t(b)] = p[b];
+  std::array<double, 3> x{0, 0, 0};  // (Layout::face's toWorld: offset 0 along a, 1/2 across)
+  for (int b = 0; b < D; ++b) x[size_t(b)] = (double(k[b]) + (b == a ? 0.0 : 0.5)) * h;
   return x;
 }
 

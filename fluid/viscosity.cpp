@@ -94,7 +94,7 @@ void viscousRows(ViscousSystem<D>* system, const VelocityConstraints<D>& vc, int
             if (vc.bodies.moving()) {
               std::array<double, 3> xs = vc.facePosition(a, k);
               xs[size_t(bx)] += dir * theta * vc.h;
-              extra += vc.bodies.velocity(xs.data())[size_t(a)] / theta;
+              extra += vc.bodies.velocity(xs.data(), a) / theta;
             }
           } else if (fixed[ni]) {
             c += 1.0;

@@ -4,7 +4,7 @@
 // VelocityConstraints::move make it on the host:
 // MODE_CELLS  solid: inside any obstacle; voxel: inside a staircase one
 // MODE_FACES  the faces' fixed flags, prescribed values and open fractions
-// MODE_FLUX   the solid's flux through the closed parts of the cells' faces
+// MODE_FLUX   the solid's flux through the closed parts of the cells' faces (0 where all are closed)
 // The obstacles are `bodies` records of 40 doubles (gpu/fluid/gpu_obstacles.cpp);
 // the images' and sdfs' fields lie in `fields`, one after another.
 layout(std430, binding = 0) readonly buffer Bodies { double body[]; };
@@ -193,7 +193,15 @@ void main() {
   if (openPerFace) open[f] = fraction;
 #else  // MODE_FLUX: VelocityConstraints::computeSolidFlux
   precise double flux = 0.0lf;
+  bool fluid = false;  // (a cell closed on every side: no flux)
   for (int a = 0; a < DIM; ++a)
+    for (int side = 0; side < 2; ++side) {
+      ivec3 fk = k, fd = cells;
+      fk[a] += side;
+      fd[a] += 1;
+      fluid = fluid || open[velOff[a] + indexOf(fk, fd)] > 0.0;
+    }
+  for (int a = 0; a < DIM && fluid; ++a)
     for (int side = 0; side < 2; ++side) {
       ivec3 fk = k, fd = cells;
       fk[a] += side;
