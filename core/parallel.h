@@ -12,6 +12,7 @@
 #include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
 
 #include "core/vec.h"
 
@@ -43,6 +44,25 @@ void parallelFor(size_t n, Fn&& fn, size_t grain = 1) {
       tbb::blocked_range<size_t>(0, n, grain),
       [&](const tbb::blocked_range<size_t>& r) {
         for (size_t i = r.begin(); i != r.end(); ++i) fn(i);
+      },
+      tbb::simple_partitioner());
+#endif
+}
+
+// Calls fn(i) for i in [0, n) as tasks that run at once: pieces of work
+// independent of one another, whose own parallel loops leave a thread idle
+// at their serial parts. Each runs isolated: a thread that waits inside one
+// of its loops takes only that loop's work, never another piece's, so what
+// it keeps thread-local (rowScratch) stays its own.
+template <typename Fn>
+void parallelTasks(size_t n, Fn&& fn) {
+#if defined(__SANITIZE_THREAD__)
+  for (size_t i = 0; i < n; ++i) fn(i);  // (one after another: parallelFor's plain threads within each)
+#else
+  tbb::parallel_for(
+      tbb::blocked_range<size_t>(0, n, 1),
+      [&](const tbb::blocked_range<size_t>& r) {
+        for (size_t i = r.begin(); i != r.end(); ++i) tbb::this_task_arena::isolate([&] { fn(i); });
       },
       tbb::simple_partitioner());
 #endif

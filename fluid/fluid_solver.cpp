@@ -79,8 +79,12 @@ void FluidSolver<D>::placeObstacles(double t, bool fill) {
   if (!moves_) return;
   IVec<D> lo, hi;
   if (!placement_.moveTo(t, &constraints_, &lo, &hi)) return;
-  projection_->rebuild(lo, hi);
-  if (settings_.viscosity > 0) viscosity_->rebuild(lo, hi);  // (an inviscid fluid never solves it)
+  // The pressure's and the viscosity's systems follow at once (each its own; an inviscid fluid never solves the
+  // latter).
+  parallelTasks(settings_.viscosity > 0 ? 2 : 1, [&](size_t k) {
+    if (k == 0) projection_->rebuild(lo, hi);
+    else viscosity_->rebuild(lo, hi);
+  });
   cutSurfaceMade_ = false;
   if (!fill) return;
   const FillPlan cells = placement_.cellFill(constraints_);

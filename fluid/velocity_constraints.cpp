@@ -38,7 +38,8 @@ void VelocityConstraints<D>::move(const Grid<uint8_t, D>& s, const Grid<uint8_t,
   solid = s;
   cut = cutSurface;
   bodies = solidBodies;
-  for (int a = 0; a < D; ++a) {
+  parallelTasks(size_t(D), [&](size_t axis) {  // (each grid's faces are its own)
+    const int a = int(axis);
     // The faces of the cells [lo, hi): their rows of the open fractions
     // written again, and their prescribed faces listed again.
     const IVec<D> flo = lo, fhi = hi + unitVector<D>(a);
@@ -58,7 +59,7 @@ void VelocityConstraints<D>::move(const Grid<uint8_t, D>& s, const Grid<uint8_t,
       }
     });
     relistFixed(a, rows, flo[0], fhi[0], held);
-  }
+  });
   if (solidFlux.empty()) solidFlux.assign(solid.size(), 0.0);
   if (bodies.moving()) computeSolidFlux(lo, hi);
 }

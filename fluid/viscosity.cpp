@@ -145,15 +145,16 @@ void updateViscousSystem(ViscousSystem<D>* C, const VelocityConstraints<D>& vc, 
 template <int D>
 void ViscositySolver<D>::rebuild(const IVec<D>& lo, const IVec<D>& hi) {
   // (the solvers refer to C.A, whose coefficients change, not its shape)
-  for (int a = 0; a < D; ++a) {
-    Component& C = comp_[size_t(a)];
+  // (the components' systems and solvers are their own: rebuilt at once)
+  parallelTasks(size_t(D), [&](size_t a) {
+    Component& C = comp_[a];
     // (the last move's rows: a resumed run places its obstacles at its
     // time before the step, and relaxes what an uninterrupted one does)
-    updateViscousSystem<D>(&C, vc_, a, lo, hi, &C.movedLo, &C.movedHi);
-    if (s_ < 0.0) continue;  // (no rate yet: the whole system follows at the first solve)
+    updateViscousSystem<D>(&C, vc_, int(a), lo, hi, &C.movedLo, &C.movedHi);
+    if (s_ < 0.0) return;  // (no rate yet: the whole system follows at the first solve)
     C.setRateRows(C.movedLo, C.movedHi);
     refreshSolvers(C, &C.movedLo, &C.movedHi);
-  }
+  });
 }
 
 namespace {
