@@ -87,10 +87,16 @@ void FluidSolver<D>::placeObstacles(double t, bool fill) {
   });
   cutSurfaceMade_ = false;
   if (!fill) return;
-  const FillPlan cells = placement_.cellFill(constraints_);
-  if (!dye_.empty()) applyFill<float>(cells, dye_.data(), std::nullopt);
-  if (!temperature_.empty()) applyFill<float>(cells, temperature_.data(), std::nullopt);
-  for (int a = 0; a < D; ++a) applyFill<float>(placement_.faceFill(constraints_, a), u_[a].data(), std::nullopt);
+  parallelTasks(size_t(1 + D), [&](size_t k) {  // (the cells' plan, and each face grid's: their own)
+    const int a = int(k) - 1;
+    if (a >= 0) {
+      applyFill<float>(placement_.faceFill(constraints_, a), u_[a].data(), std::nullopt);
+      return;
+    }
+    const FillPlan cells = placement_.cellFill(constraints_);
+    if (!dye_.empty()) applyFill<float>(cells, dye_.data(), std::nullopt);
+    if (!temperature_.empty()) applyFill<float>(cells, temperature_.data(), std::nullopt);
+  });
   constraints_.apply(&u_);
 }
 

@@ -1,5 +1,9 @@
 #include <gtest/gtest.h>
 
+#include <array>
+#include <atomic>
+#include <cstdint>
+
 #include "core/grid.h"
 #include "core/parallel.h"
 #include "core/sampling.h"
@@ -58,4 +62,31 @@ TEST(Parallel, DeterministicSumIndependentOfThreadCount) {
     b = deterministicSum(n, f);
   }
   EXPECT_EQ(a, b);  // bitwise
+}
+
+// parallelTasks runs each piece once, and a thread that waits inside one
+// piece's loop never starts another piece: what a piece keeps
+// thread-local (as rowScratch) is still its own when the loop returns.
+TEST(Parallel, TasksRunOnceEachAndKeepTheirThreadLocalScratch) {
+  ThreadLimit two(2);
+  constexpr size_t kPieces = 64;
+  std::array<std::atomic<int>, kPieces> runs{};
+  std::atomic<int> taken{0};  // a piece that found another's value in its scratch
+  parallelTasks(kPieces, [&](size_t i) {
+    thread_local size_t owner = SIZE_MAX;
+    for (int round = 0; round < 20; ++round) {
+      owner = i;
+      parallelFor(
+          64,
+          [&](size_t k) {  // (chunks of uneven length: a thread left waiting on another's)
+            volatile double x = 0.0;
+            for (size_t j = 0; j < 200 * ((k + i) % 7 + 1); ++j) x = x + double(j);
+          },
+          1);
+      if (owner != i) ++taken;
+    }
+    ++runs[i];
+  });
+  for (size_t i = 0; i < kPieces; ++i) EXPECT_EQ(runs[i].load(), 1) << "piece " << i;
+  EXPECT_EQ(taken.load(), 0);
 }
